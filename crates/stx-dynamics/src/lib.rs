@@ -1,0 +1,15 @@
+//! Flight model of the STRAPLEX descent: the seed thesis' 14-DOF, 31-state multibody model of
+//! canopy, drone, capsule and transponder (seed chapter 4), with the environment it flies in.
+//!
+//! How the parts fit:
+//! - [`vehicle`] loads and validates the vehicle's parameters (masses, geometry, aerodynamic
+//!   coefficients, servos) from TOML;
+//! - [`atmosphere`] gives air density, pressure, temperature and speed of sound (US Standard
+//!   Atmosphere 1976) and [`wind`] the air's velocity over position and time;
+//! - [`model`] evaluates the equations of motion `M [Ẋ; F_C] = N`: the state derivative and
+//!   the four line tensions, for a state, the control inputs and the environment;
+//! - [`integrate`] advances any [`integrate::OdeSystem`] in time (fixed-step RK4, adaptive
+//!   Dormand–Prince 5(4)) and finds events such as ground contact between steps.
+//!
+//! Nothing here does I/O beyond parsing a string, knows about wall-clock time or draws
+//! randomness it was not given a seed for: callers own time and files.
