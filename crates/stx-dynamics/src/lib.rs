@@ -13,3 +13,5 @@
 //!
 //! Nothing here does I/O beyond parsing a string, knows about wall-clock time or draws
 //! randomness it was not given a seed for: callers own time and files.
+
+pub mod atmosphere;
