@@ -395,14 +395,19 @@ mod tests {
             assert!(reported.to_bits() == altitude_m.to_bits());
             assert_eq!((min_m, max_m), (-5_000.0, 86_000.0));
             let message = error.to_string();
-            assert!(message.contains("-5000") && message.contains("86000"), "{message}");
+            assert!(
+                message.contains("-5000") && message.contains("86000"),
+                "{message}"
+            );
         }
         assert!(us76(-5_000.0).is_ok() && us76(86_000.0).is_ok());
     }
 
     #[test]
     fn standard_atmosphere_is_continuous_and_decreasing_through_every_layer_boundary() {
-        let boundaries_m = [0.0, 11_019.1, 20_063.1, 32_161.9, 47_350.1, 51_412.5, 71_802.0];
+        let boundaries_m = [
+            0.0, 11_019.1, 20_063.1, 32_161.9, 47_350.1, 51_412.5, 71_802.0,
+        ];
         for z in boundaries_m {
             let below = StandardAtmosphere.air_at(z - 1e-3);
             let above = StandardAtmosphere.air_at(z + 1e-3);

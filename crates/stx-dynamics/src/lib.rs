@@ -15,3 +15,4 @@
 //! randomness it was not given a seed for: callers own time and files.
 
 pub mod atmosphere;
+pub mod integrate;
