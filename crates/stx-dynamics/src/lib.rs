@@ -16,3 +16,4 @@
 
 pub mod atmosphere;
 pub mod integrate;
+pub mod wind;
