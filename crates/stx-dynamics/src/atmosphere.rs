@@ -347,6 +347,10 @@ mod tests {
                     "{name} at {altitude_m} m: relative error {error:.2e} ({air:?})"
                 );
             }
+            eprintln!(
+                "{altitude_m:>8} m: relative deviation T {:.1e}, p {:.1e}, rho {:.1e}, a {:.1e}",
+                errors[0], errors[1], errors[2], errors[3]
+            );
             for (w, e) in worst.iter_mut().zip(errors) {
                 *w = w.max(e);
             }

@@ -507,7 +507,8 @@ impl WindField for WindComposite {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
 pub enum MeanWindConfig {
-    /// No wind.
+    /// No wind. Written with braces, as a variant with no fields, so that stray keys beside
+    /// `kind = "calm"` are refused like everywhere else.
     Calm {},
     /// A [`ConstantWind`].
     Constant {
