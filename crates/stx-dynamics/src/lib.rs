@@ -16,4 +16,9 @@
 
 pub mod atmosphere;
 pub mod integrate;
+pub mod model;
+pub mod output;
+pub mod rotation;
+pub mod state;
+pub mod vehicle;
 pub mod wind;

@@ -90,8 +90,22 @@ macro_rules! impl_code {
     };
 }
 
-impl_code!(FlightStage { PreLaunch, Ascent, RoundChute, ParafoilDeploy, Parafoil, Landed });
-impl_code!(FlightMode { Uncontrolled, Manual, Heading, Course, Localizer, SpiralLanding });
+impl_code!(FlightStage {
+    PreLaunch,
+    Ascent,
+    RoundChute,
+    ParafoilDeploy,
+    Parafoil,
+    Landed
+});
+impl_code!(FlightMode {
+    Uncontrolled,
+    Manual,
+    Heading,
+    Course,
+    Localizer,
+    SpiralLanding
+});
 impl_code!(GuidancePhase {
     Idle,
     Approximation,

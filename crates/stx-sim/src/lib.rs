@@ -1,0 +1,11 @@
+//! The simulated STRAPLEX drone: the flight model of `stx-dynamics` flown through scenarios.
+//!
+//! - [`scenario`] reads scenario files (initial conditions, wind, integrator, commands);
+//! - [`open_loop`] flies a scenario's servo schedule to the ground or its end;
+//! - [`summary`] reduces a run to the figures it is judged by.
+//!
+//! Pure: no sockets, no clocks other than the wall time a run reports about itself.
+
+pub mod open_loop;
+pub mod scenario;
+pub mod summary;

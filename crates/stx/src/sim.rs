@@ -1,0 +1,111 @@
+//! `stx sim`: fly a scenario and write its trajectory and summary.
+
+use std::fs;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, anyhow};
+use clap::Args;
+use stx_dynamics::vehicle::Vehicle;
+use stx_sim::open_loop;
+use stx_sim::scenario::Scenario;
+
+use crate::BadInput;
+
+#[derive(Args)]
+pub struct SimArgs {
+    /// A built-in scenario name (uncontrolled, spiral-exit, stratospheric) or a path to a
+    /// scenario TOML file.
+    #[arg(long)]
+    scenario: String,
+    /// Vehicle file (default: the shipped STRAPLEX vehicle).
+    #[arg(long)]
+    vehicle: Option<PathBuf>,
+    /// Write the trajectory to FILE.csv or FILE.json.
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Print the summary as one JSON object on stdout.
+    #[arg(long)]
+    summary_json: bool,
+}
+
+/// Reads a scenario by built-in name or path.
+pub fn load_scenario(name_or_path: &str) -> anyhow::Result<Scenario> {
+    let path = Path::new(name_or_path);
+    if name_or_path.ends_with(".toml") || path.exists() {
+        let text = fs::read_to_string(path)
+            .with_context(|| format!("cannot read scenario file {}", path.display()))
+            .map_err(BadInput)?;
+        Scenario::from_toml_str(name_or_path, &text).map_err(|e| BadInput(e.into()).into())
+    } else {
+        Scenario::builtin(name_or_path).map_err(|e| BadInput(e.into()).into())
+    }
+}
+
+/// Reads a vehicle file, or the shipped one.
+pub fn load_vehicle(path: Option<&Path>) -> anyhow::Result<Vehicle> {
+    match path {
+        None => Ok(Vehicle::straplex()),
+        Some(path) => {
+            let text = fs::read_to_string(path)
+                .with_context(|| format!("cannot read vehicle file {}", path.display()))
+                .map_err(BadInput)?;
+            Vehicle::from_toml_str(&text)
+                .with_context(|| format!("vehicle file {}", path.display()))
+                .map_err(|e| BadInput(e).into())
+        }
+    }
+}
+
+pub fn run(args: SimArgs) -> anyhow::Result<()> {
+    let scenario = load_scenario(&args.scenario)?;
+    let vehicle = load_vehicle(args.vehicle.as_deref())?;
+    let format = match &args.out {
+        None => None,
+        Some(path) => match path.extension().and_then(|e| e.to_str()) {
+            Some("csv") => Some(OutFormat::Csv),
+            Some("json") => Some(OutFormat::Json),
+            _ => {
+                return Err(BadInput(anyhow!(
+                    "--out {}: the file must end in .csv or .json",
+                    path.display()
+                ))
+                .into());
+            }
+        },
+    };
+    let run = open_loop::run(&scenario, &vehicle)
+        .with_context(|| format!("running scenario {}", scenario.name))?;
+    if let (Some(path), Some(format)) = (&args.out, format) {
+        write_trajectory(path, format, &run)
+            .with_context(|| format!("writing {}", path.display()))?;
+    }
+    let summary = &run.summary;
+    if args.summary_json {
+        println!("{}", serde_json::to_string(summary)?);
+    } else {
+        println!("{}", serde_json::to_string_pretty(summary)?);
+    }
+    Ok(())
+}
+
+#[derive(Clone, Copy)]
+enum OutFormat {
+    Csv,
+    Json,
+}
+
+fn write_trajectory(path: &Path, format: OutFormat, run: &open_loop::Run) -> anyhow::Result<()> {
+    let mut out = std::io::BufWriter::new(fs::File::create(path)?);
+    match format {
+        OutFormat::Csv => {
+            writeln!(out, "{}", stx_dynamics::output::Sample::csv_header())?;
+            for s in &run.samples {
+                writeln!(out, "{}", s.csv_row())?;
+            }
+        }
+        OutFormat::Json => serde_json::to_writer(&mut out, run)?,
+    }
+    out.flush()?;
+    Ok(())
+}
