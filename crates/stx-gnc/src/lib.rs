@@ -4,7 +4,18 @@
 //! - [`mission`] names the flight stages, the operator-selectable control modes and the phases
 //!   of spiral-landing guidance: the vocabulary shared with the link and the dashboard;
 //! - [`measurement`] is what the drone's sensors report, [`estimate`] what the estimator makes
-//!   of it.
+//!   of it;
+//! - [`control`] holds the seed's control laws (heading, course, localizer, glide slope);
+//!   [`guidance`] picks and feeds them by mode, including the spiral landing;
+//! - [`performance`] summarises how the parafoil flies, [`pointmass`] flies that summary fast,
+//!   and [`predict`] uses it to say where the vehicle will land;
+//! - [`geo`] links the mission's local NED frame to latitude, longitude and altitude.
+pub mod control;
 pub mod estimate;
+pub mod geo;
+pub mod guidance;
 pub mod measurement;
 pub mod mission;
+pub mod performance;
+pub mod pointmass;
+pub mod predict;

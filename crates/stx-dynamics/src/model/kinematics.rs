@@ -14,7 +14,8 @@ use crate::state::{StateVector, idx, vec3_at};
 use crate::vehicle::Vehicle;
 
 /// The four bodies, in the order every per-body array uses.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
 pub enum Body {
     /// The parafoil canopy.
     Canopy = 0,

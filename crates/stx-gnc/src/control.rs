@@ -1,0 +1,351 @@
+//! The control laws of seed §5.1–5.2: PD laws on measured quantities that command the
+//! differential main line (horizontal control, `HU`) and the symmetric brakes (vertical
+//! control, `VU`).
+//!
+//! Every angle error is wrapped to (−π, π] before it is used, so a heading of 179° against a
+//! target of −179° is a 2° error, not 358°. Outputs saturate to the servos' range. Signs: a
+//! positive main-line command turns right; more brake steepens the glide.
+
+use serde::{Deserialize, Serialize};
+use stx_dynamics::rotation::wrap_pi;
+
+/// Gains and limits of the control laws, with units. The station can read and write each one
+/// as a named parameter.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ControlGains {
+    /// HK1: main line per radian of heading, course or bearing error, m/rad.
+    pub hk1_m_per_rad: f64,
+    /// HK2: main line per rad/s of heading rate (damping), m·s/rad.
+    pub hk2_m_s_per_rad: f64,
+    /// HK3: main line per metre of cross-track error in the localizer's following phase, m/m.
+    pub hk3_m_per_m: f64,
+    /// CD: convergence distance of the localizer and of the glide slope, m. The approach
+    /// phase runs while the error exceeds CD/5.
+    pub convergence_distance_m: f64,
+    /// VK1: brake per unit of glide-slope error (sink over ground speed), 1.
+    pub vk1: f64,
+    /// VK2: brake per metre of altitude error in the following phase, 1/m.
+    pub vk2_per_m: f64,
+    /// Symmetric brake held when the vertical law is centred (room to correct both ways), 0…1.
+    pub brake_trim: f64,
+    /// Largest main-line command, m.
+    pub main_line_limit_m: f64,
+}
+
+impl Default for ControlGains {
+    /// Gains tuned on the 14-DOF model (see `stx tune`; the seed's appendix A.13 vectors were
+    /// the starting point).
+    fn default() -> Self {
+        Self {
+            hk1_m_per_rad: 0.012,
+            hk2_m_s_per_rad: 0.012,
+            hk3_m_per_m: 0.0004,
+            convergence_distance_m: 40.0,
+            vk1: 3.0,
+            vk2_per_m: 0.05,
+            brake_trim: 0.4,
+            main_line_limit_m: 0.03,
+        }
+    }
+}
+
+/// Which phase of a two-phase law is active (seed §5.1.3, §5.2).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum LawPhase {
+    /// Converging on the line at an intercept angle.
+    Approach,
+    /// On the line, holding it.
+    Following,
+}
+
+/// The main-line command of a PD law on an angle error, saturated.
+fn pd(gains: &ControlGains, error_rad: f64, rate_rad_s: f64, extra_m: f64) -> f64 {
+    let command =
+        -gains.hk1_m_per_rad * wrap_pi(error_rad) - gains.hk2_m_s_per_rad * rate_rad_s - extra_m;
+    command.clamp(-gains.main_line_limit_m, gains.main_line_limit_m)
+}
+
+/// Heading hold (eqs. 5.1–5.3): `HU = −HK1·(ψ − H0) − HK2·ψ̇`.
+pub fn heading(
+    gains: &ControlGains,
+    heading_rad: f64,
+    heading_rate_rad_s: f64,
+    target_rad: f64,
+) -> f64 {
+    pd(gains, heading_rad - target_rad, heading_rate_rad_s, 0.0)
+}
+
+/// Course hold (eqs. 5.4–5.6): the course over the ground replaces the heading, so the
+/// vehicle crabs into a crosswind; the heading rate stands in for the course rate.
+pub fn course(
+    gains: &ControlGains,
+    course_rad: f64,
+    heading_rate_rad_s: f64,
+    target_rad: f64,
+) -> f64 {
+    pd(gains, course_rad - target_rad, heading_rate_rad_s, 0.0)
+}
+
+/// A localizer: the line through `point_ne_m` (north, east) with course `course_rad`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Localizer {
+    /// A point of the line, north and east, m.
+    pub point_ne_m: [f64; 2],
+    /// The line's course, rad.
+    pub course_rad: f64,
+}
+
+impl Localizer {
+    /// The line from one point through another (the seed's two-point localizer).
+    pub fn through(from_ne_m: [f64; 2], to_ne_m: [f64; 2]) -> Self {
+        Self {
+            point_ne_m: from_ne_m,
+            course_rad: (to_ne_m[1] - from_ne_m[1]).atan2(to_ne_m[0] - from_ne_m[0]),
+        }
+    }
+
+    /// Cross-track error (eq. 5.7), m: positive right of the line.
+    pub fn cross_track_m(&self, position_ne_m: [f64; 2]) -> f64 {
+        let (dn, de) = (
+            position_ne_m[0] - self.point_ne_m[0],
+            position_ne_m[1] - self.point_ne_m[1],
+        );
+        de * self.course_rad.cos() - dn * self.course_rad.sin()
+    }
+
+    /// Distance along the line from its point, m: positive ahead.
+    pub fn along_track_m(&self, position_ne_m: [f64; 2]) -> f64 {
+        let (dn, de) = (
+            position_ne_m[0] - self.point_ne_m[0],
+            position_ne_m[1] - self.point_ne_m[1],
+        );
+        dn * self.course_rad.cos() + de * self.course_rad.sin()
+    }
+}
+
+/// Output of the localizer law.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LocalizerOutput {
+    /// Main-line command, m.
+    pub main_line_m: f64,
+    /// Phase of the law.
+    pub phase: LawPhase,
+    /// Cross-track error, m.
+    pub cross_track_m: f64,
+    /// Course the law asked for, rad.
+    pub desired_course_rad: f64,
+}
+
+/// One-point localizer and course (eqs. 5.7–5.11). Approach while |CT| > CD/5: fly the line's
+/// course offset by the intercept angle `α = atan(min(|CT|, CD)/CD)·sign(CT)` (at most 45°).
+/// Following: hold the line's course with an added cross-track term.
+pub fn localizer(
+    gains: &ControlGains,
+    line: &Localizer,
+    position_ne_m: [f64; 2],
+    course_rad: f64,
+    heading_rate_rad_s: f64,
+) -> LocalizerOutput {
+    let cd = gains.convergence_distance_m;
+    let ct = line.cross_track_m(position_ne_m);
+    if ct.abs() > cd / 5.0 {
+        let intercept = (ct.abs().min(cd) / cd).atan() * ct.signum();
+        let desired = line.course_rad - intercept;
+        LocalizerOutput {
+            main_line_m: pd(gains, course_rad - desired, heading_rate_rad_s, 0.0),
+            phase: LawPhase::Approach,
+            cross_track_m: ct,
+            desired_course_rad: wrap_pi(desired),
+        }
+    } else {
+        LocalizerOutput {
+            main_line_m: pd(
+                gains,
+                course_rad - line.course_rad,
+                heading_rate_rad_s,
+                gains.hk3_m_per_m * ct,
+            ),
+            phase: LawPhase::Following,
+            cross_track_m: ct,
+            desired_course_rad: wrap_pi(line.course_rad),
+        }
+    }
+}
+
+/// A glide path: descending along a localizer to `aim_height_m` above the ground at the
+/// localizer's point, at `slope` (metres down per metre over the ground).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct GlidePath {
+    /// The horizontal line flown.
+    pub line: Localizer,
+    /// Height above ground to be at when over the line's point, m.
+    pub aim_height_m: f64,
+    /// Glide slope, sink over ground speed (the seed's GS0).
+    pub slope: f64,
+}
+
+impl GlidePath {
+    /// Height above the path, m (positive: too high). The seed's eq. 5.12 measures it
+    /// perpendicular to the path; this is the vertical distance, a factor cos γ apart.
+    pub fn altitude_error_m(&self, position_ne_m: [f64; 2], height_m: f64) -> f64 {
+        let to_go = -self.line.along_track_m(position_ne_m);
+        height_m - (self.aim_height_m + to_go * self.slope)
+    }
+}
+
+/// Output of the vertical law.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct VerticalOutput {
+    /// Symmetric brake command, 0…1.
+    pub brake: f64,
+    /// Phase of the law.
+    pub phase: LawPhase,
+    /// Height above the path, m.
+    pub altitude_error_m: f64,
+}
+
+/// Vertical glide-slope control (eqs. 5.12–5.17) with the symmetric brakes. The measured slope
+/// is the sink rate over the ground speed along the path; more brake steepens it. Approach
+/// while |A| > CD/5: aim for a slope offset by `tan β`, `β = atan(min(|A|, CD)/CD)·sign(A)`.
+/// Following: the slope error plus `VK2·A`.
+pub fn vertical(
+    gains: &ControlGains,
+    path: &GlidePath,
+    position_ne_m: [f64; 2],
+    height_m: f64,
+    velocity_ne_mps: [f64; 2],
+    sink_rate_mps: f64,
+) -> VerticalOutput {
+    let cd = gains.convergence_distance_m;
+    let a = path.altitude_error_m(position_ne_m, height_m);
+    let along = velocity_ne_mps[0] * path.line.course_rad.cos()
+        + velocity_ne_mps[1] * path.line.course_rad.sin();
+    // Going backwards or hovering over the ground: the slope is as steep as it gets.
+    let measured = if along > 0.1 {
+        sink_rate_mps / along
+    } else {
+        10.0
+    };
+    let (brake, phase) = if a.abs() > cd / 5.0 {
+        let beta = (a.abs().min(cd) / cd).atan() * a.signum();
+        let desired = path.slope + beta.tan();
+        (
+            gains.brake_trim + gains.vk1 * (desired - measured),
+            LawPhase::Approach,
+        )
+    } else {
+        (
+            gains.brake_trim + gains.vk1 * (path.slope - measured) + gains.vk2_per_m * a,
+            LawPhase::Following,
+        )
+    };
+    VerticalOutput {
+        brake: brake.clamp(0.0, 1.0),
+        phase,
+        altitude_error_m: a,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f64::consts::PI;
+
+    fn gains() -> ControlGains {
+        ControlGains::default()
+    }
+
+    #[test]
+    fn heading_error_turns_the_short_way_round_through_180_degrees() {
+        let g = gains();
+        // Heading 179°, wanted −179°: 2° to the right, so turn right (positive).
+        let u = heading(&g, 179f64.to_radians(), 0.0, (-179f64).to_radians());
+        assert!(u > 0.0, "{u}");
+        assert!((u - g.hk1_m_per_rad * 2f64.to_radians()).abs() < 1e-12);
+        // And the mirror case turns left.
+        assert!(heading(&g, (-179f64).to_radians(), 0.0, 179f64.to_radians()) < 0.0);
+        // A rate towards the target damps the command.
+        let damped = heading(&g, 179f64.to_radians(), 0.1, (-179f64).to_radians());
+        assert!(damped < u);
+    }
+
+    #[test]
+    fn commands_saturate_at_the_main_line_limit() {
+        let g = gains();
+        assert_eq!(heading(&g, 0.0, -100.0, 0.0), g.main_line_limit_m);
+        assert_eq!(course(&g, 0.0, 100.0, 0.0), -g.main_line_limit_m);
+    }
+
+    #[test]
+    fn course_law_uses_the_course_not_the_heading() {
+        let g = gains();
+        assert_eq!(course(&g, 0.5, 0.0, 0.5), 0.0);
+        assert!(course(&g, 0.4, 0.0, 0.5) > 0.0);
+    }
+
+    #[test]
+    fn cross_track_is_positive_right_of_the_line() {
+        // Line due east through the origin: a point to the south is right of it.
+        let line = Localizer {
+            point_ne_m: [0.0, 0.0],
+            course_rad: PI / 2.0,
+        };
+        assert!((line.cross_track_m([-10.0, 5.0]) - 10.0).abs() < 1e-12);
+        assert!((line.along_track_m([-10.0, 5.0]) - 5.0).abs() < 1e-12);
+        let two_point = Localizer::through([0.0, 0.0], [0.0, 100.0]);
+        assert!((two_point.course_rad - PI / 2.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn localizer_intercepts_at_up_to_45_degrees_then_follows() {
+        let g = gains();
+        let cd = g.convergence_distance_m;
+        // The seed's Fig. 5.2 geometry: localizer at x = 100, y = 200 with course 90°.
+        let line = Localizer {
+            point_ne_m: [100.0, 200.0],
+            course_rad: PI / 2.0,
+        };
+        // Far to the left of the line (north of it): intercept course 90° + 45°, to the right.
+        let far = localizer(&g, &line, [100.0 + 5.0 * cd, 0.0], PI / 2.0, 0.0);
+        assert_eq!(far.phase, LawPhase::Approach);
+        assert!((far.desired_course_rad - 135f64.to_radians()).abs() < 1e-9);
+        assert!(far.main_line_m > 0.0, "turns right towards the line");
+        // Close: following phase, cross-track term pulls back towards the line.
+        let near = localizer(&g, &line, [100.0 + 0.1 * cd, 150.0], PI / 2.0, 0.0);
+        assert_eq!(near.phase, LawPhase::Following);
+        assert!(near.main_line_m > 0.0 && near.cross_track_m < 0.0);
+        // On the line, on course: nothing to do.
+        let on = localizer(&g, &line, [100.0, 150.0], PI / 2.0, 0.0);
+        assert!(on.main_line_m.abs() < 1e-12);
+    }
+
+    #[test]
+    fn glide_slope_law_brakes_more_when_high_or_shallow() {
+        let g = gains();
+        let path = GlidePath {
+            line: Localizer {
+                point_ne_m: [0.0, 0.0],
+                course_rad: 0.0,
+            },
+            aim_height_m: 0.0,
+            slope: 0.5,
+        };
+        // 100 m before the target on a 0.5 slope the path is 50 m up.
+        let on = vertical(&g, &path, [-100.0, 0.0], 50.0, [6.0, 0.0], 3.0);
+        assert_eq!(on.phase, LawPhase::Following);
+        assert!(on.altitude_error_m.abs() < 1e-12);
+        assert!((on.brake - g.brake_trim).abs() < 1e-12);
+        let high = vertical(&g, &path, [-100.0, 0.0], 60.0, [6.0, 0.0], 3.0);
+        assert!(high.brake > on.brake);
+        let shallow = vertical(&g, &path, [-100.0, 0.0], 50.0, [7.0, 0.0], 3.0);
+        assert!(shallow.brake > on.brake);
+        let far_low = vertical(&g, &path, [-100.0, 0.0], 0.0, [6.0, 0.0], 3.0);
+        assert_eq!(far_low.phase, LawPhase::Approach);
+        assert_eq!(far_low.brake, 0.0, "far below the path: no brake at all");
+        // Blown backwards: as steep as it gets, so release the brakes.
+        let backwards = vertical(&g, &path, [-100.0, 0.0], 50.0, [-1.0, 0.0], 3.0);
+        assert_eq!(backwards.brake, 0.0);
+    }
+}

@@ -1,0 +1,281 @@
+//! Guidance: from the estimate and the operator's mode and plan to servo commands.
+//!
+//! [`Guidance::update`] runs at the drone's control rate (4 Hz) on the drone and, identically,
+//! in the ground station. The simple modes wrap one control law each (seed §5.1–5.2); spiral
+//! landing is the state machine of [`spiral`] (seed §5.3). Every phase change is an event with a
+//! reason, kept for the operator's log.
+
+pub mod spiral;
+
+use nalgebra::Vector3;
+use serde::{Deserialize, Serialize};
+use stx_dynamics::state::Controls;
+
+use crate::control::{self, ControlGains, GlidePath, LawPhase, Localizer};
+use crate::estimate::Estimate;
+use crate::mission::{FlightMode, GuidancePhase};
+use crate::performance::GlidePerformance;
+pub use spiral::{SpiralConfig, SpiralStatus};
+
+/// Everything guidance is configured with.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Default)]
+#[serde(deny_unknown_fields, default)]
+pub struct GuidanceConfig {
+    /// Control-law gains and limits.
+    pub gains: ControlGains,
+    /// How the parafoil flies, for planning.
+    pub performance: GlidePerformance,
+    /// Spiral-landing settings.
+    pub spiral: SpiralConfig,
+}
+
+/// What the operator asked to fly: targets of every mode.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Plan {
+    /// Landing target on the ground, local NED, m.
+    pub target_ned_m: Vector3<f64>,
+    /// Course of the final approach, rad; `None` lands into the wind.
+    pub approach_course_rad: Option<f64>,
+    /// Heading held in heading mode, rad.
+    pub heading_rad: f64,
+    /// Course held in course mode, rad.
+    pub course_rad: f64,
+    /// Line followed in localizer mode.
+    pub localizer: Localizer,
+    /// Glide slope (sink over ground speed) followed down the localizer to its point, if any.
+    pub localizer_glide_slope: Option<f64>,
+}
+
+impl Default for Plan {
+    fn default() -> Self {
+        Self {
+            target_ned_m: Vector3::zeros(),
+            approach_course_rad: None,
+            heading_rad: 0.0,
+            course_rad: 0.0,
+            localizer: Localizer {
+                point_ne_m: [0.0, 0.0],
+                course_rad: 0.0,
+            },
+            localizer_glide_slope: None,
+        }
+    }
+}
+
+/// A change of guidance phase, with why.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PhaseEvent {
+    /// When, s on the mission clock.
+    pub time_s: f64,
+    /// Phase left.
+    pub from: GuidancePhase,
+    /// Phase entered.
+    pub to: GuidancePhase,
+    /// Why, for the operator.
+    pub reason: String,
+}
+
+/// What guidance commands for one control period.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Command {
+    /// Servo commands.
+    pub controls: Controls,
+    /// Phase of guidance.
+    pub phase: GuidancePhase,
+}
+
+/// Guidance state for one vehicle.
+#[derive(Debug, Clone)]
+pub struct Guidance {
+    config: GuidanceConfig,
+    mode: FlightMode,
+    plan: Plan,
+    spiral: spiral::Spiral,
+    events: Vec<PhaseEvent>,
+    /// Phases of the localizer and glide-slope laws at the last update, in localizer mode.
+    law_phases: Option<(LawPhase, Option<LawPhase>)>,
+}
+
+impl Guidance {
+    /// Guidance in `Uncontrolled` mode with an empty plan.
+    pub fn new(config: GuidanceConfig) -> Self {
+        Self {
+            config,
+            mode: FlightMode::Uncontrolled,
+            plan: Plan::default(),
+            spiral: spiral::Spiral::new(),
+            events: Vec::new(),
+            law_phases: None,
+        }
+    }
+
+    /// In localizer mode, the phases of its horizontal law and (with a glide slope) its
+    /// vertical law at the last update (seed §5.1.3, §5.2).
+    pub fn law_phases(&self) -> Option<(LawPhase, Option<LawPhase>)> {
+        self.law_phases
+    }
+
+    /// The configuration in use.
+    pub fn config(&self) -> &GuidanceConfig {
+        &self.config
+    }
+
+    /// Replaces the gains (parameters set by the operator).
+    pub fn set_gains(&mut self, gains: ControlGains) {
+        self.config.gains = gains;
+    }
+
+    /// Replaces the spiral settings.
+    pub fn set_spiral_config(&mut self, spiral: SpiralConfig) {
+        self.config.spiral = spiral;
+    }
+
+    /// The mode in force.
+    pub fn mode(&self) -> FlightMode {
+        self.mode
+    }
+
+    /// Selects a mode; entering spiral landing starts its plan from the approximation.
+    pub fn set_mode(&mut self, mode: FlightMode, time_s: f64) {
+        if mode != self.mode {
+            let reason = format!("mode set to {mode:?}");
+            let to = if mode == FlightMode::SpiralLanding {
+                GuidancePhase::Approximation
+            } else {
+                GuidancePhase::Idle
+            };
+            let from = self.phase();
+            self.mode = mode;
+            self.spiral = spiral::Spiral::new();
+            self.spiral.force_phase(to);
+            if from != to {
+                self.record(time_s, from, to, reason);
+            }
+        }
+    }
+
+    /// The plan in force.
+    pub fn plan(&self) -> &Plan {
+        &self.plan
+    }
+
+    /// Replaces the plan; a spiral landing under way restarts from its approximation so the
+    /// new target is flown from where the vehicle is.
+    pub fn set_plan(&mut self, plan: Plan, time_s: f64) {
+        self.plan = plan;
+        if self.mode == FlightMode::SpiralLanding {
+            let from = self.spiral.phase();
+            self.spiral = spiral::Spiral::new();
+            self.spiral.force_phase(GuidancePhase::Approximation);
+            self.record(
+                time_s,
+                from,
+                GuidancePhase::Approximation,
+                "new plan: flying to the new target".into(),
+            );
+        }
+    }
+
+    /// The current guidance phase.
+    pub fn phase(&self) -> GuidancePhase {
+        match self.mode {
+            FlightMode::SpiralLanding => self.spiral.phase(),
+            _ => GuidancePhase::Idle,
+        }
+    }
+
+    /// The spiral's planning state for display (pattern, final-approach height, reach).
+    pub fn spiral_status(&self) -> &SpiralStatus {
+        self.spiral.status()
+    }
+
+    /// Takes the phase events recorded since the last call.
+    pub fn drain_events(&mut self) -> Vec<PhaseEvent> {
+        std::mem::take(&mut self.events)
+    }
+
+    fn record(&mut self, time_s: f64, from: GuidancePhase, to: GuidancePhase, reason: String) {
+        self.events.push(PhaseEvent {
+            time_s,
+            from,
+            to,
+            reason,
+        });
+    }
+
+    /// Commands for the estimate `est` in air of density `density_kg_per_m3`.
+    pub fn update(&mut self, est: &Estimate, density_kg_per_m3: f64) -> Command {
+        let g = &self.config.gains;
+        let position = [est.position_ned_m.x, est.position_ned_m.y];
+        let neutral = Controls::default();
+        let main_line = |m: f64| Controls {
+            main_line_m: m,
+            ..neutral
+        };
+        let controls = match self.mode {
+            FlightMode::Uncontrolled | FlightMode::Manual => neutral,
+            FlightMode::Heading => main_line(control::heading(
+                g,
+                est.heading_rad,
+                est.heading_rate_rad_s,
+                self.plan.heading_rad,
+            )),
+            FlightMode::Course => main_line(control::course(
+                g,
+                est.course_rad,
+                est.heading_rate_rad_s,
+                self.plan.course_rad,
+            )),
+            FlightMode::Localizer => {
+                let horizontal = control::localizer(
+                    g,
+                    &self.plan.localizer,
+                    position,
+                    est.course_rad,
+                    est.heading_rate_rad_s,
+                );
+                let mut vertical_phase = None;
+                let brake = match self.plan.localizer_glide_slope {
+                    Some(slope) => {
+                        let path = GlidePath {
+                            line: self.plan.localizer,
+                            aim_height_m: -self.plan.target_ned_m.z,
+                            slope,
+                        };
+                        let out = control::vertical(
+                            g,
+                            &path,
+                            position,
+                            est.height_m(),
+                            [est.velocity_ned_mps.x, est.velocity_ned_mps.y],
+                            est.sink_rate_mps,
+                        );
+                        vertical_phase = Some(out.phase);
+                        out.brake
+                    }
+                    None => 0.0,
+                };
+                self.law_phases = Some((horizontal.phase, vertical_phase));
+                Controls {
+                    main_line_m: horizontal.main_line_m,
+                    brake_right: brake,
+                    brake_left: brake,
+                }
+            }
+            FlightMode::SpiralLanding => {
+                let (controls, change) =
+                    self.spiral
+                        .update(&self.config, &self.plan, est, density_kg_per_m3);
+                if let Some((from, to, reason)) = change {
+                    self.record(est.time_s, from, to, reason);
+                }
+                controls
+            }
+        };
+        Command {
+            controls,
+            phase: self.phase(),
+        }
+    }
+}

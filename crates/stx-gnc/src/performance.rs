@@ -1,0 +1,148 @@
+//! What guidance and the landing predictor assume about how the parafoil flies: airspeed and
+//! sink rate against brake and density, and how fast it turns for a main-line command. A
+//! point-mass summary of the 14-DOF model, measured from it (the values below are checked
+//! against the model by `crates/stx-sim/tests/performance_matches_model.rs`).
+
+use serde::{Deserialize, Serialize};
+
+/// Steady flight of the parafoil, reduced to a few numbers.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct GlidePerformance {
+    /// Air density the speeds below are given at, kg/m³.
+    pub reference_density_kg_per_m3: f64,
+    /// True airspeed, brakes released, m/s.
+    pub airspeed_mps: f64,
+    /// Sink rate, brakes released, m/s.
+    pub sink_rate_mps: f64,
+    /// True airspeed, both brakes fully pulled, m/s.
+    pub braked_airspeed_mps: f64,
+    /// Sink rate, both brakes fully pulled, m/s.
+    pub braked_sink_rate_mps: f64,
+    /// Steady turn rate with the main line fully over, rad/s.
+    pub max_turn_rate_rad_s: f64,
+    /// Main-line command that gives tanh(1) ≈ 76 % of the maximum turn rate, m.
+    pub turn_main_line_scale_m: f64,
+    /// Time constant of the turn rate's response to the main line, s.
+    pub turn_time_constant_s: f64,
+    /// Extra sink in a steady turn per (rad/s)² of turn rate, m/s per (rad/s)².
+    pub turn_sink_mps_per_rad2_s2: f64,
+}
+
+impl Default for GlidePerformance {
+    /// The STRAPLEX stack as the 14-DOF model flies it near sea level.
+    fn default() -> Self {
+        Self {
+            reference_density_kg_per_m3: 1.225,
+            airspeed_mps: 6.72,
+            sink_rate_mps: 2.95,
+            braked_airspeed_mps: 5.30,
+            braked_sink_rate_mps: 2.62,
+            max_turn_rate_rad_s: 0.85,
+            turn_main_line_scale_m: 0.011,
+            turn_time_constant_s: 1.5,
+            turn_sink_mps_per_rad2_s2: 5.7,
+        }
+    }
+}
+
+impl GlidePerformance {
+    fn density_scale(&self, density_kg_per_m3: f64) -> f64 {
+        // Same lift coefficient in thinner air needs V ∝ 1/√ρ; sink scales alike.
+        (self.reference_density_kg_per_m3 / density_kg_per_m3.max(1e-6)).sqrt()
+    }
+
+    /// True airspeed at symmetric brake `brake` (0…1) and density, m/s.
+    pub fn airspeed(&self, brake: f64, density_kg_per_m3: f64) -> f64 {
+        let b = brake.clamp(0.0, 1.0);
+        (self.airspeed_mps + b * (self.braked_airspeed_mps - self.airspeed_mps))
+            * self.density_scale(density_kg_per_m3)
+    }
+
+    /// Sink rate at symmetric brake, turn rate and density, m/s.
+    pub fn sink_rate(&self, brake: f64, turn_rate_rad_s: f64, density_kg_per_m3: f64) -> f64 {
+        let b = brake.clamp(0.0, 1.0);
+        let straight = self.sink_rate_mps + b * (self.braked_sink_rate_mps - self.sink_rate_mps);
+        (straight + self.turn_sink_mps_per_rad2_s2 * turn_rate_rad_s * turn_rate_rad_s)
+            * self.density_scale(density_kg_per_m3)
+    }
+
+    /// Horizontal airspeed in straight flight, m/s.
+    pub fn horizontal_airspeed(&self, brake: f64, density_kg_per_m3: f64) -> f64 {
+        let v = self.airspeed(brake, density_kg_per_m3);
+        let s = self.sink_rate(brake, 0.0, density_kg_per_m3);
+        (v * v - s * s).max(0.0).sqrt()
+    }
+
+    /// Glide over the ground (distance per height) flying straight into a headwind
+    /// `headwind_mps` at symmetric brake `brake`; negative when blown backwards.
+    pub fn ground_glide(&self, brake: f64, headwind_mps: f64, density_kg_per_m3: f64) -> f64 {
+        (self.horizontal_airspeed(brake, density_kg_per_m3) - headwind_mps)
+            / self.sink_rate(brake, 0.0, density_kg_per_m3)
+    }
+
+    /// The symmetric brake that makes the ground glide into `headwind_mps` equal
+    /// `wanted_glide`, clamped to 0…1 (0 when even released brakes glide too short, 1 when even
+    /// full brakes glide too far). The glide falls monotonically with brake, so a bisection is
+    /// exact to its tolerance.
+    pub fn brake_for_ground_glide(
+        &self,
+        wanted_glide: f64,
+        headwind_mps: f64,
+        density_kg_per_m3: f64,
+    ) -> f64 {
+        let glide = |b: f64| self.ground_glide(b, headwind_mps, density_kg_per_m3);
+        if wanted_glide >= glide(0.0) {
+            return 0.0;
+        }
+        if wanted_glide <= glide(1.0) {
+            return 1.0;
+        }
+        let (mut low, mut high) = (0.0, 1.0);
+        for _ in 0..30 {
+            let mid = 0.5 * (low + high);
+            if glide(mid) > wanted_glide {
+                low = mid;
+            } else {
+                high = mid;
+            }
+        }
+        0.5 * (low + high)
+    }
+
+    /// Steady turn rate for a main-line command, rad/s (positive right).
+    pub fn turn_rate(&self, main_line_m: f64) -> f64 {
+        self.max_turn_rate_rad_s * (main_line_m / self.turn_main_line_scale_m).tanh()
+    }
+
+    /// Radius of a turn at the given rate in straight-flight airspeed, m.
+    pub fn turn_radius_m(&self, turn_rate_rad_s: f64, brake: f64, density_kg_per_m3: f64) -> f64 {
+        self.horizontal_airspeed(brake, density_kg_per_m3) / turn_rate_rad_s.abs().max(1e-3)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn brakes_slow_and_steepen_and_thin_air_speeds_up() {
+        let p = GlidePerformance::default();
+        let glide = |b: f64| p.horizontal_airspeed(b, 1.225) / p.sink_rate(b, 0.0, 1.225);
+        assert!(glide(1.0) < glide(0.5) && glide(0.5) < glide(0.0));
+        assert!((glide(0.0) - 2.04).abs() < 0.03, "{}", glide(0.0));
+        assert!(p.airspeed(0.0, 0.3) > 1.9 * p.airspeed(0.0, 1.225));
+        assert!(p.sink_rate(0.0, 0.5, 1.225) > p.sink_rate(0.0, 0.0, 1.225));
+        assert!(p.turn_rate(1.0).abs() <= p.max_turn_rate_rad_s);
+        // The brake that gives a glide between the extremes reproduces it.
+        for headwind in [0.0, 2.0, 4.0] {
+            let wanted =
+                0.5 * (p.ground_glide(0.0, headwind, 1.1) + p.ground_glide(1.0, headwind, 1.1));
+            let b = p.brake_for_ground_glide(wanted, headwind, 1.1);
+            assert!((p.ground_glide(b, headwind, 1.1) - wanted).abs() < 1e-6);
+            assert_eq!(p.brake_for_ground_glide(100.0, headwind, 1.1), 0.0);
+            assert_eq!(p.brake_for_ground_glide(-100.0, headwind, 1.1), 1.0);
+        }
+        assert!(p.turn_rate(-0.005) < 0.0);
+    }
+}

@@ -1,0 +1,226 @@
+//! Guidance flown on the point-mass parafoil: every phase of a spiral landing, landing into
+//! the wind, the wind too strong to reach the target, and angles across ±180°.
+
+use nalgebra::Vector3;
+use stx_dynamics::rotation::wrap_pi;
+use stx_gnc::guidance::{Guidance, GuidanceConfig, PhaseEvent, Plan};
+use stx_gnc::mission::{FlightMode, GuidancePhase};
+use stx_gnc::performance::GlidePerformance;
+use stx_gnc::pointmass::{Conditions, PointMass};
+
+struct Flight {
+    mass: PointMass,
+    guidance: Guidance,
+    events: Vec<PhaseEvent>,
+    headings: Vec<(f64, f64)>,
+}
+
+/// Wind blowing from `from_deg` at `speed`, NED.
+fn wind_from(speed: f64, from_deg: f64) -> Vector3<f64> {
+    let d = from_deg.to_radians();
+    Vector3::new(-speed * d.cos(), -speed * d.sin(), 0.0)
+}
+
+/// Flies until the drone is at the hang height (touchdown) or `max_s` passes.
+fn fly(
+    start: Vector3<f64>,
+    heading_deg: f64,
+    mode: FlightMode,
+    plan: Plan,
+    wind: Vector3<f64>,
+    max_s: f64,
+) -> Flight {
+    let perf = GlidePerformance::default();
+    let mut guidance = Guidance::new(GuidanceConfig::default());
+    guidance.set_plan(plan, 0.0);
+    guidance.set_mode(mode, 0.0);
+    let mut f = Flight {
+        mass: PointMass::new(0.0, start, heading_deg.to_radians()),
+        guidance,
+        events: Vec::new(),
+        headings: Vec::new(),
+    };
+    let hang = GuidanceConfig::default().spiral.hang_height_m;
+    while -f.mass.position_ned_m.z > hang && f.mass.time_s < max_s {
+        let command = f.guidance.update(&f.mass.estimate(&wind), 1.2);
+        f.events.extend(f.guidance.drain_events());
+        for _ in 0..5 {
+            f.mass.step(
+                &perf,
+                &command.controls,
+                &Conditions::nominal(wind, 1.2),
+                0.05,
+            );
+        }
+        f.headings.push((f.mass.time_s, f.mass.heading_rad));
+    }
+    f
+}
+
+fn target_plan(n: f64, e: f64) -> Plan {
+    Plan {
+        target_ned_m: Vector3::new(n, e, 0.0),
+        ..Plan::default()
+    }
+}
+
+fn phases(f: &Flight) -> Vec<GuidancePhase> {
+    f.events.iter().map(|e| e.to).collect()
+}
+
+#[test]
+fn a_spiral_landing_goes_through_every_phase_and_lands_on_the_target_into_the_wind() {
+    for (speed, from) in [(0.5, 0.0), (2.0, 135.0), (4.0, 250.0)] {
+        let wind = wind_from(speed, from);
+        let f = fly(
+            Vector3::new(0.0, 0.0, -700.0),
+            0.0,
+            FlightMode::SpiralLanding,
+            target_plan(200.0, 100.0),
+            wind,
+            2000.0,
+        );
+        let p = phases(&f);
+        for phase in [
+            GuidancePhase::Approximation,
+            GuidancePhase::Branch1,
+            GuidancePhase::Branch2,
+            GuidancePhase::FinalApproach,
+            GuidancePhase::Flare,
+        ] {
+            assert!(
+                p.contains(&phase),
+                "wind {speed} from {from}: {phase:?} missing in {p:?}"
+            );
+        }
+        let flare = p
+            .iter()
+            .position(|x| *x == GuidancePhase::Flare)
+            .unwrap_or(0);
+        let last_final = p
+            .iter()
+            .rposition(|x| *x == GuidancePhase::FinalApproach)
+            .unwrap_or(0);
+        assert!(
+            last_final < flare,
+            "final approach comes before the flare: {p:?}"
+        );
+        assert!(f.events.iter().all(|e| !e.reason.is_empty()));
+        let miss = (f.mass.position_ned_m.x - 200.0).hypot(f.mass.position_ned_m.y - 100.0);
+        assert!(
+            miss < 15.0,
+            "wind {speed} from {from}: missed by {miss:.1} m"
+        );
+        let upwind = from.to_radians();
+        let off = wrap_pi(f.mass.heading_rad - upwind).to_degrees();
+        assert!(
+            off.abs() < 30.0,
+            "wind {speed} from {from}: touchdown heading {off:.0}° off upwind"
+        );
+    }
+}
+
+#[test]
+fn the_final_approach_across_north_and_south_wraps_its_angles() {
+    // Wind from the south: the final approach heads 180°, where headings wrap.
+    let f = fly(
+        Vector3::new(-300.0, 50.0, -500.0),
+        -170.0,
+        FlightMode::SpiralLanding,
+        target_plan(0.0, 0.0),
+        wind_from(3.0, 180.0),
+        2000.0,
+    );
+    let miss = f.mass.position_ned_m.x.hypot(f.mass.position_ned_m.y);
+    assert!(miss < 15.0, "missed by {miss:.1} m");
+    let off = wrap_pi(f.mass.heading_rad - std::f64::consts::PI).to_degrees();
+    assert!(off.abs() < 30.0, "touchdown heading {off:.0}° off south");
+}
+
+#[test]
+fn heading_mode_turns_the_short_way_through_180_degrees() {
+    let plan = Plan {
+        heading_rad: 170f64.to_radians(),
+        ..Plan::default()
+    };
+    let f = fly(
+        Vector3::new(0.0, 0.0, -300.0),
+        -170.0,
+        FlightMode::Heading,
+        plan,
+        Vector3::zeros(),
+        40.0,
+    );
+    // From −170° to 170° is 20° to the left: the heading never passes through 0°.
+    assert!(
+        f.headings
+            .iter()
+            .all(|(_, h)| h.abs() > 150f64.to_radians()),
+        "went the long way round"
+    );
+    let (_, last) = f.headings.last().copied().unwrap_or_default();
+    assert!(wrap_pi(last - 170f64.to_radians()).abs() < 3f64.to_radians());
+}
+
+#[test]
+fn with_the_wind_stronger_than_the_airspeed_guidance_says_so_and_flies_to_the_best_point() {
+    // 8 m/s from the north, the target 800 m north (upwind): unreachable.
+    let wind = wind_from(8.0, 0.0);
+    let target = (800.0, 0.0);
+    let f = fly(
+        Vector3::new(0.0, 0.0, -400.0),
+        0.0,
+        FlightMode::SpiralLanding,
+        target_plan(target.0, target.1),
+        wind,
+        2000.0,
+    );
+    let reach = f
+        .events
+        .iter()
+        .find(|e| e.to == GuidancePhase::BestReachable)
+        .expect("guidance reports the target out of reach");
+    assert!(reach.reason.contains("out of reach"), "{}", reach.reason);
+    // It ends as close as the wind allows: nearer than drifting with the servos neutral.
+    let guided = (f.mass.position_ned_m.x - target.0).hypot(f.mass.position_ned_m.y - target.1);
+    let drifting = fly(
+        Vector3::new(0.0, 0.0, -400.0),
+        90.0,
+        FlightMode::Uncontrolled,
+        Plan::default(),
+        wind,
+        2000.0,
+    );
+    let drifted = (drifting.mass.position_ned_m.x - target.0)
+        .hypot(drifting.mass.position_ned_m.y - target.1);
+    assert!(
+        guided < drifted - 50.0,
+        "guided {guided:.0} m vs drifting {drifted:.0} m"
+    );
+    // And it lands facing the wind.
+    let off = wrap_pi(f.mass.heading_rad - 0.0).to_degrees();
+    assert!(off.abs() < 30.0, "touchdown heading {off:.0}° off upwind");
+}
+
+#[test]
+fn a_new_plan_during_the_landing_restarts_the_approach_to_the_new_target() {
+    let perf = GlidePerformance::default();
+    let mut g = Guidance::new(GuidanceConfig::default());
+    g.set_plan(target_plan(0.0, 0.0), 0.0);
+    g.set_mode(FlightMode::SpiralLanding, 0.0);
+    let mut mass = PointMass::new(0.0, Vector3::new(-200.0, 0.0, -500.0), 0.0);
+    for _ in 0..100 {
+        let c = g.update(&mass.estimate(&Vector3::zeros()), 1.2);
+        mass.step(
+            &perf,
+            &c.controls,
+            &Conditions::nominal(Vector3::zeros(), 1.2),
+            0.25,
+        );
+    }
+    g.drain_events();
+    g.set_plan(target_plan(300.0, 300.0), mass.time_s);
+    let events = g.drain_events();
+    assert_eq!(g.phase(), GuidancePhase::Approximation);
+    assert!(events.iter().any(|e| e.reason.contains("new plan")));
+}
