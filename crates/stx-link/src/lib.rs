@@ -2,3 +2,4 @@
 //! parafoil drone.
 pub mod frame;
 pub mod signing;
+pub mod telemetry;
