@@ -1,6 +1,7 @@
 //! stx-link: the MAVLink 2 link between the stx ground station and the (simulated) STRAPLEX
 //! parafoil drone.
 pub mod command;
+pub mod endpoint;
 pub mod frame;
 pub mod manual;
 pub mod param;
