@@ -8,3 +8,4 @@ pub mod param;
 pub mod plan;
 pub mod signing;
 pub mod telemetry;
+pub mod transport;
