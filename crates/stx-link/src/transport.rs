@@ -620,7 +620,7 @@ mod tests {
         assert!(matches!("localhost".parse::<Address>(), Err(AddressError::MissingScheme { .. })));
         assert!(matches!("udpin:127.0.0.1".parse::<Address>(), Err(AddressError::BadSocketAddr { .. })));
         assert!(matches!("tcp:host".parse::<Address>(), Err(AddressError::BadHostPort { .. })));
-        assert!(matches!("serial:/dev/ttyUSB0".parse::<Address>(), Err(AddressError::BadBaud { .. })));
+        assert!(matches!("serial:/dev/ttyUSB0".parse::<Address>(), Err(AddressError::BadSerial { .. })));
         assert!(matches!("serial:/dev/ttyUSB0:fast".parse::<Address>(), Err(AddressError::BadBaud { .. })));
         assert!(matches!("serial::57600".parse::<Address>(), Err(AddressError::BadSerial { .. })));
         let msg = "ftp:1.2.3.4:21".parse::<Address>().map_err(|e| e.to_string());
