@@ -54,8 +54,19 @@ fn sample(i: u32) -> Telemetry {
             temperature_c: -20.0,
             diff_temperature_c: None,
         }),
-        4 => Telemetry::Hud(Hud { airspeed_mps: 14.0, groundspeed_mps: 12.0, heading_deg: 270.0, climb_mps: -4.5, alt_msl_m: 3000.0 }),
-        5 => Telemetry::Actuators(Actuators { time_usec: i, main_line: 0.2, brake_right: 0.1, brake_left: 0.3 }),
+        4 => Telemetry::Hud(Hud {
+            airspeed_mps: 14.0,
+            groundspeed_mps: 12.0,
+            heading_deg: 270.0,
+            climb_mps: -4.5,
+            alt_msl_m: 3000.0,
+        }),
+        5 => Telemetry::Actuators(Actuators {
+            time_usec: i,
+            main_line: 0.2,
+            brake_right: 0.1,
+            brake_left: 0.3,
+        }),
         6 => Telemetry::Wind(Wind {
             time_usec: u64::from(i),
             wind_north_mps: Some(3.0),

@@ -41,10 +41,20 @@ pub enum Command {
     /// Hold a course over the ground (Course mode target), degrees true 0…360.
     HoldCourse { course_deg: f64 },
     /// Landing target; `approach_heading_deg: None` lands into the wind.
-    SetLandingTarget { lat_deg: f64, lon_deg: f64, alt_msl_m: f64, approach_heading_deg: Option<f64> },
+    SetLandingTarget {
+        lat_deg: f64,
+        lon_deg: f64,
+        alt_msl_m: f64,
+        approach_heading_deg: Option<f64>,
+    },
     /// Localizer line through a point with a course, optionally with a glide slope (degrees
     /// below the horizon).
-    SetLocalizer { lat_deg: f64, lon_deg: f64, course_deg: f64, glide_slope_deg: Option<f64> },
+    SetLocalizer {
+        lat_deg: f64,
+        lon_deg: f64,
+        course_deg: f64,
+        glide_slope_deg: Option<f64>,
+    },
     /// Flight termination: cut the payload loose.
     Cutdown,
     /// Ask for one message to be sent now.
@@ -115,10 +125,17 @@ pub enum CommandDecodeError {
     Unsupported { command: MavCmd },
     /// A parameter is out of range (answered `MAV_RESULT_DENIED`).
     #[error("command {command:?}: parameter {param} = {value} is invalid")]
-    InvalidParam { command: MavCmd, param: u8, value: f64 },
+    InvalidParam {
+        command: MavCmd,
+        param: u8,
+        value: f64,
+    },
     /// The coordinate frame is not `MAV_FRAME_GLOBAL` (answered `MAV_RESULT_COMMAND_UNSUPPORTED_MAV_FRAME`).
     #[error("command {command:?}: unsupported frame {frame:?}")]
-    UnsupportedFrame { command: MavCmd, frame: mc::MavFrame },
+    UnsupportedFrame {
+        command: MavCmd,
+        frame: mc::MavFrame,
+    },
     /// Sent as COMMAND_LONG but must be COMMAND_INT (positions need integer lat/lon).
     #[error("command {command:?} must be sent as COMMAND_INT")]
     IntOnly { command: MavCmd },
@@ -141,17 +158,29 @@ fn finite_angle(command: MavCmd, param: u8, v: f32) -> Result<f64, CommandDecode
     if v.is_finite() && (-360.0..=360.0).contains(&v) {
         Ok(v.rem_euclid(360.0))
     } else {
-        Err(CommandDecodeError::InvalidParam { command, param, value: v })
+        Err(CommandDecodeError::InvalidParam {
+            command,
+            param,
+            value: v,
+        })
     }
 }
 
 fn lat_lon(command: MavCmd, x: i32, y: i32) -> Result<(f64, f64), CommandDecodeError> {
     let (lat, lon) = (f64::from(x) / 1e7, f64::from(y) / 1e7);
     if !(-90.0..=90.0).contains(&lat) {
-        return Err(CommandDecodeError::InvalidParam { command, param: 5, value: lat });
+        return Err(CommandDecodeError::InvalidParam {
+            command,
+            param: 5,
+            value: lat,
+        });
     }
     if !(-180.0..=180.0).contains(&lon) {
-        return Err(CommandDecodeError::InvalidParam { command, param: 6, value: lon });
+        return Err(CommandDecodeError::InvalidParam {
+            command,
+            param: 6,
+            value: lon,
+        });
     }
     Ok((lat, lon))
 }
@@ -172,7 +201,12 @@ impl Command {
     }
 
     /// The COMMAND_LONG / COMMAND_INT carrying this command to `target`.
-    pub fn to_mavlink(&self, target_system: u8, target_component: u8, confirmation: u8) -> MavMessage {
+    pub fn to_mavlink(
+        &self,
+        target_system: u8,
+        target_component: u8,
+        confirmation: u8,
+    ) -> MavMessage {
         let command = self.mav_cmd();
         let long = |p: [f32; 7]| {
             MavMessage::COMMAND_LONG(mc::COMMAND_LONG_DATA {
@@ -216,7 +250,9 @@ impl Command {
                 0.0,
                 0.0,
             ]),
-            Self::HoldHeading { heading_deg } => long([heading_deg as f32, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]),
+            Self::HoldHeading { heading_deg } => {
+                long([heading_deg as f32, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0])
+            }
             Self::HoldCourse { course_deg } => long([
                 mc::HeadingType::HEADING_TYPE_COURSE_OVER_GROUND as u8 as f32,
                 course_deg as f32,
@@ -226,23 +262,54 @@ impl Command {
                 0.0,
                 0.0,
             ]),
-            Self::SetLandingTarget { lat_deg, lon_deg, alt_msl_m, approach_heading_deg } => int(
-                [0.0, 0.0, 0.0, approach_heading_deg.map_or(f32::NAN, |h| h as f32)],
+            Self::SetLandingTarget {
+                lat_deg,
+                lon_deg,
+                alt_msl_m,
+                approach_heading_deg,
+            } => int(
+                [
+                    0.0,
+                    0.0,
+                    0.0,
+                    approach_heading_deg.map_or(f32::NAN, |h| h as f32),
+                ],
                 lat_deg,
                 lon_deg,
                 alt_msl_m as f32,
             ),
-            Self::SetLocalizer { lat_deg, lon_deg, course_deg, glide_slope_deg } => int(
-                [-1.0, 0.0, glide_slope_deg.map_or(f32::NAN, |g| g as f32), course_deg.to_radians() as f32],
+            Self::SetLocalizer {
+                lat_deg,
+                lon_deg,
+                course_deg,
+                glide_slope_deg,
+            } => int(
+                [
+                    -1.0,
+                    0.0,
+                    glide_slope_deg.map_or(f32::NAN, |g| g as f32),
+                    course_deg.to_radians() as f32,
+                ],
                 lat_deg,
                 lon_deg,
                 f32::NAN,
             ),
             Self::Cutdown => long([1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]),
-            Self::RequestMessage { message_id } => long([message_id as f32, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]),
-            Self::SetMessageInterval { message_id, interval_us } => {
-                long([message_id as f32, interval_us as f32, 0.0, 0.0, 0.0, 0.0, 0.0])
+            Self::RequestMessage { message_id } => {
+                long([message_id as f32, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0])
             }
+            Self::SetMessageInterval {
+                message_id,
+                interval_us,
+            } => long([
+                message_id as f32,
+                interval_us as f32,
+                0.0,
+                0.0,
+                0.0,
+                0.0,
+                0.0,
+            ]),
         }
     }
 
@@ -257,7 +324,11 @@ impl Command {
 
     fn from_long(c: &mc::COMMAND_LONG_DATA) -> Result<Command, CommandDecodeError> {
         let command = c.command;
-        let bad = |param: u8, value: f32| CommandDecodeError::InvalidParam { command, param, value: f64::from(value) };
+        let bad = |param: u8, value: f32| CommandDecodeError::InvalidParam {
+            command,
+            param,
+            value: f64::from(value),
+        };
         match command {
             MavCmd::MAV_CMD_DO_SET_MODE => {
                 let flags = c.param1;
@@ -268,29 +339,41 @@ impl Command {
                 if !(0.0..=255.0).contains(&code) || code.fract() != 0.0 {
                     return Err(bad(2, code));
                 }
-                FlightMode::from_code(code as u8).map(Command::SetMode).ok_or_else(|| bad(2, code))
+                FlightMode::from_code(code as u8)
+                    .map(Command::SetMode)
+                    .ok_or_else(|| bad(2, code))
             }
             MavCmd::MAV_CMD_CONDITION_YAW => {
                 if c.param4 != 0.0 {
                     return Err(bad(4, c.param4));
                 }
-                Ok(Command::HoldHeading { heading_deg: finite_angle(command, 1, c.param1)? })
+                Ok(Command::HoldHeading {
+                    heading_deg: finite_angle(command, 1, c.param1)?,
+                })
             }
             MavCmd::MAV_CMD_GUIDED_CHANGE_HEADING => {
                 if c.param1 != mc::HeadingType::HEADING_TYPE_COURSE_OVER_GROUND as u8 as f32 {
                     return Err(bad(1, c.param1));
                 }
-                Ok(Command::HoldCourse { course_deg: finite_angle(command, 2, c.param2)? })
+                Ok(Command::HoldCourse {
+                    course_deg: finite_angle(command, 2, c.param2)?,
+                })
             }
             MavCmd::MAV_CMD_DO_FLIGHTTERMINATION => {
-                if c.param1 >= 0.5 { Ok(Command::Cutdown) } else { Err(bad(1, c.param1)) }
+                if c.param1 >= 0.5 {
+                    Ok(Command::Cutdown)
+                } else {
+                    Err(bad(1, c.param1))
+                }
             }
             MavCmd::MAV_CMD_REQUEST_MESSAGE => {
                 let id = c.param1;
                 if !(0.0..=16_777_215.0).contains(&id) || id.fract() != 0.0 {
                     return Err(bad(1, id));
                 }
-                Ok(Command::RequestMessage { message_id: id as u32 })
+                Ok(Command::RequestMessage {
+                    message_id: id as u32,
+                })
             }
             MavCmd::MAV_CMD_SET_MESSAGE_INTERVAL => {
                 let id = c.param1;
@@ -300,9 +383,14 @@ impl Command {
                 if !c.param2.is_finite() || c.param2 < -1.0 {
                     return Err(bad(2, c.param2));
                 }
-                Ok(Command::SetMessageInterval { message_id: id as u32, interval_us: c.param2 as i32 })
+                Ok(Command::SetMessageInterval {
+                    message_id: id as u32,
+                    interval_us: c.param2 as i32,
+                })
             }
-            MavCmd::MAV_CMD_NAV_LAND | MavCmd::MAV_CMD_DO_REPOSITION => Err(CommandDecodeError::IntOnly { command }),
+            MavCmd::MAV_CMD_NAV_LAND | MavCmd::MAV_CMD_DO_REPOSITION => {
+                Err(CommandDecodeError::IntOnly { command })
+            }
             _ => Err(CommandDecodeError::Unsupported { command }),
         }
     }
@@ -312,10 +400,15 @@ impl Command {
         // MAV_FRAME_GLOBAL_INT is the deprecated synonym older senders still use.
         #[allow(deprecated)]
         let check_frame = || {
-            if c.frame == mc::MavFrame::MAV_FRAME_GLOBAL || c.frame == mc::MavFrame::MAV_FRAME_GLOBAL_INT {
+            if c.frame == mc::MavFrame::MAV_FRAME_GLOBAL
+                || c.frame == mc::MavFrame::MAV_FRAME_GLOBAL_INT
+            {
                 Ok(())
             } else {
-                Err(CommandDecodeError::UnsupportedFrame { command, frame: c.frame })
+                Err(CommandDecodeError::UnsupportedFrame {
+                    command,
+                    frame: c.frame,
+                })
             }
         };
         match command {
@@ -323,25 +416,45 @@ impl Command {
                 check_frame()?;
                 let (lat_deg, lon_deg) = lat_lon(command, c.x, c.y)?;
                 if !c.z.is_finite() {
-                    return Err(CommandDecodeError::InvalidParam { command, param: 7, value: f64::from(c.z) });
+                    return Err(CommandDecodeError::InvalidParam {
+                        command,
+                        param: 7,
+                        value: f64::from(c.z),
+                    });
                 }
-                let approach_heading_deg =
-                    if c.param4.is_nan() { None } else { Some(finite_angle(command, 4, c.param4)?) };
-                Ok(Command::SetLandingTarget { lat_deg, lon_deg, alt_msl_m: f64::from(c.z), approach_heading_deg })
+                let approach_heading_deg = if c.param4.is_nan() {
+                    None
+                } else {
+                    Some(finite_angle(command, 4, c.param4)?)
+                };
+                Ok(Command::SetLandingTarget {
+                    lat_deg,
+                    lon_deg,
+                    alt_msl_m: f64::from(c.z),
+                    approach_heading_deg,
+                })
             }
             MavCmd::MAV_CMD_DO_REPOSITION => {
                 check_frame()?;
                 let (lat_deg, lon_deg) = lat_lon(command, c.x, c.y)?;
                 let course = f64::from(c.param4);
                 if !course.is_finite() || course.abs() > 2.0 * std::f64::consts::TAU {
-                    return Err(CommandDecodeError::InvalidParam { command, param: 4, value: course });
+                    return Err(CommandDecodeError::InvalidParam {
+                        command,
+                        param: 4,
+                        value: course,
+                    });
                 }
                 let glide_slope_deg = if c.param3.is_nan() {
                     None
                 } else if (0.0..90.0).contains(&c.param3) {
                     Some(f64::from(c.param3))
                 } else {
-                    return Err(CommandDecodeError::InvalidParam { command, param: 3, value: f64::from(c.param3) });
+                    return Err(CommandDecodeError::InvalidParam {
+                        command,
+                        param: 3,
+                        value: f64::from(c.param3),
+                    });
                 };
                 Ok(Command::SetLocalizer {
                     lat_deg,
@@ -384,7 +497,11 @@ pub struct CommandConfig {
 
 impl Default for CommandConfig {
     fn default() -> Self {
-        Self { timeout: Duration::from_secs(1), retries: 3, in_progress_timeout: Duration::from_secs(5) }
+        Self {
+            timeout: Duration::from_secs(1),
+            retries: 3,
+            in_progress_timeout: Duration::from_secs(5),
+        }
     }
 }
 
@@ -421,8 +538,14 @@ pub struct CommandEvent {
 pub enum CommandSendError {
     /// A command with the same MAV_CMD to the same target is already waiting for its ACK
     /// (MAVLink matches ACKs by command id, so two would be ambiguous).
-    #[error("command {command:?} to system {target_system} already in flight (request {in_flight:?})")]
-    Busy { command: MavCmd, target_system: u8, in_flight: RequestId },
+    #[error(
+        "command {command:?} to system {target_system} already in flight (request {in_flight:?})"
+    )]
+    Busy {
+        command: MavCmd,
+        target_system: u8,
+        in_flight: RequestId,
+    },
 }
 
 #[derive(Debug)]
@@ -447,7 +570,10 @@ pub struct CommandClient {
 impl CommandClient {
     /// A client with the given retry policy.
     pub fn new(config: CommandConfig) -> Self {
-        Self { config, ..Default::default() }
+        Self {
+            config,
+            ..Default::default()
+        }
     }
 
     /// Sends `command` to `target` (system, component) now; the outcome comes back as a
@@ -460,12 +586,27 @@ impl CommandClient {
         command: Command,
     ) -> Result<(), CommandSendError> {
         let mav = command.mav_cmd();
-        if let Some(f) = self.in_flight.iter().find(|f| f.target.0 == target.0 && f.command.mav_cmd() == mav) {
-            return Err(CommandSendError::Busy { command: mav, target_system: target.0, in_flight: f.request_id });
+        if let Some(f) = self
+            .in_flight
+            .iter()
+            .find(|f| f.target.0 == target.0 && f.command.mav_cmd() == mav)
+        {
+            return Err(CommandSendError::Busy {
+                command: mav,
+                target_system: target.0,
+                in_flight: f.request_id,
+            });
         }
         tracing::debug!(?request_id, ?command, "command sent");
-        self.transmit.push_back(command.to_mavlink(target.0, target.1, 0));
-        self.in_flight.push(InFlight { request_id, command, target, attempts: 1, deadline: now + self.config.timeout });
+        self.transmit
+            .push_back(command.to_mavlink(target.0, target.1, 0));
+        self.in_flight.push(InFlight {
+            request_id,
+            command,
+            target,
+            attempts: 1,
+            deadline: now + self.config.timeout,
+        });
         Ok(())
     }
 
@@ -475,13 +616,25 @@ impl CommandClient {
     }
 
     /// Feeds a received message; COMMAND_ACKs from `from_system` settle matching requests.
-    pub fn handle_message(&mut self, now: Duration, from_system: u8, our_system: u8, msg: &MavMessage) {
-        let MavMessage::COMMAND_ACK(ack) = msg else { return };
+    pub fn handle_message(
+        &mut self,
+        now: Duration,
+        from_system: u8,
+        our_system: u8,
+        msg: &MavMessage,
+    ) {
+        let MavMessage::COMMAND_ACK(ack) = msg else {
+            return;
+        };
         // target_system 0 = broadcast or an older sender without the extension.
         if ack.target_system != 0 && ack.target_system != our_system {
             return;
         }
-        let Some(i) = self.in_flight.iter().position(|f| f.target.0 == from_system && f.command.mav_cmd() == ack.command) else {
+        let Some(i) = self
+            .in_flight
+            .iter()
+            .position(|f| f.target.0 == from_system && f.command.mav_cmd() == ack.command)
+        else {
             tracing::debug!(command = ?ack.command, from_system, "COMMAND_ACK for nothing in flight");
             return;
         };
@@ -492,16 +645,27 @@ impl CommandClient {
                 self.events.push_back(CommandEvent {
                     request_id: f.request_id,
                     command: f.command,
-                    outcome: CommandOutcome::InProgress { progress_pct: (ack.progress <= 100).then_some(ack.progress) },
+                    outcome: CommandOutcome::InProgress {
+                        progress_pct: (ack.progress <= 100).then_some(ack.progress),
+                    },
                     attempts: f.attempts,
                 });
             }
             return;
         }
         let f = self.in_flight.remove(i);
-        let outcome = if result == CommandResult::Accepted { CommandOutcome::Accepted } else { CommandOutcome::Rejected { result } };
+        let outcome = if result == CommandResult::Accepted {
+            CommandOutcome::Accepted
+        } else {
+            CommandOutcome::Rejected { result }
+        };
         tracing::info!(request_id = ?f.request_id, ?outcome, attempts = f.attempts, "command settled");
-        self.events.push_back(CommandEvent { request_id: f.request_id, command: f.command, outcome, attempts: f.attempts });
+        self.events.push_back(CommandEvent {
+            request_id: f.request_id,
+            command: f.command,
+            outcome,
+            attempts: f.attempts,
+        });
     }
 
     /// Re-sends or gives up on requests whose deadline passed.
@@ -520,13 +684,16 @@ impl CommandClient {
                 self.events.push_back(CommandEvent {
                     request_id: f.request_id,
                     command: f.command,
-                    outcome: CommandOutcome::TimedOut { attempts: f.attempts },
+                    outcome: CommandOutcome::TimedOut {
+                        attempts: f.attempts,
+                    },
                     attempts: f.attempts,
                 });
                 continue;
             }
             // Retry: confirmation counts previous transmissions.
-            self.transmit.push_back(f.command.to_mavlink(f.target.0, f.target.1, f.attempts));
+            self.transmit
+                .push_back(f.command.to_mavlink(f.target.0, f.target.1, f.attempts));
             f.attempts = f.attempts.saturating_add(1);
             f.deadline = now + timeout;
             i += 1;
@@ -625,21 +792,31 @@ impl CommandServer {
     }
 
     fn ack(&mut self, to: (u8, u8), command: MavCmd, result: CommandResult) {
-        self.transmit.push_back(MavMessage::COMMAND_ACK(mc::COMMAND_ACK_DATA {
-            command,
-            result: result.to_mav(),
-            progress: if result == CommandResult::InProgress { u8::MAX } else { 0 },
-            result_param2: 0,
-            target_system: to.0,
-            target_component: to.1,
-        }));
+        self.transmit
+            .push_back(MavMessage::COMMAND_ACK(mc::COMMAND_ACK_DATA {
+                command,
+                result: result.to_mav(),
+                progress: if result == CommandResult::InProgress {
+                    u8::MAX
+                } else {
+                    0
+                },
+                result_param2: 0,
+                target_system: to.0,
+                target_component: to.1,
+            }));
     }
 
     /// Feeds a received message from `from` (system, component). Returns whether it was a
     /// command for us.
     pub fn handle_message(&mut self, now: Duration, from: (u8, u8), msg: &MavMessage) -> bool {
         let (target_system, target_component, confirmation, mav_cmd) = match msg {
-            MavMessage::COMMAND_LONG(c) => (c.target_system, c.target_component, Some(c.confirmation), c.command),
+            MavMessage::COMMAND_LONG(c) => (
+                c.target_system,
+                c.target_component,
+                Some(c.confirmation),
+                c.command,
+            ),
             MavMessage::COMMAND_INT(c) => (c.target_system, c.target_component, None, c.command),
             _ => return false,
         };
@@ -648,13 +825,21 @@ impl CommandServer {
         {
             return false;
         }
-        while self.recent.front().is_some_and(|r| now.saturating_sub(r.received) > self.dedup_window) {
+        while self
+            .recent
+            .front()
+            .is_some_and(|r| now.saturating_sub(r.received) > self.dedup_window)
+        {
             self.recent.pop_front();
         }
         // A retry: same sender, same content (confirmation aside), newer confirmation (or any
         // copy for COMMAND_INT, which has none).
         let canonical = canonical(msg);
-        if let Some(r) = self.recent.iter_mut().find(|r| r.from == from && r.msg == canonical) {
+        if let Some(r) = self
+            .recent
+            .iter_mut()
+            .find(|r| r.from == from && r.msg == canonical)
+        {
             let is_retry = match confirmation {
                 Some(c) => c > r.confirmation,
                 None => true,
@@ -706,13 +891,18 @@ impl CommandServer {
     /// Sends the application's answer for `id` (and remembers it for retries). Returns
     /// `false` if `id` is unknown (already forgotten).
     pub fn respond(&mut self, id: IncomingId, result: CommandResult) -> bool {
-        let Some(r) = self.recent.iter_mut().find(|r| r.id == id) else { return false };
+        let Some(r) = self.recent.iter_mut().find(|r| r.id == id) else {
+            return false;
+        };
         r.answer = Some(result);
-        let (from, cmd) = (r.from, match &r.msg {
-            MavMessage::COMMAND_LONG(c) => c.command,
-            MavMessage::COMMAND_INT(c) => c.command,
-            _ => return false,
-        });
+        let (from, cmd) = (
+            r.from,
+            match &r.msg {
+                MavMessage::COMMAND_LONG(c) => c.command,
+                MavMessage::COMMAND_INT(c) => c.command,
+                _ => return false,
+            },
+        );
         self.ack(from, cmd, result);
         true
     }
@@ -726,7 +916,10 @@ impl CommandServer {
 /// The message with its confirmation zeroed, to compare retries by content.
 fn canonical(msg: &MavMessage) -> MavMessage {
     match msg {
-        MavMessage::COMMAND_LONG(c) => MavMessage::COMMAND_LONG(mc::COMMAND_LONG_DATA { confirmation: 0, ..c.clone() }),
+        MavMessage::COMMAND_LONG(c) => MavMessage::COMMAND_LONG(mc::COMMAND_LONG_DATA {
+            confirmation: 0,
+            ..c.clone()
+        }),
         other => other.clone(),
     }
 }
@@ -740,25 +933,56 @@ mod tests {
             Command::SetMode(FlightMode::SpiralLanding),
             Command::HoldHeading { heading_deg: 270.5 },
             Command::HoldCourse { course_deg: 12.25 },
-            Command::SetLandingTarget { lat_deg: 41.1779, lon_deg: -8.5977, alt_msl_m: 120.5, approach_heading_deg: None },
-            Command::SetLandingTarget { lat_deg: 41.1779, lon_deg: -8.5977, alt_msl_m: 120.5, approach_heading_deg: Some(250.0) },
-            Command::SetLocalizer { lat_deg: 41.0, lon_deg: -8.0, course_deg: 90.0, glide_slope_deg: Some(12.0) },
-            Command::SetLocalizer { lat_deg: 41.0, lon_deg: -8.0, course_deg: 90.0, glide_slope_deg: None },
+            Command::SetLandingTarget {
+                lat_deg: 41.1779,
+                lon_deg: -8.5977,
+                alt_msl_m: 120.5,
+                approach_heading_deg: None,
+            },
+            Command::SetLandingTarget {
+                lat_deg: 41.1779,
+                lon_deg: -8.5977,
+                alt_msl_m: 120.5,
+                approach_heading_deg: Some(250.0),
+            },
+            Command::SetLocalizer {
+                lat_deg: 41.0,
+                lon_deg: -8.0,
+                course_deg: 90.0,
+                glide_slope_deg: Some(12.0),
+            },
+            Command::SetLocalizer {
+                lat_deg: 41.0,
+                lon_deg: -8.0,
+                course_deg: 90.0,
+                glide_slope_deg: None,
+            },
             Command::Cutdown,
             Command::RequestMessage { message_id: 242 },
-            Command::SetMessageInterval { message_id: 33, interval_us: 200_000 },
+            Command::SetMessageInterval {
+                message_id: 33,
+                interval_us: 200_000,
+            },
         ]
     }
 
     #[test]
     fn every_command_round_trips() {
         for c in all_commands() {
-            let back = Command::from_mavlink(&c.to_mavlink(1, 1, 0)).expect("a command").expect("decodes");
+            let back = Command::from_mavlink(&c.to_mavlink(1, 1, 0))
+                .expect("a command")
+                .expect("decodes");
             match (c, back) {
-                (Command::SetLocalizer { course_deg: a, .. }, Command::SetLocalizer { course_deg: b, .. }) => {
+                (
+                    Command::SetLocalizer { course_deg: a, .. },
+                    Command::SetLocalizer { course_deg: b, .. },
+                ) => {
                     assert!((a - b).abs() < 1e-4, "{a} {b}")
                 }
-                (Command::SetLandingTarget { lat_deg: a, .. }, Command::SetLandingTarget { lat_deg: b, .. }) => {
+                (
+                    Command::SetLandingTarget { lat_deg: a, .. },
+                    Command::SetLandingTarget { lat_deg: b, .. },
+                ) => {
                     assert!((a - b).abs() < 1e-7);
                 }
                 _ => assert_eq!(c, back),
@@ -776,13 +1000,19 @@ mod tests {
             ..Default::default()
         });
         assert!(srv.handle_message(Duration::ZERO, (255, 190), &arm));
-        let Some(MavMessage::COMMAND_ACK(a)) = srv.poll_transmit() else { panic!("no ack") };
+        let Some(MavMessage::COMMAND_ACK(a)) = srv.poll_transmit() else {
+            panic!("no ack")
+        };
         assert_eq!(a.result, mc::MavResult::MAV_RESULT_UNSUPPORTED);
         let bad_mode = Command::SetMode(FlightMode::Manual).to_mavlink(1, 1, 0);
-        let MavMessage::COMMAND_LONG(mut c) = bad_mode else { panic!() };
+        let MavMessage::COMMAND_LONG(mut c) = bad_mode else {
+            panic!()
+        };
         c.param2 = 42.0;
         srv.handle_message(Duration::ZERO, (255, 190), &MavMessage::COMMAND_LONG(c));
-        let Some(MavMessage::COMMAND_ACK(a)) = srv.poll_transmit() else { panic!("no ack") };
+        let Some(MavMessage::COMMAND_ACK(a)) = srv.poll_transmit() else {
+            panic!("no ack")
+        };
         assert_eq!(a.result, mc::MavResult::MAV_RESULT_DENIED);
         assert_eq!(srv.stats().refused, 2);
         assert!(srv.poll_event().is_none());
@@ -796,10 +1026,15 @@ mod tests {
         srv.handle_message(Duration::ZERO, gcs, &c.to_mavlink(1, 1, 0));
         let inc = srv.poll_event().expect("delivered");
         assert!(srv.respond(inc.id, CommandResult::Accepted));
-        assert!(matches!(srv.poll_transmit(), Some(MavMessage::COMMAND_ACK(_))));
+        assert!(matches!(
+            srv.poll_transmit(),
+            Some(MavMessage::COMMAND_ACK(_))
+        ));
         srv.handle_message(Duration::from_millis(1000), gcs, &c.to_mavlink(1, 1, 1));
         assert!(srv.poll_event().is_none());
-        let Some(MavMessage::COMMAND_ACK(a)) = srv.poll_transmit() else { panic!("no re-ack") };
+        let Some(MavMessage::COMMAND_ACK(a)) = srv.poll_transmit() else {
+            panic!("no re-ack")
+        };
         assert_eq!(a.result, mc::MavResult::MAV_RESULT_ACCEPTED);
         assert_eq!(srv.stats().duplicates, 1);
         // A fresh request (confirmation 0) later is delivered again.
@@ -809,9 +1044,17 @@ mod tests {
 
     #[test]
     fn client_retries_with_confirmation_then_times_out() {
-        let mut cl = CommandClient::new(CommandConfig { timeout: Duration::from_secs(1), retries: 2, ..Default::default() });
-        cl.send(Duration::ZERO, RequestId(7), (1, 1), Command::Cutdown).expect("queued");
-        assert!(matches!(cl.send(Duration::ZERO, RequestId(8), (1, 1), Command::Cutdown), Err(CommandSendError::Busy { .. })));
+        let mut cl = CommandClient::new(CommandConfig {
+            timeout: Duration::from_secs(1),
+            retries: 2,
+            ..Default::default()
+        });
+        cl.send(Duration::ZERO, RequestId(7), (1, 1), Command::Cutdown)
+            .expect("queued");
+        assert!(matches!(
+            cl.send(Duration::ZERO, RequestId(8), (1, 1), Command::Cutdown),
+            Err(CommandSendError::Busy { .. })
+        ));
         let mut confirmations = Vec::new();
         let mut t = Duration::ZERO;
         for _ in 0..4 {

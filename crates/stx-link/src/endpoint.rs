@@ -28,15 +28,22 @@ use mavlink::dialects::common::MavMessage;
 use serde::{Deserialize, Serialize};
 
 use crate::command::{
-    Command, CommandClient, CommandConfig, CommandEvent, CommandResult, CommandSendError, CommandServer, IncomingCommand,
-    IncomingId, RequestId,
+    Command, CommandClient, CommandConfig, CommandEvent, CommandResult, CommandSendError,
+    CommandServer, IncomingCommand, IncomingId, RequestId,
 };
-use crate::frame::{DecoderPolicy, DecoderStats, Frame, FrameDecoder, FrameEncoder, FrameError, FrameHeader};
+use crate::frame::{
+    DecoderPolicy, DecoderStats, Frame, FrameDecoder, FrameEncoder, FrameError, FrameHeader,
+};
 use crate::manual::{ManualEvent, ManualReceiver, ManualSender, Sticks};
-use crate::param::{ParamChange, ParamClient, ParamConfig, ParamEvent, ParamRequestError, ParamSpec, ParamTable, ParamTableError};
+use crate::param::{
+    ParamChange, ParamClient, ParamConfig, ParamEvent, ParamRequestError, ParamSpec, ParamTable,
+    ParamTableError,
+};
 use crate::plan::{PlanClient, PlanConfig, PlanEvent, PlanItem, PlanRequestError, PlanServer};
 use crate::signing::SigningConfig;
-use crate::telemetry::{Severity, StatusTextAssembler, Telemetry, VehicleStatus, split_status_text};
+use crate::telemetry::{
+    Severity, StatusTextAssembler, Telemetry, VehicleStatus, split_status_text,
+};
 
 /// Settings shared by both ends.
 #[derive(Debug, Clone)]
@@ -60,7 +67,11 @@ pub struct LinkConfig {
 impl LinkConfig {
     /// Defaults for the ground station: system 255, component 190 (MAV_COMP_ID_MISSIONPLANNER).
     pub fn ground() -> Self {
-        Self { system_id: 255, component_id: 190, ..Self::vehicle() }
+        Self {
+            system_id: 255,
+            component_id: 190,
+            ..Self::vehicle()
+        }
     }
 
     /// Defaults for the drone: system 1, component 1 (autopilot).
@@ -175,7 +186,9 @@ struct LinkCore {
 
 impl LinkCore {
     fn new(config: LinkConfig, now: Duration) -> Self {
-        let mut decoder = FrameDecoder::new(DecoderPolicy { accept_v1: config.accept_v1 });
+        let mut decoder = FrameDecoder::new(DecoderPolicy {
+            accept_v1: config.accept_v1,
+        });
         let mut encoder = FrameEncoder::new(config.system_id, config.component_id);
         if let Some(s) = &config.signing {
             let (signer, verifier) = s.build(now);
@@ -203,7 +216,11 @@ impl LinkCore {
     }
 
     fn check_persist(&mut self) {
-        if let Some(v) = self.encoder.signer_mut().and_then(|s| s.take_value_to_persist()) {
+        if let Some(v) = self
+            .encoder
+            .signer_mut()
+            .and_then(|s| s.take_value_to_persist())
+        {
             self.events.push_back(LinkEvent::PersistSigningTimestamp(v));
         }
     }
@@ -241,7 +258,8 @@ impl LinkCore {
         }
         self.arrivals.push_back(now);
         self.prune_arrivals(now);
-        self.last_by_kind.insert(h.message_id, (msg.message_name(), now));
+        self.last_by_kind
+            .insert(h.message_id, (msg.message_name(), now));
         let key = (h.system_id, h.component_id);
         match self.senders.get_mut(&key) {
             Some((last_seq, s)) => {
@@ -257,14 +275,26 @@ impl LinkCore {
             None => {
                 self.senders.insert(
                     key,
-                    (h.sequence, SenderStats { system_id: h.system_id, component_id: h.component_id, received: 1, ..Default::default() }),
+                    (
+                        h.sequence,
+                        SenderStats {
+                            system_id: h.system_id,
+                            component_id: h.component_id,
+                            received: 1,
+                            ..Default::default()
+                        },
+                    ),
                 );
             }
         }
     }
 
     fn prune_arrivals(&mut self, now: Duration) {
-        while self.arrivals.front().is_some_and(|&t| now.saturating_sub(t) > self.config.rate_window) {
+        while self
+            .arrivals
+            .front()
+            .is_some_and(|&t| now.saturating_sub(t) > self.config.rate_window)
+        {
             self.arrivals.pop_front();
         }
     }
@@ -276,20 +306,26 @@ impl LinkCore {
         if !self.connected {
             self.connected = true;
             tracing::info!(system_id = from.0, "link connected");
-            self.events.push_back(LinkEvent::Connected { system_id: from.0, component_id: from.1 });
+            self.events.push_back(LinkEvent::Connected {
+                system_id: from.0,
+                component_id: from.1,
+            });
         }
     }
 
     /// Heartbeat and liveness timers; returns whether a heartbeat is due.
     fn handle_timeout(&mut self, now: Duration) -> bool {
-        if self.connected {
-            if let (Some(last), Some(peer)) = (self.last_peer_heartbeat, self.peer) {
-                let since_last = now.saturating_sub(last);
-                if since_last >= self.config.link_timeout {
-                    self.connected = false;
-                    tracing::warn!(system_id = peer.0, ?since_last, "link lost");
-                    self.events.push_back(LinkEvent::Lost { system_id: peer.0, since_last });
-                }
+        if self.connected
+            && let (Some(last), Some(peer)) = (self.last_peer_heartbeat, self.peer)
+        {
+            let since_last = now.saturating_sub(last);
+            if since_last >= self.config.link_timeout {
+                self.connected = false;
+                tracing::warn!(system_id = peer.0, ?since_last, "link lost");
+                self.events.push_back(LinkEvent::Lost {
+                    system_id: peer.0,
+                    since_last,
+                });
             }
         }
         if now >= self.next_heartbeat {
@@ -305,10 +341,10 @@ impl LinkCore {
 
     fn poll_timeout(&self) -> Duration {
         let mut t = self.next_heartbeat;
-        if self.connected {
-            if let Some(last) = self.last_peer_heartbeat {
-                t = t.min(last + self.config.link_timeout);
-            }
+        if self.connected
+            && let Some(last) = self.last_peer_heartbeat
+        {
+            t = t.min(last + self.config.link_timeout);
         }
         t
     }
@@ -322,14 +358,25 @@ impl LinkCore {
             .values()
             .map(|(_, s)| {
                 let total = s.lost + s.received;
-                SenderStats { loss_pct: if total == 0 { 0.0 } else { 100.0 * s.lost as f64 / total as f64 }, ..*s }
+                SenderStats {
+                    loss_pct: if total == 0 {
+                        0.0
+                    } else {
+                        100.0 * s.lost as f64 / total as f64
+                    },
+                    ..*s
+                }
             })
             .collect();
         senders.sort_by_key(|s| (s.system_id, s.component_id));
-        let (lost, received) = senders.iter().fold((0, 0), |(l, r), s| (l + s.lost, r + s.received));
+        let (lost, received) = senders
+            .iter()
+            .fold((0, 0), |(l, r), s| (l + s.lost, r + s.received));
         LinkStats {
             connected: self.connected,
-            last_heartbeat_age_s: self.last_peer_heartbeat.map(|t| now.saturating_sub(t).as_secs_f64()),
+            last_heartbeat_age_s: self
+                .last_peer_heartbeat
+                .map(|t| now.saturating_sub(t).as_secs_f64()),
             messages_per_s: self.arrivals.len() as f64 / window,
             frames_in: d.frames_ok,
             frames_out: self.frames_out,
@@ -338,9 +385,20 @@ impl LinkCore {
             crc_errors: d.crc_errors,
             parse_errors: d.parse_errors,
             unknown_message_ids: d.unknown_message_ids,
-            signature_failures: d.bad_signatures + d.replays_refused + d.unsigned_refused + if self.decoder.signing_required() { d.v1_refused } else { 0 },
+            signature_failures: d.bad_signatures
+                + d.replays_refused
+                + d.unsigned_refused
+                + if self.decoder.signing_required() {
+                    d.v1_refused
+                } else {
+                    0
+                },
             bytes_discarded: d.bytes_discarded,
-            packet_loss_pct: if lost + received == 0 { 0.0 } else { 100.0 * lost as f64 / (lost + received) as f64 },
+            packet_loss_pct: if lost + received == 0 {
+                0.0
+            } else {
+                100.0 * lost as f64 / (lost + received) as f64
+            },
             senders,
             last_message_age_s: self
                 .last_by_kind
@@ -388,9 +446,16 @@ pub enum GroundEvent {
     /// Link state, dropped frames, signing timestamp to persist.
     Link(LinkEvent),
     /// A telemetry item from the drone.
-    Telemetry { from: (u8, u8), telemetry: Telemetry },
+    Telemetry {
+        from: (u8, u8),
+        telemetry: Telemetry,
+    },
     /// A complete (re-assembled) STATUSTEXT.
-    StatusText { from: (u8, u8), severity: Severity, text: String },
+    StatusText {
+        from: (u8, u8),
+        severity: Severity,
+        text: String,
+    },
     /// Outcome of a command.
     Command(CommandEvent),
     /// Outcome of a parameter operation.
@@ -398,7 +463,7 @@ pub enum GroundEvent {
     /// Outcome of a plan transfer.
     Plan(PlanEvent),
     /// Any other message from anyone (for recording and other tools).
-    Other(Frame),
+    Other(Box<Frame>),
 }
 
 /// The station's end of the link (sans-io).
@@ -440,10 +505,10 @@ impl GroundEndpoint {
         let from = (frame.header.system_id, frame.header.component_id);
         let msg = &frame.message;
         if from.0 == self.vehicle.0 {
-            if let MavMessage::HEARTBEAT(h) = msg {
-                if h.mavtype != mc::MavType::MAV_TYPE_GCS {
-                    self.core.peer_heartbeat(now, from);
-                }
+            if let MavMessage::HEARTBEAT(h) = msg
+                && h.mavtype != mc::MavType::MAV_TYPE_GCS
+            {
+                self.core.peer_heartbeat(now, from);
             }
             let our = self.core.config.system_id;
             self.commands.handle_message(now, from.0, our, msg);
@@ -452,12 +517,17 @@ impl GroundEndpoint {
         }
         match Telemetry::from_mavlink(msg) {
             Some(telemetry) => {
-                if let Telemetry::StatusText(chunk) = &telemetry {
-                    if let Some((severity, text)) = self.texts.push(from.0, from.1, chunk) {
-                        self.events.push_back(GroundEvent::StatusText { from, severity, text });
-                    }
+                if let Telemetry::StatusText(chunk) = &telemetry
+                    && let Some((severity, text)) = self.texts.push(from.0, from.1, chunk)
+                {
+                    self.events.push_back(GroundEvent::StatusText {
+                        from,
+                        severity,
+                        text,
+                    });
                 }
-                self.events.push_back(GroundEvent::Telemetry { from, telemetry });
+                self.events
+                    .push_back(GroundEvent::Telemetry { from, telemetry });
             }
             None => {
                 let protocol = matches!(
@@ -470,14 +540,19 @@ impl GroundEndpoint {
                         | MavMessage::MISSION_ACK(_)
                 );
                 if !protocol || from.0 != self.vehicle.0 {
-                    self.events.push_back(GroundEvent::Other(frame));
+                    self.events.push_back(GroundEvent::Other(Box::new(frame)));
                 }
             }
         }
     }
 
     /// Sends a command; its outcome arrives as [`GroundEvent::Command`] with `request_id`.
-    pub fn send_command(&mut self, now: Duration, request_id: RequestId, command: Command) -> Result<(), CommandSendError> {
+    pub fn send_command(
+        &mut self,
+        now: Duration,
+        request_id: RequestId,
+        command: Command,
+    ) -> Result<(), CommandSendError> {
         self.commands.send(now, request_id, self.vehicle, command)
     }
 
@@ -492,12 +567,21 @@ impl GroundEndpoint {
     }
 
     /// Sets one parameter.
-    pub fn param_set(&mut self, now: Duration, name: &str, value: f32) -> Result<(), ParamRequestError> {
+    pub fn param_set(
+        &mut self,
+        now: Duration,
+        name: &str,
+        value: f32,
+    ) -> Result<(), ParamRequestError> {
         self.params.set(now, self.vehicle, name, value)
     }
 
     /// Uploads the guidance plan.
-    pub fn plan_upload(&mut self, now: Duration, items: Vec<PlanItem>) -> Result<(), PlanRequestError> {
+    pub fn plan_upload(
+        &mut self,
+        now: Duration,
+        items: Vec<PlanItem>,
+    ) -> Result<(), PlanRequestError> {
         self.plan.upload(now, self.vehicle, items)
     }
 
@@ -654,7 +738,7 @@ pub enum VehicleEvent {
     /// Stick values, or their going stale.
     Manual(ManualEvent),
     /// Any other message.
-    Other(Frame),
+    Other(Box<Frame>),
 }
 
 /// The drone's end of the link (sans-io).
@@ -708,7 +792,7 @@ impl VehicleEndpoint {
                 }
             };
             if !handled {
-                self.events.push_back(VehicleEvent::Other(frame));
+                self.events.push_back(VehicleEvent::Other(Box::new(frame)));
             }
         }
     }
@@ -733,7 +817,8 @@ impl VehicleEndpoint {
         let id = self.next_text_id;
         self.next_text_id = self.next_text_id.checked_add(1).unwrap_or(1);
         for chunk in split_status_text(severity, text, id) {
-            self.core.send(now, &Telemetry::StatusText(chunk).to_mavlink());
+            self.core
+                .send(now, &Telemetry::StatusText(chunk).to_mavlink());
         }
     }
 
@@ -774,7 +859,14 @@ impl VehicleEndpoint {
 
     /// Earliest time [`handle_timeout`](Self::handle_timeout) must run.
     pub fn poll_timeout(&self) -> Option<Duration> {
-        [Some(self.core.poll_timeout()), self.plan.poll_timeout(), self.manual.poll_timeout()].into_iter().flatten().min()
+        [
+            Some(self.core.poll_timeout()),
+            self.plan.poll_timeout(),
+            self.manual.poll_timeout(),
+        ]
+        .into_iter()
+        .flatten()
+        .min()
     }
 
     /// Next frame to send.

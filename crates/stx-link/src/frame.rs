@@ -21,7 +21,7 @@
 use std::time::Duration;
 
 use mavlink::dialects::common::MavMessage;
-use mavlink::{Message, MavlinkVersion};
+use mavlink::{MavlinkVersion, Message};
 
 use crate::signing::{SIGNATURE_BLOCK_LEN, SignatureError, Signer, Verifier};
 
@@ -95,8 +95,14 @@ pub struct Frame {
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum FrameError {
     /// Checksum mismatch: noise, or a false start inside other data.
-    #[error("bad CRC on message id {message_id}: computed {computed:#06x}, received {received:#06x}")]
-    BadCrc { message_id: u32, computed: u16, received: u16 },
+    #[error(
+        "bad CRC on message id {message_id}: computed {computed:#06x}, received {received:#06x}"
+    )]
+    BadCrc {
+        message_id: u32,
+        computed: u16,
+        received: u16,
+    },
     /// Message id not in the common dialect; its CRC cannot be checked.
     #[error("unknown message id {message_id}")]
     UnknownMessage { message_id: u32 },
@@ -105,12 +111,18 @@ pub enum FrameError {
     UnsupportedFlags { flags: u8 },
     /// Valid CRC but the payload does not decode (e.g. an enum value outside the dialect).
     #[error("message id {message_id} (len {payload_len}) does not parse: {reason}")]
-    Parse { message_id: u32, payload_len: u8, reason: String },
+    Parse {
+        message_id: u32,
+        payload_len: u8,
+        reason: String,
+    },
     /// A MAVLink 1 frame while the policy refuses them.
     #[error("MAVLink 1 frame (message id {message_id}) refused by policy")]
     V1Refused { message_id: u32 },
     /// An unsigned frame while signing is required.
-    #[error("unsigned frame (message id {message_id}) from system {system_id} refused: signing is on")]
+    #[error(
+        "unsigned frame (message id {message_id}) from system {system_id} refused: signing is on"
+    )]
     Unsigned { message_id: u32, system_id: u8 },
     /// A signed frame whose signature or timestamp was refused.
     #[error("message id {message_id}: {source}")]
@@ -189,6 +201,9 @@ impl Default for FrameDecoder {
     }
 }
 
+// Internal and short-lived: each value is moved once out of `step`; boxing the frame would
+// cost an allocation per frame on the hot path.
+#[allow(clippy::large_enum_variant)]
 enum Step {
     NeedMore,
     Skip(usize),
@@ -199,7 +214,14 @@ enum Step {
 impl FrameDecoder {
     /// A decoder with the given policy and signing off.
     pub fn new(policy: DecoderPolicy) -> Self {
-        Self { buf: Vec::new(), pos: 0, eof: false, policy, verifier: None, stats: Default::default() }
+        Self {
+            buf: Vec::new(),
+            pos: 0,
+            eof: false,
+            policy,
+            verifier: None,
+            stats: Default::default(),
+        }
     }
 
     /// Switches signing verification on (`Some`) or off (`None`). When on, unsigned and
@@ -289,7 +311,11 @@ impl FrameDecoder {
             MAGIC_V2 => {
                 let len = usize::from(*rest.get(1)?);
                 let flags = *rest.get(2)?;
-                let sig = if flags & IFLAG_SIGNED != 0 { SIGNATURE_BLOCK_LEN } else { 0 };
+                let sig = if flags & IFLAG_SIGNED != 0 {
+                    SIGNATURE_BLOCK_LEN
+                } else {
+                    0
+                };
                 Some(V2_HEADER_LEN + len + 2 + sig)
             }
             MAGIC_V1 => Some(V1_HEADER_LEN + usize::from(*rest.get(1)?) + 2),
@@ -337,22 +363,36 @@ impl FrameDecoder {
             self.stats.unknown_message_ids += 1;
             return Step::Error(FrameError::UnknownMessage { message_id }, 1);
         };
-        let (Some(crc_input), Some(crc_bytes)) = (raw.get(1..crc_end - 2), raw.get(crc_end - 2..crc_end))
+        let (Some(crc_input), Some(crc_bytes)) =
+            (raw.get(1..crc_end - 2), raw.get(crc_end - 2..crc_end))
         else {
             return Step::Skip(1);
         };
         let computed = crc_mavlink(crc_input, extra);
-        let received = u16::from_le_bytes([crc_bytes.first().copied().unwrap_or(0), crc_bytes.get(1).copied().unwrap_or(0)]);
+        let received = u16::from_le_bytes([
+            crc_bytes.first().copied().unwrap_or(0),
+            crc_bytes.get(1).copied().unwrap_or(0),
+        ]);
         if computed != received {
             self.stats.crc_errors += 1;
-            return Step::Error(FrameError::BadCrc { message_id, computed, received }, 1);
+            return Step::Error(
+                FrameError::BadCrc {
+                    message_id,
+                    computed,
+                    received,
+                },
+                1,
+            );
         }
         let (system_id, component_id, sequence) = (*sysid, *compid, *seq);
         let signature = if signed {
             raw.get(crc_end..crc_end + 7).map(|b| {
                 let mut ts = [0_u8; 8];
                 ts[..6].copy_from_slice(b.get(1..7).unwrap_or(&[0; 6]));
-                SignatureBlock { link_id: b.first().copied().unwrap_or(0), timestamp_10us: u64::from_le_bytes(ts) }
+                SignatureBlock {
+                    link_id: b.first().copied().unwrap_or(0),
+                    timestamp_10us: u64::from_le_bytes(ts),
+                }
             })
         } else {
             None
@@ -360,7 +400,13 @@ impl FrameDecoder {
         if let Some(verifier) = self.verifier.as_mut() {
             if !signed {
                 self.stats.unsigned_refused += 1;
-                return Step::Error(FrameError::Unsigned { message_id, system_id }, total);
+                return Step::Error(
+                    FrameError::Unsigned {
+                        message_id,
+                        system_id,
+                    },
+                    total,
+                );
             }
             match verifier.verify(now, system_id, component_id, raw) {
                 Some(Ok(())) => {}
@@ -393,7 +439,14 @@ impl FrameDecoder {
             }
             Err(e) => {
                 self.stats.parse_errors += 1;
-                Step::Error(FrameError::Parse { message_id, payload_len, reason: e.to_string() }, total)
+                Step::Error(
+                    FrameError::Parse {
+                        message_id,
+                        payload_len,
+                        reason: e.to_string(),
+                    },
+                    total,
+                )
             }
         }
     }
@@ -419,7 +472,14 @@ impl FrameDecoder {
         ]);
         if computed != received {
             self.stats.crc_errors += 1;
-            return Step::Error(FrameError::BadCrc { message_id, computed, received }, 1);
+            return Step::Error(
+                FrameError::BadCrc {
+                    message_id,
+                    computed,
+                    received,
+                },
+                1,
+            );
         }
         if !self.policy.accept_v1 || self.verifier.is_some() {
             self.stats.v1_refused += 1;
@@ -442,7 +502,14 @@ impl FrameDecoder {
             }
             Err(e) => {
                 self.stats.parse_errors += 1;
-                Step::Error(FrameError::Parse { message_id, payload_len: len, reason: e.to_string() }, crc_end)
+                Step::Error(
+                    FrameError::Parse {
+                        message_id,
+                        payload_len: len,
+                        reason: e.to_string(),
+                    },
+                    crc_end,
+                )
             }
         }
     }
@@ -494,7 +561,12 @@ pub struct FrameEncoder {
 impl FrameEncoder {
     /// An encoder for frames from `system_id`/`component_id`, unsigned, sequence starting at 0.
     pub fn new(system_id: u8, component_id: u8) -> Self {
-        Self { system_id, component_id, sequence: 0, signer: None }
+        Self {
+            system_id,
+            component_id,
+            sequence: 0,
+            signer: None,
+        }
     }
 
     /// Switches signing of outgoing frames on (`Some`) or off.
@@ -520,7 +592,11 @@ impl FrameEncoder {
         encode_frame_into(
             now,
             message,
-            FrameIds { system_id: self.system_id, component_id: self.component_id, sequence: seq },
+            FrameIds {
+                system_id: self.system_id,
+                component_id: self.component_id,
+                sequence: seq,
+            },
             self.signer.as_mut(),
             out,
         );
@@ -571,7 +647,10 @@ pub fn encode_frame_into(
         id[2],
     ]);
     out.extend_from_slice(payload.get(..len).unwrap_or(&[]));
-    let crc = crc_mavlink(out.get(start + 1..).unwrap_or(&[]), MavMessage::extra_crc(message_id));
+    let crc = crc_mavlink(
+        out.get(start + 1..).unwrap_or(&[]),
+        MavMessage::extra_crc(message_id),
+    );
     out.extend_from_slice(&crc.to_le_bytes());
     if let Some(signer) = signer {
         let mut frame = out.split_off(start);
@@ -587,7 +666,13 @@ mod tests {
     use mavlink::dialects::common::{ATTITUDE_DATA, HEARTBEAT_DATA};
 
     fn attitude(roll: f32) -> MavMessage {
-        MavMessage::ATTITUDE(ATTITUDE_DATA { time_boot_ms: 7, roll, pitch: 0.5, yaw: -1.0, ..Default::default() })
+        MavMessage::ATTITUDE(ATTITUDE_DATA {
+            time_boot_ms: 7,
+            roll,
+            pitch: 0.5,
+            yaw: -1.0,
+            ..Default::default()
+        })
     }
 
     fn decode_all(dec: &mut FrameDecoder) -> (Vec<Frame>, Vec<FrameError>) {
@@ -655,7 +740,10 @@ mod tests {
         let (ok, err) = decode_all(&mut dec);
         assert_eq!(ok.len(), 2);
         assert_eq!(ok[1].message, attitude(0.3));
-        assert!(err.iter().any(|e| matches!(e, FrameError::BadCrc { message_id: 30, .. })));
+        assert!(
+            err.iter()
+                .any(|e| matches!(e, FrameError::BadCrc { message_id: 30, .. }))
+        );
         assert_eq!(dec.stats().crc_errors, 1);
         assert_eq!(dec.stats().bytes_discarded as usize, 3 + b.len() + 2);
     }
@@ -676,7 +764,10 @@ mod tests {
         let all: Vec<_> = ok.into_iter().chain(ok2).collect();
         assert_eq!(all.len(), 1);
         assert_eq!(all[0].message, attitude(0.2));
-        assert!(dec.stats().crc_errors + dec.stats().truncated >= 1, "{err2:?}");
+        assert!(
+            dec.stats().crc_errors + dec.stats().truncated >= 1,
+            "{err2:?}"
+        );
     }
 
     #[test]
@@ -711,17 +802,25 @@ mod tests {
         dec.push(&unk);
         let (ok, err) = decode_all(&mut dec);
         assert_eq!(ok.len(), 1);
-        assert_eq!(err[0], FrameError::UnknownMessage { message_id: 0xABCDEF });
+        assert_eq!(
+            err[0],
+            FrameError::UnknownMessage {
+                message_id: 0xABCDEF
+            }
+        );
         assert_eq!(dec.stats().unknown_message_ids, 1);
     }
 
     #[test]
     fn invalid_enum_is_a_counted_parse_error() {
         let mut enc = FrameEncoder::new(1, 1);
-        let mut f = enc.encode(Duration::ZERO, &MavMessage::HEARTBEAT(HEARTBEAT_DATA {
-            custom_mode: 1,
-            ..Default::default()
-        }));
+        let mut f = enc.encode(
+            Duration::ZERO,
+            &MavMessage::HEARTBEAT(HEARTBEAT_DATA {
+                custom_mode: 1,
+                ..Default::default()
+            }),
+        );
         // mavtype byte (offset 4 in the payload) set to an undefined MAV_TYPE, CRC recomputed.
         f[V2_HEADER_LEN + 4] = 250;
         let n = f.len();
@@ -745,7 +844,8 @@ mod tests {
         let signed = enc.encode(Duration::ZERO, &attitude(0.1));
         let mut plain = FrameEncoder::new(1, 1);
         let unsigned = plain.encode(Duration::ZERO, &attitude(0.1));
-        let (_, wrong) = SigningConfig::new(SigningKey::from_bytes([8; 32]), 3, t0).build(Duration::ZERO);
+        let (_, wrong) =
+            SigningConfig::new(SigningKey::from_bytes([8; 32]), 3, t0).build(Duration::ZERO);
 
         let mut dec = FrameDecoder::default();
         dec.set_verifier(Some(verifier));
@@ -756,7 +856,13 @@ mod tests {
         assert_eq!(ok.len(), 1);
         assert!(ok[0].header.is_signed());
         assert!(matches!(err[0], FrameError::Unsigned { .. }));
-        assert!(matches!(err[1], FrameError::Signature { source: SignatureError::Replay { .. }, .. }));
+        assert!(matches!(
+            err[1],
+            FrameError::Signature {
+                source: SignatureError::Replay { .. },
+                ..
+            }
+        ));
         assert_eq!(dec.stats().unsigned_refused, 1);
         assert_eq!(dec.stats().replays_refused, 1);
 

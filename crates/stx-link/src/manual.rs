@@ -34,10 +34,18 @@ pub struct Sticks {
 }
 
 fn axis_to_wire(v: f64) -> i16 {
-    if v.is_nan() { 0 } else { (v.clamp(-1.0, 1.0) * 1000.0).round() as i16 }
+    if v.is_nan() {
+        0
+    } else {
+        (v.clamp(-1.0, 1.0) * 1000.0).round() as i16
+    }
 }
 fn axis_from_wire(v: i16) -> f64 {
-    if v == i16::MAX { 0.0 } else { (f64::from(v) / 1000.0).clamp(-1.0, 1.0) }
+    if v == i16::MAX {
+        0.0
+    } else {
+        (f64::from(v) / 1000.0).clamp(-1.0, 1.0)
+    }
 }
 
 impl Sticks {
@@ -80,7 +88,12 @@ pub struct ManualSender {
 impl ManualSender {
     /// A sender streaming every `period` while held.
     pub fn new(period: Duration) -> Self {
-        Self { period, held: None, next_send: Duration::ZERO, due: false }
+        Self {
+            period,
+            held: None,
+            next_send: Duration::ZERO,
+            due: false,
+        }
     }
 
     /// Updates the held stick; the first value of a hold is sent at once.
@@ -123,7 +136,11 @@ impl ManualSender {
         }
         self.due = false;
         // Keep a steady cadence; after a long gap restart it from now.
-        self.next_send = if now >= self.next_send + self.period { now + self.period } else { self.next_send + self.period };
+        self.next_send = if now >= self.next_send + self.period {
+            now + self.period
+        } else {
+            self.next_send + self.period
+        };
         Some(sticks.to_mavlink(target_system))
     }
 }
@@ -153,12 +170,20 @@ pub struct ManualReceiver {
 impl ManualReceiver {
     /// A receiver declaring sticks stale after `timeout`.
     pub fn new(system_id: u8, timeout: Duration) -> Self {
-        Self { system_id, timeout, last: None, stale_reported: true, events: Default::default() }
+        Self {
+            system_id,
+            timeout,
+            last: None,
+            stale_reported: true,
+            events: Default::default(),
+        }
     }
 
     /// Feeds a received message. Returns whether it was a MANUAL_CONTROL for us.
     pub fn handle_message(&mut self, now: Duration, msg: &MavMessage) -> bool {
-        let MavMessage::MANUAL_CONTROL(m) = msg else { return false };
+        let MavMessage::MANUAL_CONTROL(m) = msg else {
+            return false;
+        };
         if m.target != 0 && m.target != self.system_id {
             return false;
         }
@@ -182,7 +207,8 @@ impl ManualReceiver {
             if age >= self.timeout && !self.stale_reported {
                 self.stale_reported = true;
                 tracing::warn!(age_ms = age.as_millis() as u64, "manual control stale");
-                self.events.push_back(ManualEvent::Stale { since_last: age });
+                self.events
+                    .push_back(ManualEvent::Stale { since_last: age });
             }
         }
     }
@@ -207,8 +233,16 @@ mod tests {
 
     #[test]
     fn sticks_round_trip_with_buttons2() {
-        let s = Sticks { x: -1.0, y: 0.25, z: 0.999, r: 1.0, buttons: 0x8001_0003 };
-        let MavMessage::MANUAL_CONTROL(m) = s.to_mavlink(1) else { panic!() };
+        let s = Sticks {
+            x: -1.0,
+            y: 0.25,
+            z: 0.999,
+            r: 1.0,
+            buttons: 0x8001_0003,
+        };
+        let MavMessage::MANUAL_CONTROL(m) = s.to_mavlink(1) else {
+            panic!()
+        };
         assert_eq!(Sticks::from_mavlink(&m), s);
     }
 
@@ -233,7 +267,10 @@ mod tests {
     #[test]
     fn receiver_never_holds_a_value_past_the_timeout() {
         let mut rx = ManualReceiver::new(1, Duration::from_millis(500));
-        let s = Sticks { y: 0.7, ..Default::default() };
+        let s = Sticks {
+            y: 0.7,
+            ..Default::default()
+        };
         rx.handle_message(Duration::ZERO, &s.to_mavlink(1));
         assert_eq!(rx.sticks(Duration::from_millis(499)), Some(s));
         // Even without handle_timeout being called:
@@ -241,7 +278,12 @@ mod tests {
         assert_eq!(rx.poll_timeout(), Some(Duration::from_millis(500)));
         rx.handle_timeout(Duration::from_millis(500));
         assert_eq!(rx.poll_event(), Some(ManualEvent::Sticks(s)));
-        assert_eq!(rx.poll_event(), Some(ManualEvent::Stale { since_last: Duration::from_millis(500) }));
+        assert_eq!(
+            rx.poll_event(),
+            Some(ManualEvent::Stale {
+                since_last: Duration::from_millis(500)
+            })
+        );
         rx.handle_timeout(Duration::from_millis(900));
         assert_eq!(rx.poll_event(), None);
     }

@@ -74,7 +74,11 @@ pub struct ParamConfig {
 
 impl Default for ParamConfig {
     fn default() -> Self {
-        Self { timeout: Duration::from_secs(1), retries: 3, max_rereads_per_round: 32 }
+        Self {
+            timeout: Duration::from_secs(1),
+            retries: 3,
+            max_rereads_per_round: 32,
+        }
     }
 }
 
@@ -85,16 +89,29 @@ pub enum ParamEvent {
     /// Every parameter of the list, by index.
     ListComplete { params: Vec<ParamValue> },
     /// The list could not be completed; what arrived and which indices are missing.
-    ListFailed { received: Vec<ParamValue>, missing: Vec<u16>, expected_count: Option<u16> },
+    ListFailed {
+        received: Vec<ParamValue>,
+        missing: Vec<u16>,
+        expected_count: Option<u16>,
+    },
     /// A read answered.
     ReadDone { param: ParamValue },
     /// A read unanswered after all retries.
     ReadFailed { name: String, attempts: u8 },
     /// A set answered: `actual` is the value the vehicle now holds (differs from
     /// `requested` when the vehicle refused it).
-    SetDone { name: String, requested: f32, actual: f32, accepted: bool },
+    SetDone {
+        name: String,
+        requested: f32,
+        actual: f32,
+        accepted: bool,
+    },
     /// A set unanswered after all retries.
-    SetFailed { name: String, requested: f32, attempts: u8 },
+    SetFailed {
+        name: String,
+        requested: f32,
+        attempts: u8,
+    },
     /// A PARAM_VALUE outside any operation (another station's change, or a late echo).
     Value { param: ParamValue },
 }
@@ -115,7 +132,9 @@ pub enum ParamRequestError {
 
 fn check_name(name: &str) -> Result<(), ParamRequestError> {
     if name.is_empty() || name.len() > PARAM_NAME_LEN || !name.is_ascii() || name.contains('\0') {
-        return Err(ParamRequestError::BadName { name: name.to_string() });
+        return Err(ParamRequestError::BadName {
+            name: name.to_string(),
+        });
     }
     Ok(())
 }
@@ -153,7 +172,10 @@ pub struct ParamClient {
 impl ParamClient {
     /// A client with the given retry policy.
     pub fn new(config: ParamConfig) -> Self {
-        Self { config, ..Default::default() }
+        Self {
+            config,
+            ..Default::default()
+        }
     }
 
     /// Starts fetching the whole table of `target`.
@@ -162,26 +184,61 @@ impl ParamClient {
             return Err(ParamRequestError::ListInProgress);
         }
         self.transmit.push_back(request_list(target));
-        self.list = Some(ListOp { target, received: BTreeMap::new(), count: None, attempts: 1, deadline: now + self.config.timeout });
+        self.list = Some(ListOp {
+            target,
+            received: BTreeMap::new(),
+            count: None,
+            attempts: 1,
+            deadline: now + self.config.timeout,
+        });
         Ok(())
     }
 
     /// Reads one parameter by name.
-    pub fn read(&mut self, now: Duration, target: (u8, u8), name: &str) -> Result<(), ParamRequestError> {
+    pub fn read(
+        &mut self,
+        now: Duration,
+        target: (u8, u8),
+        name: &str,
+    ) -> Result<(), ParamRequestError> {
         self.start_named(now, target, name, None)
     }
 
     /// Sets one parameter; the outcome reports the value the vehicle holds afterwards.
-    pub fn set(&mut self, now: Duration, target: (u8, u8), name: &str, value: f32) -> Result<(), ParamRequestError> {
+    pub fn set(
+        &mut self,
+        now: Duration,
+        target: (u8, u8),
+        name: &str,
+        value: f32,
+    ) -> Result<(), ParamRequestError> {
         self.start_named(now, target, name, Some(value))
     }
 
-    fn start_named(&mut self, now: Duration, target: (u8, u8), name: &str, set: Option<f32>) -> Result<(), ParamRequestError> {
+    fn start_named(
+        &mut self,
+        now: Duration,
+        target: (u8, u8),
+        name: &str,
+        set: Option<f32>,
+    ) -> Result<(), ParamRequestError> {
         check_name(name)?;
-        if self.named.iter().any(|o| o.name == name && o.target.0 == target.0) {
-            return Err(ParamRequestError::Busy { name: name.to_string() });
+        if self
+            .named
+            .iter()
+            .any(|o| o.name == name && o.target.0 == target.0)
+        {
+            return Err(ParamRequestError::Busy {
+                name: name.to_string(),
+            });
         }
-        let op = NamedOp { target, name: name.to_string(), set, attempts: 1, deadline: now + self.config.timeout };
+        let op = NamedOp {
+            target,
+            name: name.to_string(),
+            set,
+            attempts: 1,
+            deadline: now + self.config.timeout,
+        };
         self.transmit.push_back(named_request(&op));
         self.named.push(op);
         Ok(())
@@ -189,10 +246,21 @@ impl ParamClient {
 
     /// Feeds a received message from `from_system`.
     pub fn handle_message(&mut self, now: Duration, from_system: u8, msg: &MavMessage) {
-        let MavMessage::PARAM_VALUE(v) = msg else { return };
-        let param = ParamValue { name: name_from_wire(&v.param_id), value: v.param_value, index: v.param_index, count: v.param_count };
+        let MavMessage::PARAM_VALUE(v) = msg else {
+            return;
+        };
+        let param = ParamValue {
+            name: name_from_wire(&v.param_id),
+            value: v.param_value,
+            index: v.param_index,
+            count: v.param_count,
+        };
         let mut used = false;
-        if let Some(i) = self.named.iter().position(|o| o.target.0 == from_system && o.name == param.name) {
+        if let Some(i) = self
+            .named
+            .iter()
+            .position(|o| o.target.0 == from_system && o.name == param.name)
+        {
             let op = self.named.remove(i);
             used = true;
             self.events.push_back(match op.set {
@@ -202,7 +270,9 @@ impl ParamClient {
                     actual: param.value,
                     accepted: param.value.to_bits() == requested.to_bits(),
                 },
-                None => ParamEvent::ReadDone { param: param.clone() },
+                None => ParamEvent::ReadDone {
+                    param: param.clone(),
+                },
             });
         }
         let mut list_done = false;
@@ -213,13 +283,15 @@ impl ParamClient {
                 list.count.get_or_insert(param.count);
                 list.received.insert(param.index, param.clone());
                 list.deadline = now + self.config.timeout;
-                list_done = list.count.is_some_and(|c| list.received.len() >= usize::from(c));
+                list_done = list
+                    .count
+                    .is_some_and(|c| list.received.len() >= usize::from(c));
             }
         }
-        if list_done {
-            if let Some(list) = self.list.take() {
-                self.events.push_back(ParamEvent::ListComplete { params: list.received.into_values().collect() });
-            }
+        if list_done && let Some(list) = self.list.take() {
+            self.events.push_back(ParamEvent::ListComplete {
+                params: list.received.into_values().collect(),
+            });
         }
         if !used {
             self.events.push_back(ParamEvent::Value { param });
@@ -246,13 +318,18 @@ impl ParamClient {
                 if list.count.is_none() {
                     self.transmit.push_back(request_list(list.target));
                 } else {
-                    for index in missing_indices(list).into_iter().take(self.config.max_rereads_per_round) {
-                        self.transmit.push_back(MavMessage::PARAM_REQUEST_READ(mc::PARAM_REQUEST_READ_DATA {
-                            param_index: i16::try_from(index).unwrap_or(i16::MAX),
-                            target_system: list.target.0,
-                            target_component: list.target.1,
-                            param_id: name_to_wire(""),
-                        }));
+                    for index in missing_indices(list)
+                        .into_iter()
+                        .take(self.config.max_rereads_per_round)
+                    {
+                        self.transmit.push_back(MavMessage::PARAM_REQUEST_READ(
+                            mc::PARAM_REQUEST_READ_DATA {
+                                param_index: i16::try_from(index).unwrap_or(i16::MAX),
+                                target_system: list.target.0,
+                                target_component: list.target.1,
+                                param_id: name_to_wire(""),
+                            },
+                        ));
                     }
                 }
             }
@@ -266,8 +343,15 @@ impl ParamClient {
             if op.attempts > retries {
                 let op = self.named.remove(i);
                 self.events.push_back(match op.set {
-                    Some(requested) => ParamEvent::SetFailed { name: op.name, requested, attempts: op.attempts },
-                    None => ParamEvent::ReadFailed { name: op.name, attempts: op.attempts },
+                    Some(requested) => ParamEvent::SetFailed {
+                        name: op.name,
+                        requested,
+                        attempts: op.attempts,
+                    },
+                    None => ParamEvent::ReadFailed {
+                        name: op.name,
+                        attempts: op.attempts,
+                    },
                 });
                 continue;
             }
@@ -281,7 +365,11 @@ impl ParamClient {
 
     /// Earliest deadline.
     pub fn poll_timeout(&self) -> Option<Duration> {
-        self.list.iter().map(|l| l.deadline).chain(self.named.iter().map(|o| o.deadline)).min()
+        self.list
+            .iter()
+            .map(|l| l.deadline)
+            .chain(self.named.iter().map(|o| o.deadline))
+            .min()
     }
 
     /// Next message to send.
@@ -296,11 +384,16 @@ impl ParamClient {
 }
 
 fn missing_indices(list: &ListOp) -> Vec<u16> {
-    (0..list.count.unwrap_or(0)).filter(|i| !list.received.contains_key(i)).collect()
+    (0..list.count.unwrap_or(0))
+        .filter(|i| !list.received.contains_key(i))
+        .collect()
 }
 
 fn request_list(target: (u8, u8)) -> MavMessage {
-    MavMessage::PARAM_REQUEST_LIST(mc::PARAM_REQUEST_LIST_DATA { target_system: target.0, target_component: target.1 })
+    MavMessage::PARAM_REQUEST_LIST(mc::PARAM_REQUEST_LIST_DATA {
+        target_system: target.0,
+        target_component: target.1,
+    })
 }
 
 fn named_request(op: &NamedOp) -> MavMessage {
@@ -339,7 +432,13 @@ pub struct ParamSpec {
 impl ParamSpec {
     /// A parameter definition.
     pub fn new(name: &str, default: f32, min: f32, max: f32, description: &str) -> Self {
-        Self { name: name.to_string(), default, min, max, description: description.to_string() }
+        Self {
+            name: name.to_string(),
+            default,
+            min,
+            max,
+            description: description.to_string(),
+        }
     }
 }
 
@@ -354,7 +453,12 @@ pub enum ParamTableError {
     Duplicate { name: String },
     /// Default outside [min, max], or non-finite bounds.
     #[error("parameter {name:?}: default {default} outside [{min}, {max}]")]
-    BadDefault { name: String, default: f32, min: f32, max: f32 },
+    BadDefault {
+        name: String,
+        default: f32,
+        min: f32,
+        max: f32,
+    },
     /// More parameters than PARAM_VALUE can index.
     #[error("{count} parameters is more than the protocol can index")]
     TooMany { count: usize },
@@ -363,7 +467,12 @@ pub enum ParamTableError {
     Unknown { name: String },
     /// Set outside the range (or not finite).
     #[error("{name} = {value} outside [{min}, {max}]")]
-    OutOfRange { name: String, value: f32, min: f32, max: f32 },
+    OutOfRange {
+        name: String,
+        value: f32,
+        min: f32,
+        max: f32,
+    },
 }
 
 /// A change of a vehicle parameter, for the application to apply.
@@ -402,17 +511,29 @@ pub struct ParamTable {
 
 impl ParamTable {
     /// A table of `specs`, every value at its default.
-    pub fn new(system_id: u8, component_id: u8, specs: Vec<ParamSpec>) -> Result<Self, ParamTableError> {
+    pub fn new(
+        system_id: u8,
+        component_id: u8,
+        specs: Vec<ParamSpec>,
+    ) -> Result<Self, ParamTableError> {
         if specs.len() >= usize::from(u16::MAX) {
             return Err(ParamTableError::TooMany { count: specs.len() });
         }
         for (i, s) in specs.iter().enumerate() {
             check_name(&s.name)?;
             if specs.iter().take(i).any(|o| o.name == s.name) {
-                return Err(ParamTableError::Duplicate { name: s.name.clone() });
+                return Err(ParamTableError::Duplicate {
+                    name: s.name.clone(),
+                });
             }
-            if !(s.min.is_finite() && s.max.is_finite() && s.min <= s.default && s.default <= s.max) {
-                return Err(ParamTableError::BadDefault { name: s.name.clone(), default: s.default, min: s.min, max: s.max });
+            if !(s.min.is_finite() && s.max.is_finite() && s.min <= s.default && s.default <= s.max)
+            {
+                return Err(ParamTableError::BadDefault {
+                    name: s.name.clone(),
+                    default: s.default,
+                    min: s.min,
+                    max: s.max,
+                });
             }
         }
         let values = specs.iter().map(|s| s.default).collect();
@@ -454,16 +575,33 @@ impl ParamTable {
 
     /// Sets a value locally (from the application), announcing it to the station.
     pub fn set(&mut self, name: &str, value: f32) -> Result<(), ParamTableError> {
-        let i = self.specs.iter().position(|s| s.name == name).ok_or_else(|| ParamTableError::Unknown { name: name.to_string() })?;
-        let spec = self.specs.get(i).ok_or_else(|| ParamTableError::Unknown { name: name.to_string() })?;
+        let i = self
+            .specs
+            .iter()
+            .position(|s| s.name == name)
+            .ok_or_else(|| ParamTableError::Unknown {
+                name: name.to_string(),
+            })?;
+        let spec = self.specs.get(i).ok_or_else(|| ParamTableError::Unknown {
+            name: name.to_string(),
+        })?;
         if !(value.is_finite() && spec.min <= value && value <= spec.max) {
-            return Err(ParamTableError::OutOfRange { name: name.to_string(), value, min: spec.min, max: spec.max });
+            return Err(ParamTableError::OutOfRange {
+                name: name.to_string(),
+                value,
+                min: spec.min,
+                max: spec.max,
+            });
         }
         if let Some(slot) = self.values.get_mut(i) {
             let old = *slot;
             *slot = value;
             if old.to_bits() != value.to_bits() {
-                self.changes.push_back(ParamChange { name: name.to_string(), old, new: value });
+                self.changes.push_back(ParamChange {
+                    name: name.to_string(),
+                    old,
+                    new: value,
+                });
             }
         }
         if let Some(v) = self.value_at(i) {
@@ -474,7 +612,9 @@ impl ParamTable {
 
     /// Feeds a received message. Returns whether it was a parameter request for us.
     pub fn handle_message(&mut self, msg: &MavMessage) -> bool {
-        let for_us = |ts: u8, tc: u8| (ts == 0 || ts == self.system_id) && (tc == 0 || tc == self.component_id);
+        let for_us = |ts: u8, tc: u8| {
+            (ts == 0 || ts == self.system_id) && (tc == 0 || tc == self.component_id)
+        };
         match msg {
             MavMessage::PARAM_REQUEST_LIST(r) if for_us(r.target_system, r.target_component) => {
                 for i in 0..self.specs.len() {
@@ -486,7 +626,9 @@ impl ParamTable {
             }
             MavMessage::PARAM_REQUEST_READ(r) if for_us(r.target_system, r.target_component) => {
                 let index = if r.param_index >= 0 {
-                    usize::try_from(r.param_index).ok().filter(|&i| i < self.specs.len())
+                    usize::try_from(r.param_index)
+                        .ok()
+                        .filter(|&i| i < self.specs.len())
                 } else {
                     let name = name_from_wire(&r.param_id);
                     self.specs.iter().position(|s| s.name == name)
@@ -511,10 +653,10 @@ impl ParamTable {
                     Err(e) => {
                         self.stats.sets_refused += 1;
                         tracing::warn!(error = %e, "parameter set refused");
-                        if let Some(i) = self.specs.iter().position(|sp| sp.name == name) {
-                            if let Some(v) = self.value_at(i) {
-                                self.transmit.push_back(param_value_msg(&v));
-                            }
+                        if let Some(i) = self.specs.iter().position(|sp| sp.name == name)
+                            && let Some(v) = self.value_at(i)
+                        {
+                            self.transmit.push_back(param_value_msg(&v));
                         }
                         self.status_text(Severity::Warning, &format!("PARAM {e}"));
                     }
@@ -526,7 +668,8 @@ impl ParamTable {
     }
 
     fn status_text(&mut self, severity: Severity, text: &str) {
-        self.transmit.push_back(Telemetry::StatusText(StatusText::single(severity, text)).to_mavlink());
+        self.transmit
+            .push_back(Telemetry::StatusText(StatusText::single(severity, text)).to_mavlink());
     }
 
     /// Next change for the application.
@@ -576,10 +719,27 @@ mod tests {
 
     #[test]
     fn table_refuses_bad_definitions() {
-        assert!(matches!(ParamTable::new(1, 1, vec![ParamSpec::new("A_NAME_TOO_LONG_X", 0.0, 0.0, 1.0, "")]), Err(ParamTableError::Name(_))));
-        assert!(matches!(ParamTable::new(1, 1, vec![ParamSpec::new("A", 2.0, 0.0, 1.0, "")]), Err(ParamTableError::BadDefault { .. })));
         assert!(matches!(
-            ParamTable::new(1, 1, vec![ParamSpec::new("A", 0.0, 0.0, 1.0, ""), ParamSpec::new("A", 0.0, 0.0, 1.0, "")]),
+            ParamTable::new(
+                1,
+                1,
+                vec![ParamSpec::new("A_NAME_TOO_LONG_X", 0.0, 0.0, 1.0, "")]
+            ),
+            Err(ParamTableError::Name(_))
+        ));
+        assert!(matches!(
+            ParamTable::new(1, 1, vec![ParamSpec::new("A", 2.0, 0.0, 1.0, "")]),
+            Err(ParamTableError::BadDefault { .. })
+        ));
+        assert!(matches!(
+            ParamTable::new(
+                1,
+                1,
+                vec![
+                    ParamSpec::new("A", 0.0, 0.0, 1.0, ""),
+                    ParamSpec::new("A", 0.0, 0.0, 1.0, "")
+                ]
+            ),
             Err(ParamTableError::Duplicate { .. })
         ));
     }
@@ -590,40 +750,79 @@ mod tests {
         let mut cl = ParamClient::default();
         cl.list(Duration::ZERO, (1, 1)).expect("started");
         pump(&mut cl, &mut tb);
-        let Some(ParamEvent::ListComplete { params }) = cl.poll_event() else { panic!("no list") };
-        assert_eq!(params.iter().map(|p| p.name.as_str()).collect::<Vec<_>>(), ["HDG_KP", "HDG_KD", "FLARE_ALT_M"]);
+        let Some(ParamEvent::ListComplete { params }) = cl.poll_event() else {
+            panic!("no list")
+        };
+        assert_eq!(
+            params.iter().map(|p| p.name.as_str()).collect::<Vec<_>>(),
+            ["HDG_KP", "HDG_KD", "FLARE_ALT_M"]
+        );
 
-        cl.set(Duration::ZERO, (1, 1), "HDG_KP", 1.5).expect("started");
+        cl.set(Duration::ZERO, (1, 1), "HDG_KP", 1.5)
+            .expect("started");
         pump(&mut cl, &mut tb);
-        assert_eq!(cl.poll_event(), Some(ParamEvent::SetDone { name: "HDG_KP".into(), requested: 1.5, actual: 1.5, accepted: true }));
-        assert_eq!(tb.poll_change(), Some(ParamChange { name: "HDG_KP".into(), old: 0.8, new: 1.5 }));
+        assert_eq!(
+            cl.poll_event(),
+            Some(ParamEvent::SetDone {
+                name: "HDG_KP".into(),
+                requested: 1.5,
+                actual: 1.5,
+                accepted: true
+            })
+        );
+        assert_eq!(
+            tb.poll_change(),
+            Some(ParamChange {
+                name: "HDG_KP".into(),
+                old: 0.8,
+                new: 1.5
+            })
+        );
 
         // Out of range: the unchanged value comes back, with a STATUSTEXT saying why.
-        cl.set(Duration::ZERO, (1, 1), "HDG_KP", 99.0).expect("started");
+        cl.set(Duration::ZERO, (1, 1), "HDG_KP", 99.0)
+            .expect("started");
         let m = cl.poll_transmit().expect("PARAM_SET");
         tb.handle_message(&m);
         let mut saw_text = false;
         while let Some(m) = tb.poll_transmit() {
             if let MavMessage::STATUSTEXT(t) = &m {
                 let text = String::from_utf8_lossy(&t.text[..]).to_string();
-                assert!(text.contains("HDG_KP") && text.contains("outside"), "{text}");
+                assert!(
+                    text.contains("HDG_KP") && text.contains("outside"),
+                    "{text}"
+                );
                 saw_text = true;
             }
             cl.handle_message(Duration::ZERO, 1, &m);
         }
         assert!(saw_text);
-        assert_eq!(cl.poll_event(), Some(ParamEvent::SetDone { name: "HDG_KP".into(), requested: 99.0, actual: 1.5, accepted: false }));
+        assert_eq!(
+            cl.poll_event(),
+            Some(ParamEvent::SetDone {
+                name: "HDG_KP".into(),
+                requested: 99.0,
+                actual: 1.5,
+                accepted: false
+            })
+        );
         assert_eq!(tb.poll_change(), None);
         assert_eq!(tb.stats().sets_refused, 1);
 
-        cl.read(Duration::ZERO, (1, 1), "FLARE_ALT_M").expect("started");
+        cl.read(Duration::ZERO, (1, 1), "FLARE_ALT_M")
+            .expect("started");
         pump(&mut cl, &mut tb);
-        assert!(matches!(cl.poll_event(), Some(ParamEvent::ReadDone { param }) if param.value == 8.0 && param.index == 2));
+        assert!(
+            matches!(cl.poll_event(), Some(ParamEvent::ReadDone { param }) if param.value == 8.0 && param.index == 2)
+        );
     }
 
     #[test]
     fn read_times_out_after_retries() {
-        let mut cl = ParamClient::new(ParamConfig { retries: 2, ..Default::default() });
+        let mut cl = ParamClient::new(ParamConfig {
+            retries: 2,
+            ..Default::default()
+        });
         cl.read(Duration::ZERO, (1, 1), "X").expect("started");
         let mut sent = 0;
         let mut t = Duration::ZERO;

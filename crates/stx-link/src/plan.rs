@@ -27,9 +27,18 @@ pub const MAX_PLAN_ITEMS: u16 = 512;
 #[serde(tag = "kind", rename_all = "snake_case")]
 pub enum PlanItem {
     /// A localizer point.
-    Waypoint { lat_deg: f64, lon_deg: f64, alt_msl_m: f64 },
+    Waypoint {
+        lat_deg: f64,
+        lon_deg: f64,
+        alt_msl_m: f64,
+    },
     /// The landing target; `approach_heading_deg: None` lands into the wind.
-    Land { lat_deg: f64, lon_deg: f64, alt_msl_m: f64, approach_heading_deg: Option<f64> },
+    Land {
+        lat_deg: f64,
+        lon_deg: f64,
+        alt_msl_m: f64,
+        approach_heading_deg: Option<f64>,
+    },
 }
 
 /// Why a MISSION_ITEM_INT is not a [`PlanItem`], as the MISSION_ACK result to answer with.
@@ -64,10 +73,29 @@ impl PlanItem {
     /// The MISSION_ITEM_INT carrying this item at `seq`.
     pub fn to_mavlink(&self, target: (u8, u8), seq: u16) -> MavMessage {
         let (command, lat, lon, alt, p4) = match *self {
-            Self::Waypoint { lat_deg, lon_deg, alt_msl_m } => (MavCmd::MAV_CMD_NAV_WAYPOINT, lat_deg, lon_deg, alt_msl_m, 0.0),
-            Self::Land { lat_deg, lon_deg, alt_msl_m, approach_heading_deg } => {
-                (MavCmd::MAV_CMD_NAV_LAND, lat_deg, lon_deg, alt_msl_m, approach_heading_deg.map_or(f32::NAN, |h| h as f32))
-            }
+            Self::Waypoint {
+                lat_deg,
+                lon_deg,
+                alt_msl_m,
+            } => (
+                MavCmd::MAV_CMD_NAV_WAYPOINT,
+                lat_deg,
+                lon_deg,
+                alt_msl_m,
+                0.0,
+            ),
+            Self::Land {
+                lat_deg,
+                lon_deg,
+                alt_msl_m,
+                approach_heading_deg,
+            } => (
+                MavCmd::MAV_CMD_NAV_LAND,
+                lat_deg,
+                lon_deg,
+                alt_msl_m,
+                approach_heading_deg.map_or(f32::NAN, |h| h as f32),
+            ),
         };
         MavMessage::MISSION_ITEM_INT(mc::MISSION_ITEM_INT_DATA {
             param1: 0.0,
@@ -91,8 +119,12 @@ impl PlanItem {
     /// The item a MISSION_ITEM_INT carries.
     pub fn from_mavlink(m: &mc::MISSION_ITEM_INT_DATA) -> Result<PlanItem, PlanItemError> {
         #[allow(deprecated)] // MAV_FRAME_GLOBAL_INT: deprecated synonym older senders use.
-        let frame_ok = m.frame == mc::MavFrame::MAV_FRAME_GLOBAL || m.frame == mc::MavFrame::MAV_FRAME_GLOBAL_INT;
-        if !matches!(m.command, MavCmd::MAV_CMD_NAV_WAYPOINT | MavCmd::MAV_CMD_NAV_LAND) {
+        let frame_ok = m.frame == mc::MavFrame::MAV_FRAME_GLOBAL
+            || m.frame == mc::MavFrame::MAV_FRAME_GLOBAL_INT;
+        if !matches!(
+            m.command,
+            MavCmd::MAV_CMD_NAV_WAYPOINT | MavCmd::MAV_CMD_NAV_LAND
+        ) {
             return Err(PlanItemError::Unsupported { command: m.command });
         }
         if !frame_ok {
@@ -118,9 +150,18 @@ impl PlanItem {
                 } else {
                     return Err(PlanItemError::Invalid { param: 4 });
                 };
-                PlanItem::Land { lat_deg, lon_deg, alt_msl_m, approach_heading_deg }
+                PlanItem::Land {
+                    lat_deg,
+                    lon_deg,
+                    alt_msl_m,
+                    approach_heading_deg,
+                }
             }
-            _ => PlanItem::Waypoint { lat_deg, lon_deg, alt_msl_m },
+            _ => PlanItem::Waypoint {
+                lat_deg,
+                lon_deg,
+                alt_msl_m,
+            },
         })
     }
 }
@@ -136,7 +177,10 @@ pub struct PlanConfig {
 
 impl Default for PlanConfig {
     fn default() -> Self {
-        Self { timeout: Duration::from_millis(1500), retries: 4 }
+        Self {
+            timeout: Duration::from_millis(1500),
+            retries: 4,
+        }
     }
 }
 
@@ -168,8 +212,14 @@ pub enum PlanRequestError {
 
 #[derive(Debug)]
 enum ClientOp {
-    Upload { items: Vec<PlanItem>, acked_through: Option<u16> },
-    Download { count: Option<u16>, items: Vec<PlanItem> },
+    Upload {
+        items: Vec<PlanItem>,
+        acked_through: Option<u16>,
+    },
+    Download {
+        count: Option<u16>,
+        items: Vec<PlanItem>,
+    },
 }
 
 #[derive(Debug)]
@@ -227,7 +277,10 @@ fn is_mission(t: mc::MavMissionType) -> bool {
 impl PlanClient {
     /// A client with the given timing.
     pub fn new(config: PlanConfig) -> Self {
-        Self { config, ..Default::default() }
+        Self {
+            config,
+            ..Default::default()
+        }
     }
 
     /// Whether a transfer is running.
@@ -247,13 +300,33 @@ impl PlanClient {
     }
 
     /// Starts uploading `items` to `target`.
-    pub fn upload(&mut self, now: Duration, target: (u8, u8), items: Vec<PlanItem>) -> Result<(), PlanRequestError> {
+    pub fn upload(
+        &mut self,
+        now: Duration,
+        target: (u8, u8),
+        items: Vec<PlanItem>,
+    ) -> Result<(), PlanRequestError> {
         if self.state.is_some() {
             return Err(PlanRequestError::Busy);
         }
-        let count = u16::try_from(items.len()).ok().filter(|&c| c <= MAX_PLAN_ITEMS).ok_or(PlanRequestError::TooLong { count: items.len(), max: MAX_PLAN_ITEMS })?;
+        let count = u16::try_from(items.len())
+            .ok()
+            .filter(|&c| c <= MAX_PLAN_ITEMS)
+            .ok_or(PlanRequestError::TooLong {
+                count: items.len(),
+                max: MAX_PLAN_ITEMS,
+            })?;
         let msg = mission_count(target, count);
-        self.state = Some(ClientState { target, op: ClientOp::Upload { items, acked_through: None }, last_sent: msg.clone(), attempts: 1, deadline: now });
+        self.state = Some(ClientState {
+            target,
+            op: ClientOp::Upload {
+                items,
+                acked_through: None,
+            },
+            last_sent: msg.clone(),
+            attempts: 1,
+            deadline: now,
+        });
         self.send(now, msg, true);
         Ok(())
     }
@@ -268,7 +341,16 @@ impl PlanClient {
             target_component: target.1,
             mission_type: mc::MavMissionType::MAV_MISSION_TYPE_MISSION,
         });
-        self.state = Some(ClientState { target, op: ClientOp::Download { count: None, items: Vec::new() }, last_sent: msg.clone(), attempts: 1, deadline: now });
+        self.state = Some(ClientState {
+            target,
+            op: ClientOp::Download {
+                count: None,
+                items: Vec::new(),
+            },
+            last_sent: msg.clone(),
+            attempts: 1,
+            deadline: now,
+        });
         self.send(now, msg, true);
         Ok(())
     }
@@ -278,14 +360,34 @@ impl PlanClient {
     // MISSION_REQUEST_INT, as MAVLink asks.
     #[allow(deprecated)]
     pub fn handle_message(&mut self, now: Duration, from_system: u8, msg: &MavMessage) {
-        let Some(state) = self.state.as_mut() else { return };
+        let Some(state) = self.state.as_mut() else {
+            return;
+        };
         if state.target.0 != from_system {
             return;
         }
         let target = state.target;
         match (&mut state.op, msg) {
-            (ClientOp::Upload { items, acked_through }, MavMessage::MISSION_REQUEST_INT(mc::MISSION_REQUEST_INT_DATA { seq, mission_type, .. }))
-            | (ClientOp::Upload { items, acked_through }, MavMessage::MISSION_REQUEST(mc::MISSION_REQUEST_DATA { seq, mission_type, .. })) => {
+            (
+                ClientOp::Upload {
+                    items,
+                    acked_through,
+                },
+                MavMessage::MISSION_REQUEST_INT(mc::MISSION_REQUEST_INT_DATA {
+                    seq,
+                    mission_type,
+                    ..
+                }),
+            )
+            | (
+                ClientOp::Upload {
+                    items,
+                    acked_through,
+                },
+                MavMessage::MISSION_REQUEST(mc::MISSION_REQUEST_DATA {
+                    seq, mission_type, ..
+                }),
+            ) => {
                 if !is_mission(*mission_type) {
                     return;
                 }
@@ -300,35 +402,53 @@ impl PlanClient {
                 let m = item.to_mavlink(target, *seq);
                 self.send(now, m, progress);
             }
-            (ClientOp::Upload { items, .. }, MavMessage::MISSION_ACK(a)) if is_mission(a.mission_type) => {
+            (ClientOp::Upload { items, .. }, MavMessage::MISSION_ACK(a))
+                if is_mission(a.mission_type) =>
+            {
                 let n = items.len();
                 self.state = None;
-                self.events.push_back(if a.mavtype == MavMissionResult::MAV_MISSION_ACCEPTED {
-                    PlanEvent::UploadDone { items: n }
-                } else {
-                    PlanEvent::UploadFailed { result: Some(a.mavtype as u8), reason: format!("vehicle answered {:?}", a.mavtype) }
-                });
+                self.events
+                    .push_back(if a.mavtype == MavMissionResult::MAV_MISSION_ACCEPTED {
+                        PlanEvent::UploadDone { items: n }
+                    } else {
+                        PlanEvent::UploadFailed {
+                            result: Some(a.mavtype as u8),
+                            reason: format!("vehicle answered {:?}", a.mavtype),
+                        }
+                    });
             }
-            (ClientOp::Download { count, items }, MavMessage::MISSION_COUNT(c)) if is_mission(c.mission_type) => {
+            (ClientOp::Download { count, items }, MavMessage::MISSION_COUNT(c))
+                if is_mission(c.mission_type) =>
+            {
                 if count.is_some() {
                     return; // a duplicate COUNT; our request for the next item is out already
                 }
                 if c.count > MAX_PLAN_ITEMS {
                     self.state = None;
-                    self.events.push_back(PlanEvent::DownloadFailed { reason: format!("plan of {} items exceeds {MAX_PLAN_ITEMS}", c.count) });
+                    self.events.push_back(PlanEvent::DownloadFailed {
+                        reason: format!("plan of {} items exceeds {MAX_PLAN_ITEMS}", c.count),
+                    });
                     return;
                 }
                 *count = Some(c.count);
                 if c.count == 0 {
                     self.state = None;
-                    self.transmit.push_back(mission_ack(target, MavMissionResult::MAV_MISSION_ACCEPTED));
-                    self.events.push_back(PlanEvent::DownloadDone { items: Vec::new() });
+                    self.transmit
+                        .push_back(mission_ack(target, MavMissionResult::MAV_MISSION_ACCEPTED));
+                    self.events
+                        .push_back(PlanEvent::DownloadDone { items: Vec::new() });
                     return;
                 }
                 items.clear();
                 self.send(now, mission_request(target, 0), true);
             }
-            (ClientOp::Download { count: Some(count), items }, MavMessage::MISSION_ITEM_INT(m)) if is_mission(m.mission_type) => {
+            (
+                ClientOp::Download {
+                    count: Some(count),
+                    items,
+                },
+                MavMessage::MISSION_ITEM_INT(m),
+            ) if is_mission(m.mission_type) => {
                 if usize::from(m.seq) != items.len() {
                     return; // late duplicate; the current request is re-sent on timeout
                 }
@@ -337,7 +457,9 @@ impl PlanClient {
                     Err(e) => {
                         self.state = None;
                         self.transmit.push_back(mission_ack(target, e.result()));
-                        self.events.push_back(PlanEvent::DownloadFailed { reason: format!("item {}: {e}", m.seq) });
+                        self.events.push_back(PlanEvent::DownloadFailed {
+                            reason: format!("item {}: {e}", m.seq),
+                        });
                         return;
                     }
                 }
@@ -345,7 +467,8 @@ impl PlanClient {
                 if items.len() >= usize::from(count) {
                     let items = std::mem::take(items);
                     self.state = None;
-                    self.transmit.push_back(mission_ack(target, MavMissionResult::MAV_MISSION_ACCEPTED));
+                    self.transmit
+                        .push_back(mission_ack(target, MavMissionResult::MAV_MISSION_ACCEPTED));
                     self.events.push_back(PlanEvent::DownloadDone { items });
                 } else {
                     let next = items.len() as u16;
@@ -358,7 +481,9 @@ impl PlanClient {
 
     /// Re-sends, or gives up, when the deadline passed.
     pub fn handle_timeout(&mut self, now: Duration) {
-        let Some(state) = self.state.as_mut() else { return };
+        let Some(state) = self.state.as_mut() else {
+            return;
+        };
         if state.deadline > now {
             return;
         }
@@ -367,7 +492,14 @@ impl PlanClient {
             let upload = matches!(state.op, ClientOp::Upload { .. });
             self.state = None;
             tracing::warn!(%reason, upload, "plan transfer failed");
-            self.events.push_back(if upload { PlanEvent::UploadFailed { result: None, reason } } else { PlanEvent::DownloadFailed { reason } });
+            self.events.push_back(if upload {
+                PlanEvent::UploadFailed {
+                    result: None,
+                    reason,
+                }
+            } else {
+                PlanEvent::DownloadFailed { reason }
+            });
             return;
         }
         state.attempts += 1;
@@ -470,14 +602,22 @@ impl PlanServer {
     #[allow(deprecated)]
     pub fn handle_message(&mut self, now: Duration, from: (u8, u8), msg: &MavMessage) -> bool {
         match msg {
-            MavMessage::MISSION_COUNT(c) if self.for_us(c.target_system, c.target_component) && is_mission(c.mission_type) => {
-                if self.receiving.as_ref().is_some_and(|r| r.from == from && r.count == c.count && r.items.is_empty()) {
+            MavMessage::MISSION_COUNT(c)
+                if self.for_us(c.target_system, c.target_component)
+                    && is_mission(c.mission_type) =>
+            {
+                if self
+                    .receiving
+                    .as_ref()
+                    .is_some_and(|r| r.from == from && r.count == c.count && r.items.is_empty())
+                {
                     // Re-sent COUNT: our request for item 0 was lost.
                     self.transmit.push_back(mission_request(from, 0));
                     return true;
                 }
                 if c.count > MAX_PLAN_ITEMS {
-                    self.transmit.push_back(mission_ack(from, MavMissionResult::MAV_MISSION_NO_SPACE));
+                    self.transmit
+                        .push_back(mission_ack(from, MavMissionResult::MAV_MISSION_NO_SPACE));
                     self.stats.uploads_failed += 1;
                     return true;
                 }
@@ -485,15 +625,28 @@ impl PlanServer {
                     self.finish_upload(from, Vec::new());
                     return true;
                 }
-                self.receiving = Some(Receiving { from, count: c.count, items: Vec::new(), attempts: 1, deadline: now + self.config.timeout });
+                self.receiving = Some(Receiving {
+                    from,
+                    count: c.count,
+                    items: Vec::new(),
+                    attempts: 1,
+                    deadline: now + self.config.timeout,
+                });
                 self.transmit.push_back(mission_request(from, 0));
                 true
             }
-            MavMessage::MISSION_ITEM_INT(m) if self.for_us(m.target_system, m.target_component) && is_mission(m.mission_type) => {
+            MavMessage::MISSION_ITEM_INT(m)
+                if self.for_us(m.target_system, m.target_component)
+                    && is_mission(m.mission_type) =>
+            {
                 let Some(rx) = self.receiving.as_mut().filter(|r| r.from == from) else {
                     // The last item again after we finished: our ACK was lost.
-                    if self.last_upload.is_some_and(|(f, n)| f == from && m.seq.checked_add(1) == Some(n)) {
-                        self.transmit.push_back(mission_ack(from, MavMissionResult::MAV_MISSION_ACCEPTED));
+                    if self
+                        .last_upload
+                        .is_some_and(|(f, n)| f == from && m.seq.checked_add(1) == Some(n))
+                    {
+                        self.transmit
+                            .push_back(mission_ack(from, MavMissionResult::MAV_MISSION_ACCEPTED));
                     }
                     return true;
                 };
@@ -524,18 +677,33 @@ impl PlanServer {
                 }
                 true
             }
-            MavMessage::MISSION_REQUEST_LIST(r) if self.for_us(r.target_system, r.target_component) && is_mission(r.mission_type) => {
+            MavMessage::MISSION_REQUEST_LIST(r)
+                if self.for_us(r.target_system, r.target_component)
+                    && is_mission(r.mission_type) =>
+            {
                 self.stats.downloads += 1;
-                self.transmit.push_back(mission_count(from, self.plan.len() as u16));
+                self.transmit
+                    .push_back(mission_count(from, self.plan.len() as u16));
                 true
             }
-            MavMessage::MISSION_REQUEST_INT(mc::MISSION_REQUEST_INT_DATA { seq, target_system, target_component, mission_type })
-            | MavMessage::MISSION_REQUEST(mc::MISSION_REQUEST_DATA { seq, target_system, target_component, mission_type })
-                if self.for_us(*target_system, *target_component) && is_mission(*mission_type) =>
-            {
+            MavMessage::MISSION_REQUEST_INT(mc::MISSION_REQUEST_INT_DATA {
+                seq,
+                target_system,
+                target_component,
+                mission_type,
+            })
+            | MavMessage::MISSION_REQUEST(mc::MISSION_REQUEST_DATA {
+                seq,
+                target_system,
+                target_component,
+                mission_type,
+            }) if self.for_us(*target_system, *target_component) && is_mission(*mission_type) => {
                 match self.plan.get(usize::from(*seq)) {
                     Some(item) => self.transmit.push_back(item.to_mavlink(from, *seq)),
-                    None => self.transmit.push_back(mission_ack(from, MavMissionResult::MAV_MISSION_INVALID_SEQUENCE)),
+                    None => self.transmit.push_back(mission_ack(
+                        from,
+                        MavMissionResult::MAV_MISSION_INVALID_SEQUENCE,
+                    )),
                 }
                 true
             }
@@ -548,19 +716,29 @@ impl PlanServer {
         self.last_upload = Some((from, items.len() as u16));
         self.plan = items.clone();
         self.stats.uploads += 1;
-        self.transmit.push_back(mission_ack(from, MavMissionResult::MAV_MISSION_ACCEPTED));
+        self.transmit
+            .push_back(mission_ack(from, MavMissionResult::MAV_MISSION_ACCEPTED));
         self.received.push_back(items);
     }
 
     /// Re-requests the awaited item, or abandons the upload, when the deadline passed.
     pub fn handle_timeout(&mut self, now: Duration) {
-        let Some(rx) = self.receiving.as_mut().filter(|r| r.deadline <= now) else { return };
+        let Some(rx) = self.receiving.as_mut().filter(|r| r.deadline <= now) else {
+            return;
+        };
         if rx.attempts > self.config.retries {
-            tracing::warn!(received = rx.items.len(), count = rx.count, "plan upload abandoned: station silent");
+            tracing::warn!(
+                received = rx.items.len(),
+                count = rx.count,
+                "plan upload abandoned: station silent"
+            );
             let from = rx.from;
             self.receiving = None;
             self.stats.uploads_failed += 1;
-            self.transmit.push_back(mission_ack(from, MavMissionResult::MAV_MISSION_OPERATION_CANCELLED));
+            self.transmit.push_back(mission_ack(
+                from,
+                MavMissionResult::MAV_MISSION_OPERATION_CANCELLED,
+            ));
             return;
         }
         rx.attempts += 1;
@@ -591,9 +769,22 @@ mod tests {
 
     fn plan() -> Vec<PlanItem> {
         vec![
-            PlanItem::Waypoint { lat_deg: 41.1, lon_deg: -8.6, alt_msl_m: 300.0 },
-            PlanItem::Waypoint { lat_deg: 41.2, lon_deg: -8.5, alt_msl_m: 200.0 },
-            PlanItem::Land { lat_deg: 41.15, lon_deg: -8.55, alt_msl_m: 90.0, approach_heading_deg: Some(270.0) },
+            PlanItem::Waypoint {
+                lat_deg: 41.1,
+                lon_deg: -8.6,
+                alt_msl_m: 300.0,
+            },
+            PlanItem::Waypoint {
+                lat_deg: 41.2,
+                lon_deg: -8.5,
+                alt_msl_m: 200.0,
+            },
+            PlanItem::Land {
+                lat_deg: 41.15,
+                lon_deg: -8.55,
+                alt_msl_m: 90.0,
+                approach_heading_deg: Some(270.0),
+            },
         ]
     }
 
@@ -624,14 +815,18 @@ mod tests {
         assert_eq!(srv.poll_plan().map(|p| p.len()), Some(3));
         cl.download(Duration::ZERO, (1, 1)).expect("started");
         pump(&mut cl, &mut srv);
-        let Some(PlanEvent::DownloadDone { items }) = cl.poll_event() else { panic!("no download") };
+        let Some(PlanEvent::DownloadDone { items }) = cl.poll_event() else {
+            panic!("no download")
+        };
         assert_eq!(items.len(), 3);
         for (a, b) in items.iter().zip(plan()) {
             let (PlanItem::Waypoint { lat_deg: x, .. } | PlanItem::Land { lat_deg: x, .. }) = *a;
             let (PlanItem::Waypoint { lat_deg: y, .. } | PlanItem::Land { lat_deg: y, .. }) = b;
             assert!((x - y).abs() < 1e-7);
         }
-        assert!(matches!(items[2], PlanItem::Land { approach_heading_deg: Some(h), .. } if h == 270.0));
+        assert!(
+            matches!(items[2], PlanItem::Land { approach_heading_deg: Some(h), .. } if h == 270.0)
+        );
     }
 
     #[test]
@@ -639,10 +834,14 @@ mod tests {
         let mut srv = PlanServer::new(1, 1, PlanConfig::default());
         srv.handle_message(Duration::ZERO, (255, 190), &mission_count((1, 1), 1));
         let _ = srv.poll_transmit();
-        let MavMessage::MISSION_ITEM_INT(mut m) = plan()[0].to_mavlink((1, 1), 0) else { panic!() };
+        let MavMessage::MISSION_ITEM_INT(mut m) = plan()[0].to_mavlink((1, 1), 0) else {
+            panic!()
+        };
         m.command = MavCmd::MAV_CMD_NAV_TAKEOFF;
         srv.handle_message(Duration::ZERO, (255, 190), &MavMessage::MISSION_ITEM_INT(m));
-        let Some(MavMessage::MISSION_ACK(a)) = srv.poll_transmit() else { panic!("no ack") };
+        let Some(MavMessage::MISSION_ACK(a)) = srv.poll_transmit() else {
+            panic!("no ack")
+        };
         assert_eq!(a.mavtype, MavMissionResult::MAV_MISSION_UNSUPPORTED);
         assert_eq!(srv.stats().uploads_failed, 1);
     }

@@ -102,13 +102,18 @@ impl SigningClock {
     pub fn new(unix_time: Duration, mono_at_reading: Duration) -> Self {
         let since_epoch =
             unix_time.saturating_sub(Duration::from_secs(MAVLINK_SIGNING_EPOCH_UNIX_S));
-        Self { base_10us: duration_to_10us(since_epoch), mono_at_reading }
+        Self {
+            base_10us: duration_to_10us(since_epoch),
+            mono_at_reading,
+        }
     }
 
     /// Signing time at monotonic `now`, 10 µs units since 2015-01-01 UTC.
     pub fn timestamp_at(&self, now: Duration) -> u64 {
         let elapsed = now.saturating_sub(self.mono_at_reading);
-        self.base_10us.saturating_add(duration_to_10us(elapsed)).min(MAX_TIMESTAMP)
+        self.base_10us
+            .saturating_add(duration_to_10us(elapsed))
+            .min(MAX_TIMESTAMP)
     }
 }
 
@@ -141,7 +146,9 @@ impl Signer {
         now: Duration,
         persisted: Option<u64>,
     ) -> Self {
-        let floor = persisted.unwrap_or(0).max(clock.timestamp_at(now).saturating_sub(1));
+        let floor = persisted
+            .unwrap_or(0)
+            .max(clock.timestamp_at(now).saturating_sub(1));
         let mut signer = Self {
             key,
             link_id,
@@ -183,7 +190,10 @@ impl Signer {
 
     fn bump_reservation(&mut self) {
         if self.last_used.saturating_add(PERSIST_RESERVE_10US / 2) > self.reserved {
-            self.reserved = self.last_used.saturating_add(PERSIST_RESERVE_10US).min(MAX_TIMESTAMP);
+            self.reserved = self
+                .last_used
+                .saturating_add(PERSIST_RESERVE_10US)
+                .min(MAX_TIMESTAMP);
             self.persist_pending = true;
         }
     }
@@ -191,7 +201,11 @@ impl Signer {
     /// Next timestamp: the clock's time, or one more than the last one if the clock has not
     /// advanced past it.
     fn next_timestamp(&mut self, now: Duration) -> u64 {
-        let ts = self.clock.timestamp_at(now).max(self.last_used.saturating_add(1)).min(MAX_TIMESTAMP);
+        let ts = self
+            .clock
+            .timestamp_at(now)
+            .max(self.last_used.saturating_add(1))
+            .min(MAX_TIMESTAMP);
         self.last_used = ts;
         self.bump_reservation();
         ts
@@ -234,12 +248,22 @@ pub fn constant_time_eq(a: &[u8; 6], b: &[u8; 6]) -> bool {
 pub enum SignatureError {
     /// The signature does not match our key.
     #[error("bad signature from system {system_id} component {component_id} link {link_id}")]
-    BadSignature { system_id: u8, component_id: u8, link_id: u8 },
+    BadSignature {
+        system_id: u8,
+        component_id: u8,
+        link_id: u8,
+    },
     /// The timestamp is not newer than the last one accepted on the same stream.
     #[error(
         "replayed or reordered frame from system {system_id} component {component_id} link {link_id}: timestamp {timestamp} <= last {last}"
     )]
-    Replay { system_id: u8, component_id: u8, link_id: u8, timestamp: u64, last: u64 },
+    Replay {
+        system_id: u8,
+        component_id: u8,
+        link_id: u8,
+        timestamp: u64,
+        last: u64,
+    },
     /// A stream never seen before starts too far in the past.
     #[error(
         "new stream from system {system_id} component {component_id} link {link_id} starts at {timestamp}, older than {oldest_accepted}"
@@ -299,7 +323,11 @@ impl Verifier {
 
         let expected = compute_signature(&self.key, signed_part);
         if !constant_time_eq(&expected, sig) {
-            return Some(Err(SignatureError::BadSignature { system_id, component_id, link_id }));
+            return Some(Err(SignatureError::BadSignature {
+                system_id,
+                component_id,
+                link_id,
+            }));
         }
         let stream = (system_id, component_id, link_id);
         match self.streams.get(&stream) {
@@ -315,8 +343,10 @@ impl Verifier {
             Some(_) => {}
             None => {
                 if let Some(window) = self.new_stream_window {
-                    let oldest_accepted =
-                        self.clock.timestamp_at(now).saturating_sub(duration_to_10us(window));
+                    let oldest_accepted = self
+                        .clock
+                        .timestamp_at(now)
+                        .saturating_sub(duration_to_10us(window));
                     if timestamp < oldest_accepted {
                         return Some(Err(SignatureError::StaleNewStream {
                             system_id,
@@ -327,12 +357,14 @@ impl Verifier {
                         }));
                     }
                 }
-                if self.streams.len() >= MAX_STREAMS {
-                    if let Some(oldest) =
-                        self.streams.iter().min_by_key(|(_, ts)| **ts).map(|(k, _)| *k)
-                    {
-                        self.streams.remove(&oldest);
-                    }
+                if self.streams.len() >= MAX_STREAMS
+                    && let Some(oldest) = self
+                        .streams
+                        .iter()
+                        .min_by_key(|(_, ts)| **ts)
+                        .map(|(k, _)| *k)
+                {
+                    self.streams.remove(&oldest);
                 }
             }
         }
@@ -384,8 +416,13 @@ impl SigningConfig {
     /// reading.
     pub fn build(&self, now: Duration) -> (Signer, Verifier) {
         let clock = SigningClock::new(self.unix_time_at_start, now);
-        let signer =
-            Signer::new(self.key.clone(), self.link_id, clock, now, self.persisted_timestamp);
+        let signer = Signer::new(
+            self.key.clone(),
+            self.link_id,
+            clock,
+            now,
+            self.persisted_timestamp,
+        );
         let mut verifier = Verifier::new(self.key.clone(), clock);
         verifier.new_stream_window = self.new_stream_window;
         (signer, verifier)
@@ -404,7 +441,10 @@ mod tests {
     #[test]
     fn key_debug_is_redacted() {
         let key = SigningKey::from_bytes([0xAB; 32]);
-        let shown = format!("{key:?} {:?}", SigningConfig::new(key.clone(), 1, Duration::ZERO));
+        let shown = format!(
+            "{key:?} {:?}",
+            SigningConfig::new(key.clone(), 1, Duration::ZERO)
+        );
         assert!(shown.contains("SigningKey(<redacted>)"));
         assert!(!shown.to_lowercase().contains("ab, ab"));
         assert!(!shown.contains("171"));
@@ -424,7 +464,13 @@ mod tests {
 
     #[test]
     fn signer_timestamps_strictly_increase_even_without_clock_progress() {
-        let mut s = Signer::new(SigningKey::from_bytes([1; 32]), 0, clock(), Duration::ZERO, None);
+        let mut s = Signer::new(
+            SigningKey::from_bytes([1; 32]),
+            0,
+            clock(),
+            Duration::ZERO,
+            None,
+        );
         let mut last = 0;
         for _ in 0..100 {
             let ts = s.next_timestamp(Duration::ZERO);
@@ -435,7 +481,13 @@ mod tests {
 
     #[test]
     fn restart_with_clock_behind_continues_after_persisted_mark() {
-        let mut s = Signer::new(SigningKey::from_bytes([1; 32]), 0, clock(), Duration::ZERO, None);
+        let mut s = Signer::new(
+            SigningKey::from_bytes([1; 32]),
+            0,
+            clock(),
+            Duration::ZERO,
+            None,
+        );
         let mut persisted = s.take_value_to_persist();
         let mut last = 0;
         for i in 0..5_000_u64 {
@@ -447,8 +499,13 @@ mod tests {
         assert!(persisted.is_some_and(|p| p > last));
         // Restart with a wall clock one hour behind.
         let behind = SigningClock::new(Duration::from_secs(1_767_225_600 - 3600), Duration::ZERO);
-        let mut s2 =
-            Signer::new(SigningKey::from_bytes([1; 32]), 0, behind, Duration::ZERO, persisted);
+        let mut s2 = Signer::new(
+            SigningKey::from_bytes([1; 32]),
+            0,
+            behind,
+            Duration::ZERO,
+            persisted,
+        );
         assert!(s2.next_timestamp(Duration::ZERO) > last);
     }
 

@@ -71,7 +71,11 @@ fn course_to_cdeg(deg: Option<f64>) -> u16 {
     }
 }
 fn cdeg_to_course(v: u16) -> Option<f64> {
-    if v == u16::MAX { None } else { Some(f64::from(v) / 100.0) }
+    if v == u16::MAX {
+        None
+    } else {
+        Some(f64::from(v) / 100.0)
+    }
 }
 
 /// Onboard system state (HEARTBEAT `system_status`, MAV_STATE).
@@ -142,7 +146,9 @@ impl VehicleStatus {
     }
 
     /// Unpacks a `custom_mode`; `None` if any code is unknown or the top byte is not zero.
-    pub fn unpack_custom_mode(custom_mode: u32) -> Option<(FlightMode, FlightStage, GuidancePhase)> {
+    pub fn unpack_custom_mode(
+        custom_mode: u32,
+    ) -> Option<(FlightMode, FlightStage, GuidancePhase)> {
         let [mode, stage, phase, top] = custom_mode.to_le_bytes();
         if top != 0 {
             return None;
@@ -234,7 +240,11 @@ fn acc_to_mm(v: Option<f64>) -> u32 {
     }
 }
 fn mm_to_acc(v: u32) -> Option<f64> {
-    if v == 0 { None } else { Some(f64::from(v) / 1000.0) }
+    if v == 0 {
+        None
+    } else {
+        Some(f64::from(v) / 1000.0)
+    }
 }
 
 /// Onboard position and velocity estimate (GLOBAL_POSITION_INT).
@@ -380,7 +390,11 @@ fn volts_to_mv(v: Option<f64>) -> u16 {
     }
 }
 fn mv_to_volts(v: u16) -> Option<f64> {
-    if v == u16::MAX { None } else { Some(f64::from(v) / 1000.0) }
+    if v == u16::MAX {
+        None
+    } else {
+        Some(f64::from(v) / 1000.0)
+    }
 }
 fn amps_to_ca(a: Option<f64>) -> i16 {
     match a {
@@ -393,7 +407,11 @@ fn amps_to_ca(a: Option<f64>) -> i16 {
     }
 }
 fn ca_to_amps(v: i16) -> Option<f64> {
-    if v == -1 { None } else { Some(f64::from(v) / 100.0) }
+    if v == -1 {
+        None
+    } else {
+        Some(f64::from(v) / 100.0)
+    }
 }
 fn pct_to_i8(p: Option<u8>) -> i8 {
     p.map_or(-1, |p| p.min(100) as i8)
@@ -487,7 +505,12 @@ impl StatusText {
         while !text.is_char_boundary(end) {
             end -= 1;
         }
-        Self { severity, text: text.as_bytes().get(..end).unwrap_or(&[]).to_vec(), id: 0, chunk_seq: 0 }
+        Self {
+            severity,
+            text: text.as_bytes().get(..end).unwrap_or(&[]).to_vec(),
+            id: 0,
+            chunk_seq: 0,
+        }
     }
 
     /// The chunk's text, with invalid UTF-8 replaced.
@@ -504,28 +527,51 @@ impl StatusText {
 pub fn split_status_text(severity: Severity, text: &str, id: u16) -> Vec<StatusText> {
     let bytes = text.as_bytes();
     if bytes.len() <= STATUSTEXT_LEN {
-        return vec![StatusText { severity, text: bytes.to_vec(), id: 0, chunk_seq: 0 }];
+        return vec![StatusText {
+            severity,
+            text: bytes.to_vec(),
+            id: 0,
+            chunk_seq: 0,
+        }];
     }
     let id = id.max(1);
     let mut chunks: Vec<StatusText> = bytes
         .chunks(STATUSTEXT_LEN)
         .take(256)
         .enumerate()
-        .map(|(i, c)| StatusText { severity, text: c.to_vec(), id, chunk_seq: i as u8 })
+        .map(|(i, c)| StatusText {
+            severity,
+            text: c.to_vec(),
+            id,
+            chunk_seq: i as u8,
+        })
         .collect();
-    if chunks.last().is_some_and(|c| c.text.len() == STATUSTEXT_LEN) && chunks.len() < 256 {
+    if chunks
+        .last()
+        .is_some_and(|c| c.text.len() == STATUSTEXT_LEN)
+        && chunks.len() < 256
+    {
         let seq = chunks.len() as u8;
-        chunks.push(StatusText { severity, text: Vec::new(), id, chunk_seq: seq });
+        chunks.push(StatusText {
+            severity,
+            text: Vec::new(),
+            id,
+            chunk_seq: seq,
+        });
     }
     chunks
 }
+
+/// A text being re-assembled: ((system id, component id, text id), severity, bytes so far,
+/// next expected `chunk_seq`).
+type PendingText = ((u8, u8, u16), Severity, Vec<u8>, u8);
 
 /// Re-assembles chunked STATUSTEXTs per (sender, id). Incomplete texts are dropped when a new
 /// text with the same id starts or when more than [`StatusTextAssembler::MAX_PENDING`] are
 /// pending; both cases are counted in `dropped`.
 #[derive(Debug, Default)]
 pub struct StatusTextAssembler {
-    pending: Vec<((u8, u8, u16), Severity, Vec<u8>, u8)>,
+    pending: Vec<PendingText>,
     /// Incomplete texts dropped.
     pub dropped: u64,
 }
@@ -535,7 +581,12 @@ impl StatusTextAssembler {
     pub const MAX_PENDING: usize = 16;
 
     /// Feeds one chunk from `(system_id, component_id)`; returns the whole text when complete.
-    pub fn push(&mut self, system_id: u8, component_id: u8, chunk: &StatusText) -> Option<(Severity, String)> {
+    pub fn push(
+        &mut self,
+        system_id: u8,
+        component_id: u8,
+        chunk: &StatusText,
+    ) -> Option<(Severity, String)> {
         if chunk.id == 0 {
             return Some((chunk.severity, chunk.text_lossy()));
         }
@@ -574,7 +625,8 @@ impl StatusTextAssembler {
                     self.pending.remove(0);
                     self.dropped += 1;
                 }
-                self.pending.push((key, chunk.severity, chunk.text.clone(), 1));
+                self.pending
+                    .push((key, chunk.severity, chunk.text.clone(), 1));
                 None
             }
         }
@@ -773,9 +825,15 @@ impl Telemetry {
                 ..Default::default()
             }),
             Self::System(s) => MavMessage::SYS_STATUS(mc::SYS_STATUS_DATA {
-                onboard_control_sensors_present: mc::MavSysStatusSensor::from_bits_retain(s.sensors_present),
-                onboard_control_sensors_enabled: mc::MavSysStatusSensor::from_bits_retain(s.sensors_enabled),
-                onboard_control_sensors_health: mc::MavSysStatusSensor::from_bits_retain(s.sensors_health),
+                onboard_control_sensors_present: mc::MavSysStatusSensor::from_bits_retain(
+                    s.sensors_present,
+                ),
+                onboard_control_sensors_enabled: mc::MavSysStatusSensor::from_bits_retain(
+                    s.sensors_enabled,
+                ),
+                onboard_control_sensors_health: mc::MavSysStatusSensor::from_bits_retain(
+                    s.sensors_health,
+                ),
                 load: (s.load_pct * 10.0).round().clamp(0.0, 65535.0) as u16,
                 voltage_battery: volts_to_mv(s.battery_voltage_v),
                 current_battery: amps_to_ca(s.battery_current_a),
@@ -796,7 +854,9 @@ impl Telemetry {
                 MavMessage::BATTERY_STATUS(mc::BATTERY_STATUS_DATA {
                     current_consumed: b.consumed_mah.map_or(-1, |c| c.max(0)),
                     energy_consumed: -1,
-                    temperature: b.temperature_c.map_or(i16::MAX, |c| c_to_cdeg(c).min(i16::MAX - 1)),
+                    temperature: b
+                        .temperature_c
+                        .map_or(i16::MAX, |c| c_to_cdeg(c).min(i16::MAX - 1)),
                     voltages,
                     current_battery: amps_to_ca(b.current_a),
                     id: b.id,
@@ -832,16 +892,18 @@ impl Telemetry {
                 horiz_accuracy: w.horiz_accuracy_mps as f32,
                 vert_accuracy: w.vert_accuracy_mps as f32,
             }),
-            Self::Guidance(g) => MavMessage::NAV_CONTROLLER_OUTPUT(mc::NAV_CONTROLLER_OUTPUT_DATA {
-                nav_roll: g.desired_roll_deg as f32,
-                nav_pitch: 0.0,
-                alt_error: g.alt_error_m as f32,
-                aspd_error: 0.0,
-                xtrack_error: g.xtrack_error_m as f32,
-                nav_bearing: g.desired_heading_deg.round() as i16,
-                target_bearing: g.bearing_to_target_deg.round() as i16,
-                wp_dist: g.distance_to_target_m.round() as u16,
-            }),
+            Self::Guidance(g) => {
+                MavMessage::NAV_CONTROLLER_OUTPUT(mc::NAV_CONTROLLER_OUTPUT_DATA {
+                    nav_roll: g.desired_roll_deg as f32,
+                    nav_pitch: 0.0,
+                    alt_error: g.alt_error_m as f32,
+                    aspd_error: 0.0,
+                    xtrack_error: g.xtrack_error_m as f32,
+                    nav_bearing: g.desired_heading_deg.round() as i16,
+                    target_bearing: g.bearing_to_target_deg.round() as i16,
+                    wp_dist: g.distance_to_target_m.round() as u16,
+                })
+            }
             Self::PredictedLanding(p) => {
                 MavMessage::POSITION_TARGET_GLOBAL_INT(mc::POSITION_TARGET_GLOBAL_INT_DATA {
                     time_boot_ms: p.time_boot_ms,
@@ -869,12 +931,19 @@ impl Telemetry {
         Some(match msg {
             MavMessage::HEARTBEAT(h) => {
                 if h.mavtype != mc::MavType::MAV_TYPE_PARAFOIL
-                    || !h.base_mode.contains(mc::MavModeFlag::MAV_MODE_FLAG_CUSTOM_MODE_ENABLED)
+                    || !h
+                        .base_mode
+                        .contains(mc::MavModeFlag::MAV_MODE_FLAG_CUSTOM_MODE_ENABLED)
                 {
                     return None;
                 }
                 let (mode, stage, phase) = VehicleStatus::unpack_custom_mode(h.custom_mode)?;
-                Self::Status(VehicleStatus { mode, stage, phase, state: SystemState::from_mav(h.system_status) })
+                Self::Status(VehicleStatus {
+                    mode,
+                    stage,
+                    phase,
+                    state: SystemState::from_mav(h.system_status),
+                })
             }
             MavMessage::GPS_RAW_INT(g) => Self::GpsRaw(GpsRaw {
                 time_usec: g.time_usec,
@@ -882,9 +951,17 @@ impl Telemetry {
                 lat_deg: e7_to_deg(g.lat),
                 lon_deg: e7_to_deg(g.lon),
                 alt_msl_m: mm_to_m(g.alt),
-                ground_speed_mps: if g.vel == u16::MAX { None } else { Some(f64::from(g.vel) / 100.0) },
+                ground_speed_mps: if g.vel == u16::MAX {
+                    None
+                } else {
+                    Some(f64::from(g.vel) / 100.0)
+                },
                 course_deg: cdeg_to_course(g.cog),
-                satellites: if g.satellites_visible == u8::MAX { None } else { Some(g.satellites_visible) },
+                satellites: if g.satellites_visible == u8::MAX {
+                    None
+                } else {
+                    Some(g.satellites_visible)
+                },
                 h_acc_m: mm_to_acc(g.h_acc),
                 v_acc_m: mm_to_acc(g.v_acc),
             }),
@@ -947,9 +1024,17 @@ impl Telemetry {
                 id: b.id,
                 voltage_v: mv_to_volts(b.voltages[0]),
                 current_a: ca_to_amps(b.current_battery),
-                consumed_mah: if b.current_consumed < 0 { None } else { Some(b.current_consumed) },
+                consumed_mah: if b.current_consumed < 0 {
+                    None
+                } else {
+                    Some(b.current_consumed)
+                },
                 remaining_pct: i8_to_pct(b.battery_remaining),
-                temperature_c: if b.temperature == i16::MAX { None } else { Some(f64::from(b.temperature) / 100.0) },
+                temperature_c: if b.temperature == i16::MAX {
+                    None
+                } else {
+                    Some(f64::from(b.temperature) / 100.0)
+                },
             }),
             MavMessage::STATUSTEXT(t) => {
                 let raw: &[u8] = &t.text[..];
@@ -985,7 +1070,9 @@ impl Telemetry {
                 let position_ignored = M::POSITION_TARGET_TYPEMASK_X_IGNORE
                     | M::POSITION_TARGET_TYPEMASK_Y_IGNORE
                     | M::POSITION_TARGET_TYPEMASK_Z_IGNORE;
-                if p.coordinate_frame != mc::MavFrame::MAV_FRAME_GLOBAL || p.type_mask.intersects(position_ignored) {
+                if p.coordinate_frame != mc::MavFrame::MAV_FRAME_GLOBAL
+                    || p.type_mask.intersects(position_ignored)
+                {
                     return None;
                 }
                 Self::PredictedLanding(PredictedLanding {

@@ -58,14 +58,20 @@ pub enum Address {
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum AddressError {
     /// Nothing before the first `:` we know.
-    #[error("unknown transport {scheme:?} in {address:?}: use udpin:, udpout:, tcp:, tcpin: or serial:")]
+    #[error(
+        "unknown transport {scheme:?} in {address:?}: use udpin:, udpout:, tcp:, tcpin: or serial:"
+    )]
     UnknownScheme { address: String, scheme: String },
     /// No `:` at all.
     #[error("{address:?} has no transport prefix: expected e.g. udpin:127.0.0.1:14550")]
     MissingScheme { address: String },
     /// The socket address does not parse.
     #[error("{address:?}: {rest:?} is not IP:PORT ({reason})")]
-    BadSocketAddr { address: String, rest: String, reason: String },
+    BadSocketAddr {
+        address: String,
+        rest: String,
+        reason: String,
+    },
     /// TCP client without a port.
     #[error("{address:?}: expected HOST:PORT")]
     BadHostPort { address: String },
@@ -82,31 +88,49 @@ impl FromStr for Address {
 
     fn from_str(address: &str) -> Result<Self, AddressError> {
         let owned = || address.to_string();
-        let (scheme, rest) = address.split_once(':').ok_or_else(|| AddressError::MissingScheme { address: owned() })?;
+        let (scheme, rest) = address
+            .split_once(':')
+            .ok_or_else(|| AddressError::MissingScheme { address: owned() })?;
         let sock = |rest: &str| {
-            rest.parse::<SocketAddr>().map_err(|e| AddressError::BadSocketAddr {
-                address: owned(),
-                rest: rest.to_string(),
-                reason: e.to_string(),
-            })
+            rest.parse::<SocketAddr>()
+                .map_err(|e| AddressError::BadSocketAddr {
+                    address: owned(),
+                    rest: rest.to_string(),
+                    reason: e.to_string(),
+                })
         };
         match scheme {
             "udpin" => Ok(Self::UdpIn(sock(rest)?)),
             "udpout" | "udp" => Ok(Self::UdpOut(sock(rest)?)),
             "tcpin" => Ok(Self::TcpServer(sock(rest)?)),
             "tcp" | "tcpout" => match rest.rsplit_once(':') {
-                Some((host, port)) if !host.is_empty() && port.parse::<u16>().is_ok() => Ok(Self::TcpClient(rest.to_string())),
+                Some((host, port)) if !host.is_empty() && port.parse::<u16>().is_ok() => {
+                    Ok(Self::TcpClient(rest.to_string()))
+                }
                 _ => Err(AddressError::BadHostPort { address: owned() }),
             },
             "serial" => {
-                let (path, baud) = rest.rsplit_once(':').ok_or_else(|| AddressError::BadSerial { address: owned() })?;
+                let (path, baud) = rest
+                    .rsplit_once(':')
+                    .ok_or_else(|| AddressError::BadSerial { address: owned() })?;
                 if path.is_empty() {
                     return Err(AddressError::BadSerial { address: owned() });
                 }
-                let b = baud.parse::<u32>().ok().filter(|&b| b > 0).ok_or_else(|| AddressError::BadBaud { address: owned(), baud: baud.to_string() })?;
-                Ok(Self::Serial { path: path.to_string(), baud: b })
+                let b = baud.parse::<u32>().ok().filter(|&b| b > 0).ok_or_else(|| {
+                    AddressError::BadBaud {
+                        address: owned(),
+                        baud: baud.to_string(),
+                    }
+                })?;
+                Ok(Self::Serial {
+                    path: path.to_string(),
+                    baud: b,
+                })
             }
-            other => Err(AddressError::UnknownScheme { address: owned(), scheme: other.to_string() }),
+            other => Err(AddressError::UnknownScheme {
+                address: owned(),
+                scheme: other.to_string(),
+            }),
         }
     }
 }
@@ -185,9 +209,21 @@ trait ByteStream: AsyncRead + AsyncWrite + Unpin + Send {}
 impl<T: AsyncRead + AsyncWrite + Unpin + Send> ByteStream for T {}
 
 enum Kind {
-    Udp { socket: UdpSocket, peer: Option<SocketAddr>, fixed: bool, queue: VecDeque<Vec<u8>> },
-    TcpServer { listener: TcpListener, conn: Option<TcpStream> },
-    Reopening { address: Address, conn: Option<Box<dyn ByteStream>>, retry_at: Option<Instant> },
+    Udp {
+        socket: UdpSocket,
+        peer: Option<SocketAddr>,
+        fixed: bool,
+        queue: VecDeque<Vec<u8>>,
+    },
+    TcpServer {
+        listener: TcpListener,
+        conn: Option<TcpStream>,
+    },
+    Reopening {
+        address: Address,
+        conn: Option<Box<dyn ByteStream>>,
+        retry_at: Option<Instant>,
+    },
 }
 
 /// An open transport.
@@ -200,7 +236,10 @@ pub struct Transport {
 
 impl fmt::Debug for Transport {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.debug_struct("Transport").field("address", &self.address).field("stats", &self.stats).finish()
+        f.debug_struct("Transport")
+            .field("address", &self.address)
+            .field("stats", &self.stats)
+            .finish()
     }
 }
 
@@ -209,18 +248,29 @@ async fn open_stream(address: &Address) -> io::Result<(Box<dyn ByteStream>, Stri
         Address::TcpClient(a) => {
             let s = TcpStream::connect(a.as_str()).await?;
             s.set_nodelay(true)?;
-            let peer = s.peer_addr().map(|p| p.to_string()).unwrap_or_else(|_| a.clone());
+            let peer = s
+                .peer_addr()
+                .map(|p| p.to_string())
+                .unwrap_or_else(|_| a.clone());
             Ok((Box::new(s), peer))
         }
         #[cfg(feature = "serial")]
         Address::Serial { path, baud } => {
             use tokio_serial::SerialPortBuilderExt;
-            let s = tokio_serial::new(path.as_str(), *baud).open_native_async().map_err(io::Error::other)?;
+            let s = tokio_serial::new(path.as_str(), *baud)
+                .open_native_async()
+                .map_err(io::Error::other)?;
             Ok((Box::new(s), path.clone()))
         }
         #[cfg(not(feature = "serial"))]
-        Address::Serial { .. } => Err(io::Error::new(io::ErrorKind::Unsupported, "serial feature disabled")),
-        _ => Err(io::Error::new(io::ErrorKind::InvalidInput, "not a stream address")),
+        Address::Serial { .. } => Err(io::Error::new(
+            io::ErrorKind::Unsupported,
+            "serial feature disabled",
+        )),
+        _ => Err(io::Error::new(
+            io::ErrorKind::InvalidInput,
+            "not a stream address",
+        )),
     }
 }
 
@@ -232,36 +282,80 @@ impl Transport {
 
     /// Opens `address`.
     pub async fn open(address: Address) -> Result<Self, TransportError> {
-        let err = |source| TransportError::Open { address: address.to_string(), source };
+        let err = |source| TransportError::Open {
+            address: address.to_string(),
+            source,
+        };
         let kind = match &address {
-            Address::UdpIn(a) => Kind::Udp { socket: UdpSocket::bind(a).await.map_err(err)?, peer: None, fixed: false, queue: VecDeque::new() },
+            Address::UdpIn(a) => Kind::Udp {
+                socket: UdpSocket::bind(a).await.map_err(err)?,
+                peer: None,
+                fixed: false,
+                queue: VecDeque::new(),
+            },
             Address::UdpOut(a) => {
-                let local: SocketAddr = if a.is_ipv4() { ([0, 0, 0, 0], 0).into() } else { (std::net::Ipv6Addr::UNSPECIFIED, 0).into() };
-                Kind::Udp { socket: UdpSocket::bind(local).await.map_err(err)?, peer: Some(*a), fixed: true, queue: VecDeque::new() }
+                let local: SocketAddr = if a.is_ipv4() {
+                    ([0, 0, 0, 0], 0).into()
+                } else {
+                    (std::net::Ipv6Addr::UNSPECIFIED, 0).into()
+                };
+                Kind::Udp {
+                    socket: UdpSocket::bind(local).await.map_err(err)?,
+                    peer: Some(*a),
+                    fixed: true,
+                    queue: VecDeque::new(),
+                }
             }
-            Address::TcpServer(a) => Kind::TcpServer { listener: TcpListener::bind(a).await.map_err(err)?, conn: None },
+            Address::TcpServer(a) => Kind::TcpServer {
+                listener: TcpListener::bind(a).await.map_err(err)?,
+                conn: None,
+            },
             Address::TcpClient(_) | Address::Serial { .. } => {
                 #[cfg(not(feature = "serial"))]
                 if matches!(address, Address::Serial { .. }) {
                     return Err(TransportError::SerialDisabled);
                 }
                 let (conn, _) = open_stream(&address).await.map_err(err)?;
-                Kind::Reopening { address: address.clone(), conn: Some(conn), retry_at: None }
+                Kind::Reopening {
+                    address: address.clone(),
+                    conn: Some(conn),
+                    retry_at: None,
+                }
             }
         };
-        let mut t = Self { address, kind, stats: IoStats::default(), events: VecDeque::new() };
+        let mut t = Self {
+            address,
+            kind,
+            stats: IoStats::default(),
+            events: VecDeque::new(),
+        };
         if matches!(t.kind, Kind::Reopening { .. }) {
             t.stats.connects += 1;
-            t.events.push_back(IoEvent::Connected { peer: t.address.to_string() });
+            t.events.push_back(IoEvent::Connected {
+                peer: t.address.to_string(),
+            });
         }
         Ok(t)
     }
 
     /// Wraps an already open byte stream (e.g. one end of a pseudo-terminal pair in tests).
-    pub fn from_stream<S: AsyncRead + AsyncWrite + Unpin + Send + 'static>(label: &str, stream: S) -> Self {
+    pub fn from_stream<S: AsyncRead + AsyncWrite + Unpin + Send + 'static>(
+        label: &str,
+        stream: S,
+    ) -> Self {
         Self {
-            address: Address::Serial { path: label.to_string(), baud: 1 },
-            kind: Kind::Reopening { address: Address::Serial { path: label.to_string(), baud: 1 }, conn: Some(Box::new(stream)), retry_at: None },
+            address: Address::Serial {
+                path: label.to_string(),
+                baud: 1,
+            },
+            kind: Kind::Reopening {
+                address: Address::Serial {
+                    path: label.to_string(),
+                    baud: 1,
+                },
+                conn: Some(Box::new(stream)),
+                retry_at: None,
+            },
             stats: IoStats::default(),
             events: VecDeque::new(),
         }
@@ -294,20 +388,31 @@ impl Transport {
     fn recv_error(&mut self, e: &io::Error) {
         self.stats.recv_errors += 1;
         tracing::warn!(address = %self.address, error = %e, "receive error");
-        self.events.push_back(IoEvent::RecvError { error: e.to_string(), count: self.stats.recv_errors });
+        self.events.push_back(IoEvent::RecvError {
+            error: e.to_string(),
+            count: self.stats.recv_errors,
+        });
     }
 
     fn send_error(&mut self, e: &io::Error) {
         self.stats.send_errors += 1;
         tracing::warn!(address = %self.address, error = %e, "send error");
-        self.events.push_back(IoEvent::SendError { error: e.to_string(), count: self.stats.send_errors });
+        self.events.push_back(IoEvent::SendError {
+            error: e.to_string(),
+            count: self.stats.send_errors,
+        });
     }
 
     /// Waits for bytes; returns how many were put in `buf` (0 when an event, such as an error
     /// or a connection change, happened instead). Cancel-safe.
     pub async fn recv(&mut self, buf: &mut [u8]) -> usize {
         match &mut self.kind {
-            Kind::Udp { socket, peer, fixed, .. } => match socket.recv_from(buf).await {
+            Kind::Udp {
+                socket,
+                peer,
+                fixed,
+                ..
+            } => match socket.recv_from(buf).await {
                 Ok((n, from)) => {
                     if !*fixed && *peer != Some(from) {
                         *peer = Some(from);
@@ -326,7 +431,9 @@ impl Transport {
                 Some(stream) => match stream.read(buf).await {
                     Ok(0) => {
                         *conn = None;
-                        self.events.push_back(IoEvent::Disconnected { reason: "peer closed".into() });
+                        self.events.push_back(IoEvent::Disconnected {
+                            reason: "peer closed".into(),
+                        });
                         0
                     }
                     Ok(n) => {
@@ -336,16 +443,22 @@ impl Transport {
                     Err(e) => {
                         *conn = None;
                         self.recv_error(&e);
-                        self.events.push_back(IoEvent::Disconnected { reason: e.to_string() });
+                        self.events.push_back(IoEvent::Disconnected {
+                            reason: e.to_string(),
+                        });
                         0
                     }
                 },
                 None => match listener.accept().await {
                     Ok((stream, peer)) => {
-                        let _ = stream.set_nodelay(true).inspect_err(|e| tracing::debug!(error = %e, "set_nodelay"));
+                        let _ = stream
+                            .set_nodelay(true)
+                            .inspect_err(|e| tracing::debug!(error = %e, "set_nodelay"));
                         *conn = Some(stream);
                         self.stats.connects += 1;
-                        self.events.push_back(IoEvent::Connected { peer: peer.to_string() });
+                        self.events.push_back(IoEvent::Connected {
+                            peer: peer.to_string(),
+                        });
                         0
                     }
                     Err(e) => {
@@ -354,12 +467,18 @@ impl Transport {
                     }
                 },
             },
-            Kind::Reopening { address, conn, retry_at } => match conn {
+            Kind::Reopening {
+                address,
+                conn,
+                retry_at,
+            } => match conn {
                 Some(stream) => match stream.read(buf).await {
                     Ok(0) => {
                         *conn = None;
                         *retry_at = Some(Instant::now() + REOPEN_DELAY);
-                        self.events.push_back(IoEvent::Disconnected { reason: "closed".into() });
+                        self.events.push_back(IoEvent::Disconnected {
+                            reason: "closed".into(),
+                        });
                         0
                     }
                     Ok(n) => {
@@ -370,7 +489,9 @@ impl Transport {
                         *conn = None;
                         *retry_at = Some(Instant::now() + REOPEN_DELAY);
                         self.recv_error(&e);
-                        self.events.push_back(IoEvent::Disconnected { reason: e.to_string() });
+                        self.events.push_back(IoEvent::Disconnected {
+                            reason: e.to_string(),
+                        });
                         0
                     }
                 },
@@ -402,7 +523,12 @@ impl Transport {
     /// Sends one frame (or queues it, for UDP-in without a peer).
     pub async fn send(&mut self, frame: &[u8]) {
         let result = match &mut self.kind {
-            Kind::Udp { socket, peer: Some(peer), queue, .. } => {
+            Kind::Udp {
+                socket,
+                peer: Some(peer),
+                queue,
+                ..
+            } => {
                 let peer = *peer;
                 let mut r = Ok(());
                 // Flush what was queued before the peer was known, in order.
@@ -414,15 +540,22 @@ impl Transport {
                     self.stats.tx_bytes += q.len() as u64;
                 }
                 match r {
-                    Ok(()) => socket.send_to(frame, peer).await.map(|n| self.stats.tx_bytes += n as u64),
+                    Ok(()) => socket
+                        .send_to(frame, peer)
+                        .await
+                        .map(|n| self.stats.tx_bytes += n as u64),
                     Err(e) => Err(e),
                 }
             }
-            Kind::Udp { peer: None, queue, .. } => {
+            Kind::Udp {
+                peer: None, queue, ..
+            } => {
                 if queue.len() >= MAX_QUEUED_WITHOUT_PEER {
                     queue.pop_front();
                     self.stats.dropped_without_peer += 1;
-                    self.events.push_back(IoEvent::DroppedWithoutPeer { dropped_total: self.stats.dropped_without_peer });
+                    self.events.push_back(IoEvent::DroppedWithoutPeer {
+                        dropped_total: self.stats.dropped_without_peer,
+                    });
                 }
                 queue.push_back(frame.to_vec());
                 self.stats.queued_without_peer += 1;
@@ -431,8 +564,18 @@ impl Transport {
                 self.events.push_back(IoEvent::QueuedWithoutPeer { queued });
                 Ok(())
             }
-            Kind::TcpServer { conn: Some(stream), .. } => stream.write_all(frame).await.map(|()| self.stats.tx_bytes += frame.len() as u64),
-            Kind::Reopening { conn: Some(stream), .. } => stream.write_all(frame).await.map(|()| self.stats.tx_bytes += frame.len() as u64),
+            Kind::TcpServer {
+                conn: Some(stream), ..
+            } => stream
+                .write_all(frame)
+                .await
+                .map(|()| self.stats.tx_bytes += frame.len() as u64),
+            Kind::Reopening {
+                conn: Some(stream), ..
+            } => stream
+                .write_all(frame)
+                .await
+                .map(|()| self.stats.tx_bytes += frame.len() as u64),
             Kind::TcpServer { conn: None, .. } | Kind::Reopening { conn: None, .. } => {
                 Err(io::Error::new(io::ErrorKind::NotConnected, "no connection"))
             }
@@ -515,7 +658,11 @@ pub struct DriveOptions {
 /// Reads a persisted signing timestamp; `Ok(None)` if the file does not exist.
 pub fn load_signing_timestamp(path: &Path) -> io::Result<Option<u64>> {
     match std::fs::read_to_string(path) {
-        Ok(s) => s.trim().parse::<u64>().map(Some).map_err(|e| io::Error::new(io::ErrorKind::InvalidData, e)),
+        Ok(s) => s
+            .trim()
+            .parse::<u64>()
+            .map(Some)
+            .map_err(|e| io::Error::new(io::ErrorKind::InvalidData, e)),
         Err(e) if e.kind() == io::ErrorKind::NotFound => Ok(None),
         Err(e) => Err(e),
     }
@@ -551,11 +698,16 @@ pub async fn drive<E: SansIo>(
             transport.send(&frame).await;
         }
         while let Some(e) = endpoint.poll_event() {
-            if let (Some(v), Some(path)) = (E::persist_request(&e), options.signing_timestamp_file.as_deref()) {
-                if let Err(err) = store_signing_timestamp(path, v) {
-                    tracing::error!(path = %path.display(), error = %err, "cannot persist signing timestamp");
-                    transport.events.push_back(IoEvent::PersistFailed { path: path.to_path_buf(), error: err.to_string() });
-                }
+            if let (Some(v), Some(path)) = (
+                E::persist_request(&e),
+                options.signing_timestamp_file.as_deref(),
+            ) && let Err(err) = store_signing_timestamp(path, v)
+            {
+                tracing::error!(path = %path.display(), error = %err, "cannot persist signing timestamp");
+                transport.events.push_back(IoEvent::PersistFailed {
+                    path: path.to_path_buf(),
+                    error: err.to_string(),
+                });
             }
             if events.send(DriverEvent::Endpoint(e)).await.is_err() {
                 open = false;
@@ -569,7 +721,10 @@ pub async fn drive<E: SansIo>(
         if !open {
             break;
         }
-        let deadline = endpoint.poll_timeout().map(|t| start + t).unwrap_or_else(|| Instant::now() + Duration::from_secs(1));
+        let deadline = endpoint
+            .poll_timeout()
+            .map(|t| start + t)
+            .unwrap_or_else(|| Instant::now() + Duration::from_secs(1));
         tokio::select! {
             n = transport.recv(&mut buf) => {
                 if n > 0 {
@@ -604,26 +759,74 @@ mod tests {
 
     #[test]
     fn addresses_parse() {
-        assert_eq!("udpin:127.0.0.1:14550".parse(), Ok(Address::UdpIn(([127, 0, 0, 1], 14550).into())));
-        assert_eq!("udpout:127.0.0.1:14550".parse(), Ok(Address::UdpOut(([127, 0, 0, 1], 14550).into())));
-        assert_eq!("tcp:localhost:5760".parse(), Ok(Address::TcpClient("localhost:5760".into())));
-        assert_eq!("tcpin:0.0.0.0:5760".parse(), Ok(Address::TcpServer(([0, 0, 0, 0], 5760).into())));
-        assert_eq!("serial:/dev/ttyUSB0:57600".parse(), Ok(Address::Serial { path: "/dev/ttyUSB0".into(), baud: 57600 }));
-        for a in ["udpin:127.0.0.1:14550", "tcpin:0.0.0.0:5760", "serial:/dev/ttyUSB0:57600"] {
-            assert_eq!(a.parse::<Address>().map(|x| x.to_string()), Ok(a.to_string()));
+        assert_eq!(
+            "udpin:127.0.0.1:14550".parse(),
+            Ok(Address::UdpIn(([127, 0, 0, 1], 14550).into()))
+        );
+        assert_eq!(
+            "udpout:127.0.0.1:14550".parse(),
+            Ok(Address::UdpOut(([127, 0, 0, 1], 14550).into()))
+        );
+        assert_eq!(
+            "tcp:localhost:5760".parse(),
+            Ok(Address::TcpClient("localhost:5760".into()))
+        );
+        assert_eq!(
+            "tcpin:0.0.0.0:5760".parse(),
+            Ok(Address::TcpServer(([0, 0, 0, 0], 5760).into()))
+        );
+        assert_eq!(
+            "serial:/dev/ttyUSB0:57600".parse(),
+            Ok(Address::Serial {
+                path: "/dev/ttyUSB0".into(),
+                baud: 57600
+            })
+        );
+        for a in [
+            "udpin:127.0.0.1:14550",
+            "tcpin:0.0.0.0:5760",
+            "serial:/dev/ttyUSB0:57600",
+        ] {
+            assert_eq!(
+                a.parse::<Address>().map(|x| x.to_string()),
+                Ok(a.to_string())
+            );
         }
     }
 
     #[test]
     fn malformed_addresses_say_what_is_wrong() {
-        assert!(matches!("127.0.0.1:14550".parse::<Address>(), Err(AddressError::UnknownScheme { .. })));
-        assert!(matches!("localhost".parse::<Address>(), Err(AddressError::MissingScheme { .. })));
-        assert!(matches!("udpin:127.0.0.1".parse::<Address>(), Err(AddressError::BadSocketAddr { .. })));
-        assert!(matches!("tcp:host".parse::<Address>(), Err(AddressError::BadHostPort { .. })));
-        assert!(matches!("serial:/dev/ttyUSB0".parse::<Address>(), Err(AddressError::BadSerial { .. })));
-        assert!(matches!("serial:/dev/ttyUSB0:fast".parse::<Address>(), Err(AddressError::BadBaud { .. })));
-        assert!(matches!("serial::57600".parse::<Address>(), Err(AddressError::BadSerial { .. })));
-        let msg = "ftp:1.2.3.4:21".parse::<Address>().map_err(|e| e.to_string());
+        assert!(matches!(
+            "127.0.0.1:14550".parse::<Address>(),
+            Err(AddressError::UnknownScheme { .. })
+        ));
+        assert!(matches!(
+            "localhost".parse::<Address>(),
+            Err(AddressError::MissingScheme { .. })
+        ));
+        assert!(matches!(
+            "udpin:127.0.0.1".parse::<Address>(),
+            Err(AddressError::BadSocketAddr { .. })
+        ));
+        assert!(matches!(
+            "tcp:host".parse::<Address>(),
+            Err(AddressError::BadHostPort { .. })
+        ));
+        assert!(matches!(
+            "serial:/dev/ttyUSB0".parse::<Address>(),
+            Err(AddressError::BadSerial { .. })
+        ));
+        assert!(matches!(
+            "serial:/dev/ttyUSB0:fast".parse::<Address>(),
+            Err(AddressError::BadBaud { .. })
+        ));
+        assert!(matches!(
+            "serial::57600".parse::<Address>(),
+            Err(AddressError::BadSerial { .. })
+        ));
+        let msg = "ftp:1.2.3.4:21"
+            .parse::<Address>()
+            .map_err(|e| e.to_string());
         assert!(msg.is_err_and(|m| m.contains("udpin:") && m.contains("ftp")));
     }
 }

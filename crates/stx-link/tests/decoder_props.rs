@@ -11,27 +11,37 @@ use stx_link::telemetry::{Attitude, GlobalPosition, Hud, Severity, StatusText, T
 
 fn telemetry() -> impl Strategy<Value = Telemetry> {
     prop_oneof![
-        (any::<u32>(), -3.0..3.0_f64, -1.5..1.5_f64).prop_map(|(t, r, p)| Telemetry::Attitude(Attitude {
-            time_boot_ms: t,
-            roll_rad: r,
-            pitch_rad: p,
-            yaw_rad: 0.0,
-            roll_rate_radps: 0.0,
-            pitch_rate_radps: 0.0,
-            yaw_rate_radps: 0.0,
+        (any::<u32>(), -3.0..3.0_f64, -1.5..1.5_f64).prop_map(|(t, r, p)| Telemetry::Attitude(
+            Attitude {
+                time_boot_ms: t,
+                roll_rad: r,
+                pitch_rad: p,
+                yaw_rad: 0.0,
+                roll_rate_radps: 0.0,
+                pitch_rate_radps: 0.0,
+                yaw_rate_radps: 0.0,
+            }
+        )),
+        (any::<u32>(), -90.0..90.0_f64, -180.0..180.0_f64).prop_map(|(t, la, lo)| {
+            Telemetry::Position(GlobalPosition {
+                time_boot_ms: t,
+                lat_deg: la,
+                lon_deg: lo,
+                alt_msl_m: 1000.0,
+                alt_rel_m: 900.0,
+                v_north_mps: 1.0,
+                v_east_mps: -2.0,
+                v_down_mps: 4.0,
+                heading_deg: Some(12.0),
+            })
+        }),
+        (0.0..50.0_f64).prop_map(|a| Telemetry::Hud(Hud {
+            airspeed_mps: a,
+            groundspeed_mps: a,
+            heading_deg: 90.0,
+            climb_mps: -4.0,
+            alt_msl_m: 100.0
         })),
-        (any::<u32>(), -90.0..90.0_f64, -180.0..180.0_f64).prop_map(|(t, la, lo)| Telemetry::Position(GlobalPosition {
-            time_boot_ms: t,
-            lat_deg: la,
-            lon_deg: lo,
-            alt_msl_m: 1000.0,
-            alt_rel_m: 900.0,
-            v_north_mps: 1.0,
-            v_east_mps: -2.0,
-            v_down_mps: 4.0,
-            heading_deg: Some(12.0),
-        })),
-        (0.0..50.0_f64).prop_map(|a| Telemetry::Hud(Hud { airspeed_mps: a, groundspeed_mps: a, heading_deg: 90.0, climb_mps: -4.0, alt_msl_m: 100.0 })),
         "[ -~]{0,50}".prop_map(|s| Telemetry::StatusText(StatusText::single(Severity::Info, &s))),
     ]
 }
@@ -44,7 +54,11 @@ fn frame_len(f: &Frame) -> u64 {
     }
 }
 
-fn decode_chunks(bytes: &[u8], cuts: &[usize], mut dec: FrameDecoder) -> (Vec<Frame>, FrameDecoder) {
+fn decode_chunks(
+    bytes: &[u8],
+    cuts: &[usize],
+    mut dec: FrameDecoder,
+) -> (Vec<Frame>, FrameDecoder) {
     let now = Duration::from_secs(1);
     let mut frames = Vec::new();
     let mut start = 0;

@@ -7,7 +7,9 @@ use std::time::Duration;
 use common::{Pair, msg_id};
 use stx_gnc::mission::FlightMode;
 use stx_link::command::{Command, CommandOutcome, CommandResult, RequestId};
-use stx_link::endpoint::{GroundConfig, GroundEvent, LinkConfig, LinkEvent, VehicleConfig, VehicleEvent};
+use stx_link::endpoint::{
+    GroundConfig, GroundEvent, LinkConfig, LinkEvent, VehicleConfig, VehicleEvent,
+};
 use stx_link::manual::{ManualEvent, Sticks};
 use stx_link::param::{ParamEvent, ParamSpec};
 use stx_link::plan::{PlanEvent, PlanItem};
@@ -24,7 +26,9 @@ fn secs(s: f64) -> Duration {
 
 fn command_outcome(pair: &Pair, id: RequestId) -> Option<(CommandOutcome, u8)> {
     pair.ground_events.iter().find_map(|(_, e)| match e {
-        GroundEvent::Command(c) if c.request_id == id && !matches!(c.outcome, CommandOutcome::InProgress { .. }) => {
+        GroundEvent::Command(c)
+            if c.request_id == id && !matches!(c.outcome, CommandOutcome::InProgress { .. }) =>
+        {
             Some((c.outcome, c.attempts))
         }
         _ => None,
@@ -32,7 +36,10 @@ fn command_outcome(pair: &Pair, id: RequestId) -> Option<(CommandOutcome, u8)> {
 }
 
 fn delivered_commands(pair: &Pair) -> usize {
-    pair.vehicle_events.iter().filter(|(_, e)| matches!(e, VehicleEvent::Command(_))).count()
+    pair.vehicle_events
+        .iter()
+        .filter(|(_, e)| matches!(e, VehicleEvent::Command(_)))
+        .count()
 }
 
 #[test]
@@ -41,8 +48,23 @@ fn heartbeats_connect_both_ends() {
     pair.run_for(secs(2.0));
     assert!(pair.ground.is_connected());
     assert!(pair.vehicle.is_connected());
-    assert!(pair.ground_events.iter().any(|(_, e)| matches!(e, GroundEvent::Link(LinkEvent::Connected { system_id: 1, .. }))));
-    let hb = pair.ground_events.iter().filter(|(_, e)| matches!(e, GroundEvent::Telemetry { telemetry: Telemetry::Status(_), .. })).count();
+    assert!(pair.ground_events.iter().any(|(_, e)| matches!(
+        e,
+        GroundEvent::Link(LinkEvent::Connected { system_id: 1, .. })
+    )));
+    let hb = pair
+        .ground_events
+        .iter()
+        .filter(|(_, e)| {
+            matches!(
+                e,
+                GroundEvent::Telemetry {
+                    telemetry: Telemetry::Status(_),
+                    ..
+                }
+            )
+        })
+        .count();
     assert!((2..=3).contains(&hb), "{hb} heartbeats in 2 s");
 }
 
@@ -58,12 +80,25 @@ fn command_retried_through_loss_then_acked() {
         false
     }));
     pair.run_for(secs(1.5));
-    pair.ground.send_command(pair.now, RequestId(42), Command::SetMode(FlightMode::SpiralLanding)).expect("sent");
+    pair.ground
+        .send_command(
+            pair.now,
+            RequestId(42),
+            Command::SetMode(FlightMode::SpiralLanding),
+        )
+        .expect("sent");
     pair.run_for(secs(5.0));
-    assert_eq!(command_outcome(&pair, RequestId(42)), Some((CommandOutcome::Accepted, 3)));
+    assert_eq!(
+        command_outcome(&pair, RequestId(42)),
+        Some((CommandOutcome::Accepted, 3))
+    );
     assert_eq!(delivered_commands(&pair), 1);
     // The retry carried confirmation 2 and arrived after two 1 s timeouts.
-    let (t, _) = pair.ground_events.iter().find(|(_, e)| matches!(e, GroundEvent::Command(_))).expect("event");
+    let (t, _) = pair
+        .ground_events
+        .iter()
+        .find(|(_, e)| matches!(e, GroundEvent::Command(_)))
+        .expect("event");
     assert!(*t >= secs(101.5 + 2.0) && *t < secs(101.5 + 2.5), "{t:?}");
 }
 
@@ -79,10 +114,19 @@ fn lost_ack_is_recovered_by_retry_without_executing_twice() {
         false
     }));
     pair.run_for(secs(1.5));
-    pair.ground.send_command(pair.now, RequestId(1), Command::Cutdown).expect("sent");
+    pair.ground
+        .send_command(pair.now, RequestId(1), Command::Cutdown)
+        .expect("sent");
     pair.run_for(secs(5.0));
-    assert_eq!(command_outcome(&pair, RequestId(1)), Some((CommandOutcome::Accepted, 2)));
-    assert_eq!(delivered_commands(&pair), 1, "a retried cutdown must not be executed twice");
+    assert_eq!(
+        command_outcome(&pair, RequestId(1)),
+        Some((CommandOutcome::Accepted, 2))
+    );
+    assert_eq!(
+        delivered_commands(&pair),
+        1,
+        "a retried cutdown must not be executed twice"
+    );
 }
 
 #[test]
@@ -91,10 +135,19 @@ fn command_times_out_after_all_attempts_lost() {
     pair.to_vehicle.filter = Some(Box::new(|f| msg_id(f) == Some(COMMAND_LONG)));
     pair.run_for(secs(1.5));
     let t0 = pair.now;
-    pair.ground.send_command(t0, RequestId(9), Command::HoldHeading { heading_deg: 90.0 }).expect("sent");
+    pair.ground
+        .send_command(t0, RequestId(9), Command::HoldHeading { heading_deg: 90.0 })
+        .expect("sent");
     pair.run_for(secs(10.0));
-    assert_eq!(command_outcome(&pair, RequestId(9)), Some((CommandOutcome::TimedOut { attempts: 4 }, 4)));
-    let (t, _) = pair.ground_events.iter().find(|(_, e)| matches!(e, GroundEvent::Command(_))).expect("event");
+    assert_eq!(
+        command_outcome(&pair, RequestId(9)),
+        Some((CommandOutcome::TimedOut { attempts: 4 }, 4))
+    );
+    let (t, _) = pair
+        .ground_events
+        .iter()
+        .find(|(_, e)| matches!(e, GroundEvent::Command(_)))
+        .expect("event");
     assert_eq!(*t - t0, secs(4.0));
     assert_eq!(delivered_commands(&pair), 0);
 }
@@ -104,18 +157,37 @@ fn rejected_command_reports_the_mav_result() {
     let mut pair = Pair::default_pair(5);
     pair.auto_ack = Some(CommandResult::Denied);
     pair.run_for(secs(1.5));
-    pair.ground.send_command(pair.now, RequestId(5), Command::Cutdown).expect("sent");
+    pair.ground
+        .send_command(pair.now, RequestId(5), Command::Cutdown)
+        .expect("sent");
     pair.run_for(secs(2.0));
-    assert_eq!(command_outcome(&pair, RequestId(5)), Some((CommandOutcome::Rejected { result: CommandResult::Denied }, 1)));
+    assert_eq!(
+        command_outcome(&pair, RequestId(5)),
+        Some((
+            CommandOutcome::Rejected {
+                result: CommandResult::Denied
+            },
+            1
+        ))
+    );
 }
 
 fn many_params() -> Vec<ParamSpec> {
-    (0..20).map(|i| ParamSpec::new(&format!("P{i:02}"), i as f32, 0.0, 100.0, "test")).collect()
+    (0..20)
+        .map(|i| ParamSpec::new(&format!("P{i:02}"), i as f32, 0.0, 100.0, "test"))
+        .collect()
 }
 
 #[test]
 fn param_list_completes_despite_lost_values() {
-    let mut pair = Pair::new(GroundConfig::default(), VehicleConfig { params: many_params(), ..Default::default() }, 6);
+    let mut pair = Pair::new(
+        GroundConfig::default(),
+        VehicleConfig {
+            params: many_params(),
+            ..Default::default()
+        },
+        6,
+    );
     let mut count = 0;
     // Drop PARAM_VALUEs number 3, 4, 10 and 19 of the first answer.
     pair.to_ground.filter = Some(Box::new(move |f| {
@@ -127,8 +199,15 @@ fn param_list_completes_despite_lost_values() {
     }));
     pair.run_for(secs(1.0));
     pair.ground.param_list(pair.now).expect("started");
-    let done = pair.run_until_ground(secs(10.0), |e| matches!(e, GroundEvent::Param(ParamEvent::ListComplete { .. } | ParamEvent::ListFailed { .. })));
-    let Some(GroundEvent::Param(ParamEvent::ListComplete { params })) = done else { panic!("{done:?}") };
+    let done = pair.run_until_ground(secs(10.0), |e| {
+        matches!(
+            e,
+            GroundEvent::Param(ParamEvent::ListComplete { .. } | ParamEvent::ListFailed { .. })
+        )
+    });
+    let Some(GroundEvent::Param(ParamEvent::ListComplete { params })) = done else {
+        panic!("{done:?}")
+    };
     assert_eq!(params.len(), 20);
     for (i, p) in params.iter().enumerate() {
         assert_eq!(p.name, format!("P{i:02}"));
@@ -138,30 +217,79 @@ fn param_list_completes_despite_lost_values() {
 
 #[test]
 fn param_list_fails_when_vehicle_is_silent() {
-    let mut pair = Pair::new(GroundConfig::default(), VehicleConfig { params: many_params(), ..Default::default() }, 7);
+    let mut pair = Pair::new(
+        GroundConfig::default(),
+        VehicleConfig {
+            params: many_params(),
+            ..Default::default()
+        },
+        7,
+    );
     pair.to_ground.filter = Some(Box::new(|f| msg_id(f) == Some(PARAM_VALUE)));
     pair.ground.param_list(pair.now).expect("started");
     let done = pair.run_until_ground(secs(10.0), |e| matches!(e, GroundEvent::Param(_)));
-    assert!(matches!(done, Some(GroundEvent::Param(ParamEvent::ListFailed { expected_count: None, .. }))), "{done:?}");
+    assert!(
+        matches!(
+            done,
+            Some(GroundEvent::Param(ParamEvent::ListFailed {
+                expected_count: None,
+                ..
+            }))
+        ),
+        "{done:?}"
+    );
 }
 
 #[test]
 fn param_set_through_loss_reports_value_and_vehicle_change() {
-    let mut pair = Pair::new(GroundConfig::default(), VehicleConfig { params: many_params(), ..Default::default() }, 8);
+    let mut pair = Pair::new(
+        GroundConfig::default(),
+        VehicleConfig {
+            params: many_params(),
+            ..Default::default()
+        },
+        8,
+    );
     pair.to_vehicle.loss = 0.3;
     pair.to_ground.loss = 0.3;
-    pair.ground.param_set(pair.now, "P05", 55.5).expect("started");
-    let done = pair.run_until_ground(secs(10.0), |e| matches!(e, GroundEvent::Param(ParamEvent::SetDone { .. } | ParamEvent::SetFailed { .. })));
-    assert_eq!(done, Some(GroundEvent::Param(ParamEvent::SetDone { name: "P05".into(), requested: 55.5, actual: 55.5, accepted: true })));
+    pair.ground
+        .param_set(pair.now, "P05", 55.5)
+        .expect("started");
+    let done = pair.run_until_ground(secs(10.0), |e| {
+        matches!(
+            e,
+            GroundEvent::Param(ParamEvent::SetDone { .. } | ParamEvent::SetFailed { .. })
+        )
+    });
+    assert_eq!(
+        done,
+        Some(GroundEvent::Param(ParamEvent::SetDone {
+            name: "P05".into(),
+            requested: 55.5,
+            actual: 55.5,
+            accepted: true
+        }))
+    );
     assert_eq!(pair.vehicle.params().get("P05"), Some(55.5));
-    assert!(pair.vehicle_events.iter().any(|(_, e)| matches!(e, VehicleEvent::ParamChanged(c) if c.name == "P05" && c.new == 55.5)));
+    assert!(pair.vehicle_events.iter().any(
+        |(_, e)| matches!(e, VehicleEvent::ParamChanged(c) if c.name == "P05" && c.new == 55.5)
+    ));
 }
 
 fn test_plan() -> Vec<PlanItem> {
     let mut plan: Vec<PlanItem> = (0..8)
-        .map(|i| PlanItem::Waypoint { lat_deg: 41.0 + f64::from(i) * 0.01, lon_deg: -8.6, alt_msl_m: 1000.0 - f64::from(i) * 100.0 })
+        .map(|i| PlanItem::Waypoint {
+            lat_deg: 41.0 + f64::from(i) * 0.01,
+            lon_deg: -8.6,
+            alt_msl_m: 1000.0 - f64::from(i) * 100.0,
+        })
         .collect();
-    plan.push(PlanItem::Land { lat_deg: 41.1, lon_deg: -8.61, alt_msl_m: 95.0, approach_heading_deg: None });
+    plan.push(PlanItem::Land {
+        lat_deg: 41.1,
+        lon_deg: -8.61,
+        alt_msl_m: 95.0,
+        approach_heading_deg: None,
+    });
     plan
 }
 
@@ -169,30 +297,68 @@ fn test_plan() -> Vec<PlanItem> {
 fn plan_upload_and_download_with_losses() {
     // 25 % loss each way: an exchange fails 44 % of the time, so allow more retries than the
     // default for the 20 exchanges of an upload and a download.
-    let plan = stx_link::plan::PlanConfig { retries: 10, ..Default::default() };
-    let mut pair = Pair::new(GroundConfig { plan, ..Default::default() }, VehicleConfig { plan, ..Default::default() }, 9);
+    let plan = stx_link::plan::PlanConfig {
+        retries: 10,
+        ..Default::default()
+    };
+    let mut pair = Pair::new(
+        GroundConfig {
+            plan,
+            ..Default::default()
+        },
+        VehicleConfig {
+            plan,
+            ..Default::default()
+        },
+        9,
+    );
     pair.to_vehicle.loss = 0.25;
     pair.to_ground.loss = 0.25;
-    pair.ground.plan_upload(pair.now, test_plan()).expect("started");
+    pair.ground
+        .plan_upload(pair.now, test_plan())
+        .expect("started");
     let done = pair.run_until_ground(secs(60.0), |e| matches!(e, GroundEvent::Plan(_)));
-    assert_eq!(done, Some(GroundEvent::Plan(PlanEvent::UploadDone { items: 9 })));
+    assert_eq!(
+        done,
+        Some(GroundEvent::Plan(PlanEvent::UploadDone { items: 9 }))
+    );
     assert_eq!(pair.vehicle.plan().len(), 9);
-    assert!(pair.vehicle_events.iter().any(|(_, e)| matches!(e, VehicleEvent::PlanReceived(p) if p.len() == 9)));
+    assert!(
+        pair.vehicle_events
+            .iter()
+            .any(|(_, e)| matches!(e, VehicleEvent::PlanReceived(p) if p.len() == 9))
+    );
     pair.ground_events.clear();
     pair.ground.plan_download(pair.now).expect("started");
     let done = pair.run_until_ground(secs(60.0), |e| matches!(e, GroundEvent::Plan(_)));
-    let Some(GroundEvent::Plan(PlanEvent::DownloadDone { items })) = done else { panic!("{done:?}") };
+    let Some(GroundEvent::Plan(PlanEvent::DownloadDone { items })) = done else {
+        panic!("{done:?}")
+    };
     assert_eq!(items, pair.vehicle.plan());
-    assert!(pair.to_vehicle.dropped > 0 && pair.to_ground.dropped > 0, "the channel lost nothing: test is void");
+    assert!(
+        pair.to_vehicle.dropped > 0 && pair.to_ground.dropped > 0,
+        "the channel lost nothing: test is void"
+    );
 }
 
 #[test]
 fn plan_upload_fails_when_vehicle_never_answers() {
     let mut pair = Pair::default_pair(10);
     pair.to_vehicle.loss = 1.0;
-    pair.ground.plan_upload(pair.now, test_plan()).expect("started");
+    pair.ground
+        .plan_upload(pair.now, test_plan())
+        .expect("started");
     let done = pair.run_until_ground(secs(60.0), |e| matches!(e, GroundEvent::Plan(_)));
-    assert!(matches!(done, Some(GroundEvent::Plan(PlanEvent::UploadFailed { result: None, .. }))), "{done:?}");
+    assert!(
+        matches!(
+            done,
+            Some(GroundEvent::Plan(PlanEvent::UploadFailed {
+                result: None,
+                ..
+            }))
+        ),
+        "{done:?}"
+    );
 }
 
 #[test]
@@ -200,7 +366,13 @@ fn manual_control_streams_then_goes_stale_after_release() {
     let mut pair = Pair::default_pair(11);
     pair.run_for(secs(1.0));
     let t0 = pair.now;
-    pair.ground.manual_hold(t0, Sticks { y: 0.5, ..Default::default() });
+    pair.ground.manual_hold(
+        t0,
+        Sticks {
+            y: 0.5,
+            ..Default::default()
+        },
+    );
     pair.run_for(secs(1.0));
     pair.ground.manual_release();
     let released = pair.now;
@@ -211,7 +383,11 @@ fn manual_control_streams_then_goes_stale_after_release() {
         .filter(|(_, e)| matches!(e, VehicleEvent::Manual(ManualEvent::Sticks(s)) if s.y == 0.5))
         .map(|(t, _)| *t)
         .collect();
-    assert!((10..=11).contains(&sticks.len()), "{} stick messages in 1 s at 10 Hz", sticks.len());
+    assert!(
+        (10..=11).contains(&sticks.len()),
+        "{} stick messages in 1 s at 10 Hz",
+        sticks.len()
+    );
     let stale: Vec<Duration> = pair
         .vehicle_events
         .iter()
@@ -242,15 +418,32 @@ fn link_lost_and_regained() {
         .map(|(t, _)| *t)
         .expect("lost");
     // Heartbeats already in flight (50 ms) still arrive after the cut.
-    assert!(lost_at > cut && lost_at <= cut + secs(3.55), "{:?}", lost_at - cut);
-    assert!(pair.ground.link_stats(pair.now).last_heartbeat_age_s.is_some_and(|a| a > 5.0));
+    assert!(
+        lost_at > cut && lost_at <= cut + secs(3.55),
+        "{:?}",
+        lost_at - cut
+    );
+    assert!(
+        pair.ground
+            .link_stats(pair.now)
+            .last_heartbeat_age_s
+            .is_some_and(|a| a > 5.0)
+    );
     pair.to_ground.loss = 0.0;
     pair.to_vehicle.loss = 0.0;
     pair.run_for(secs(2.0));
     assert!(pair.ground.is_connected() && pair.vehicle.is_connected());
-    let connected = pair.ground_events.iter().filter(|(_, e)| matches!(e, GroundEvent::Link(LinkEvent::Connected { .. }))).count();
+    let connected = pair
+        .ground_events
+        .iter()
+        .filter(|(_, e)| matches!(e, GroundEvent::Link(LinkEvent::Connected { .. })))
+        .count();
     assert_eq!(connected, 2);
-    assert!(pair.vehicle_events.iter().any(|(_, e)| matches!(e, VehicleEvent::Link(LinkEvent::Lost { .. }))));
+    assert!(
+        pair.vehicle_events
+            .iter()
+            .any(|(_, e)| matches!(e, VehicleEvent::Link(LinkEvent::Lost { .. })))
+    );
 }
 
 #[test]
@@ -275,76 +468,150 @@ fn packet_loss_is_computed_from_sequence_gaps() {
     let stats = pair.ground.link_stats(pair.now);
     let sent = pair.to_ground.sent as f64;
     let truth = 100.0 * pair.to_ground.dropped as f64 / sent;
-    let v = stats.senders.iter().find(|s| s.system_id == 1).expect("vehicle sender");
+    let v = stats
+        .senders
+        .iter()
+        .find(|s| s.system_id == 1)
+        .expect("vehicle sender");
     // Frames lost after the last received one cannot be seen as a gap: allow one.
-    assert!((v.loss_pct - truth).abs() < 0.1, "estimated {} vs true {truth}", v.loss_pct);
-    assert!((stats.packet_loss_pct - 10.0).abs() < 2.0, "{}", stats.packet_loss_pct);
-    assert!((stats.messages_per_s - 45.0).abs() < 5.0, "{}", stats.messages_per_s);
-    assert!(stats.last_message_age_s.get("ATTITUDE").is_some_and(|&a| a < 1.5));
+    assert!(
+        (v.loss_pct - truth).abs() < 0.1,
+        "estimated {} vs true {truth}",
+        v.loss_pct
+    );
+    assert!(
+        (stats.packet_loss_pct - 10.0).abs() < 2.0,
+        "{}",
+        stats.packet_loss_pct
+    );
+    assert!(
+        (stats.messages_per_s - 45.0).abs() < 5.0,
+        "{}",
+        stats.messages_per_s
+    );
+    assert!(
+        stats
+            .last_message_age_s
+            .get("ATTITUDE")
+            .is_some_and(|&a| a < 1.5)
+    );
     // Serialisable for the station.
     let json = serde_json::to_string(&stats).expect("serialises");
     assert!(json.contains("packet_loss_pct"));
 }
 
 fn signing(key: u8, link_id: u8, unix_s: u64) -> SigningConfig {
-    SigningConfig::new(SigningKey::from_bytes([key; 32]), link_id, Duration::from_secs(unix_s))
+    SigningConfig::new(
+        SigningKey::from_bytes([key; 32]),
+        link_id,
+        Duration::from_secs(unix_s),
+    )
 }
 
 const JAN_2026: u64 = 1_767_225_600;
 
 fn signed_pair(ground: Option<SigningConfig>, vehicle: Option<SigningConfig>, seed: u64) -> Pair {
-    let g = GroundConfig { link: LinkConfig::ground().with_signing(ground), ..Default::default() };
-    let v = VehicleConfig { link: LinkConfig::vehicle().with_signing(vehicle), ..Default::default() };
+    let g = GroundConfig {
+        link: LinkConfig::ground().with_signing(ground),
+        ..Default::default()
+    };
+    let v = VehicleConfig {
+        link: LinkConfig::vehicle().with_signing(vehicle),
+        ..Default::default()
+    };
     Pair::new(g, v, seed)
 }
 
 #[test]
 fn signed_link_works_end_to_end() {
-    let mut pair = signed_pair(Some(signing(7, 1, JAN_2026)), Some(signing(7, 2, JAN_2026)), 14);
+    let mut pair = signed_pair(
+        Some(signing(7, 1, JAN_2026)),
+        Some(signing(7, 2, JAN_2026)),
+        14,
+    );
     pair.run_for(secs(1.5));
-    pair.ground.send_command(pair.now, RequestId(3), Command::Cutdown).expect("sent");
+    pair.ground
+        .send_command(pair.now, RequestId(3), Command::Cutdown)
+        .expect("sent");
     pair.run_for(secs(2.0));
-    assert_eq!(command_outcome(&pair, RequestId(3)), Some((CommandOutcome::Accepted, 1)));
+    assert_eq!(
+        command_outcome(&pair, RequestId(3)),
+        Some((CommandOutcome::Accepted, 1))
+    );
     let s = pair.vehicle.link_stats(pair.now);
     assert!(s.decoder.signed_frames > 0);
     assert_eq!(s.signature_failures, 0);
-    assert!(pair.ground_events.iter().any(|(_, e)| matches!(e, GroundEvent::Link(LinkEvent::PersistSigningTimestamp(_)))));
+    assert!(
+        pair.ground_events
+            .iter()
+            .any(|(_, e)| matches!(e, GroundEvent::Link(LinkEvent::PersistSigningTimestamp(_))))
+    );
 }
 
 #[test]
 fn signing_on_refuses_and_counts_unsigned_frames() {
     let mut pair = signed_pair(None, Some(signing(7, 2, JAN_2026)), 15);
     pair.run_for(secs(3.0));
-    pair.ground.send_command(pair.now, RequestId(4), Command::Cutdown).expect("sent");
+    pair.ground
+        .send_command(pair.now, RequestId(4), Command::Cutdown)
+        .expect("sent");
     pair.run_for(secs(6.0));
     assert_eq!(delivered_commands(&pair), 0);
-    assert!(!pair.vehicle.is_connected(), "unsigned heartbeats must not count");
+    assert!(
+        !pair.vehicle.is_connected(),
+        "unsigned heartbeats must not count"
+    );
     let s = pair.vehicle.link_stats(pair.now);
     assert!(s.decoder.unsigned_refused >= 8, "{:?}", s.decoder);
     assert_eq!(s.signature_failures, s.decoder.unsigned_refused);
-    assert_eq!(command_outcome(&pair, RequestId(4)), Some((CommandOutcome::TimedOut { attempts: 4 }, 4)));
+    assert_eq!(
+        command_outcome(&pair, RequestId(4)),
+        Some((CommandOutcome::TimedOut { attempts: 4 }, 4))
+    );
     // A wrong key is refused as well.
-    let mut pair = signed_pair(Some(signing(8, 1, JAN_2026)), Some(signing(7, 2, JAN_2026)), 16);
+    let mut pair = signed_pair(
+        Some(signing(8, 1, JAN_2026)),
+        Some(signing(7, 2, JAN_2026)),
+        16,
+    );
     pair.run_for(secs(3.0));
     assert!(pair.vehicle.link_stats(pair.now).decoder.bad_signatures >= 3);
 }
 
 #[test]
 fn replayed_signed_frame_is_refused() {
-    let mut pair = signed_pair(Some(signing(7, 1, JAN_2026)), Some(signing(7, 2, JAN_2026)), 17);
+    let mut pair = signed_pair(
+        Some(signing(7, 1, JAN_2026)),
+        Some(signing(7, 2, JAN_2026)),
+        17,
+    );
     pair.run_for(secs(1.5));
-    pair.ground.send_command(pair.now, RequestId(1), Command::Cutdown).expect("sent");
+    pair.ground
+        .send_command(pair.now, RequestId(1), Command::Cutdown)
+        .expect("sent");
     pair.run_for(secs(1.0));
     assert_eq!(delivered_commands(&pair), 1);
-    let recorded = pair.to_vehicle.log.iter().find(|f| msg_id(f) == Some(COMMAND_LONG)).expect("recorded").clone();
+    let recorded = pair
+        .to_vehicle
+        .log
+        .iter()
+        .find(|f| msg_id(f) == Some(COMMAND_LONG))
+        .expect("recorded")
+        .clone();
     pair.run_for(secs(10.0));
     pair.vehicle.handle_bytes(pair.now, &recorded);
     pair.drive_now();
-    assert_eq!(delivered_commands(&pair), 1, "a replayed cutdown must not execute");
+    assert_eq!(
+        delivered_commands(&pair),
+        1,
+        "a replayed cutdown must not execute"
+    );
     assert_eq!(pair.vehicle.link_stats(pair.now).decoder.replays_refused, 1);
     assert!(pair.vehicle_events.iter().any(|(_, e)| matches!(
         e,
-        VehicleEvent::Link(LinkEvent::FrameError(stx_link::frame::FrameError::Signature { .. }))
+        VehicleEvent::Link(LinkEvent::FrameError(
+            stx_link::frame::FrameError::Signature { .. }
+        ))
     )));
 }
 
@@ -354,7 +621,11 @@ fn replayed_signed_frame_is_refused() {
 #[test]
 fn signing_timestamp_is_monotonic_across_restart() {
     for use_persisted in [true, false] {
-        let mut pair = signed_pair(Some(signing(7, 1, JAN_2026)), Some(signing(7, 2, JAN_2026)), 18);
+        let mut pair = signed_pair(
+            Some(signing(7, 1, JAN_2026)),
+            Some(signing(7, 2, JAN_2026)),
+            18,
+        );
         pair.ground.link_stats(pair.now);
         pair.run_for(secs(5.0));
         let persisted = pair
@@ -367,8 +638,15 @@ fn signing_timestamp_is_monotonic_across_restart() {
             .max();
         assert!(persisted.is_some());
         // Restart: new endpoint, clock one hour behind.
-        let behind = signing(7, 2, JAN_2026 - 3600).with_persisted_timestamp(if use_persisted { persisted } else { None });
-        let cfg = VehicleConfig { link: LinkConfig::vehicle().with_signing(Some(behind)), ..Default::default() };
+        let behind = signing(7, 2, JAN_2026 - 3600).with_persisted_timestamp(if use_persisted {
+            persisted
+        } else {
+            None
+        });
+        let cfg = VehicleConfig {
+            link: LinkConfig::vehicle().with_signing(Some(behind)),
+            ..Default::default()
+        };
         pair.vehicle = stx_link::endpoint::VehicleEndpoint::new(cfg, pair.now).expect("vehicle");
         let before = pair.ground.link_stats(pair.now).decoder;
         pair.run_for(secs(3.0));
@@ -378,7 +656,10 @@ fn signing_timestamp_is_monotonic_across_restart() {
             assert!(after.signed_frames > before.signed_frames + 2);
             assert!(pair.ground.is_connected());
         } else {
-            assert!(after.replays_refused > before.replays_refused, "control case: without the mark frames are replays");
+            assert!(
+                after.replays_refused > before.replays_refused,
+                "control case: without the mark frames are replays"
+            );
         }
     }
 }
@@ -387,11 +668,16 @@ fn signing_timestamp_is_monotonic_across_restart() {
 fn long_status_text_arrives_whole() {
     let mut pair = Pair::default_pair(19);
     let text = "Parafoil deployed; round chute released at 3124 m; guidance entering approximation phase towards branch 2";
-    pair.vehicle.send_status_text(pair.now, stx_link::telemetry::Severity::Notice, text);
+    pair.vehicle
+        .send_status_text(pair.now, stx_link::telemetry::Severity::Notice, text);
     let got = pair.run_until_ground(secs(1.0), |e| matches!(e, GroundEvent::StatusText { .. }));
     assert_eq!(
         got,
-        Some(GroundEvent::StatusText { from: (1, 1), severity: stx_link::telemetry::Severity::Notice, text: text.to_string() })
+        Some(GroundEvent::StatusText {
+            from: (1, 1),
+            severity: stx_link::telemetry::Severity::Notice,
+            text: text.to_string()
+        })
     );
     let _ = HEARTBEAT;
 }

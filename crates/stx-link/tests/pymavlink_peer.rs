@@ -27,7 +27,9 @@ fn workspace_root() -> PathBuf {
 }
 
 fn python() -> PathBuf {
-    let p = std::env::var_os("STX_PYTHON").map(PathBuf::from).unwrap_or_else(|| workspace_root().join(".venv/bin/python"));
+    let p = std::env::var_os("STX_PYTHON")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| workspace_root().join(".venv/bin/python"));
     assert!(
         p.exists(),
         "pymavlink peer: no Python at {} (set STX_PYTHON, or create the venv at the workspace root: \
@@ -38,8 +40,15 @@ fn python() -> PathBuf {
 }
 
 fn run_py(script: &str, args: &[&str]) -> String {
-    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/peers").join(script);
-    let out = Command::new(python()).env("MAVLINK20", "1").arg(&script).args(args).output().expect("python runs");
+    let script = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/peers")
+        .join(script);
+    let out = Command::new(python())
+        .env("MAVLINK20", "1")
+        .arg(&script)
+        .args(args)
+        .output()
+        .expect("python runs");
     assert!(
         out.status.success(),
         "{} failed ({}): {}\n(is pymavlink installed? `.venv/bin/pip install pymavlink==2.4.50`)",
@@ -54,7 +63,9 @@ fn run_py(script: &str, args: &[&str]) -> String {
 fn make_streams(label: &str) -> (PathBuf, Value) {
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("pymavlink-streams-{label}"));
     run_py("make_streams.py", &[dir.to_str().expect("utf-8 path")]);
-    let manifest: Value = serde_json::from_slice(&std::fs::read(dir.join("manifest.json")).expect("manifest")).expect("json");
+    let manifest: Value =
+        serde_json::from_slice(&std::fs::read(dir.join("manifest.json")).expect("manifest"))
+            .expect("json");
     (dir, manifest)
 }
 
@@ -141,42 +152,87 @@ fn check_frames(got: &[Frame], expected: &[Value], label: &str) {
     for (i, (f, e)) in got.iter().zip(expected).enumerate() {
         let ctx = format!("{label} frame {i} ({})", e["name"]);
         assert_eq!(f.header.version, WireVersion::V2, "{ctx}");
-        assert_eq!(u64::from(f.header.message_id), e["msgid"].as_u64().unwrap_or(u64::MAX), "{ctx}: id");
-        assert_eq!(f.message.message_name(), e["name"].as_str().unwrap_or(""), "{ctx}: name");
-        assert_eq!(u64::from(f.header.system_id), e["sysid"].as_u64().unwrap_or(0), "{ctx}: sysid");
-        assert_eq!(u64::from(f.header.component_id), e["compid"].as_u64().unwrap_or(0), "{ctx}: compid");
-        assert_eq!(u64::from(f.header.sequence), e["seq"].as_u64().unwrap_or(999), "{ctx}: seq");
-        assert_eq!(f.header.is_signed(), e["signed"].as_bool().unwrap_or(false), "{ctx}: signed");
+        assert_eq!(
+            u64::from(f.header.message_id),
+            e["msgid"].as_u64().unwrap_or(u64::MAX),
+            "{ctx}: id"
+        );
+        assert_eq!(
+            f.message.message_name(),
+            e["name"].as_str().unwrap_or(""),
+            "{ctx}: name"
+        );
+        assert_eq!(
+            u64::from(f.header.system_id),
+            e["sysid"].as_u64().unwrap_or(0),
+            "{ctx}: sysid"
+        );
+        assert_eq!(
+            u64::from(f.header.component_id),
+            e["compid"].as_u64().unwrap_or(0),
+            "{ctx}: compid"
+        );
+        assert_eq!(
+            u64::from(f.header.sequence),
+            e["seq"].as_u64().unwrap_or(999),
+            "{ctx}: seq"
+        );
+        assert_eq!(
+            f.header.is_signed(),
+            e["signed"].as_bool().unwrap_or(false),
+            "{ctx}: signed"
+        );
         // Every field: our re-encoding of the decoded message gives pymavlink's payload.
         let mut payload = [0_u8; 255];
         let n = f.message.ser(MavlinkVersion::V2, &mut payload);
-        assert_eq!(hex(&payload[..n]), e["payload_hex"].as_str().unwrap_or(""), "{ctx}: payload");
+        assert_eq!(
+            hex(&payload[..n]),
+            e["payload_hex"].as_str().unwrap_or(""),
+            "{ctx}: payload"
+        );
         // And a few values, compared with what pymavlink was asked to encode.
         for (name, want) in e["spot"].as_object().into_iter().flatten() {
             match (name.as_str(), &f.message) {
                 ("text", MavMessage::STATUSTEXT(_)) => {
-                    let Some(Telemetry::StatusText(t)) = Telemetry::from_mavlink(&f.message) else { panic!("{ctx}: statustext") };
+                    let Some(Telemetry::StatusText(t)) = Telemetry::from_mavlink(&f.message) else {
+                        panic!("{ctx}: statustext")
+                    };
                     assert_eq!(t.text_lossy(), want.as_str().unwrap_or(""), "{ctx}: text");
                 }
                 ("param_id", MavMessage::PARAM_VALUE(p)) => {
                     let raw: &[u8] = &p.param_id[..];
                     let end = raw.iter().position(|&b| b == 0).unwrap_or(raw.len());
-                    assert_eq!(std::str::from_utf8(&raw[..end]).ok(), want.as_str(), "{ctx}: param_id");
+                    assert_eq!(
+                        std::str::from_utf8(&raw[..end]).ok(),
+                        want.as_str(),
+                        "{ctx}: param_id"
+                    );
                 }
                 _ => {
-                    let got = field(&f.message, name).unwrap_or_else(|| panic!("{ctx}: no accessor for {name}"));
+                    let got = field(&f.message, name)
+                        .unwrap_or_else(|| panic!("{ctx}: no accessor for {name}"));
                     let want = want.as_f64().unwrap_or(f64::NAN);
                     // pymavlink reports the double it was given; the wire holds an f32.
-                    assert!((got - want).abs() <= 1e-6 * want.abs().max(1.0), "{ctx}: {name} = {got}, pymavlink {want}");
+                    assert!(
+                        (got - want).abs() <= 1e-6 * want.abs().max(1.0),
+                        "{ctx}: {name} = {got}, pymavlink {want}"
+                    );
                 }
             }
         }
         // Telemetry messages map to stx telemetry.
         if matches!(
             f.message,
-            MavMessage::HEARTBEAT(_) | MavMessage::GPS_RAW_INT(_) | MavMessage::ATTITUDE(_) | MavMessage::WIND_COV(_) | MavMessage::SERVO_OUTPUT_RAW(_)
+            MavMessage::HEARTBEAT(_)
+                | MavMessage::GPS_RAW_INT(_)
+                | MavMessage::ATTITUDE(_)
+                | MavMessage::WIND_COV(_)
+                | MavMessage::SERVO_OUTPUT_RAW(_)
         ) {
-            assert!(Telemetry::from_mavlink(&f.message).is_some(), "{ctx}: not read as telemetry");
+            assert!(
+                Telemetry::from_mavlink(&f.message).is_some(),
+                "{ctx}: not read as telemetry"
+            );
         }
     }
 }
@@ -190,7 +246,10 @@ fn decoder_recovers_every_pymavlink_frame_and_counts_the_corrupt_ones() {
     let corrupted = m["corrupted_crc"].as_u64().expect("count");
     let truncated = m["truncated"].as_u64().expect("count");
     let garbage = m["garbage_bytes"].as_u64().expect("count");
-    assert!(expected.len() > 1000 && corrupted > 10 && truncated > 10 && garbage > 100, "stream too tame: {m:?}");
+    assert!(
+        expected.len() > 1000 && corrupted > 10 && truncated > 10 && garbage > 100,
+        "stream too tame: {m:?}"
+    );
     for chunk in [1, 2, 7, 64, 1500, bytes.len()] {
         let (frames, dec) = decode(&bytes, chunk, FrameDecoder::default());
         check_frames(&frames, expected, &format!("unsigned, chunk {chunk}"));
@@ -199,7 +258,10 @@ fn decoder_recovers_every_pymavlink_frame_and_counts_the_corrupt_ones() {
         // Each corrupted frame fails its CRC; each truncated one fails the CRC of the bytes it
         // swallowed (or is cut by the end of the stream).
         assert!(s.crc_errors >= corrupted, "{s:?}");
-        assert!(s.crc_errors + s.truncated + s.unknown_message_ids >= corrupted + truncated, "{s:?}");
+        assert!(
+            s.crc_errors + s.truncated + s.unknown_message_ids >= corrupted + truncated,
+            "{s:?}"
+        );
         assert!(s.bytes_discarded >= garbage, "{s:?}");
         assert_eq!(s.bytes_in, bytes.len() as u64);
     }
@@ -215,21 +277,43 @@ fn signed_pymavlink_stream_verifies_and_refusals_are_counted() {
     for (i, b) in key.iter_mut().enumerate() {
         *b = u8::from_str_radix(&key_hex[2 * i..2 * i + 2], 16).expect("hex");
     }
-    let (_, verifier) = SigningConfig::new(SigningKey::from_bytes(key), 0, Duration::from_secs(JAN_2026)).build(Duration::from_secs(1));
+    let (_, verifier) = SigningConfig::new(
+        SigningKey::from_bytes(key),
+        0,
+        Duration::from_secs(JAN_2026),
+    )
+    .build(Duration::from_secs(1));
     let mut dec = FrameDecoder::default();
     dec.set_verifier(Some(verifier));
     let (frames, dec) = decode(&bytes, 13, dec);
     check_frames(&frames, m["frames"].as_array().expect("frames"), "signed");
     let s = dec.stats();
     let e = &m["expect"];
-    assert_eq!(s.unsigned_refused, e["unsigned_refused"].as_u64().expect("n"), "{s:?}");
-    assert_eq!(s.replays_refused, e["replays_refused"].as_u64().expect("n"), "{s:?}");
-    assert_eq!(s.bad_signatures, e["bad_signatures"].as_u64().expect("n"), "{s:?}");
+    assert_eq!(
+        s.unsigned_refused,
+        e["unsigned_refused"].as_u64().expect("n"),
+        "{s:?}"
+    );
+    assert_eq!(
+        s.replays_refused,
+        e["replays_refused"].as_u64().expect("n"),
+        "{s:?}"
+    );
+    assert_eq!(
+        s.bad_signatures,
+        e["bad_signatures"].as_u64().expect("n"),
+        "{s:?}"
+    );
     assert_eq!(s.v1_refused, e["v1_refused"].as_u64().expect("n"), "{s:?}");
     assert_eq!(s.signed_frames, frames.len() as u64);
 
     // The same stream with the wrong key: nothing gets through.
-    let (_, wrong) = SigningConfig::new(SigningKey::from_bytes([9; 32]), 0, Duration::from_secs(JAN_2026)).build(Duration::from_secs(1));
+    let (_, wrong) = SigningConfig::new(
+        SigningKey::from_bytes([9; 32]),
+        0,
+        Duration::from_secs(JAN_2026),
+    )
+    .build(Duration::from_secs(1));
     let mut dec = FrameDecoder::default();
     dec.set_verifier(Some(wrong));
     let (frames, dec) = decode(&bytes, bytes.len(), dec);
@@ -240,7 +324,11 @@ fn signed_pymavlink_stream_verifies_and_refusals_are_counted() {
 #[test]
 fn pymavlink_verifies_frames_signed_by_stx_link() {
     let key = [0x5A_u8; 32];
-    let cfg = SigningConfig::new(SigningKey::from_bytes(key), 7, Duration::from_secs(JAN_2026));
+    let cfg = SigningConfig::new(
+        SigningKey::from_bytes(key),
+        7,
+        Duration::from_secs(JAN_2026),
+    );
     let (signer, _) = cfg.build(Duration::ZERO);
     let mut enc = FrameEncoder::new(1, 1);
     enc.set_signer(Some(signer));
@@ -255,7 +343,12 @@ fn pymavlink_verifies_frames_signed_by_stx_link() {
             pitch_rate_radps: 0.0,
             yaw_rate_radps: 0.0,
         }),
-        Telemetry::PredictedLanding(stx_link::telemetry::PredictedLanding { time_boot_ms: 5, lat_deg: 41.2, lon_deg: -8.6, alt_msl_m: 95.0 }),
+        Telemetry::PredictedLanding(stx_link::telemetry::PredictedLanding {
+            time_boot_ms: 5,
+            lat_deg: 41.2,
+            lon_deg: -8.6,
+            alt_msl_m: 95.0,
+        }),
     ];
     for i in 0..50_u64 {
         let t = &telemetry[(i % 2) as usize];
@@ -265,7 +358,10 @@ fn pymavlink_verifies_frames_signed_by_stx_link() {
     std::fs::write(&path, &stream).expect("write");
     let key_hex = hex(&key);
     let start = (JAN_2026 - 1_420_070_400) * 100_000;
-    let out = run_py("verify_stream.py", &[path.to_str().expect("utf-8"), &key_hex, &start.to_string()]);
+    let out = run_py(
+        "verify_stream.py",
+        &[path.to_str().expect("utf-8"), &key_hex, &start.to_string()],
+    );
     let v: Value = serde_json::from_str(out.trim()).expect("json summary");
     assert_eq!(v["goodsig"].as_u64(), Some(50), "{v}");
     assert_eq!(v["badsig"].as_u64(), Some(0), "{v}");
@@ -273,7 +369,14 @@ fn pymavlink_verifies_frames_signed_by_stx_link() {
     assert_eq!(v["messages"].as_array().map(Vec::len), Some(50), "{v}");
 
     // With another key pymavlink refuses them all: the check above can fail.
-    let out = run_py("verify_stream.py", &[path.to_str().expect("utf-8"), &hex(&[1; 32]), &start.to_string()]);
+    let out = run_py(
+        "verify_stream.py",
+        &[
+            path.to_str().expect("utf-8"),
+            &hex(&[1; 32]),
+            &start.to_string(),
+        ],
+    );
     let v: Value = serde_json::from_str(out.trim()).expect("json summary");
     assert_eq!(v["goodsig"].as_u64(), Some(0), "{v}");
     assert_eq!(v["messages"].as_array().map(Vec::len), Some(0), "{v}");

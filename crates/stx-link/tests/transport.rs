@@ -4,9 +4,14 @@
 use std::time::Duration;
 
 use stx_link::command::{Command, CommandOutcome, CommandResult, RequestId};
-use stx_link::endpoint::{GroundConfig, GroundEndpoint, GroundEvent, LinkConfig, VehicleConfig, VehicleEndpoint, VehicleEvent};
+use stx_link::endpoint::{
+    GroundConfig, GroundEndpoint, GroundEvent, LinkConfig, VehicleConfig, VehicleEndpoint,
+    VehicleEvent,
+};
 use stx_link::param::{ParamEvent, ParamSpec};
-use stx_link::transport::{Action, DriveOptions, DriverEvent, IoEvent, Transport, TransportError, drive};
+use stx_link::transport::{
+    Action, DriveOptions, DriverEvent, IoEvent, Transport, TransportError, drive,
+};
 use tokio::sync::mpsc;
 use tokio::task::JoinHandle;
 
@@ -25,31 +30,68 @@ struct Driven<E: stx_link::transport::SansIo> {
 fn spawn<E: stx_link::transport::SansIo>(transport: Transport, endpoint: E) -> Driven<E> {
     let (atx, arx) = mpsc::channel(16);
     let (etx, erx) = mpsc::channel(1024);
-    let task = tokio::spawn(drive(transport, endpoint, arx, etx, DriveOptions::default()));
-    Driven { actions: atx, events: erx, task }
+    let task = tokio::spawn(drive(
+        transport,
+        endpoint,
+        arx,
+        etx,
+        DriveOptions::default(),
+    ));
+    Driven {
+        actions: atx,
+        events: erx,
+        task,
+    }
 }
 
 fn ground() -> GroundEndpoint {
-    GroundEndpoint::new(GroundConfig { link: fast(LinkConfig::ground()), ..Default::default() }, Duration::ZERO)
+    GroundEndpoint::new(
+        GroundConfig {
+            link: fast(LinkConfig::ground()),
+            ..Default::default()
+        },
+        Duration::ZERO,
+    )
 }
 
 fn vehicle() -> VehicleEndpoint {
-    let params = vec![ParamSpec::new("FLARE_ALT_M", 8.0, 0.0, 50.0, "flare height, m")];
-    VehicleEndpoint::new(VehicleConfig { link: fast(LinkConfig::vehicle()), params, ..Default::default() }, Duration::ZERO)
-        .expect("vehicle")
+    let params = vec![ParamSpec::new(
+        "FLARE_ALT_M",
+        8.0,
+        0.0,
+        50.0,
+        "flare height, m",
+    )];
+    VehicleEndpoint::new(
+        VehicleConfig {
+            link: fast(LinkConfig::vehicle()),
+            params,
+            ..Default::default()
+        },
+        Duration::ZERO,
+    )
+    .expect("vehicle")
 }
 
 /// Runs the vehicle's application side: accepts every command.
-fn vehicle_app(mut v: Driven<VehicleEndpoint>) -> (mpsc::Sender<Action<VehicleEndpoint>>, JoinHandle<Vec<DriverEvent<VehicleEvent>>>) {
+fn vehicle_app(
+    mut v: Driven<VehicleEndpoint>,
+) -> (
+    mpsc::Sender<Action<VehicleEndpoint>>,
+    JoinHandle<Vec<DriverEvent<VehicleEvent>>>,
+) {
     let actions = v.actions.clone();
     let handle = tokio::spawn(async move {
         let mut seen = Vec::new();
         while let Some(e) = v.events.recv().await {
             if let DriverEvent::Endpoint(VehicleEvent::Command(c)) = &e {
                 let id = c.id;
-                let _ = v.actions.send(Box::new(move |ep: &mut VehicleEndpoint, _| {
-                    ep.respond_command(id, CommandResult::Accepted);
-                })).await;
+                let _ = v
+                    .actions
+                    .send(Box::new(move |ep: &mut VehicleEndpoint, _| {
+                        ep.respond_command(id, CommandResult::Accepted);
+                    }))
+                    .await;
             }
             seen.push(e);
         }
@@ -79,24 +121,37 @@ async fn wait_for<E: std::fmt::Debug>(
 
 #[tokio::test]
 async fn udp_in_and_out_carry_a_command_and_its_ack() {
-    let g = Transport::open_str("udpin:127.0.0.1:0").await.expect("bind");
+    let g = Transport::open_str("udpin:127.0.0.1:0")
+        .await
+        .expect("bind");
     let port = g.local_addr().expect("addr").port();
     let mut g = spawn(g, ground());
     // The ground heartbeats before anyone was heard: queued, not silently dropped.
-    wait_for(&mut g.events, |e| matches!(e, DriverEvent::Io(IoEvent::QueuedWithoutPeer { .. }))).await;
+    wait_for(&mut g.events, |e| {
+        matches!(e, DriverEvent::Io(IoEvent::QueuedWithoutPeer { .. }))
+    })
+    .await;
 
-    let v = Transport::open_str(&format!("udpout:127.0.0.1:{port}")).await.expect("udpout");
+    let v = Transport::open_str(&format!("udpout:127.0.0.1:{port}"))
+        .await
+        .expect("udpout");
     let (v_actions, v_app) = vehicle_app(spawn(v, vehicle()));
 
-    wait_for(&mut g.events, |e| matches!(e, DriverEvent::Io(IoEvent::PeerChanged { .. }))).await;
+    wait_for(&mut g.events, |e| {
+        matches!(e, DriverEvent::Io(IoEvent::PeerChanged { .. }))
+    })
+    .await;
     g.actions
         .send(Box::new(|ep: &mut GroundEndpoint, now| {
-            ep.send_command(now, RequestId(77), Command::Cutdown).expect("sent");
+            ep.send_command(now, RequestId(77), Command::Cutdown)
+                .expect("sent");
         }))
         .await
         .expect("driver alive");
     let seen = wait_for(&mut g.events, |e| matches!(e, DriverEvent::Endpoint(GroundEvent::Command(c)) if c.request_id == RequestId(77))).await;
-    let Some(DriverEvent::Endpoint(GroundEvent::Command(c))) = seen.last() else { panic!() };
+    let Some(DriverEvent::Endpoint(GroundEvent::Command(c))) = seen.last() else {
+        panic!()
+    };
     assert_eq!(c.outcome, CommandOutcome::Accepted);
 
     drop(g.actions);
@@ -111,19 +166,40 @@ async fn udp_in_and_out_carry_a_command_and_its_ack() {
 
 #[tokio::test]
 async fn tcp_client_and_server_carry_a_param_read() {
-    let v = Transport::open_str("tcpin:127.0.0.1:0").await.expect("listen");
+    let v = Transport::open_str("tcpin:127.0.0.1:0")
+        .await
+        .expect("listen");
     let port = v.local_addr().expect("addr").port();
     let (_v_actions, v_app) = vehicle_app(spawn(v, vehicle()));
-    let g = Transport::open_str(&format!("tcp:127.0.0.1:{port}")).await.expect("connect");
+    let g = Transport::open_str(&format!("tcp:127.0.0.1:{port}"))
+        .await
+        .expect("connect");
     let mut g = spawn(g, ground());
     g.actions
-        .send(Box::new(|ep: &mut GroundEndpoint, now| ep.param_read(now, "FLARE_ALT_M").expect("read")))
+        .send(Box::new(|ep: &mut GroundEndpoint, now| {
+            ep.param_read(now, "FLARE_ALT_M").expect("read")
+        }))
         .await
         .expect("driver alive");
-    let seen = wait_for(&mut g.events, |e| matches!(e, DriverEvent::Endpoint(GroundEvent::Param(_)))).await;
-    let Some(DriverEvent::Endpoint(GroundEvent::Param(ParamEvent::ReadDone { param }))) = seen.last() else { panic!("{seen:?}") };
+    let seen = wait_for(&mut g.events, |e| {
+        matches!(e, DriverEvent::Endpoint(GroundEvent::Param(_)))
+    })
+    .await;
+    let Some(DriverEvent::Endpoint(GroundEvent::Param(ParamEvent::ReadDone { param }))) =
+        seen.last()
+    else {
+        panic!("{seen:?}")
+    };
     assert_eq!(param.value, 8.0);
-    wait_for(&mut g.events, |e| matches!(e, DriverEvent::Endpoint(GroundEvent::Link(stx_link::endpoint::LinkEvent::Connected { .. })))).await;
+    wait_for(&mut g.events, |e| {
+        matches!(
+            e,
+            DriverEvent::Endpoint(GroundEvent::Link(
+                stx_link::endpoint::LinkEvent::Connected { .. }
+            ))
+        )
+    })
+    .await;
 
     // The station goes away: the vehicle's server reports it, then loses the link.
     drop(g.actions);
@@ -133,13 +209,23 @@ async fn tcp_client_and_server_carry_a_param_read() {
 
 #[tokio::test]
 async fn tcp_server_reports_client_leaving() {
-    let v = Transport::open_str("tcpin:127.0.0.1:0").await.expect("listen");
+    let v = Transport::open_str("tcpin:127.0.0.1:0")
+        .await
+        .expect("listen");
     let port = v.local_addr().expect("addr").port();
     let mut vd = spawn(v, vehicle());
-    let client = tokio::net::TcpStream::connect(("127.0.0.1", port)).await.expect("connect");
-    wait_for(&mut vd.events, |e| matches!(e, DriverEvent::Io(IoEvent::Connected { .. }))).await;
+    let client = tokio::net::TcpStream::connect(("127.0.0.1", port))
+        .await
+        .expect("connect");
+    wait_for(&mut vd.events, |e| {
+        matches!(e, DriverEvent::Io(IoEvent::Connected { .. }))
+    })
+    .await;
     drop(client);
-    wait_for(&mut vd.events, |e| matches!(e, DriverEvent::Io(IoEvent::Disconnected { .. }))).await;
+    wait_for(&mut vd.events, |e| {
+        matches!(e, DriverEvent::Io(IoEvent::Disconnected { .. }))
+    })
+    .await;
     drop(vd.actions);
     let (_, io) = vd.task.await.expect("task");
     assert_eq!(io.connects, 1);
@@ -147,7 +233,9 @@ async fn tcp_server_reports_client_leaving() {
 
 #[tokio::test(start_paused = true)]
 async fn udpin_without_peer_queues_every_send_and_counts_it() {
-    let g = Transport::open_str("udpin:127.0.0.1:0").await.expect("bind");
+    let g = Transport::open_str("udpin:127.0.0.1:0")
+        .await
+        .expect("bind");
     let mut g = spawn(g, ground());
     // Paused clock: 1 s of heartbeats at 10 Hz, all queued.
     tokio::time::sleep(Duration::from_millis(1050)).await;
@@ -171,14 +259,23 @@ async fn serial_pty_pair_links_ground_and_vehicle() {
         Ok(p) => p,
         Err(e) => panic!("cannot create a pseudo-terminal pair here: {e}"),
     };
-    let (_v_actions, v_app) = vehicle_app(spawn(Transport::from_stream("pty-slave", slave), vehicle()));
+    let (_v_actions, v_app) =
+        vehicle_app(spawn(Transport::from_stream("pty-slave", slave), vehicle()));
     let mut g = spawn(Transport::from_stream("pty-master", master), ground());
     g.actions
-        .send(Box::new(|ep: &mut GroundEndpoint, now| ep.send_command(now, RequestId(5), Command::Cutdown).expect("sent")))
+        .send(Box::new(|ep: &mut GroundEndpoint, now| {
+            ep.send_command(now, RequestId(5), Command::Cutdown)
+                .expect("sent")
+        }))
         .await
         .expect("driver alive");
-    let seen = wait_for(&mut g.events, |e| matches!(e, DriverEvent::Endpoint(GroundEvent::Command(_)))).await;
-    assert!(matches!(seen.last(), Some(DriverEvent::Endpoint(GroundEvent::Command(c))) if c.outcome == CommandOutcome::Accepted));
+    let seen = wait_for(&mut g.events, |e| {
+        matches!(e, DriverEvent::Endpoint(GroundEvent::Command(_)))
+    })
+    .await;
+    assert!(
+        matches!(seen.last(), Some(DriverEvent::Endpoint(GroundEvent::Command(c))) if c.outcome == CommandOutcome::Accepted)
+    );
     drop(g.actions);
     let _ = g.task.await;
     v_app.abort();
@@ -186,9 +283,13 @@ async fn serial_pty_pair_links_ground_and_vehicle() {
 
 #[tokio::test]
 async fn opening_bad_addresses_fails_clearly() {
-    let e = Transport::open_str("udpin:not-an-ip:1").await.expect_err("must fail");
+    let e = Transport::open_str("udpin:not-an-ip:1")
+        .await
+        .expect_err("must fail");
     assert!(matches!(e, TransportError::Address(_)), "{e}");
-    let e = Transport::open_str("serial:/nonexistent/tty-stx:57600").await.expect_err("must fail");
+    let e = Transport::open_str("serial:/nonexistent/tty-stx:57600")
+        .await
+        .expect_err("must fail");
     assert!(e.to_string().contains("/nonexistent/tty-stx"), "{e}");
 }
 
@@ -198,21 +299,47 @@ async fn signing_timestamp_file_is_written_and_read_back() {
     std::fs::create_dir_all(&dir).expect("tmp dir");
     let path = dir.join("signing_ts");
     let _ = std::fs::remove_file(&path);
-    assert_eq!(stx_link::transport::load_signing_timestamp(&path).expect("read"), None);
+    assert_eq!(
+        stx_link::transport::load_signing_timestamp(&path).expect("read"),
+        None
+    );
     let key = stx_link::signing::SigningKey::from_bytes([3; 32]);
     let signing = stx_link::signing::SigningConfig::new(key, 0, Duration::from_secs(1_767_225_600));
     let ep = GroundEndpoint::new(
-        GroundConfig { link: fast(LinkConfig::ground()).with_signing(Some(signing)), ..Default::default() },
+        GroundConfig {
+            link: fast(LinkConfig::ground()).with_signing(Some(signing)),
+            ..Default::default()
+        },
         Duration::ZERO,
     );
-    let t = Transport::open_str("udpin:127.0.0.1:0").await.expect("bind");
+    let t = Transport::open_str("udpin:127.0.0.1:0")
+        .await
+        .expect("bind");
     let (atx, arx) = mpsc::channel::<Action<GroundEndpoint>>(1);
     let (etx, mut erx) = mpsc::channel(1024);
-    let task = tokio::spawn(drive(t, ep, arx, etx, DriveOptions { signing_timestamp_file: Some(path.clone()) }));
-    wait_for(&mut erx, |e| matches!(e, DriverEvent::Endpoint(GroundEvent::Link(stx_link::endpoint::LinkEvent::PersistSigningTimestamp(_))))).await;
+    let task = tokio::spawn(drive(
+        t,
+        ep,
+        arx,
+        etx,
+        DriveOptions {
+            signing_timestamp_file: Some(path.clone()),
+        },
+    ));
+    wait_for(&mut erx, |e| {
+        matches!(
+            e,
+            DriverEvent::Endpoint(GroundEvent::Link(
+                stx_link::endpoint::LinkEvent::PersistSigningTimestamp(_)
+            ))
+        )
+    })
+    .await;
     drop(atx);
     let _ = task.await;
-    let stored = stx_link::transport::load_signing_timestamp(&path).expect("read").expect("written");
+    let stored = stx_link::transport::load_signing_timestamp(&path)
+        .expect("read")
+        .expect("written");
     // 2026-01-01 is 347 155 200 s = 34 715 520 000 000 units of 10 µs after 2015-01-01; the
     // mark reserves 10 s (1 000 000 units) ahead of the first timestamp.
     assert_eq!(stored, 34_715_520_000_000 - 1 + 1_000_000);

@@ -9,7 +9,9 @@ use std::time::Duration;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use stx_link::command::CommandResult;
-use stx_link::endpoint::{GroundConfig, GroundEndpoint, GroundEvent, VehicleConfig, VehicleEndpoint, VehicleEvent};
+use stx_link::endpoint::{
+    GroundConfig, GroundEndpoint, GroundEvent, VehicleConfig, VehicleEndpoint, VehicleEvent,
+};
 
 /// Message id of a MAVLink 2 frame.
 pub fn msg_id(frame: &[u8]) -> Option<u32> {
@@ -39,7 +41,15 @@ pub struct Channel {
 
 impl Channel {
     fn new(latency: Duration) -> Self {
-        Self { latency, loss: 0.0, filter: None, queue: VecDeque::new(), sent: 0, dropped: 0, log: Vec::new() }
+        Self {
+            latency,
+            loss: 0.0,
+            filter: None,
+            queue: VecDeque::new(),
+            sent: 0,
+            dropped: 0,
+            log: Vec::new(),
+        }
     }
 
     fn push(&mut self, now: Duration, frame: Vec<u8>, rng: &mut ChaCha8Rng) {
@@ -59,7 +69,11 @@ impl Channel {
     }
 
     fn pop_due(&mut self, now: Duration) -> Option<Vec<u8>> {
-        if self.queue.front().is_some_and(|(t, _)| *t <= now) { self.queue.pop_front().map(|(_, f)| f) } else { None }
+        if self.queue.front().is_some_and(|(t, _)| *t <= now) {
+            self.queue.pop_front().map(|(_, f)| f)
+        } else {
+            None
+        }
     }
 }
 
@@ -168,7 +182,11 @@ impl Pair {
     }
 
     /// Runs until `pred` holds for some ground event, or `timeout` passes.
-    pub fn run_until_ground<F: Fn(&GroundEvent) -> bool>(&mut self, timeout: Duration, pred: F) -> Option<GroundEvent> {
+    pub fn run_until_ground<F: Fn(&GroundEvent) -> bool>(
+        &mut self,
+        timeout: Duration,
+        pred: F,
+    ) -> Option<GroundEvent> {
         let until = self.now + timeout;
         let mut seen = 0;
         loop {
