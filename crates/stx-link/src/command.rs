@@ -735,7 +735,10 @@ pub struct IncomingCommand {
 struct Recent {
     id: IncomingId,
     from: (u8, u8),
-    msg: MavMessage,
+    command: MavCmd,
+    /// Message id and wire payload with `confirmation` zeroed: retries compare equal even
+    /// when a parameter is NaN (as in a landing target "into the wind").
+    content: Vec<u8>,
     confirmation: u8,
     received: Duration,
     answer: Option<CommandResult>,
@@ -838,7 +841,7 @@ impl CommandServer {
         if let Some(r) = self
             .recent
             .iter_mut()
-            .find(|r| r.from == from && r.msg == canonical)
+            .find(|r| r.from == from && r.content == canonical)
         {
             let is_retry = match confirmation {
                 Some(c) => c > r.confirmation,
@@ -865,7 +868,8 @@ impl CommandServer {
                 self.recent.push_back(Recent {
                     id,
                     from,
-                    msg: canonical,
+                    command: mav_cmd,
+                    content: canonical,
                     confirmation: confirmation.unwrap_or(0),
                     received: now,
                     answer: None,
@@ -895,14 +899,7 @@ impl CommandServer {
             return false;
         };
         r.answer = Some(result);
-        let (from, cmd) = (
-            r.from,
-            match &r.msg {
-                MavMessage::COMMAND_LONG(c) => c.command,
-                MavMessage::COMMAND_INT(c) => c.command,
-                _ => return false,
-            },
-        );
+        let (from, cmd) = (r.from, r.command);
         self.ack(from, cmd, result);
         true
     }
@@ -913,15 +910,26 @@ impl CommandServer {
     }
 }
 
-/// The message with its confirmation zeroed, to compare retries by content.
-fn canonical(msg: &MavMessage) -> MavMessage {
-    match msg {
-        MavMessage::COMMAND_LONG(c) => MavMessage::COMMAND_LONG(mc::COMMAND_LONG_DATA {
-            confirmation: 0,
-            ..c.clone()
-        }),
-        other => other.clone(),
-    }
+/// Message id and wire payload with the confirmation zeroed, to compare retries by content
+/// (bit-exact, so NaN parameters compare equal).
+fn canonical(msg: &MavMessage) -> Vec<u8> {
+    use mavlink::{MavlinkVersion, Message};
+    let zeroed;
+    let msg = match msg {
+        MavMessage::COMMAND_LONG(c) => {
+            zeroed = MavMessage::COMMAND_LONG(mc::COMMAND_LONG_DATA {
+                confirmation: 0,
+                ..c.clone()
+            });
+            &zeroed
+        }
+        other => other,
+    };
+    let mut payload = [0_u8; 255];
+    let n = msg.ser(MavlinkVersion::V2, &mut payload);
+    let mut out = msg.message_id().to_le_bytes().to_vec();
+    out.extend_from_slice(payload.get(..n).unwrap_or(&[]));
+    out
 }
 
 #[cfg(test)]
@@ -1040,6 +1048,25 @@ mod tests {
         // A fresh request (confirmation 0) later is delivered again.
         srv.handle_message(Duration::from_millis(2000), gcs, &c.to_mavlink(1, 1, 0));
         assert!(srv.poll_event().is_some());
+    }
+
+    /// Regression: retries were compared with `PartialEq`, and a NaN parameter (landing target
+    /// "into the wind") never equals itself, so each COMMAND_INT retry was executed again.
+    #[test]
+    fn command_int_retry_with_nan_parameter_is_recognised() {
+        let mut srv = CommandServer::new(1, 1);
+        let c = Command::SetLandingTarget {
+            lat_deg: 41.0,
+            lon_deg: -8.0,
+            alt_msl_m: 90.0,
+            approach_heading_deg: None,
+        };
+        srv.handle_message(Duration::ZERO, (255, 190), &c.to_mavlink(1, 1, 0));
+        let inc = srv.poll_event().expect("delivered");
+        srv.respond(inc.id, CommandResult::Accepted);
+        srv.handle_message(Duration::from_secs(1), (255, 190), &c.to_mavlink(1, 1, 0));
+        assert!(srv.poll_event().is_none(), "retry delivered again");
+        assert_eq!(srv.stats().duplicates, 1);
     }
 
     #[test]

@@ -215,6 +215,24 @@ impl LinkCore {
         core
     }
 
+    /// Switches signing on (`Some`) or off (`None`) at `now`.
+    fn set_signing(&mut self, now: Duration, signing: Option<SigningConfig>) {
+        match &signing {
+            Some(s) => {
+                let (signer, verifier) = s.build(now);
+                self.encoder.set_signer(Some(signer));
+                self.decoder.set_verifier(Some(verifier));
+            }
+            None => {
+                self.encoder.set_signer(None);
+                self.decoder.set_verifier(None);
+            }
+        }
+        tracing::info!(on = signing.is_some(), "signing switched");
+        self.config.signing = signing;
+        self.check_persist();
+    }
+
     fn check_persist(&mut self) {
         if let Some(v) = self
             .encoder
@@ -686,6 +704,12 @@ impl GroundEndpoint {
     pub fn is_connected(&self) -> bool {
         self.core.connected
     }
+
+    /// Switches MAVLink 2 signing on (`Some`, refusing unsigned and MAVLink 1 frames from now
+    /// on) or off (`None`).
+    pub fn set_signing(&mut self, now: Duration, signing: Option<SigningConfig>) {
+        self.core.set_signing(now, signing);
+    }
 }
 
 /// Everything the vehicle endpoint needs.
@@ -911,5 +935,10 @@ impl VehicleEndpoint {
     /// Whether a ground station's heartbeats are arriving.
     pub fn is_connected(&self) -> bool {
         self.core.connected
+    }
+
+    /// Switches MAVLink 2 signing on (`Some`) or off (`None`).
+    pub fn set_signing(&mut self, now: Duration, signing: Option<SigningConfig>) {
+        self.core.set_signing(now, signing);
     }
 }

@@ -579,6 +579,25 @@ fn signing_on_refuses_and_counts_unsigned_frames() {
 }
 
 #[test]
+fn signing_switched_on_at_run_time_refuses_the_unsigned_peer() {
+    let mut pair = Pair::default_pair(20);
+    pair.run_for(secs(2.0));
+    assert!(pair.vehicle.is_connected());
+    pair.vehicle
+        .set_signing(pair.now, Some(signing(7, 2, JAN_2026)));
+    pair.run_for(secs(5.0));
+    assert!(
+        !pair.vehicle.is_connected(),
+        "unsigned ground heartbeats still accepted"
+    );
+    assert!(pair.vehicle.link_stats(pair.now).decoder.unsigned_refused >= 4);
+    pair.ground
+        .set_signing(pair.now, Some(signing(7, 1, JAN_2026)));
+    pair.run_for(secs(2.0));
+    assert!(pair.vehicle.is_connected() && pair.ground.is_connected());
+}
+
+#[test]
 fn replayed_signed_frame_is_refused() {
     let mut pair = signed_pair(
         Some(signing(7, 1, JAN_2026)),
