@@ -281,6 +281,34 @@ async fn serial_pty_pair_links_ground_and_vehicle() {
     v_app.abort();
 }
 
+/// `serial:PATH:BAUD` opened by path: the vehicle end of a pseudo-terminal pair.
+#[cfg(feature = "serial")]
+#[tokio::test]
+async fn serial_address_opens_a_tty_by_path() {
+    use tokio_serial::SerialPort;
+    let (master, slave) = tokio_serial::SerialStream::pair().expect("pseudo-terminal pair");
+    let path = slave.name().expect("pty has a path");
+    let v = Transport::open_str(&format!("serial:{path}:57600"))
+        .await
+        .expect("open by path");
+    let (_v_actions, v_app) = vehicle_app(spawn(v, vehicle()));
+    let mut g = spawn(Transport::from_stream("pty-master", master), ground());
+    let seen = wait_for(&mut g.events, |e| {
+        matches!(
+            e,
+            DriverEvent::Endpoint(GroundEvent::Link(
+                stx_link::endpoint::LinkEvent::Connected { system_id: 1, .. }
+            ))
+        )
+    })
+    .await;
+    assert!(!seen.is_empty());
+    drop(g.actions);
+    let _ = g.task.await;
+    drop(slave);
+    v_app.abort();
+}
+
 #[tokio::test]
 async fn opening_bad_addresses_fails_clearly() {
     let e = Transport::open_str("udpin:not-an-ip:1")
