@@ -1,0 +1,944 @@
+//! The two ends of the link, each composing framing, signing and the micro-protocols behind
+//! one sans-io surface: bytes and `now` in, events and bytes out.
+//!
+//! - [`GroundEndpoint`] (station): sends commands, parameter and plan requests and the
+//!   joystick; receives telemetry; tracks whether the drone is connected.
+//! - [`VehicleEndpoint`] (drone, simulated or not): sends telemetry and its status heartbeat;
+//!   answers commands, parameters and plan transfers; turns MANUAL_CONTROL into sticks that go
+//!   stale.
+//!
+//! Both send a HEARTBEAT every [`LinkConfig::heartbeat_period`] and declare the peer connected
+//! on its first heartbeat and lost after [`LinkConfig::link_timeout`] without one, with a
+//! [`LinkEvent`] on each change. [`LinkStats`] (serde-serialisable, for the dashboard) counts
+//! traffic, errors, signing refusals, per-sender packet loss from sequence-number gaps, the
+//! message rate over a sliding window and the age of the last message of each kind.
+//!
+//! The calling convention follows quinn-proto: after [`handle_bytes`](GroundEndpoint::handle_bytes)
+//! or [`handle_timeout`](GroundEndpoint::handle_timeout), drain
+//! [`poll_event`](GroundEndpoint::poll_event) and [`poll_transmit`](GroundEndpoint::poll_transmit),
+//! then sleep until [`poll_timeout`](GroundEndpoint::poll_timeout). No sockets, clocks or
+//! sleeps in here: `now` is a monotonic [`Duration`] from any fixed origin.
+
+use std::collections::{BTreeMap, HashMap, VecDeque};
+use std::time::Duration;
+
+use mavlink::Message;
+use mavlink::dialects::common as mc;
+use mavlink::dialects::common::MavMessage;
+use serde::{Deserialize, Serialize};
+
+use crate::command::{
+    Command, CommandClient, CommandConfig, CommandEvent, CommandResult, CommandSendError,
+    CommandServer, IncomingCommand, IncomingId, RequestId,
+};
+use crate::frame::{
+    DecoderPolicy, DecoderStats, Frame, FrameDecoder, FrameEncoder, FrameError, FrameHeader,
+};
+use crate::manual::{ManualEvent, ManualReceiver, ManualSender, Sticks};
+use crate::param::{
+    ParamChange, ParamClient, ParamConfig, ParamEvent, ParamRequestError, ParamSpec, ParamTable,
+    ParamTableError,
+};
+use crate::plan::{PlanClient, PlanConfig, PlanEvent, PlanItem, PlanRequestError, PlanServer};
+use crate::signing::SigningConfig;
+use crate::telemetry::{
+    Severity, StatusTextAssembler, Telemetry, VehicleStatus, split_status_text,
+};
+
+/// Settings shared by both ends.
+#[derive(Debug, Clone)]
+pub struct LinkConfig {
+    /// Our MAVLink system id.
+    pub system_id: u8,
+    /// Our MAVLink component id.
+    pub component_id: u8,
+    /// Time between our heartbeats (1 s is MAVLink's norm).
+    pub heartbeat_period: Duration,
+    /// Peer declared lost after this long without its heartbeat.
+    pub link_timeout: Duration,
+    /// Window over which the message rate is averaged.
+    pub rate_window: Duration,
+    /// Accept MAVLink 1 frames (never while signing is on).
+    pub accept_v1: bool,
+    /// MAVLink 2 signing; `None` = off.
+    pub signing: Option<SigningConfig>,
+}
+
+impl LinkConfig {
+    /// Defaults for the ground station: system 255, component 190 (MAV_COMP_ID_MISSIONPLANNER).
+    pub fn ground() -> Self {
+        Self {
+            system_id: 255,
+            component_id: 190,
+            ..Self::vehicle()
+        }
+    }
+
+    /// Defaults for the drone: system 1, component 1 (autopilot).
+    pub fn vehicle() -> Self {
+        Self {
+            system_id: 1,
+            component_id: 1,
+            heartbeat_period: Duration::from_secs(1),
+            link_timeout: Duration::from_millis(3500),
+            rate_window: Duration::from_secs(5),
+            accept_v1: true,
+            signing: None,
+        }
+    }
+
+    /// Sets signing.
+    pub fn with_signing(mut self, signing: Option<SigningConfig>) -> Self {
+        self.signing = signing;
+        self
+    }
+}
+
+/// Link-level events of either end.
+#[derive(Debug, Clone, PartialEq)]
+pub enum LinkEvent {
+    /// The peer's first heartbeat, or the first after it was lost.
+    Connected { system_id: u8, component_id: u8 },
+    /// No heartbeat from the peer for the link timeout.
+    Lost { system_id: u8, since_last: Duration },
+    /// A frame was dropped (also counted in [`LinkStats`]).
+    FrameError(FrameError),
+    /// Our signing timestamp high-water mark moved: persist it (see
+    /// [`crate::signing::Signer::take_value_to_persist`]).
+    PersistSigningTimestamp(u64),
+}
+
+/// Loss accounting for one sender (system, component).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct SenderStats {
+    /// Sender system id.
+    pub system_id: u8,
+    /// Sender component id.
+    pub component_id: u8,
+    /// Frames received.
+    pub received: u64,
+    /// Frames missing, from sequence-number gaps.
+    pub lost: u64,
+    /// Frames repeating the previous sequence number.
+    pub duplicates: u64,
+    /// `lost / (lost + received)`, %.
+    pub loss_pct: f64,
+}
+
+/// Link quality, for the dashboard and recordings.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct LinkStats {
+    /// Whether the peer's heartbeats are arriving.
+    pub connected: bool,
+    /// Seconds since the peer's last heartbeat.
+    pub last_heartbeat_age_s: Option<f64>,
+    /// Messages received per second over the rate window.
+    pub messages_per_s: f64,
+    /// Frames received and delivered.
+    pub frames_in: u64,
+    /// Frames sent.
+    pub frames_out: u64,
+    /// Bytes received.
+    pub bytes_in: u64,
+    /// Bytes sent.
+    pub bytes_out: u64,
+    /// Checksum failures.
+    pub crc_errors: u64,
+    /// Frames with a good CRC that did not parse.
+    pub parse_errors: u64,
+    /// Frames with a message id outside the dialect.
+    pub unknown_message_ids: u64,
+    /// Frames refused by signing: bad signature, replay, unsigned or MAVLink 1 while signing.
+    pub signature_failures: u64,
+    /// Bytes not part of any delivered frame.
+    pub bytes_discarded: u64,
+    /// Packet loss over all senders, %.
+    pub packet_loss_pct: f64,
+    /// Per-sender loss.
+    pub senders: Vec<SenderStats>,
+    /// Seconds since the last message of each kind, by MAVLink message name.
+    pub last_message_age_s: BTreeMap<String, f64>,
+    /// Every decoder counter.
+    pub decoder: DecoderStats,
+}
+
+/// Most arrival times kept for the rate window.
+const MAX_RATE_SAMPLES: usize = 65_536;
+
+/// Framing, signing, heartbeats, liveness and statistics shared by both ends.
+#[derive(Debug)]
+struct LinkCore {
+    config: LinkConfig,
+    decoder: FrameDecoder,
+    encoder: FrameEncoder,
+    out: VecDeque<Vec<u8>>,
+    events: VecDeque<LinkEvent>,
+    next_heartbeat: Duration,
+    peer: Option<(u8, u8)>,
+    last_peer_heartbeat: Option<Duration>,
+    connected: bool,
+    arrivals: VecDeque<Duration>,
+    senders: HashMap<(u8, u8), (u8, SenderStats)>,
+    last_by_kind: HashMap<u32, (&'static str, Duration)>,
+    frames_out: u64,
+    bytes_out: u64,
+}
+
+impl LinkCore {
+    fn new(config: LinkConfig, now: Duration) -> Self {
+        let mut decoder = FrameDecoder::new(DecoderPolicy {
+            accept_v1: config.accept_v1,
+        });
+        let mut encoder = FrameEncoder::new(config.system_id, config.component_id);
+        if let Some(s) = &config.signing {
+            let (signer, verifier) = s.build(now);
+            encoder.set_signer(Some(signer));
+            decoder.set_verifier(Some(verifier));
+        }
+        let mut core = Self {
+            config,
+            decoder,
+            encoder,
+            out: VecDeque::new(),
+            events: VecDeque::new(),
+            next_heartbeat: now,
+            peer: None,
+            last_peer_heartbeat: None,
+            connected: false,
+            arrivals: VecDeque::new(),
+            senders: HashMap::new(),
+            last_by_kind: HashMap::new(),
+            frames_out: 0,
+            bytes_out: 0,
+        };
+        core.check_persist();
+        core
+    }
+
+    /// Switches signing on (`Some`) or off (`None`) at `now`.
+    fn set_signing(&mut self, now: Duration, signing: Option<SigningConfig>) {
+        match &signing {
+            Some(s) => {
+                let (signer, verifier) = s.build(now);
+                self.encoder.set_signer(Some(signer));
+                self.decoder.set_verifier(Some(verifier));
+            }
+            None => {
+                self.encoder.set_signer(None);
+                self.decoder.set_verifier(None);
+            }
+        }
+        tracing::info!(on = signing.is_some(), "signing switched");
+        self.config.signing = signing;
+        self.check_persist();
+    }
+
+    fn check_persist(&mut self) {
+        if let Some(v) = self
+            .encoder
+            .signer_mut()
+            .and_then(|s| s.take_value_to_persist())
+        {
+            self.events.push_back(LinkEvent::PersistSigningTimestamp(v));
+        }
+    }
+
+    fn send(&mut self, now: Duration, msg: &MavMessage) {
+        let bytes = self.encoder.encode(now, msg);
+        self.frames_out += 1;
+        self.bytes_out += bytes.len() as u64;
+        self.out.push_back(bytes);
+        self.check_persist();
+    }
+
+    /// Decodes `bytes`, returning the frames for the endpoint to dispatch.
+    fn ingest(&mut self, now: Duration, bytes: &[u8]) -> Vec<Frame> {
+        self.decoder.push(bytes);
+        let mut frames = Vec::new();
+        while let Some(r) = self.decoder.poll(now) {
+            match r {
+                Ok(frame) => {
+                    self.account(now, &frame.header, &frame.message);
+                    frames.push(frame);
+                }
+                Err(e) => {
+                    tracing::debug!(error = %e, "frame dropped");
+                    self.events.push_back(LinkEvent::FrameError(e));
+                }
+            }
+        }
+        frames
+    }
+
+    fn account(&mut self, now: Duration, h: &FrameHeader, msg: &MavMessage) {
+        if self.arrivals.len() >= MAX_RATE_SAMPLES {
+            self.arrivals.pop_front();
+        }
+        self.arrivals.push_back(now);
+        self.prune_arrivals(now);
+        self.last_by_kind
+            .insert(h.message_id, (msg.message_name(), now));
+        let key = (h.system_id, h.component_id);
+        match self.senders.get_mut(&key) {
+            Some((last_seq, s)) => {
+                let gap = h.sequence.wrapping_sub(*last_seq);
+                if gap == 0 {
+                    s.duplicates += 1;
+                } else {
+                    s.lost += u64::from(gap - 1);
+                }
+                s.received += 1;
+                *last_seq = h.sequence;
+            }
+            None => {
+                self.senders.insert(
+                    key,
+                    (
+                        h.sequence,
+                        SenderStats {
+                            system_id: h.system_id,
+                            component_id: h.component_id,
+                            received: 1,
+                            ..Default::default()
+                        },
+                    ),
+                );
+            }
+        }
+    }
+
+    fn prune_arrivals(&mut self, now: Duration) {
+        while self
+            .arrivals
+            .front()
+            .is_some_and(|&t| now.saturating_sub(t) > self.config.rate_window)
+        {
+            self.arrivals.pop_front();
+        }
+    }
+
+    /// A heartbeat from the peer we track.
+    fn peer_heartbeat(&mut self, now: Duration, from: (u8, u8)) {
+        self.last_peer_heartbeat = Some(now);
+        self.peer = Some(from);
+        if !self.connected {
+            self.connected = true;
+            tracing::info!(system_id = from.0, "link connected");
+            self.events.push_back(LinkEvent::Connected {
+                system_id: from.0,
+                component_id: from.1,
+            });
+        }
+    }
+
+    /// Heartbeat and liveness timers; returns whether a heartbeat is due.
+    fn handle_timeout(&mut self, now: Duration) -> bool {
+        if self.connected
+            && let (Some(last), Some(peer)) = (self.last_peer_heartbeat, self.peer)
+        {
+            let since_last = now.saturating_sub(last);
+            if since_last >= self.config.link_timeout {
+                self.connected = false;
+                tracing::warn!(system_id = peer.0, ?since_last, "link lost");
+                self.events.push_back(LinkEvent::Lost {
+                    system_id: peer.0,
+                    since_last,
+                });
+            }
+        }
+        if now >= self.next_heartbeat {
+            self.next_heartbeat = if now >= self.next_heartbeat + self.config.heartbeat_period {
+                now + self.config.heartbeat_period
+            } else {
+                self.next_heartbeat + self.config.heartbeat_period
+            };
+            return true;
+        }
+        false
+    }
+
+    fn poll_timeout(&self) -> Duration {
+        let mut t = self.next_heartbeat;
+        if self.connected
+            && let Some(last) = self.last_peer_heartbeat
+        {
+            t = t.min(last + self.config.link_timeout);
+        }
+        t
+    }
+
+    fn stats(&mut self, now: Duration) -> LinkStats {
+        self.prune_arrivals(now);
+        let d = *self.decoder.stats();
+        let window = self.config.rate_window.as_secs_f64().max(1e-9);
+        let mut senders: Vec<SenderStats> = self
+            .senders
+            .values()
+            .map(|(_, s)| {
+                let total = s.lost + s.received;
+                SenderStats {
+                    loss_pct: if total == 0 {
+                        0.0
+                    } else {
+                        100.0 * s.lost as f64 / total as f64
+                    },
+                    ..*s
+                }
+            })
+            .collect();
+        senders.sort_by_key(|s| (s.system_id, s.component_id));
+        let (lost, received) = senders
+            .iter()
+            .fold((0, 0), |(l, r), s| (l + s.lost, r + s.received));
+        LinkStats {
+            connected: self.connected,
+            last_heartbeat_age_s: self
+                .last_peer_heartbeat
+                .map(|t| now.saturating_sub(t).as_secs_f64()),
+            messages_per_s: self.arrivals.len() as f64 / window,
+            frames_in: d.frames_ok,
+            frames_out: self.frames_out,
+            bytes_in: d.bytes_in,
+            bytes_out: self.bytes_out,
+            crc_errors: d.crc_errors,
+            parse_errors: d.parse_errors,
+            unknown_message_ids: d.unknown_message_ids,
+            signature_failures: d.bad_signatures
+                + d.replays_refused
+                + d.unsigned_refused
+                + if self.decoder.signing_required() {
+                    d.v1_refused
+                } else {
+                    0
+                },
+            bytes_discarded: d.bytes_discarded,
+            packet_loss_pct: if lost + received == 0 {
+                0.0
+            } else {
+                100.0 * lost as f64 / (lost + received) as f64
+            },
+            senders,
+            last_message_age_s: self
+                .last_by_kind
+                .values()
+                .map(|(name, t)| ((*name).to_string(), now.saturating_sub(*t).as_secs_f64()))
+                .collect(),
+            decoder: d,
+        }
+    }
+}
+
+/// Everything the ground endpoint needs.
+#[derive(Debug, Clone)]
+pub struct GroundConfig {
+    /// Link settings (ids, heartbeat, signing).
+    pub link: LinkConfig,
+    /// The drone's (system, component).
+    pub vehicle: (u8, u8),
+    /// Command retries.
+    pub command: CommandConfig,
+    /// Parameter retries.
+    pub param: ParamConfig,
+    /// Plan transfer timing.
+    pub plan: PlanConfig,
+    /// Time between MANUAL_CONTROL messages while the stick is held (100 ms = 10 Hz).
+    pub manual_period: Duration,
+}
+
+impl Default for GroundConfig {
+    fn default() -> Self {
+        Self {
+            link: LinkConfig::ground(),
+            vehicle: (1, 1),
+            command: CommandConfig::default(),
+            param: ParamConfig::default(),
+            plan: PlanConfig::default(),
+            manual_period: Duration::from_millis(100),
+        }
+    }
+}
+
+/// What the ground endpoint reports.
+#[derive(Debug, Clone, PartialEq)]
+pub enum GroundEvent {
+    /// Link state, dropped frames, signing timestamp to persist.
+    Link(LinkEvent),
+    /// A telemetry item from the drone.
+    Telemetry {
+        from: (u8, u8),
+        telemetry: Telemetry,
+    },
+    /// A complete (re-assembled) STATUSTEXT.
+    StatusText {
+        from: (u8, u8),
+        severity: Severity,
+        text: String,
+    },
+    /// Outcome of a command.
+    Command(CommandEvent),
+    /// Outcome of a parameter operation.
+    Param(ParamEvent),
+    /// Outcome of a plan transfer.
+    Plan(PlanEvent),
+    /// Any other message from anyone (for recording and other tools).
+    Other(Box<Frame>),
+}
+
+/// The station's end of the link (sans-io).
+#[derive(Debug)]
+pub struct GroundEndpoint {
+    core: LinkCore,
+    vehicle: (u8, u8),
+    commands: CommandClient,
+    params: ParamClient,
+    plan: PlanClient,
+    manual: ManualSender,
+    texts: StatusTextAssembler,
+    events: VecDeque<GroundEvent>,
+}
+
+impl GroundEndpoint {
+    /// A ground endpoint started at `now`.
+    pub fn new(config: GroundConfig, now: Duration) -> Self {
+        Self {
+            core: LinkCore::new(config.link, now),
+            vehicle: config.vehicle,
+            commands: CommandClient::new(config.command),
+            params: ParamClient::new(config.param),
+            plan: PlanClient::new(config.plan),
+            manual: ManualSender::new(config.manual_period),
+            texts: StatusTextAssembler::default(),
+            events: VecDeque::new(),
+        }
+    }
+
+    /// Feeds bytes received from the transport.
+    pub fn handle_bytes(&mut self, now: Duration, bytes: &[u8]) {
+        for frame in self.core.ingest(now, bytes) {
+            self.dispatch(now, frame);
+        }
+    }
+
+    fn dispatch(&mut self, now: Duration, frame: Frame) {
+        let from = (frame.header.system_id, frame.header.component_id);
+        let msg = &frame.message;
+        if from.0 == self.vehicle.0 {
+            if let MavMessage::HEARTBEAT(h) = msg
+                && h.mavtype != mc::MavType::MAV_TYPE_GCS
+            {
+                self.core.peer_heartbeat(now, from);
+            }
+            let our = self.core.config.system_id;
+            self.commands.handle_message(now, from.0, our, msg);
+            self.params.handle_message(now, from.0, msg);
+            self.plan.handle_message(now, from.0, msg);
+        }
+        match Telemetry::from_mavlink(msg) {
+            Some(telemetry) => {
+                if let Telemetry::StatusText(chunk) = &telemetry
+                    && let Some((severity, text)) = self.texts.push(from.0, from.1, chunk)
+                {
+                    self.events.push_back(GroundEvent::StatusText {
+                        from,
+                        severity,
+                        text,
+                    });
+                }
+                self.events
+                    .push_back(GroundEvent::Telemetry { from, telemetry });
+            }
+            None => {
+                let protocol = matches!(
+                    msg,
+                    MavMessage::COMMAND_ACK(_)
+                        | MavMessage::PARAM_VALUE(_)
+                        | MavMessage::MISSION_REQUEST_INT(_)
+                        | MavMessage::MISSION_ITEM_INT(_)
+                        | MavMessage::MISSION_COUNT(_)
+                        | MavMessage::MISSION_ACK(_)
+                );
+                if !protocol || from.0 != self.vehicle.0 {
+                    self.events.push_back(GroundEvent::Other(Box::new(frame)));
+                }
+            }
+        }
+    }
+
+    /// Sends a command; its outcome arrives as [`GroundEvent::Command`] with `request_id`.
+    pub fn send_command(
+        &mut self,
+        now: Duration,
+        request_id: RequestId,
+        command: Command,
+    ) -> Result<(), CommandSendError> {
+        self.commands.send(now, request_id, self.vehicle, command)
+    }
+
+    /// Fetches the whole parameter table.
+    pub fn param_list(&mut self, now: Duration) -> Result<(), ParamRequestError> {
+        self.params.list(now, self.vehicle)
+    }
+
+    /// Reads one parameter.
+    pub fn param_read(&mut self, now: Duration, name: &str) -> Result<(), ParamRequestError> {
+        self.params.read(now, self.vehicle, name)
+    }
+
+    /// Sets one parameter.
+    pub fn param_set(
+        &mut self,
+        now: Duration,
+        name: &str,
+        value: f32,
+    ) -> Result<(), ParamRequestError> {
+        self.params.set(now, self.vehicle, name, value)
+    }
+
+    /// Uploads the guidance plan.
+    pub fn plan_upload(
+        &mut self,
+        now: Duration,
+        items: Vec<PlanItem>,
+    ) -> Result<(), PlanRequestError> {
+        self.plan.upload(now, self.vehicle, items)
+    }
+
+    /// Downloads the plan the drone holds.
+    pub fn plan_download(&mut self, now: Duration) -> Result<(), PlanRequestError> {
+        self.plan.download(now, self.vehicle)
+    }
+
+    /// Holds the stick at `sticks` (streamed until released).
+    pub fn manual_hold(&mut self, now: Duration, sticks: Sticks) {
+        self.manual.hold(now, sticks);
+    }
+
+    /// Releases the stick.
+    pub fn manual_release(&mut self) {
+        self.manual.release();
+    }
+
+    /// Sends any other message now (e.g. for tools).
+    pub fn send_message(&mut self, now: Duration, msg: &MavMessage) {
+        self.core.send(now, msg);
+    }
+
+    /// Runs timers: heartbeats, link liveness, retries, manual streaming.
+    pub fn handle_timeout(&mut self, now: Duration) {
+        if self.core.handle_timeout(now) {
+            let hb = MavMessage::HEARTBEAT(mc::HEARTBEAT_DATA {
+                custom_mode: 0,
+                mavtype: mc::MavType::MAV_TYPE_GCS,
+                autopilot: mc::MavAutopilot::MAV_AUTOPILOT_INVALID,
+                base_mode: mc::MavModeFlag::empty(),
+                system_status: mc::MavState::MAV_STATE_ACTIVE,
+                mavlink_version: 3,
+            });
+            self.core.send(now, &hb);
+        }
+        self.commands.handle_timeout(now);
+        self.params.handle_timeout(now);
+        self.plan.handle_timeout(now);
+        self.manual.handle_timeout(now);
+    }
+
+    /// Earliest time [`handle_timeout`](Self::handle_timeout) must run.
+    pub fn poll_timeout(&self) -> Option<Duration> {
+        [
+            Some(self.core.poll_timeout()),
+            self.commands.poll_timeout(),
+            self.params.poll_timeout(),
+            self.plan.poll_timeout(),
+            self.manual.poll_timeout(),
+        ]
+        .into_iter()
+        .flatten()
+        .min()
+    }
+
+    fn flush(&mut self, now: Duration) {
+        let target = self.vehicle.0;
+        while let Some(m) = self.commands.poll_transmit() {
+            self.core.send(now, &m);
+        }
+        while let Some(m) = self.params.poll_transmit() {
+            self.core.send(now, &m);
+        }
+        while let Some(m) = self.plan.poll_transmit() {
+            self.core.send(now, &m);
+        }
+        while let Some(m) = self.manual.poll_transmit(now, target) {
+            self.core.send(now, &m);
+        }
+    }
+
+    /// Next frame to send (one MAVLink frame per call).
+    pub fn poll_transmit(&mut self, now: Duration) -> Option<Vec<u8>> {
+        self.flush(now);
+        self.core.out.pop_front()
+    }
+
+    /// Next event.
+    pub fn poll_event(&mut self) -> Option<GroundEvent> {
+        while let Some(e) = self.core.events.pop_front() {
+            self.events.push_back(GroundEvent::Link(e));
+        }
+        while let Some(e) = self.commands.poll_event() {
+            self.events.push_back(GroundEvent::Command(e));
+        }
+        while let Some(e) = self.params.poll_event() {
+            self.events.push_back(GroundEvent::Param(e));
+        }
+        while let Some(e) = self.plan.poll_event() {
+            self.events.push_back(GroundEvent::Plan(e));
+        }
+        self.events.pop_front()
+    }
+
+    /// Link quality now.
+    pub fn link_stats(&mut self, now: Duration) -> LinkStats {
+        self.core.stats(now)
+    }
+
+    /// Whether the drone's heartbeats are arriving.
+    pub fn is_connected(&self) -> bool {
+        self.core.connected
+    }
+
+    /// Switches MAVLink 2 signing on (`Some`, refusing unsigned and MAVLink 1 frames from now
+    /// on) or off (`None`).
+    pub fn set_signing(&mut self, now: Duration, signing: Option<SigningConfig>) {
+        self.core.set_signing(now, signing);
+    }
+}
+
+/// Everything the vehicle endpoint needs.
+#[derive(Debug, Clone)]
+pub struct VehicleConfig {
+    /// Link settings.
+    pub link: LinkConfig,
+    /// The parameter table.
+    pub params: Vec<ParamSpec>,
+    /// Plan transfer timing.
+    pub plan: PlanConfig,
+    /// Sticks stale after this long without MANUAL_CONTROL.
+    pub manual_timeout: Duration,
+    /// How long commands are remembered to recognise retries.
+    pub command_dedup_window: Duration,
+    /// Status sent in heartbeats until the application sets one.
+    pub initial_status: VehicleStatus,
+}
+
+impl Default for VehicleConfig {
+    fn default() -> Self {
+        use stx_gnc::mission::{FlightMode, FlightStage, GuidancePhase};
+        Self {
+            link: LinkConfig::vehicle(),
+            params: Vec::new(),
+            plan: PlanConfig::default(),
+            manual_timeout: Duration::from_millis(500),
+            command_dedup_window: Duration::from_secs(5),
+            initial_status: VehicleStatus {
+                mode: FlightMode::Uncontrolled,
+                stage: FlightStage::PreLaunch,
+                phase: GuidancePhase::Idle,
+                state: crate::telemetry::SystemState::Standby,
+            },
+        }
+    }
+}
+
+/// What the vehicle endpoint reports.
+#[derive(Debug, Clone, PartialEq)]
+pub enum VehicleEvent {
+    /// Link state (peer = a ground station), dropped frames, signing timestamp to persist.
+    Link(LinkEvent),
+    /// A command to execute; answer with [`VehicleEndpoint::respond_command`].
+    Command(IncomingCommand),
+    /// A parameter changed (by the station).
+    ParamChanged(ParamChange),
+    /// A new plan was uploaded.
+    PlanReceived(Vec<PlanItem>),
+    /// Stick values, or their going stale.
+    Manual(ManualEvent),
+    /// Any other message.
+    Other(Box<Frame>),
+}
+
+/// The drone's end of the link (sans-io).
+#[derive(Debug)]
+pub struct VehicleEndpoint {
+    core: LinkCore,
+    status: VehicleStatus,
+    commands: CommandServer,
+    params: ParamTable,
+    plan: PlanServer,
+    manual: ManualReceiver,
+    next_text_id: u16,
+    events: VecDeque<VehicleEvent>,
+}
+
+impl VehicleEndpoint {
+    /// A vehicle endpoint started at `now`; fails if the parameter table is invalid.
+    pub fn new(config: VehicleConfig, now: Duration) -> Result<Self, ParamTableError> {
+        let (sys, comp) = (config.link.system_id, config.link.component_id);
+        let mut commands = CommandServer::new(sys, comp);
+        commands.dedup_window = config.command_dedup_window;
+        Ok(Self {
+            params: ParamTable::new(sys, comp, config.params)?,
+            plan: PlanServer::new(sys, comp, config.plan),
+            manual: ManualReceiver::new(sys, config.manual_timeout),
+            commands,
+            status: config.initial_status,
+            core: LinkCore::new(config.link, now),
+            next_text_id: 1,
+            events: VecDeque::new(),
+        })
+    }
+
+    /// Feeds bytes received from the transport.
+    pub fn handle_bytes(&mut self, now: Duration, bytes: &[u8]) {
+        for frame in self.core.ingest(now, bytes) {
+            let from = (frame.header.system_id, frame.header.component_id);
+            let msg = &frame.message;
+            let handled = match msg {
+                MavMessage::HEARTBEAT(h) => {
+                    if h.mavtype == mc::MavType::MAV_TYPE_GCS {
+                        self.core.peer_heartbeat(now, from);
+                    }
+                    false
+                }
+                _ => {
+                    self.commands.handle_message(now, from, msg)
+                        || self.params.handle_message(msg)
+                        || self.plan.handle_message(now, from, msg)
+                        || self.manual.handle_message(now, msg)
+                }
+            };
+            if !handled {
+                self.events.push_back(VehicleEvent::Other(Box::new(frame)));
+            }
+        }
+    }
+
+    /// Sets the status sent in heartbeats (mode, stage, phase, state).
+    pub fn set_status(&mut self, status: VehicleStatus) {
+        self.status = status;
+    }
+
+    /// The status sent in heartbeats.
+    pub fn status(&self) -> VehicleStatus {
+        self.status
+    }
+
+    /// Sends a telemetry item now.
+    pub fn send_telemetry(&mut self, now: Duration, telemetry: &Telemetry) {
+        self.core.send(now, &telemetry.to_mavlink());
+    }
+
+    /// Sends a text of any length (split into STATUSTEXT chunks when over 50 bytes).
+    pub fn send_status_text(&mut self, now: Duration, severity: Severity, text: &str) {
+        let id = self.next_text_id;
+        self.next_text_id = self.next_text_id.checked_add(1).unwrap_or(1);
+        for chunk in split_status_text(severity, text, id) {
+            self.core
+                .send(now, &Telemetry::StatusText(chunk).to_mavlink());
+        }
+    }
+
+    /// Answers a command.
+    pub fn respond_command(&mut self, id: IncomingId, result: CommandResult) -> bool {
+        self.commands.respond(id, result)
+    }
+
+    /// The parameter table.
+    pub fn params(&self) -> &ParamTable {
+        &self.params
+    }
+
+    /// The parameter table, to set values from onboard (announced to the station).
+    pub fn params_mut(&mut self) -> &mut ParamTable {
+        &mut self.params
+    }
+
+    /// The plan held.
+    pub fn plan(&self) -> &[PlanItem] {
+        self.plan.plan()
+    }
+
+    /// Current sticks; `None` when stale or never received.
+    pub fn sticks(&self, now: Duration) -> Option<Sticks> {
+        self.manual.sticks(now)
+    }
+
+    /// Runs timers: heartbeats, liveness, plan re-requests, manual staleness.
+    pub fn handle_timeout(&mut self, now: Duration) {
+        if self.core.handle_timeout(now) {
+            let hb = Telemetry::Status(self.status).to_mavlink();
+            self.core.send(now, &hb);
+        }
+        self.plan.handle_timeout(now);
+        self.manual.handle_timeout(now);
+    }
+
+    /// Earliest time [`handle_timeout`](Self::handle_timeout) must run.
+    pub fn poll_timeout(&self) -> Option<Duration> {
+        [
+            Some(self.core.poll_timeout()),
+            self.plan.poll_timeout(),
+            self.manual.poll_timeout(),
+        ]
+        .into_iter()
+        .flatten()
+        .min()
+    }
+
+    /// Next frame to send.
+    pub fn poll_transmit(&mut self, now: Duration) -> Option<Vec<u8>> {
+        while let Some(m) = self.commands.poll_transmit() {
+            self.core.send(now, &m);
+        }
+        while let Some(m) = self.params.poll_transmit() {
+            self.core.send(now, &m);
+        }
+        while let Some(m) = self.plan.poll_transmit() {
+            self.core.send(now, &m);
+        }
+        self.core.out.pop_front()
+    }
+
+    /// Next event.
+    pub fn poll_event(&mut self) -> Option<VehicleEvent> {
+        while let Some(e) = self.core.events.pop_front() {
+            self.events.push_back(VehicleEvent::Link(e));
+        }
+        while let Some(e) = self.commands.poll_event() {
+            self.events.push_back(VehicleEvent::Command(e));
+        }
+        while let Some(c) = self.params.poll_change() {
+            self.events.push_back(VehicleEvent::ParamChanged(c));
+        }
+        while let Some(p) = self.plan.poll_plan() {
+            self.events.push_back(VehicleEvent::PlanReceived(p));
+        }
+        while let Some(m) = self.manual.poll_event() {
+            self.events.push_back(VehicleEvent::Manual(m));
+        }
+        self.events.pop_front()
+    }
+
+    /// Link quality now.
+    pub fn link_stats(&mut self, now: Duration) -> LinkStats {
+        self.core.stats(now)
+    }
+
+    /// Whether a ground station's heartbeats are arriving.
+    pub fn is_connected(&self) -> bool {
+        self.core.connected
+    }
+
+    /// Switches MAVLink 2 signing on (`Some`) or off (`None`).
+    pub fn set_signing(&mut self, now: Duration, signing: Option<SigningConfig>) {
+        self.core.set_signing(now, signing);
+    }
+}

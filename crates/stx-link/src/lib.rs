@@ -1,0 +1,57 @@
+//! stx-link: the MAVLink 2 link between the stx ground station and the (simulated) STRAPLEX
+//! parafoil drone.
+//!
+//! It exists so that the station, the simulated drone and any other MAVLink tool
+//! (QGroundControl, MAVProxy, pymavlink) speak the same common-dialect messages, and so that
+//! everything above the link works with stx's own types in SI units rather than with MAVLink's
+//! scaled integers. Both ends live here: the station uses the ground side, the simulator the
+//! vehicle side.
+//!
+//! # How the parts fit
+//! The protocol logic is sans-io, in the style of quinn-proto: bytes and a monotonic `now:
+//! Duration` go in, events and bytes come out, nothing here owns a socket, a clock or a sleep.
+//!
+//! ```text
+//!  transport (tokio: udpin/udpout/tcp/tcpin/serial)          ← thin adapter, the only I/O
+//!        │ bytes                         ▲ bytes
+//!        ▼                               │
+//!  endpoint::{GroundEndpoint, VehicleEndpoint}               ← heartbeats, liveness, LinkStats
+//!        │ frames                        ▲ messages
+//!  frame (decoder / encoder) + signing                       ← framing, CRC, resync, signatures
+//!        │ MavMessage                    ▲ MavMessage
+//!  telemetry · command · param · plan · manual               ← stx types ↔ MAVLink, micro-protocols
+//! ```
+//!
+//! - [`frame`]: the sans-io decoder (any chunk in, checked frames out, resync after garbage,
+//!   everything counted) and the MAVLink 2 encoder with sequence numbers.
+//! - [`signing`]: MAVLink 2 signing: key that never prints, constant-time check, replay
+//!   refusal, outgoing timestamps monotonic across restarts.
+//! - [`telemetry`]: [`telemetry::Telemetry`] and its exact two-way mapping to MAVLink messages.
+//! - [`command`]: operator commands, retried until acknowledged (ground) and de-duplicated and
+//!   acknowledged (vehicle).
+//! - [`param`]: the PARAM_* protocol, both sides.
+//! - [`plan`]: upload / download of the landing target and localizer points (mission protocol).
+//! - [`manual`]: joystick streaming and stick staleness.
+//! - [`endpoint`]: the two ends composing all of the above, with [`endpoint::LinkStats`].
+//! - [`transport`]: tokio adapters and [`transport::drive`], which runs an endpoint over an
+//!   address string such as `udpin:0.0.0.0:14550`.
+//!
+//! # Conventions
+//! Units are in names (`lat_deg`, `alt_msl_m`, `airspeed_mps`); nothing panics on data from
+//! the wire; every dropped frame, lost packet or I/O error is counted and surfaced, never
+//! hidden; retries and timeouts take `now` from the caller so tests run on a fake clock.
+//!
+//! The mission vocabulary ([`stx_gnc::mission`]: flight mode, flight stage, guidance phase)
+//! travels in HEARTBEAT's `custom_mode` as `mode | stage << 8 | phase << 16`.
+
+pub mod command;
+pub mod endpoint;
+pub mod frame;
+pub mod manual;
+pub mod param;
+pub mod plan;
+pub mod signing;
+pub mod telemetry;
+pub mod transport;
+
+pub use mavlink::dialects::common::MavMessage;
