@@ -1,0 +1,406 @@
+//! The navigation estimator: GPS, AHRS and pitot measurements in, an [`Estimate`] with an
+//! uncertainty for every quantity out. The same code runs on the (simulated) drone and in the
+//! ground station.
+//!
+//! Pure: no clock, no threads, no randomness. The caller hands in each measurement with the
+//! instant it arrived ([`Estimator::handle`]) and asks for the estimate at any later instant
+//! ([`Estimator::estimate`]); tests drive it with a fake clock.
+//!
+//! # What the drone measures, and what that allows
+//!
+//! GPS position and NED velocity (≈4 Hz, late by a few tenths of a second), the AHRS's roll,
+//! pitch and yaw of the drone, and a pitot whose differential pressure gives the air's speed
+//! along the drone's x axis only. There are no gyro rates and no accelerations. The drone hangs
+//! 3.3 m below the canopy and swings: in the flight model its body sideslip reaches 10–25° in
+//! steady turns and far more while a turn reverses, and its x axis sits about 17–20° above the
+//! air-relative velocity in a glide. So the pitot's reading is *not* the airspeed, and the air
+//! does not come from straight ahead; the filter must not assume either.
+//!
+//! # Design
+//!
+//! Two parts, advanced together one measurement at a time in timestamp order:
+//!
+//! 1. **Angle filters** (one each for roll φ, pitch θ, yaw ψ; `angle.rs`): angle and rate with a
+//!    white angular-acceleration model, fed by the AHRS angle. They give the attitude at any
+//!    instant between AHRS samples, the heading rate the estimate reports, and the attitude's
+//!    uncertainty. Innovations and angles are wrapped to (−π, π].
+//!
+//! 2. **Navigation EKF** (`filter.rs`), ten states
+//!
+//!    ```text
+//!    x = [ p (NED, m) | a = [u, v, w] (air-relative velocity in the drone frame, m/s)
+//!        | w_N, w_E (horizontal wind, m/s) | k (pitot scale) | b (baro bias, ln Pa) ]
+//!    ```
+//!
+//!    with the attitude treated as a known input `C = Rz(ψ)·Ry(θ)·Rx(φ)` (drone → NED). The
+//!    ground velocity is *derived*: `v = C·a + [w_N, w_E, 0]` (the vertical wind is taken as
+//!    zero). Keeping the air velocity in the drone frame is the point of the design: in a
+//!    steady turn `a` is constant while `C` rotates, so GPS velocity alone separates the air
+//!    velocity (including sideslip and angle of attack) from the wind — the circle's radius
+//!    and its centre — and the pitot pins `u`, hence the scale `k`. In straight flight the
+//!    wind along the track is not separable from `u`/`k` (it becomes so at the next turn),
+//!    and the crosswind only through the sideslip's pull towards zero.
+//!
+//!    Process model over a step `Δt` (roll and pitch at mid-step, yaw integrated at the
+//!    filtered rate `r`, exact for a constant-rate turn):
+//!
+//!    ```text
+//!    p⁺ = p + A·a + [w_N, w_E, 0]·Δt,   A = ∫₀^Δt Rz(ψ + rτ) dτ · Ry(θ)·Rx(φ)
+//!    u⁺ = u + n_u,   w⁺ = w + n_w          (random walks)
+//!    v⁺ = e^(−Δt/τ_β)·v + n_v              (Gauss–Markov: the drone weathervanes)
+//!    wind⁺ = wind + n_wind,  k⁺ = k + n_k,  b⁺ = b + n_b
+//!    ```
+//!
+//!    and the covariance `P⁺ = F P Fᵀ + Q`, with the body-velocity noise carried into position
+//!    through `A` (`Q_pa = C̄·Q_a·Δt/2`, `Q_pp = C̄·Q_a·C̄ᵀ·Δt²/3`, `C̄ = A/Δt`).
+//!
+//!    Measurements (each an EKF update, gated on its normalised innovation squared):
+//!
+//!    ```text
+//!    GPS position   z = p                                   R = diag(σ_h², σ_h², σ_v²)
+//!    GPS velocity   z = C·a + [w_N, w_E, 0]                 R = σ_s²·I + J_att Σ_att J_attᵀ
+//!    pitot          z = √(2Δp/ρ), ρ = p_s/(R_air·T)  = k·u   R = (σ_Δp/(ρ z))² + σ_floor²
+//!    barometer      z = ln p_s = ln p_US76(h₀ − p_D) + b     R = (σ_ps/p_s)²
+//!    ```
+//!
+//!    `J_att = ∂(C·a)/∂(φ, θ, ψ)` and `Σ_att` the angle filters' variances: an uncertain
+//!    heading makes a GPS velocity less informative about the air velocity and the wind. The
+//!    pitot is not used below a minimum airspeed (a pitot reads nothing for air from behind,
+//!    which a swinging drone does see). The barometer holds the height, and with it the sink
+//!    rate, through GPS dropouts; its bias is learnt from GPS.
+//!
+//! During a GPS dropout the same equations dead-reckon: position integrates `C·a + wind`, the
+//! pitot keeps `u`, the AHRS keeps `C`, the barometer keeps the height, and the covariance
+//! grows (mostly through the sideslip and the wind). When fixes return the gate still passes
+//! them because `P` grew; a filter that has gone wrong anyway is re-started from GPS after
+//! [`EstimatorConfig::reset_after_rejections`] rejected fixes in a row.
+//!
+//! # Late and out-of-order measurements
+//!
+//! Every measurement is stamped with the instant it describes, and the filter processes them
+//! in that order. Two copies of the filter are kept:
+//!
+//! - *committed*: everything older than the latest arrival minus
+//!   [`EstimatorConfig::max_latency_s`] — final, never revisited;
+//! - *head*: the committed filter plus every newer measurement, the source of estimates.
+//!
+//! Newer measurements wait in a short buffer sorted by instant. One that arrives in order
+//! updates the head directly; one that slots in earlier than the head's instant makes the head
+//! be rebuilt from the committed copy by replaying the buffer (a handful of measurements: the
+//! rates times the latency). A measurement older than the latency window is counted as stale
+//! and dropped. The per-sensor outcome counters (used, gated, reset, unused) are counted when a
+//! measurement is committed, so replays do not count anything twice.
+//!
+//! Cost: fixed-size `nalgebra` matrices, no allocation after [`Estimator::new`]; see the
+//! report in `crates/stx-sim/tests/sensors_estimator.rs` for measured times.
+
+mod angle;
+mod config;
+mod filter;
+
+pub use config::{EstimatorConfig, EstimatorConfigError};
+
+use std::collections::VecDeque;
+
+use serde::{Deserialize, Serialize};
+
+use crate::estimate::Estimate;
+use crate::measurement::Measurement;
+use config::Tuning;
+use filter::{NavFilter, Outcome, Timeouts};
+
+/// Most measurements held for re-ordering, each with a filter snapshot (about 1.5 kB). At 4 Hz
+/// from three sensors and a 0.6-s window about eight wait at once; the rest is headroom for
+/// faster sensors or a longer window. When full, the oldest is committed early (counted in
+/// [`EstimatorCounters::early_commits`]).
+pub const PENDING_CAPACITY: usize = 48;
+
+/// What [`Estimator::handle`] did with a measurement.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Disposition {
+    /// Taken in (its effect on the filter is counted when it is committed).
+    Accepted,
+    /// Older than the latency window, or than what is already committed: dropped.
+    Stale,
+    /// A non-finite time or value: refused.
+    NonFinite,
+    /// Finite but impossible (non-positive pressure or temperature, pitch beyond ±90°):
+    /// refused.
+    Invalid,
+    /// Stamped later than its arrival plus the allowed clock skew: refused.
+    FromFuture,
+}
+
+/// Counts per sensor.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct SensorCounts {
+    /// GPS fixes.
+    pub gps: u64,
+    /// AHRS samples.
+    pub attitude: u64,
+    /// Pitot samples.
+    pub air_data: u64,
+}
+
+impl SensorCounts {
+    fn bump(&mut self, m: &Measurement) {
+        match m {
+            Measurement::Gps(_) => self.gps += 1,
+            Measurement::Attitude(_) => self.attitude += 1,
+            Measurement::AirData(_) => self.air_data += 1,
+        }
+    }
+
+    /// All sensors together.
+    pub fn total(&self) -> u64 {
+        self.gps + self.attitude + self.air_data
+    }
+}
+
+/// What happened to every measurement handed in: for the link statistics and the operators
+/// (loss is shown, never hidden).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct EstimatorCounters {
+    /// Measurements taken in.
+    pub accepted: u64,
+    /// Dropped as older than the latency window.
+    pub stale: u64,
+    /// Refused for a non-finite time or value.
+    pub non_finite: u64,
+    /// Refused as physically impossible.
+    pub invalid: u64,
+    /// Refused as stamped in the future.
+    pub from_future: u64,
+    /// Committed and used by the filter.
+    pub used: SensorCounts,
+    /// Committed but (partly) rejected by the innovation gate.
+    pub gated: SensorCounts,
+    /// Committed and (re)started a filter: the first of each, or after repeated rejections.
+    pub resets: SensorCounts,
+    /// Committed but unusable (nothing to update yet; pitot below its minimum airspeed).
+    pub unused: SensorCounts,
+    /// Times the head was rebuilt because a measurement arrived out of order.
+    pub replays: u64,
+    /// Measurements committed before their latency window closed because the buffer was full.
+    pub early_commits: u64,
+}
+
+/// The navigation estimator. See the module documentation for the filter.
+#[derive(Debug, Clone)]
+pub struct Estimator {
+    config: EstimatorConfig,
+    tuning: Tuning,
+    timeouts: Timeouts,
+    /// Final state: every measurement older than the latency window applied.
+    committed: NavFilter,
+    /// Measurements newer than the committed state, sorted by instant then sensor, each with
+    /// the filter state just after it (the last one's is the head).
+    pending: VecDeque<Pending>,
+    /// Latest arrival seen, s: the estimator's notion of "now" for staleness.
+    latest_arrival_s: f64,
+    /// Instant of the newest committed measurement, s (−∞ before the first).
+    committed_time_s: f64,
+    counters: EstimatorCounters,
+}
+
+/// A measurement waiting to be committed, with what applying it did.
+#[derive(Debug, Clone)]
+struct Pending {
+    measurement: Measurement,
+    outcome: Outcome,
+    /// The filter after this measurement: replays start from the one before an insertion.
+    after: NavFilter,
+}
+
+/// Order among measurements of the same instant: attitude first (the others are projected
+/// with it), then GPS, then air data.
+fn sensor_rank(m: &Measurement) -> u8 {
+    match m {
+        Measurement::Attitude(_) => 0,
+        Measurement::Gps(_) => 1,
+        Measurement::AirData(_) => 2,
+    }
+}
+
+/// Checks a measurement from outside before it touches the filter.
+fn check(m: &Measurement) -> Result<(), Disposition> {
+    let finite = |values: &[f64]| values.iter().all(|v| v.is_finite());
+    match m {
+        Measurement::Gps(g) => {
+            let ok = finite(&[
+                g.time_s,
+                g.horizontal_accuracy_m,
+                g.vertical_accuracy_m,
+                g.speed_accuracy_mps,
+            ]) && finite(g.position_ned_m.as_slice())
+                && finite(g.velocity_ned_mps.as_slice());
+            if !ok {
+                return Err(Disposition::NonFinite);
+            }
+            if g.horizontal_accuracy_m < 0.0
+                || g.vertical_accuracy_m < 0.0
+                || g.speed_accuracy_mps < 0.0
+            {
+                return Err(Disposition::Invalid);
+            }
+        }
+        Measurement::Attitude(a) => {
+            if !finite(&[a.time_s, a.roll_rad, a.pitch_rad, a.yaw_rad]) {
+                return Err(Disposition::NonFinite);
+            }
+            if a.pitch_rad.abs() > std::f64::consts::FRAC_PI_2 + 1e-9 {
+                return Err(Disposition::Invalid);
+            }
+        }
+        Measurement::AirData(a) => {
+            if !finite(&[
+                a.time_s,
+                a.differential_pressure_pa,
+                a.static_pressure_pa,
+                a.temperature_k,
+            ]) {
+                return Err(Disposition::NonFinite);
+            }
+            if a.static_pressure_pa <= 0.0 || a.temperature_k <= 0.0 {
+                return Err(Disposition::Invalid);
+            }
+        }
+    }
+    Ok(())
+}
+
+impl Estimator {
+    /// An estimator that has seen nothing, after validating `config`.
+    pub fn new(config: EstimatorConfig) -> Result<Self, EstimatorConfigError> {
+        config.validate()?;
+        let tuning = Tuning::new(&config);
+        let timeouts = Timeouts {
+            gps_s: config.gps_timeout_s,
+            attitude_s: config.attitude_timeout_s,
+            air_data_s: config.air_data_timeout_s,
+        };
+        Ok(Self {
+            config,
+            tuning,
+            timeouts,
+            committed: NavFilter::new(),
+            pending: VecDeque::with_capacity(PENDING_CAPACITY),
+            latest_arrival_s: f64::NEG_INFINITY,
+            committed_time_s: f64::NEG_INFINITY,
+            counters: EstimatorCounters::default(),
+        })
+    }
+
+    /// The configuration in use.
+    pub fn config(&self) -> &EstimatorConfig {
+        &self.config
+    }
+
+    /// What happened to the measurements so far.
+    pub fn counters(&self) -> &EstimatorCounters {
+        &self.counters
+    }
+
+    /// Takes in a measurement that reached the estimator at `arrival_s` (s, mission clock).
+    /// Never panics: bad input is refused and counted.
+    pub fn handle(&mut self, arrival_s: f64, m: &Measurement) -> Disposition {
+        let disposition = self.admit(arrival_s, m);
+        match disposition {
+            Disposition::Accepted => self.counters.accepted += 1,
+            Disposition::Stale => self.counters.stale += 1,
+            Disposition::NonFinite => self.counters.non_finite += 1,
+            Disposition::Invalid => self.counters.invalid += 1,
+            Disposition::FromFuture => self.counters.from_future += 1,
+        }
+        disposition
+    }
+
+    fn admit(&mut self, arrival_s: f64, m: &Measurement) -> Disposition {
+        if !arrival_s.is_finite() {
+            return Disposition::NonFinite;
+        }
+        if let Err(refusal) = check(m) {
+            return refusal;
+        }
+        let time_s = m.time_s();
+        if time_s > arrival_s + self.tuning.max_clock_skew_s {
+            return Disposition::FromFuture;
+        }
+        self.latest_arrival_s = self.latest_arrival_s.max(arrival_s);
+        let horizon_s = self.latest_arrival_s - self.tuning.max_latency_s;
+        if self.pending.len() == PENDING_CAPACITY {
+            self.commit_front();
+            self.counters.early_commits += 1;
+        }
+        if time_s < horizon_s || time_s < self.committed_time_s {
+            return Disposition::Stale;
+        }
+
+        // Insert after every pending measurement that sorts before or with it, then bring the
+        // states from there on up to date: only the measurements after it are replayed.
+        let key = (time_s, sensor_rank(m));
+        let at = self
+            .pending
+            .iter()
+            .rposition(|p| (p.measurement.time_s(), sensor_rank(&p.measurement)) <= key)
+            .map_or(0, |i| i + 1);
+        let mut state = match at {
+            0 => self.committed,
+            _ => self.pending[at - 1].after,
+        };
+        if at < self.pending.len() {
+            self.counters.replays += 1;
+        }
+        self.pending.insert(
+            at,
+            Pending {
+                measurement: *m,
+                outcome: Outcome::Unused,
+                after: state,
+            },
+        );
+        for entry in self.pending.iter_mut().skip(at) {
+            entry.outcome = state.apply(&entry.measurement, &self.tuning);
+            entry.after = state;
+        }
+
+        // Commit what the window has closed on.
+        while self
+            .pending
+            .front()
+            .is_some_and(|p| p.measurement.time_s() < horizon_s)
+        {
+            self.commit_front();
+        }
+        Disposition::Accepted
+    }
+
+    /// Makes the oldest pending measurement final and counts what it did.
+    fn commit_front(&mut self) {
+        let Some(entry) = self.pending.pop_front() else {
+            return;
+        };
+        self.committed = entry.after;
+        self.committed_time_s = entry.measurement.time_s();
+        let c = &mut self.counters;
+        let m = &entry.measurement;
+        match entry.outcome {
+            Outcome::Used => c.used.bump(m),
+            Outcome::Gated => c.gated.bump(m),
+            Outcome::Reset => c.resets.bump(m),
+            Outcome::Unused => c.unused.bump(m),
+        }
+    }
+
+    /// The newest state: the committed one with every pending measurement applied.
+    fn head(&self) -> &NavFilter {
+        self.pending.back().map_or(&self.committed, |p| &p.after)
+    }
+
+    /// The estimate at `now_s` (s): the newest state predicted forward to `now_s`. For an
+    /// instant before the newest measurement, the newest state is reported as it is.
+    pub fn estimate(&self, now_s: f64) -> Estimate {
+        self.head().estimate(now_s, &self.tuning, &self.timeouts)
+    }
+}
