@@ -63,6 +63,9 @@ pub struct EstimatorConfig {
     pub vertical_wind_sigma_mps: f64,
     /// Correlation time of the vertical wind, s (> 0).
     pub vertical_wind_correlation_s: f64,
+    /// Random walk of the straight-flight sideslip offset (which includes the AHRS's heading
+    /// bias), degrees/√s (≥ 0).
+    pub sideslip_random_walk_deg_per_sqrt_s: f64,
     /// Random walk of the position beyond what the velocity explains (vertical gusts, attitude
     /// errors), m/√s (≥ 0).
     pub position_random_walk_m_per_sqrt_s: f64,
@@ -103,10 +106,25 @@ pub struct EstimatorConfig {
     /// Smallest GPS speed accuracy believed, 1-σ, m/s (> 0).
     pub gps_min_speed_accuracy_mps: f64,
 
+    /// Spread of the sideslip about its offset in straight flight (the drone's swing), 1-σ,
+    /// degrees (> 0).
+    pub straight_sideslip_sigma_deg: f64,
+    /// The flight counts as straight while the air velocity turns slower than this, rad/s
+    /// (> 0)...
+    pub straight_turn_rate_rad_s: f64,
+    /// ...and the drone's heading changes slower than this, rad/s (> 0)...
+    pub straight_yaw_rate_rad_s: f64,
+    /// ...and has done so for this long, s (≥ 0): the swing after a turn takes a few seconds
+    /// to fade.
+    pub straight_settle_s: f64,
+
     /// Wind uncertainty before any turn, 1-σ per component, m/s (> 0).
     pub initial_wind_sigma_mps: f64,
     /// Pitot scale-factor uncertainty at start, 1-σ (> 0).
     pub initial_pitot_scale_sigma: f64,
+    /// Uncertainty of the straight-flight sideslip offset at start, 1-σ, degrees (> 0): mostly
+    /// the magnetometer's heading bias.
+    pub initial_sideslip_sigma_deg: f64,
     /// Barometric-bias uncertainty before the first pressure reading, 1-σ, natural log of
     /// pressure (> 0).
     pub initial_baro_bias_sigma: f64,
@@ -135,6 +153,7 @@ impl Default for EstimatorConfig {
             turn_rate_random_walk_rad_s_per_sqrt_s: 0.3,
             vertical_wind_sigma_mps: 0.5,
             vertical_wind_correlation_s: 10.0,
+            sideslip_random_walk_deg_per_sqrt_s: 0.1,
             position_random_walk_m_per_sqrt_s: 0.1,
             pitot_scale_random_walk_per_sqrt_s: 1e-3,
             baro_bias_random_walk_per_sqrt_s: 1e-5,
@@ -152,8 +171,14 @@ impl Default for EstimatorConfig {
             gps_min_vertical_accuracy_m: 1.0,
             gps_min_speed_accuracy_mps: 0.05,
 
+            straight_sideslip_sigma_deg: 4.0,
+            straight_turn_rate_rad_s: 0.08,
+            straight_yaw_rate_rad_s: 0.3,
+            straight_settle_s: 1.0,
+
             initial_wind_sigma_mps: 5.0,
             initial_pitot_scale_sigma: 0.05,
+            initial_sideslip_sigma_deg: 5.0,
             initial_baro_bias_sigma: 0.05,
 
             innovation_gate_sigma: 5.0,
@@ -257,6 +282,21 @@ impl EstimatorConfig {
         positive("initial_wind_sigma_mps", self.initial_wind_sigma_mps)?;
         positive("initial_pitot_scale_sigma", self.initial_pitot_scale_sigma)?;
         positive("initial_baro_bias_sigma", self.initial_baro_bias_sigma)?;
+        non_negative(
+            "sideslip_random_walk_deg_per_sqrt_s",
+            self.sideslip_random_walk_deg_per_sqrt_s,
+        )?;
+        positive(
+            "straight_sideslip_sigma_deg",
+            self.straight_sideslip_sigma_deg,
+        )?;
+        positive("straight_turn_rate_rad_s", self.straight_turn_rate_rad_s)?;
+        positive("straight_yaw_rate_rad_s", self.straight_yaw_rate_rad_s)?;
+        non_negative("straight_settle_s", self.straight_settle_s)?;
+        positive(
+            "initial_sideslip_sigma_deg",
+            self.initial_sideslip_sigma_deg,
+        )?;
         positive("innovation_gate_sigma", self.innovation_gate_sigma)?;
         if self.reset_after_rejections == 0 {
             return Err(EstimatorConfigError::Invalid {
@@ -285,6 +325,12 @@ pub(crate) struct Tuning {
     pub vertical_wind_correlation_s: f64,
     pub q_scale: f64,
     pub q_baro: f64,
+    pub q_sideslip: f64,
+    pub straight_sideslip_sigma_rad: f64,
+    pub straight_turn_rate_rad_s: f64,
+    pub straight_yaw_rate_rad_s: f64,
+    pub straight_settle_s: f64,
+    pub initial_sideslip_variance: f64,
     /// Angular-acceleration spectral densities, rad²/s³.
     pub q_roll_pitch: f64,
     pub q_yaw: f64,
@@ -324,6 +370,12 @@ impl Tuning {
             vertical_wind_correlation_s: c.vertical_wind_correlation_s,
             q_scale: c.pitot_scale_random_walk_per_sqrt_s.powi(2),
             q_baro: c.baro_bias_random_walk_per_sqrt_s.powi(2),
+            q_sideslip: c.sideslip_random_walk_deg_per_sqrt_s.to_radians().powi(2),
+            straight_sideslip_sigma_rad: c.straight_sideslip_sigma_deg.to_radians(),
+            straight_turn_rate_rad_s: c.straight_turn_rate_rad_s,
+            straight_yaw_rate_rad_s: c.straight_yaw_rate_rad_s,
+            straight_settle_s: c.straight_settle_s,
+            initial_sideslip_variance: c.initial_sideslip_sigma_deg.to_radians().powi(2),
             q_roll_pitch: c.roll_pitch_acceleration_noise.powi(2),
             q_yaw: c.yaw_acceleration_noise.powi(2),
             max_angular_rate_rad_s: c.max_angular_rate_rad_s,

@@ -15,7 +15,7 @@ use crate::estimate::Estimate;
 use crate::measurement::{AIR_GAS_CONSTANT, AirDataSample, AttitudeSample, GpsFix, Measurement};
 
 /// Number of navigation states.
-pub(crate) const N: usize = 12;
+pub(crate) const N: usize = 13;
 pub(crate) type StateVec = SVector<f64, N>;
 pub(crate) type Covariance = SMatrix<f64, N, N>;
 
@@ -35,6 +35,9 @@ pub(crate) mod ix {
     pub const SCALE: usize = 10;
     /// Barometric bias, natural log of pressure.
     pub const BARO: usize = 11;
+    /// Sideslip of the air velocity from the drone's measured heading in straight flight, rad
+    /// (the AHRS's heading bias included).
+    pub const SIDESLIP: usize = 12;
 }
 
 /// What became of one measurement.
@@ -221,6 +224,7 @@ impl Nav {
             t.vertical_wind_variance * (1.0 - vertical_decay * vertical_decay);
         q[(ix::SCALE, ix::SCALE)] = t.q_scale * dt_s;
         q[(ix::BARO, ix::BARO)] = t.q_baro * dt_s;
+        q[(ix::SIDESLIP, ix::SIDESLIP)] = t.q_sideslip * dt_s;
 
         self.p += q;
     }
@@ -277,6 +281,8 @@ pub(crate) struct NavFilter {
     gated_velocity_in_row: u32,
     /// Whether a static pressure has set the barometric bias.
     baro_started: bool,
+    /// Since when the flight has been straight, s (+∞ while turning).
+    straight_since_s: f64,
 }
 
 /// Turn-rate uncertainty when the navigation filter starts, rad/s.
@@ -297,6 +303,7 @@ impl NavFilter {
             gated_position_in_row: 0,
             gated_velocity_in_row: 0,
             baro_started: false,
+            straight_since_s: f64::INFINITY,
         }
     }
 
@@ -344,10 +351,59 @@ impl NavFilter {
             started |= self.attitude[k].update(measured[k], variances[k], t.max_angular_rate_rad_s);
         }
         if started {
-            Outcome::Reset
-        } else {
-            Outcome::Used
+            return Outcome::Reset;
         }
+        self.sideslip_update(a.time_s, t);
+        Outcome::Used
+    }
+
+    /// In straight flight the drone weathervanes: the horizontal air velocity lies along its
+    /// heading, give or take its swing and a slowly varying offset `β₀` (which also takes up the
+    /// AHRS's heading bias). That pseudo-measurement,
+    /// `0 = e_y·a_h − |a_h|·β₀` with `e_y = [−sin ψ, cos ψ]`, gives the cross-wind from a
+    /// single heading. Turns (and the swing after them) break it, so it is used only after the
+    /// flight has been straight for a while; `β₀` itself is learnt from the wind found in turns.
+    fn sideslip_update(&mut self, time_s: f64, t: &Tuning) {
+        let Some(mut nav) = self.nav else {
+            return;
+        };
+        let yaw = &self.attitude[2];
+        let straight = nav.x[ix::TURN].abs() < t.straight_turn_rate_rad_s
+            && yaw.rate_rad_s.abs() < t.straight_yaw_rate_rad_s;
+        if !straight {
+            self.straight_since_s = f64::INFINITY;
+            return;
+        }
+        self.straight_since_s = self.straight_since_s.min(time_s);
+        if time_s - self.straight_since_s < t.straight_settle_s {
+            return;
+        }
+        let air_h = Vector2::new(nav.x[ix::AIR], nav.x[ix::AIR + 1]);
+        let speed_h = air_h.norm();
+        if speed_h < t.pitot_min_airspeed_mps {
+            return;
+        }
+        let (s, c) = yaw.angle_rad.sin_cos();
+        let e_y = Vector2::new(-s, c);
+        let beta = nav.x[ix::SIDESLIP];
+        let predicted = e_y.dot(&air_h) - speed_h * beta;
+        let mut h = SMatrix::<f64, 1, N>::zeros();
+        let d_air = e_y - air_h * (beta / speed_h);
+        h[(0, ix::AIR)] = d_air.x;
+        h[(0, ix::AIR + 1)] = d_air.y;
+        h[(0, ix::SIDESLIP)] = -speed_h;
+        // The swing, and the heading's own uncertainty (∂(e_y·a)/∂ψ = −e_x·a).
+        let along = Vector2::new(c, s).dot(&air_h);
+        let variance = (speed_h * t.straight_sideslip_sigma_rad).powi(2)
+            + along * along * yaw.angle_variance();
+        let y = SMatrix::<f64, 1, 1>::new(-predicted);
+        nav.update(
+            &y,
+            &h,
+            &SMatrix::<f64, 1, 1>::new(variance),
+            Some(t.gate_nis[0]),
+        );
+        self.nav = Some(nav);
     }
 
     /// GPS noise: position variances (horizontal, vertical) and speed variance, floored.
@@ -392,6 +448,7 @@ impl NavFilter {
         x[ix::SCALE] = scale.0;
         p[(ix::SCALE, ix::SCALE)] = scale.1;
         p[(ix::BARO, ix::BARO)] = t.initial_baro_variance;
+        p[(ix::SIDESLIP, ix::SIDESLIP)] = t.initial_sideslip_variance;
         let mut nav = Nav { x, p };
         Self::velocity_update(&mut nav, g, s_var, None);
         self.nav = Some(nav);
@@ -733,6 +790,7 @@ mod tests {
         t.q_position = 0.0;
         t.q_scale = 0.0;
         t.q_baro = 0.0;
+        t.q_sideslip = 0.0;
         t.vertical_wind_variance = 0.0;
         t
     }
@@ -741,7 +799,7 @@ mod tests {
     fn covariance_propagation_is_the_jacobian_of_the_state_propagation() {
         let t = noiseless();
         let x = StateVec::from_column_slice(&[
-            10.0, -20.0, -500.0, 6.0, -3.0, 4.5, 0.7, -2.0, 3.0, 0.4, 0.97, 0.01,
+            10.0, -20.0, -500.0, 6.0, -3.0, 4.5, 0.7, -2.0, 3.0, 0.4, 0.97, 0.01, 0.05,
         ]);
         // A full, symmetric positive-definite covariance.
         let a = Covariance::from_fn(|i, j| ((i * 7 + j * 3) % 11) as f64 * 0.1 - 0.5);

@@ -10,89 +10,101 @@
 //!
 //! GPS position and NED velocity (≈4 Hz, late by a few tenths of a second), the AHRS's roll,
 //! pitch and yaw of the drone, and a pitot whose differential pressure gives the air's speed
-//! along the drone's x axis only. There are no gyro rates and no accelerations. The drone hangs
-//! 3.3 m below the canopy and swings: in the flight model its body sideslip reaches 10–25° in
-//! steady turns and far more while a turn reverses, and its x axis sits about 17–20° above the
-//! air-relative velocity in a glide. So the pitot's reading is *not* the airspeed, and the air
-//! does not come from straight ahead; the filter must not assume either.
+//! along the drone's x axis only, plus static pressure and temperature. No gyro rates, no
+//! accelerations. The drone hangs 3.3 m below the canopy and swings: in the flight model its
+//! heading jitters by tens of degrees at about 1 Hz around the stack's track, its body sideslip
+//! reaches 10–25° in steady turns and far more while a turn reverses (the air sometimes comes
+//! from behind), and its x axis sits 17–20° above the air-relative velocity in a glide. So the
+//! pitot's reading is not the airspeed, the air does not come from straight ahead, and the
+//! drone's heading is a poor guide to where the stack is going. The filter assumes none of
+//! these.
 //!
 //! # Design
 //!
 //! Two parts, advanced together one measurement at a time in timestamp order:
 //!
-//! 1. **Angle filters** (one each for roll φ, pitch θ, yaw ψ; `angle.rs`): angle and rate with a
-//!    white angular-acceleration model, fed by the AHRS angle. They give the attitude at any
-//!    instant between AHRS samples, the heading rate the estimate reports, and the attitude's
-//!    uncertainty. Innovations and angles are wrapped to (−π, π].
+//! 1. **Angle filters** (roll φ, pitch θ, yaw ψ; `angle.rs`): angle and rate with a white
+//!    angular-acceleration model, fed by the AHRS angle (wrapped innovations, a physical rate
+//!    limit against aliasing). They give the attitude at any instant between AHRS samples, the
+//!    heading and heading rate the estimate reports, and the attitude's uncertainty.
 //!
-//! 2. **Navigation EKF** (`filter.rs`), ten states
-//!
-//!    ```text
-//!    x = [ p (NED, m) | a = [u, v, w] (air-relative velocity in the drone frame, m/s)
-//!        | w_N, w_E (horizontal wind, m/s) | k (pitot scale) | b (baro bias, ln Pa) ]
-//!    ```
-//!
-//!    with the attitude treated as a known input `C = Rz(ψ)·Ry(θ)·Rx(φ)` (drone → NED). The
-//!    ground velocity is *derived*: `v = C·a + [w_N, w_E, 0]` (the vertical wind is taken as
-//!    zero). Keeping the air velocity in the drone frame is the point of the design: in a
-//!    steady turn `a` is constant while `C` rotates, so GPS velocity alone separates the air
-//!    velocity (including sideslip and angle of attack) from the wind — the circle's radius
-//!    and its centre — and the pitot pins `u`, hence the scale `k`. In straight flight the
-//!    wind along the track is not separable from `u`/`k` (it becomes so at the next turn),
-//!    and the crosswind only through the sideslip's pull towards zero.
-//!
-//!    Process model over a step `Δt` (roll and pitch at mid-step, yaw integrated at the
-//!    filtered rate `r`, exact for a constant-rate turn):
+//! 2. **Navigation EKF** (`filter.rs`), twelve states
 //!
 //!    ```text
-//!    p⁺ = p + A·a + [w_N, w_E, 0]·Δt,   A = ∫₀^Δt Rz(ψ + rτ) dτ · Ry(θ)·Rx(φ)
-//!    u⁺ = u + n_u,   w⁺ = w + n_w          (random walks)
-//!    v⁺ = e^(−Δt/τ_β)·v + n_v              (Gauss–Markov: the drone weathervanes)
-//!    wind⁺ = wind + n_wind,  k⁺ = k + n_k,  b⁺ = b + n_b
+//!    x = [ p (NED position, m) | a (NED velocity relative to the air, m/s) | ω (turn rate
+//!          of the horizontal air velocity, rad/s) | w_N, w_E, w_D (wind, m/s)
+//!          | k (pitot scale) | b (barometric bias, ln Pa) ]
 //!    ```
 //!
-//!    and the covariance `P⁺ = F P Fᵀ + Q`, with the body-velocity noise carried into position
-//!    through `A` (`Q_pa = C̄·Q_a·Δt/2`, `Q_pp = C̄·Q_a·C̄ᵀ·Δt²/3`, `C̄ = A/Δt`).
+//!    The ground velocity is `v = a + w`. The air velocity is kept in NED, not in the drone's
+//!    frame, because the stack's air velocity is smooth (a twelve-metre, nine-kilogram
+//!    stack) while the drone's frame jitters with its swing; it turns at the rate ω
+//!    in a turn. The vertical wind is a Gauss–Markov process about zero: in a spiral the drone
+//!    pitches 35° nose-down, so the pitot sees a good part of the sink rate, and an unmodelled
+//!    vertical gust would otherwise be blamed on the horizontal wind.
+//!
+//!    Process model over a step `Δt`, with `R(α)` the horizontal rotation by `α`:
+//!
+//!    ```text
+//!    a_h⁺ = R(ωΔt)·a_h + n,   a_D⁺ = a_D + n            (turning, random walks)
+//!    p_h⁺ = p_h + G·a_h + w_h·Δt,   G = ∫₀^Δt R(ωτ) dτ   (exact along a constant-rate arc)
+//!    p_D⁺ = p_D + (a_D + w_D)·Δt
+//!    ω⁺ = ω + n,   w_h⁺ = w_h + n,   w_D⁺ = e^(−Δt/τ)·w_D + n,   k⁺ = k + n,   b⁺ = b + n
+//!    ```
+//!
+//!    and `P⁺ = F P Fᵀ + Q` with `F` the Jacobian (including `∂G/∂ω` and `∂R/∂ω`) and the
+//!    air velocity's and wind's random walks carried into position (`Δt²/2`, `Δt³/3` terms).
 //!
 //!    Measurements (each an EKF update, gated on its normalised innovation squared):
 //!
 //!    ```text
-//!    GPS position   z = p                                   R = diag(σ_h², σ_h², σ_v²)
-//!    GPS velocity   z = C·a + [w_N, w_E, 0]                 R = σ_s²·I + J_att Σ_att J_attᵀ
-//!    pitot          z = √(2Δp/ρ), ρ = p_s/(R_air·T)  = k·u   R = (σ_Δp/(ρ z))² + σ_floor²
-//!    barometer      z = ln p_s = ln p_US76(h₀ − p_D) + b     R = (σ_ps/p_s)²
+//!    GPS position   z = p                                    R = diag(σ_h², σ_h², σ_v²)
+//!    GPS velocity   z = a + w                                R = σ_s²·I
+//!    pitot          z = √(2Δp/ρ), ρ = p_s/(R_air·T)  = k·(e_x·a)
+//!                   e_x = [cos θ cos ψ, cos θ sin ψ, −sin θ]   R = (σ_Δp/(ρ z))² + J Σ_θψ Jᵀ + σ_floor²
+//!    barometer      z = ln p_s = ln p_US76(h₀ − p_D) + b      R = (σ_ps/p_s)²
 //!    ```
 //!
-//!    `J_att = ∂(C·a)/∂(φ, θ, ψ)` and `Σ_att` the angle filters' variances: an uncertain
-//!    heading makes a GPS velocity less informative about the air velocity and the wind. The
-//!    pitot is not used below a minimum airspeed (a pitot reads nothing for air from behind,
-//!    which a swinging drone does see). The barometer holds the height, and with it the sink
-//!    rate, through GPS dropouts; its bias is learnt from GPS.
+//!    `J = k·∂(e_x·a)/∂(θ, ψ)` and `Σ_θψ` the angle filters' variances: an uncertain attitude
+//!    makes the pitot less informative. The pitot is not used below a minimum airspeed (it
+//!    reads nothing for air from behind, which the swinging drone does see).
 //!
-//! During a GPS dropout the same equations dead-reckon: position integrates `C·a + wind`, the
-//! pitot keeps `u`, the AHRS keeps `C`, the barometer keeps the height, and the covariance
-//! grows (mostly through the sideslip and the wind). When fixes return the gate still passes
-//! them because `P` grew; a filter that has gone wrong anyway is re-started from GPS after
-//! [`EstimatorConfig::reset_after_rejections`] rejected fixes in a row.
+//! **How the wind is found.** Each pitot sample, with the GPS velocity of the same instant,
+//! measures the wind along the drone's x axis: `e_x·w = e_x·v − u_pitot/k`. The component
+//! across x is seen only as x points elsewhere — in turns, and through the drone's swing — so
+//! straight flight leaves the cross-wind to what was learnt in the last turn (its uncertainty
+//! grows meanwhile), and the accuracy in turbulence is set by how fast the x axis sweeps
+//! compared with how fast the wind changes. A turning flight through light turbulence
+//! (σ = 0.1 × the wind speed) gives 0.2–0.35 m/s RMS; steady air about 0.1 m/s (the figures
+//! are printed by `crates/stx-sim/tests/sensors_estimator.rs`). The scale `k` separates from
+//! the along-x wind once the flight turns.
+//!
+//! During a GPS dropout the same equations dead-reckon: the air velocity keeps turning at ω,
+//! the pitot keeps its x component, the barometer keeps the height, and the covariance grows.
+//! When fixes return the gate still passes them because `P` grew; a filter that has gone wrong
+//! anyway is re-started from GPS after [`EstimatorConfig::reset_after_rejections`] rejected
+//! fixes in a row.
+//!
+//! The drone's heading and heading rate come from the angle filters. Between AHRS samples they
+//! are extrapolated, and the drone's ~1 Hz swing under the canopy is barely sampled at 4 Hz, so
+//! these are the least accurate outputs; the course and the turn rate of the air velocity are
+//! smooth.
 //!
 //! # Late and out-of-order measurements
 //!
 //! Every measurement is stamped with the instant it describes, and the filter processes them
-//! in that order. Two copies of the filter are kept:
+//! in that order. Measurements newer than the latest arrival minus
+//! [`EstimatorConfig::max_latency_s`] wait in a short buffer sorted by instant, each with a
+//! copy of the filter just after it; older ones are *committed*, final, never revisited. One
+//! that arrives in order is applied to the newest copy; one that slots in earlier is applied to
+//! the copy before its place, and only the measurements after it are replayed (with GPS 0.25 s
+//! late and the AHRS and pitot on time, one or two). A measurement older than the window is
+//! counted as stale and dropped. Each sensor's outcome (used, gated, reset, unused) is counted
+//! when its measurement is committed, so replays count nothing twice.
 //!
-//! - *committed*: everything older than the latest arrival minus
-//!   [`EstimatorConfig::max_latency_s`] — final, never revisited;
-//! - *head*: the committed filter plus every newer measurement, the source of estimates.
-//!
-//! Newer measurements wait in a short buffer sorted by instant. One that arrives in order
-//! updates the head directly; one that slots in earlier than the head's instant makes the head
-//! be rebuilt from the committed copy by replaying the buffer (a handful of measurements: the
-//! rates times the latency). A measurement older than the latency window is counted as stale
-//! and dropped. The per-sensor outcome counters (used, gated, reset, unused) are counted when a
-//! measurement is committed, so replays do not count anything twice.
-//!
-//! Cost: fixed-size `nalgebra` matrices, no allocation after [`Estimator::new`]; see the
-//! report in `crates/stx-sim/tests/sensors_estimator.rs` for measured times.
+//! Cost: fixed-size `nalgebra` matrices, the transition's sparsity exploited, no allocation
+//! after [`Estimator::new`]; `crates/stx-sim/tests/sensors_estimator.rs` prints the measured
+//! time per call.
 
 mod angle;
 mod config;
