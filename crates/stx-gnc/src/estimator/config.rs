@@ -147,7 +147,7 @@ impl Default for EstimatorConfig {
             air_data_timeout_s: 0.75,
             ground_altitude_msl_m: 0.0,
 
-            wind_random_walk_mps_per_sqrt_s: 0.15,
+            wind_random_walk_mps_per_sqrt_s: 0.1,
             air_velocity_random_walk_mps_per_sqrt_s: 0.6,
             sink_rate_random_walk_mps_per_sqrt_s: 0.3,
             turn_rate_random_walk_rad_s_per_sqrt_s: 0.3,
@@ -172,8 +172,8 @@ impl Default for EstimatorConfig {
             gps_min_speed_accuracy_mps: 0.05,
 
             straight_sideslip_sigma_deg: 4.0,
-            straight_turn_rate_rad_s: 0.08,
-            straight_yaw_rate_rad_s: 0.3,
+            straight_turn_rate_rad_s: 0.15,
+            straight_yaw_rate_rad_s: 0.6,
             straight_settle_s: 1.0,
 
             initial_wind_sigma_mps: 5.0,
