@@ -462,6 +462,136 @@ fn bad_input_is_refused_and_counted_without_touching_the_state() {
     assert_eq!(counters.invalid, 4);
     assert_eq!(counters.from_future, 1);
     assert_eq!(est.estimate(20.5), before, "refused input changed nothing");
+    // Asking at a non-finite instant reads the newest state out rather than poisoning it.
+    let odd = est.estimate(f64::NAN);
+    assert!(odd.time_s.is_finite() && odd.position_ned_m.iter().all(|v| v.is_finite()));
+}
+
+/// A small deterministic generator for the wild-input test (xorshift64*).
+struct Wild(u64);
+
+impl Wild {
+    fn next(&mut self) -> u64 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        self.0.wrapping_mul(0x2545_f491_4f6c_dd1d)
+    }
+
+    /// A finite value from the ordinary to the absurd.
+    fn value(&mut self) -> f64 {
+        let magnitude = match self.next() % 6 {
+            0 => 0.0,
+            1 => 1e-300,
+            2 => 1.0,
+            3 => 1e3,
+            4 => 1e150,
+            _ => f64::MAX,
+        };
+        let fraction = (self.next() % 1000) as f64 / 1000.0;
+        let sign = if self.next().is_multiple_of(2) {
+            1.0
+        } else {
+            -1.0
+        };
+        sign * magnitude * fraction
+    }
+}
+
+/// A wild but finite measurement stamped `time_s`.
+fn wild_measurement(wild: &mut Wild, time_s: f64) -> Measurement {
+    let v = |w: &mut Wild| Vector3::new(w.value(), w.value(), w.value());
+    match wild.next() % 3 {
+        0 => Measurement::Gps(GpsFix {
+            time_s,
+            position_ned_m: v(wild),
+            velocity_ned_mps: v(wild),
+            horizontal_accuracy_m: wild.value().abs(),
+            vertical_accuracy_m: wild.value().abs(),
+            speed_accuracy_mps: wild.value().abs(),
+        }),
+        1 => Measurement::Attitude(AttitudeSample {
+            time_s,
+            roll_rad: wild.value(),
+            pitch_rad: wild.value().clamp(-1.5, 1.5),
+            yaw_rad: wild.value(),
+        }),
+        _ => Measurement::AirData(AirDataSample {
+            time_s,
+            differential_pressure_pa: wild.value(),
+            static_pressure_pa: wild.value().abs(),
+            temperature_k: wild.value().abs(),
+        }),
+    }
+}
+
+#[test]
+fn wild_values_never_panic_and_the_filter_recovers_once_they_stop() {
+    let mut wild = Wild(0x5eed);
+    let mut est = estimator();
+    // Ten minutes of absurd values on an ordinary clock, out of order within the window.
+    for k in 0..20_000 {
+        let time_s = k as f64 * 0.03 + (wild.next() % 10) as f64 * 0.05;
+        let m = wild_measurement(&mut wild, time_s);
+        est.handle(time_s + 0.1, &m);
+        let e = est.estimate(time_s + 0.1);
+        assert!(!e.gps_age_s.is_nan());
+    }
+    assert!(est.counters().accepted > 10_000, "{:?}", est.counters());
+    // Then an ordinary flight: whatever the wild values did, the filter finds it.
+    let mut flight = Flight::turning(60.0, 3.0, 0.4);
+    flight.start_ned_m -= flight.wind_ned_mps * 700.0;
+    flight.track0_rad -= 0.4 * 700.0;
+    let history = feed(
+        &mut est,
+        &deliveries(&flight, 700.0, 760.0, USUAL, |_| true),
+    );
+    let (t, e) = history.last().expect("estimates");
+    assert!((e.position_ned_m - flight.position_ned(*t)).norm() < 1.0);
+    assert!(wrap_pi(e.heading_rad - flight.yaw_rad(*t)).abs() < 0.05);
+    assert!(horizontal(e.wind_ned_mps - flight.wind_ned_mps) < 0.3);
+}
+
+#[test]
+fn a_gap_long_enough_to_overflow_the_covariance_restarts_the_filter() {
+    // After 1e110 s the predicted variance (∝ Δt³) overflows; the filter must not stay
+    // undefined for ever but start again from the next measurements.
+    let attitude = |time_s: f64, yaw_rad: f64| {
+        Measurement::Attitude(AttitudeSample {
+            time_s,
+            roll_rad: 0.0,
+            pitch_rad: -0.1,
+            yaw_rad,
+        })
+    };
+    let mut est = estimator();
+    est.handle(0.0, &attitude(0.0, 0.5));
+    est.handle(1e110, &attitude(1e110, 1.0));
+    est.handle(1e110, &attitude(1e110, 1.1));
+    let e = est.estimate(1e110);
+    assert!(
+        e.heading_rad.is_finite() && (e.heading_rad - 1.05).abs() < 0.1,
+        "{e:?}"
+    );
+    assert!(e.heading_sigma_rad.is_finite());
+}
+
+#[test]
+fn wild_timestamps_never_panic() {
+    let mut wild = Wild(0xc10c);
+    let mut est = estimator();
+    for _ in 0..20_000 {
+        let time_s = wild.value();
+        let arrival_s = wild.value();
+        let m = wild_measurement(&mut wild, time_s);
+        est.handle(arrival_s, &m);
+        let _ = est.estimate(wild.value());
+    }
+    let c = est.counters();
+    assert_eq!(
+        c.accepted + c.stale + c.non_finite + c.invalid + c.from_future,
+        20_000
+    );
 }
 
 #[test]

@@ -335,10 +335,35 @@ impl NavFilter {
     /// Advances to the measurement's instant and feeds it.
     pub fn apply(&mut self, m: &Measurement, t: &Tuning) -> Outcome {
         self.predict_to(m.time_s(), t);
-        match m {
+        let outcome = match m {
             Measurement::Attitude(a) => self.apply_attitude(a, t),
             Measurement::Gps(g) => self.apply_gps(g, t),
             Measurement::AirData(a) => self.apply_air_data(a, t),
+        };
+        self.heal();
+        outcome
+    }
+
+    /// Finite but absurd input (positions of 1e300 m, a gap of centuries) can overflow the
+    /// arithmetic; a non-finite state would then stay so for ever. Such a part is dropped and
+    /// starts again from the next measurement instead.
+    fn heal(&mut self) {
+        for angle in &mut self.attitude {
+            let finite = angle.angle_rad.is_finite()
+                && angle.rate_rad_s.is_finite()
+                && angle.covariance.iter().all(|v| v.is_finite());
+            if !finite {
+                *angle = AngleFilter::new();
+            }
+        }
+        let nav_finite = self.nav.as_ref().is_none_or(|nav| {
+            nav.x.iter().all(|v| v.is_finite()) && nav.p.iter().all(|v| v.is_finite())
+        });
+        if !nav_finite || !self.time_s.is_finite() {
+            self.nav = None;
+        }
+        if !self.time_s.is_finite() {
+            *self = Self::new();
         }
     }
 
@@ -380,7 +405,7 @@ impl NavFilter {
         }
         let air_h = Vector2::new(nav.x[ix::AIR], nav.x[ix::AIR + 1]);
         let speed_h = air_h.norm();
-        if speed_h < t.pitot_min_airspeed_mps {
+        if speed_h < t.pitot_min_airspeed_mps.max(MIN_SPEED_FOR_DIRECTION_MPS) {
             return;
         }
         let (s, c) = yaw.angle_rad.sin_cos();
@@ -598,7 +623,8 @@ impl NavFilter {
         let e_x = x_axis_ned(pitch.angle_rad, yaw.angle_rad);
         let along_x = e_x.dot(&air);
         let scale = nav.x[ix::SCALE];
-        if measured < t.pitot_min_airspeed_mps || scale * along_x < t.pitot_min_airspeed_mps {
+        let floor = t.pitot_min_airspeed_mps.max(MIN_SPEED_FOR_DIRECTION_MPS);
+        if measured < floor || scale * along_x < floor {
             return Outcome::Unused;
         }
         let density = a.density_kg_per_m3();
@@ -627,7 +653,11 @@ impl NavFilter {
     }
 
     /// The estimate at `now_s`: this state predicted forward (never backward) and read out.
+    /// A non-finite `now_s` reads the state out as it is, at its own instant.
     pub fn estimate(&self, now_s: f64, t: &Tuning, timeouts: &Timeouts) -> Estimate {
+        if !now_s.is_finite() {
+            return self.read_out(self.time_s, timeouts);
+        }
         let mut f = *self;
         if now_s > f.time_s {
             f.predict_to(now_s, t);
@@ -709,13 +739,17 @@ impl NavFilter {
         };
         e.sink_rate_mps = velocity.z;
         e.sink_rate_sigma_mps = e.velocity_sigma_mps.z;
-        let (glide_air, glide_ground) = if velocity.z > MIN_SINK_FOR_GLIDE_MPS {
-            (air.x.hypot(air.y) / velocity.z, ground_speed / velocity.z)
-        } else {
-            (f64::INFINITY, f64::INFINITY)
+        // Through the air mass with the air-relative sink; over the ground with the height
+        // lost (they differ by the vertical wind).
+        let glide = |distance_rate: f64, sink: f64| {
+            if sink > MIN_SINK_FOR_GLIDE_MPS {
+                distance_rate / sink
+            } else {
+                f64::INFINITY
+            }
         };
-        e.glide_ratio_air = glide_air;
-        e.glide_ratio_ground = glide_ground;
+        e.glide_ratio_air = glide(air.x.hypot(air.y), air.z);
+        e.glide_ratio_ground = glide(ground_speed, velocity.z);
         e.wind_ned_mps = Vector3::new(nav.x[ix::WIND], nav.x[ix::WIND + 1], 0.0);
         e.wind_sigma_mps = Vector3::new(
             sigma(nav.p[(ix::WIND, ix::WIND)]),
@@ -728,6 +762,10 @@ impl NavFilter {
 
 /// Below this sink rate a glide ratio means nothing and is reported as infinite, m/s.
 const MIN_SINK_FOR_GLIDE_MPS: f64 = 0.05;
+
+/// Below this horizontal air speed the air velocity's direction, and the pitot's reading, mean
+/// too little to use, m/s (and it keeps divisions by the speed away from zero).
+const MIN_SPEED_FOR_DIRECTION_MPS: f64 = 1.0;
 
 /// The status timeouts, s.
 #[derive(Debug, Clone, Copy, PartialEq)]
