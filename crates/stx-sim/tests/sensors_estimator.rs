@@ -609,3 +609,18 @@ fn cost_per_call_is_a_few_microseconds() {
     );
     assert_eq!(run.deliveries.len(), 2400);
 }
+
+#[test]
+fn estimator_and_sensor_settings_read_from_toml_and_refuse_unknown_keys() {
+    let estimator: EstimatorConfig =
+        toml::from_str("max_latency_s = 1.2\nground_altitude_msl_m = 350.0\n").expect("valid");
+    assert_eq!(estimator.max_latency_s, 1.2);
+    assert_eq!(
+        estimator.gps_timeout_s,
+        EstimatorConfig::default().gps_timeout_s
+    );
+    Estimator::new(estimator).expect("valid settings");
+    assert!(toml::from_str::<EstimatorConfig>("max_latncy_s = 1.2\n").is_err());
+    let sensors: SensorConfig = toml::from_str("[pitot]\nrate_hz = 10.0\n").expect("valid");
+    SensorSuite::new(&sensors, 1).expect("valid settings");
+}

@@ -75,8 +75,9 @@ pub struct EstimatorConfig {
     /// the standard one with height), in natural log of pressure per √s (≥ 0); 1e-4 is about
     /// 0.85 m near the ground.
     pub baro_bias_random_walk_per_sqrt_s: f64,
-    /// White angular acceleration driving the roll and pitch filters, rad/s²/√Hz (> 0). The
-    /// drone swings under the canopy, so this is large.
+    /// White angular acceleration driving the roll and pitch filters, rad/s²/√Hz (> 0): large
+    /// enough to follow the drone's swing, small enough that a rate estimated from 4-Hz angles
+    /// is not mere noise.
     pub roll_pitch_acceleration_noise: f64,
     /// The same for the heading filter, rad/s²/√Hz (> 0).
     pub yaw_acceleration_noise: f64,
@@ -114,11 +115,11 @@ pub struct EstimatorConfig {
     pub straight_turn_rate_rad_s: f64,
     /// ...and the drone's heading changes slower than this, rad/s (> 0)...
     pub straight_yaw_rate_rad_s: f64,
-    /// ...and has done so for this long, s (≥ 0): the swing after a turn takes a few seconds
-    /// to fade.
+    /// ...and has done so for this long, s (≥ 0): a moment for the swing after a turn to
+    /// fade.
     pub straight_settle_s: f64,
 
-    /// Wind uncertainty before any turn, 1-σ per component, m/s (> 0).
+    /// Wind uncertainty when the filter starts, 1-σ per component, m/s (> 0).
     pub initial_wind_sigma_mps: f64,
     /// Pitot scale-factor uncertainty at start, 1-σ (> 0).
     pub initial_pitot_scale_sigma: f64,
@@ -132,8 +133,8 @@ pub struct EstimatorConfig {
     /// Innovation gate: a measurement whose innovation is less likely than a normal deviate
     /// beyond this many σ is rejected and counted, σ (> 0).
     pub innovation_gate_sigma: f64,
-    /// After this many consecutive rejected GPS fixes, the filter
-    /// re-initialises from the sensor rather than trust a state that has gone wrong (≥ 1).
+    /// After this many consecutive rejected GPS positions (or velocities), the filter takes
+    /// them from the fix rather than trust a state that has gone wrong (≥ 1).
     pub reset_after_rejections: u32,
 }
 
