@@ -415,6 +415,26 @@ fn wind_meets_the_goal_on_cases_the_tuning_never_saw() {
 }
 
 #[test]
+fn pitot_samples_between_ahrs_samples_cost_some_accuracy_but_not_the_estimate() {
+    // The default sensors sample in the same instant, as the drone's 4 Hz loop does; here the
+    // pitot comes 0.05 s (then 0.1 s) after the AHRS and the estimator interpolates the
+    // attitude across the drone's swing.
+    let mut worst: f64 = 0.0;
+    for (offset_s, speed, from, seed) in [(0.05, 3.0, 300.0, 1), (0.1, 5.0, 45.0, 2)] {
+        let mut case = Case::new(speed, from, seed, Turns::ALTERNATING);
+        case.sensors.pitot.phase_s = offset_s;
+        case.sensors.gps.phase_s = 0.15;
+        let f = figures(&fly(&case), 30.0);
+        print_figures(
+            &format!("pitot {offset_s} s after the AHRS: {}", case.label()),
+            &f,
+        );
+        worst = worst.max(f.wind);
+    }
+    assert!(worst < 0.45, "worst wind RMSE {worst:.3}");
+}
+
+#[test]
 fn stronger_and_faster_gusts_degrade_the_wind_gracefully() {
     // Beyond the standard's light turbulence: 0.2 m/s stronger, and gusts 1.5 (horizontal)
     // to 6 (vertical) times faster. The goal is not claimed here; a bound guards against the
@@ -575,11 +595,13 @@ fn cost_per_call_is_a_few_microseconds() {
     case.duration_s = 200.0;
     let run = fly(&case);
     let repeats = 20;
-    let mut handle_s = 0.0;
-    let mut estimate_s = 0.0;
+    // (handle, estimate) wall time of each repeat, s. The best repeat is the least disturbed
+    // by whatever else shares the machine; the mean is what a busy machine gives.
+    let mut times = Vec::with_capacity(repeats);
     let mut checksum = 0.0;
     for _ in 0..repeats {
         let mut est = Estimator::new(EstimatorConfig::default()).expect("valid");
+        let (mut handle_s, mut estimate_s) = (0.0, 0.0);
         let mut i = 0;
         for s in &run.samples {
             let t = s.truth.time_s;
@@ -594,18 +616,31 @@ fn cost_per_call_is_a_few_microseconds() {
             checksum += est.estimate(t).wind_ned_mps.x;
             estimate_s += started.elapsed().as_secs_f64();
         }
+        times.push((handle_s, estimate_s));
     }
-    let handles = (run.deliveries.len() * repeats) as f64;
-    let estimates = (run.samples.len() * repeats) as f64;
+    let handles = run.deliveries.len() as f64;
+    let estimates = run.samples.len() as f64;
+    let best = times
+        .iter()
+        .copied()
+        .fold((f64::INFINITY, f64::INFINITY), |a, b| {
+            (a.0.min(b.0), a.1.min(b.1))
+        });
+    let mean = times.iter().fold((0.0, 0.0), |a, b| (a.0 + b.0, a.1 + b.1));
+    let mean = (mean.0 / repeats as f64, mean.1 / repeats as f64);
     println!(
-        "cost: handle {:.2} µs per measurement ({} per run), estimate {:.2} µs per call \
-         ({} per run); 200 s at 4 Hz from three sensors and one estimate per 0.05-s tick: \
-         {:.1} ms per run (checksum {checksum:.3})",
-        handle_s / handles * 1e6,
+        "cost (best of {repeats} / mean): handle {:.2} / {:.2} µs per measurement ({} per \
+         run), estimate {:.2} / {:.2} µs per call ({} per run); a 200-s run at 4 Hz from \
+         three sensors with an estimate every 0.05-s tick: {:.1} / {:.1} ms \
+         (checksum {checksum:.3})",
+        best.0 / handles * 1e6,
+        mean.0 / handles * 1e6,
         run.deliveries.len(),
-        estimate_s / estimates * 1e6,
+        best.1 / estimates * 1e6,
+        mean.1 / estimates * 1e6,
         run.samples.len(),
-        (handle_s + estimate_s) / repeats as f64 * 1e3
+        (best.0 + best.1) * 1e3,
+        (mean.0 + mean.1) * 1e3,
     );
     assert_eq!(run.deliveries.len(), 2400);
 }

@@ -281,6 +281,9 @@ pub(crate) struct NavFilter {
     gated_velocity_in_row: u32,
     /// Whether a static pressure has set the barometric bias.
     baro_started: bool,
+    /// The latest AHRS sample, to interpolate the attitude of a pitot sample that falls
+    /// between two.
+    last_attitude: Option<AttitudeSample>,
     /// Since when the flight has been straight, s (+∞ while turning).
     straight_since_s: f64,
 }
@@ -303,8 +306,14 @@ impl NavFilter {
             gated_position_in_row: 0,
             gated_velocity_in_row: 0,
             baro_started: false,
+            last_attitude: None,
             straight_since_s: f64::INFINITY,
         }
+    }
+
+    /// Instant of the latest AHRS sample applied, s (−∞ before the first).
+    pub fn last_attitude_time_s(&self) -> f64 {
+        self.last_attitude.map_or(f64::NEG_INFINITY, |a| a.time_s)
     }
 
     fn attitude_started(&self) -> bool {
@@ -332,13 +341,20 @@ impl NavFilter {
         self.time_s = time_s;
     }
 
-    /// Advances to the measurement's instant and feeds it.
-    pub fn apply(&mut self, m: &Measurement, t: &Tuning) -> Outcome {
+    /// Advances to the measurement's instant and feeds it. `next_attitude` is the first AHRS
+    /// sample after it, if already received: a pitot sample between two AHRS samples is
+    /// projected with the attitude interpolated between them.
+    pub fn apply(
+        &mut self,
+        m: &Measurement,
+        next_attitude: Option<&AttitudeSample>,
+        t: &Tuning,
+    ) -> Outcome {
         self.predict_to(m.time_s(), t);
         let outcome = match m {
             Measurement::Attitude(a) => self.apply_attitude(a, t),
             Measurement::Gps(g) => self.apply_gps(g, t),
-            Measurement::AirData(a) => self.apply_air_data(a, t),
+            Measurement::AirData(a) => self.apply_air_data(a, next_attitude, t),
         };
         self.heal();
         outcome
@@ -369,6 +385,7 @@ impl NavFilter {
 
     fn apply_attitude(&mut self, a: &AttitudeSample, t: &Tuning) -> Outcome {
         self.last_attitude_s = a.time_s;
+        self.last_attitude = Some(*a);
         let measured = [a.roll_rad, a.pitch_rad, a.yaw_rad];
         let variances = [t.r_roll_pitch, t.r_roll_pitch, t.r_yaw];
         let mut started = false;
@@ -559,7 +576,12 @@ impl NavFilter {
         outcome
     }
 
-    fn apply_air_data(&mut self, a: &AirDataSample, t: &Tuning) -> Outcome {
+    fn apply_air_data(
+        &mut self,
+        a: &AirDataSample,
+        next_attitude: Option<&AttitudeSample>,
+        t: &Tuning,
+    ) -> Outcome {
         self.last_air_data_s = a.time_s;
         if !self.attitude_started() {
             return Outcome::Unused;
@@ -568,7 +590,7 @@ impl NavFilter {
             return Outcome::Unused;
         };
         let baro = self.baro_update(&mut nav, a, t);
-        let pitot = self.pitot_update(&mut nav, a, t);
+        let pitot = self.pitot_update(&mut nav, a, next_attitude, t);
         self.nav = Some(nav);
         match (baro, pitot) {
             (Outcome::Gated, _) | (_, Outcome::Gated) => Outcome::Gated,
@@ -614,13 +636,67 @@ impl NavFilter {
         }
     }
 
+    /// Pitch and heading at `time_s` with their variances: the AHRS's own if sampled at that
+    /// instant, else interpolated between the AHRS samples around it when both are known (the
+    /// drone swings too fast for the angle filters' extrapolation), else the angle filters'.
+    fn attitude_at(
+        &self,
+        time_s: f64,
+        next: Option<&AttitudeSample>,
+        t: &Tuning,
+    ) -> (f64, f64, f64, f64) {
+        let [_, pitch, yaw] = &self.attitude;
+        let filtered = (
+            pitch.angle_rad,
+            pitch.angle_variance(),
+            yaw.angle_rad,
+            yaw.angle_variance(),
+        );
+        let Some(before) = self.last_attitude else {
+            return filtered;
+        };
+        if before.time_s == time_s {
+            // Sampled together (the drone's 4 Hz loop): the AHRS's own angles.
+            return (before.pitch_rad, t.r_roll_pitch, before.yaw_rad, t.r_yaw);
+        }
+        let Some(after) = next else {
+            return filtered;
+        };
+        let span_s = after.time_s - before.time_s;
+        if !(before.time_s <= time_s && time_s <= after.time_s && span_s <= MAX_INTERPOLATION_S) {
+            return filtered;
+        }
+        let f = if span_s > 0.0 {
+            (time_s - before.time_s) / span_s
+        } else {
+            0.0
+        };
+        let d_pitch = after.pitch_rad - before.pitch_rad;
+        let d_yaw = wrap_pi(after.yaw_rad - before.yaw_rad);
+        // The swing between the samples is not a straight line: allow for the chord's error.
+        let bow = 0.5 * f.min(1.0 - f);
+        (
+            before.pitch_rad + f * d_pitch,
+            t.r_roll_pitch + (bow * d_pitch).powi(2),
+            wrap_pi(before.yaw_rad + f * d_yaw),
+            t.r_yaw + (bow * d_yaw).powi(2),
+        )
+    }
+
     /// Pitot: indicated airspeed `z = k·(e_x·v_air)`, the air along the drone's x axis from
     /// the AHRS's pitch and heading; their uncertainty is added to the noise.
-    fn pitot_update(&self, nav: &mut Nav, a: &AirDataSample, t: &Tuning) -> Outcome {
+    fn pitot_update(
+        &self,
+        nav: &mut Nav,
+        a: &AirDataSample,
+        next_attitude: Option<&AttitudeSample>,
+        t: &Tuning,
+    ) -> Outcome {
         let measured = a.indicated_airspeed_mps();
-        let [_, pitch, yaw] = &self.attitude;
+        let (pitch, pitch_variance, yaw, yaw_variance) =
+            self.attitude_at(a.time_s, next_attitude, t);
         let air = nav.air_ned();
-        let e_x = x_axis_ned(pitch.angle_rad, yaw.angle_rad);
+        let e_x = x_axis_ned(pitch, yaw);
         let along_x = e_x.dot(&air);
         let scale = nav.x[ix::SCALE];
         let floor = t.pitot_min_airspeed_mps.max(MIN_SPEED_FOR_DIRECTION_MPS);
@@ -628,11 +704,11 @@ impl NavFilter {
             return Outcome::Unused;
         }
         let density = a.density_kg_per_m3();
-        let (d_pitch, d_yaw) = x_axis_projection_gradient(pitch.angle_rad, yaw.angle_rad, &air);
+        let (d_pitch, d_yaw) = x_axis_projection_gradient(pitch, yaw, &air);
         // σ_u = σ_Δp / (ρ·u) from u = √(2Δp/ρ), plus the attitude's share and a floor.
         let variance = (t.differential_pressure_noise_pa / (density * measured)).powi(2)
-            + (scale * d_pitch).powi(2) * pitch.angle_variance()
-            + (scale * d_yaw).powi(2) * yaw.angle_variance()
+            + (scale * d_pitch).powi(2) * pitch_variance
+            + (scale * d_yaw).powi(2) * yaw_variance
             + t.pitot_floor_variance;
         let mut h = SMatrix::<f64, 1, N>::zeros();
         for k in 0..3 {
@@ -762,6 +838,10 @@ impl NavFilter {
 
 /// Below this sink rate a glide ratio means nothing and is reported as infinite, m/s.
 const MIN_SINK_FOR_GLIDE_MPS: f64 = 0.05;
+
+/// Longest gap between two AHRS samples across which a pitot sample's attitude is
+/// interpolated, s; beyond it the angle filters' estimate is used.
+pub(crate) const MAX_INTERPOLATION_S: f64 = 1.0;
 
 /// Below this horizontal air speed the air velocity's direction, and the pitot's reading, mean
 /// too little to use, m/s (and it keeps divisions by the speed away from zero).

@@ -68,9 +68,15 @@
 //!                                                             R = (|a_h| σ_β)² + (e_x·a_h)² σ_ψ²
 //!    ```
 //!
-//!    `J = k·∂(e_x·a)/∂(θ, ψ)` and `Σ_θψ` the angle filters' variances: an uncertain attitude
-//!    makes the pitot less informative. The pitot is not used below a minimum airspeed (it
-//!    reads nothing for air from behind, which the swinging drone does see). The last line is
+//!    `J = k·∂(e_x·a)/∂(θ, ψ)` and `Σ_θψ` the variances of the pitch and heading used: an
+//!    uncertain attitude makes the pitot less informative. Which pitch and heading: the AHRS's
+//!    own when it sampled in the same instant (the drone's 4 Hz loop reads all its sensors
+//!    together); else interpolated between the AHRS samples either side (the pitot sample is
+//!    processed again when the later one arrives, and waits for it before being committed);
+//!    else the angle filters' extrapolation. The drone's swing makes this matter: a pitot
+//!    0.05–0.1 s off the AHRS costs 0.1 m/s of wind accuracy even with the interpolation. The
+//!    pitot is not used below a minimum airspeed (it reads nothing for air from behind, which
+//!    the swinging drone does see). The last line is
 //!    a pseudo-measurement used with each AHRS sample once the flight has been straight for a
 //!    moment (slow ω and heading rate): a weathervaning drone points into its relative wind
 //!    give or take its swing and an offset `β₀`. `β₀` also takes up the magnetometer's heading
@@ -87,9 +93,9 @@
 //! by how fast the x axis sweeps compared with how fast the wind changes. On the flight model
 //! with the simulator's default sensors and MIL-F-8785C low-altitude turbulence
 //! (σ = 0.1 × wind, L = 300 m), 22 flights of 200 s in 2–5 m/s of wind, in alternating
-//! spirals, spiral-landing legs and slow weaving, give 0.13–0.29 m/s RMS from 30 s on (the
+//! spirals, spiral-landing legs and slow weaving, give 0.12–0.29 m/s RMS from 30 s on (the
 //! project's goal is 0.3); steady air about 0.1 m/s. In gusts 0.2 m/s stronger and faster
-//! (L = 200 m horizontally, 50 m vertically), 0.28–0.43 m/s: the goal then is not met. The
+//! (L = 200 m horizontally, 50 m vertically), 0.28–0.42 m/s: the goal then is not met. The
 //! figures are printed by `crates/stx-sim/tests/sensors_estimator.rs`. The scale `k`
 //! separates from the along-x wind once the flight turns.
 //!
@@ -112,7 +118,9 @@
 //! copy of the filter just after it; older ones are *committed*, final, never revisited. One
 //! that arrives in order is applied to the newest copy; one that slots in earlier is applied to
 //! the copy before its place, and only the measurements after it are replayed (with GPS 0.25 s
-//! late and the AHRS and pitot on time, one or two). A measurement older than the window is
+//! late and the AHRS and pitot on time, one). As long as every measurement arrives within the
+//! window, the result does not depend on the order of arrival. A measurement older than the
+//! window is
 //! counted as stale and dropped. Each sensor's outcome (used, gated, reset, unused) is counted
 //! when its measurement is committed, so replays count nothing twice.
 //!
@@ -133,7 +141,7 @@ use serde::{Deserialize, Serialize};
 use crate::estimate::Estimate;
 use crate::measurement::Measurement;
 use config::Tuning;
-use filter::{NavFilter, Outcome, Timeouts};
+use filter::{MAX_INTERPOLATION_S, NavFilter, Outcome, Timeouts};
 
 /// Most measurements held for re-ordering, each with a filter snapshot (about 1.5 kB). At 4 Hz
 /// from three sensors and a 0.6-s window about eight wait at once; the rest is headroom for
@@ -247,6 +255,14 @@ fn sensor_rank(m: &Measurement) -> u8 {
         Measurement::Gps(_) => 1,
         Measurement::AirData(_) => 2,
     }
+}
+
+fn is_attitude(p: &Pending) -> bool {
+    matches!(p.measurement, Measurement::Attitude(_))
+}
+
+fn is_air_data(m: &Measurement) -> bool {
+    matches!(m, Measurement::AirData(_))
 }
 
 /// Checks a measurement from outside before it touches the filter.
@@ -371,32 +387,63 @@ impl Estimator {
             .iter()
             .rposition(|p| (p.measurement.time_s(), sensor_rank(&p.measurement)) <= key)
             .map_or(0, |i| i + 1);
-        let mut state = match at {
-            0 => self.committed,
-            _ => self.pending[at - 1].after,
-        };
-        if at < self.pending.len() {
-            self.counters.replays += 1;
-        }
         self.pending.insert(
             at,
             Pending {
                 measurement: *m,
                 outcome: Outcome::Unused,
-                after: state,
+                after: NavFilter::new(),
             },
         );
-        for entry in self.pending.iter_mut().skip(at) {
-            entry.outcome = state.apply(&entry.measurement, &self.tuning);
+        // A new AHRS sample closes the interval of the pitot samples since the previous one,
+        // which were projected with an extrapolated attitude: replay them with it. (A pitot
+        // sample of the very instant of an AHRS sample needs no interpolation.)
+        let mut start = at;
+        if matches!(m, Measurement::Attitude(_)) {
+            let previous = self.pending.range(..at).rposition(is_attitude);
+            let (first, previous_s) = match previous {
+                Some(i) => (i + 1, self.pending[i].measurement.time_s()),
+                None => (0, self.committed.last_attitude_time_s()),
+            };
+            if let Some(i) = (first..at).find(|&i| {
+                let p = &self.pending[i].measurement;
+                is_air_data(p) && p.time_s() > previous_s
+            }) {
+                start = i;
+            }
+        }
+        if start + 1 < self.pending.len() {
+            self.counters.replays += 1;
+        }
+        let mut state = match start {
+            0 => self.committed,
+            _ => self.pending[start - 1].after,
+        };
+        for i in start..self.pending.len() {
+            let next_attitude = self
+                .pending
+                .range(i + 1..)
+                .find_map(|p| match &p.measurement {
+                    Measurement::Attitude(a) => Some(*a),
+                    _ => None,
+                });
+            let entry = &mut self.pending[i];
+            entry.outcome = state.apply(&entry.measurement, next_attitude.as_ref(), &self.tuning);
             entry.after = state;
         }
 
-        // Commit what the window has closed on.
-        while self
-            .pending
-            .front()
-            .is_some_and(|p| p.measurement.time_s() < horizon_s)
-        {
+        // Commit what the window has closed on; a pitot sample waits (a little longer) for
+        // the AHRS sample after it, so that its final processing does not depend on the order
+        // in which the two arrived.
+        while let Some(front) = self.pending.front() {
+            let front_s = front.measurement.time_s();
+            let awaits_attitude = is_air_data(&front.measurement)
+                && front_s > self.committed.last_attitude_time_s()
+                && front_s >= horizon_s - MAX_INTERPOLATION_S
+                && !self.pending.iter().skip(1).any(is_attitude);
+            if front_s >= horizon_s || awaits_attitude {
+                break;
+            }
             self.commit_front();
         }
         Disposition::Accepted
