@@ -5,6 +5,9 @@
 //!   of spiral-landing guidance: the vocabulary shared with the link and the dashboard;
 //! - [`measurement`] is what the drone's sensors report, [`estimate`] what the estimator makes
 //!   of it;
+//! - [`estimator`] turns measurements (late, out of order, with gaps) into that estimate: the
+//!   wind, airspeed, heading and position with their uncertainties, onboard and in the station
+//!   alike;
 //! - [`control`] holds the seed's control laws (heading, course, localizer, glide slope);
 //!   [`guidance`] picks and feeds them by mode, including the spiral landing;
 //! - [`performance`] summarises how the parafoil flies, [`pointmass`] flies that summary fast,
@@ -12,6 +15,7 @@
 //! - [`geo`] links the mission's local NED frame to latitude, longitude and altitude.
 pub mod control;
 pub mod estimate;
+pub mod estimator;
 pub mod geo;
 pub mod guidance;
 pub mod measurement;

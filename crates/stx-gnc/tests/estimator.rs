@@ -1,0 +1,688 @@
+//! The estimator against synthetic flights whose every quantity is known exactly: straight
+//! flight and constant-rate turns in a known wind, headings through ±180°, late and shuffled
+//! arrivals, GPS gaps, and input that must be refused.
+
+use std::f64::consts::PI;
+
+use nalgebra::Vector3;
+use stx_dynamics::atmosphere::{Atmosphere, StandardAtmosphere};
+use stx_dynamics::rotation::wrap_pi;
+use stx_gnc::estimate::Estimate;
+use stx_gnc::estimator::{Disposition, Estimator, EstimatorConfig, PENDING_CAPACITY};
+use stx_gnc::measurement::{AirDataSample, AttitudeSample, GpsFix, Measurement};
+
+/// A flight whose air velocity turns at a constant rate in a constant wind.
+#[derive(Clone, Copy, Debug)]
+struct Flight {
+    /// Wind, NED, m/s (horizontal).
+    wind_ned_mps: Vector3<f64>,
+    /// Horizontal speed through the air, m/s.
+    airspeed_h_mps: f64,
+    /// Sink rate through the air, m/s.
+    sink_mps: f64,
+    /// Direction of the horizontal air velocity at t = 0, rad.
+    track0_rad: f64,
+    /// Its turn rate, rad/s.
+    turn_rate_rad_s: f64,
+    /// Heading minus air track, rad: the drone's sideslip offset (or a heading bias).
+    heading_offset_rad: f64,
+    pitch_rad: f64,
+    roll_rad: f64,
+    /// Pitot scale: the pitot reads `scale × u_x`.
+    pitot_scale: f64,
+    start_ned_m: Vector3<f64>,
+}
+
+impl Flight {
+    fn straight(wind_from_deg: f64, wind_speed_mps: f64) -> Self {
+        let (s, c) = wind_from_deg.to_radians().sin_cos();
+        Self {
+            wind_ned_mps: Vector3::new(-wind_speed_mps * c, -wind_speed_mps * s, 0.0),
+            airspeed_h_mps: 6.5,
+            sink_mps: 3.0,
+            track0_rad: 0.3,
+            turn_rate_rad_s: 0.0,
+            heading_offset_rad: 0.0,
+            pitch_rad: -0.12,
+            roll_rad: 0.02,
+            pitot_scale: 1.0,
+            start_ned_m: Vector3::new(0.0, 0.0, -1500.0),
+        }
+    }
+
+    fn turning(wind_from_deg: f64, wind_speed_mps: f64, rate_rad_s: f64) -> Self {
+        Self {
+            turn_rate_rad_s: rate_rad_s,
+            roll_rad: 0.3 * rate_rad_s.signum(),
+            ..Self::straight(wind_from_deg, wind_speed_mps)
+        }
+    }
+
+    fn track_rad(&self, t: f64) -> f64 {
+        self.track0_rad + self.turn_rate_rad_s * t
+    }
+
+    fn air_ned(&self, t: f64) -> Vector3<f64> {
+        let (s, c) = self.track_rad(t).sin_cos();
+        Vector3::new(
+            self.airspeed_h_mps * c,
+            self.airspeed_h_mps * s,
+            self.sink_mps,
+        )
+    }
+
+    fn velocity_ned(&self, t: f64) -> Vector3<f64> {
+        self.air_ned(t) + self.wind_ned_mps
+    }
+
+    fn position_ned(&self, t: f64) -> Vector3<f64> {
+        let v = self.airspeed_h_mps;
+        let r = self.turn_rate_rad_s;
+        let (n, e) = if r.abs() < 1e-12 {
+            let (s, c) = self.track0_rad.sin_cos();
+            (v * c * t, v * s * t)
+        } else {
+            let (a0, a1) = (self.track0_rad, self.track_rad(t));
+            (v * (a1.sin() - a0.sin()) / r, v * (a0.cos() - a1.cos()) / r)
+        };
+        self.start_ned_m + Vector3::new(n, e, self.sink_mps * t) + self.wind_ned_mps * t
+    }
+
+    fn yaw_rad(&self, t: f64) -> f64 {
+        wrap_pi(self.track_rad(t) + self.heading_offset_rad)
+    }
+
+    /// The three measurements of instant `t`.
+    fn measurements(&self, t: f64) -> [Measurement; 3] {
+        let p = self.position_ned(t);
+        let air = StandardAtmosphere.air_at(-p.z);
+        let (st, ct) = self.pitch_rad.sin_cos();
+        let (sp, cp) = self.yaw_rad(t).sin_cos();
+        let e_x = Vector3::new(ct * cp, ct * sp, -st);
+        let u_x = self.pitot_scale * e_x.dot(&self.air_ned(t));
+        [
+            Measurement::Attitude(AttitudeSample {
+                time_s: t,
+                roll_rad: self.roll_rad,
+                pitch_rad: self.pitch_rad,
+                yaw_rad: self.yaw_rad(t),
+            }),
+            Measurement::Gps(GpsFix {
+                time_s: t,
+                position_ned_m: p,
+                velocity_ned_mps: self.velocity_ned(t),
+                horizontal_accuracy_m: 1.5,
+                vertical_accuracy_m: 3.0,
+                speed_accuracy_mps: 0.15,
+            }),
+            Measurement::AirData(AirDataSample {
+                time_s: t,
+                differential_pressure_pa: 0.5 * air.density_kg_per_m3 * u_x * u_x.abs(),
+                static_pressure_pa: air.pressure_pa,
+                temperature_k: air.temperature_k,
+            }),
+        ]
+    }
+}
+
+/// Latencies of AHRS, GPS and pitot, s.
+#[derive(Clone, Copy)]
+struct Latency([f64; 3]);
+
+const ON_TIME: Latency = Latency([0.0, 0.0, 0.0]);
+const USUAL: Latency = Latency([0.02, 0.25, 0.02]);
+
+/// Sensor instants: every 0.25 s.
+const PERIOD_S: f64 = 0.25;
+
+/// Everything sampled in `[from_s, to_s)` that `keep` lets through, as (arrival, measurement)
+/// in arrival order (ties in sensor order, as a radio would deliver them).
+fn deliveries(
+    flight: &Flight,
+    from_s: f64,
+    to_s: f64,
+    latency: Latency,
+    keep: impl Fn(&Measurement) -> bool,
+) -> Vec<(f64, Measurement)> {
+    let first = (from_s / PERIOD_S).ceil() as i64;
+    let last = (to_s / PERIOD_S).ceil() as i64;
+    let mut out: Vec<(f64, Measurement)> = (first..last)
+        .flat_map(|k| {
+            let t = k as f64 * PERIOD_S;
+            flight
+                .measurements(t)
+                .into_iter()
+                .zip(latency.0)
+                .map(move |(m, l)| (t + l, m))
+        })
+        .filter(|(_, m)| keep(m))
+        .collect();
+    out.sort_by(|a, b| a.0.total_cmp(&b.0));
+    out
+}
+
+fn estimator() -> Estimator {
+    Estimator::new(EstimatorConfig::default()).expect("default config is valid")
+}
+
+/// Feeds `deliveries` as they arrive and returns the estimate at every 0.05-s tick, taken
+/// after the arrivals due by then (`(instant, estimate)`).
+fn feed(est: &mut Estimator, deliveries: &[(f64, Measurement)]) -> Vec<(f64, Estimate)> {
+    let mut out = Vec::new();
+    let mut next = 0;
+    let end = deliveries.last().map_or(0.0, |d| d.0);
+    // A 20 Hz control tick from the first tick at or before the first arrival.
+    let first_tick = (deliveries.first().map_or(0.0, |d| d.0) / 0.05).floor() as i64;
+    for tick in first_tick.. {
+        let t = tick as f64 * 0.05;
+        if t > end + 0.05 {
+            break;
+        }
+        while next < deliveries.len() && deliveries[next].0 <= t + 1e-9 {
+            est.handle(deliveries[next].0, &deliveries[next].1);
+            next += 1;
+        }
+        out.push((t, est.estimate(t)));
+    }
+    out
+}
+
+fn horizontal(v: Vector3<f64>) -> f64 {
+    v.x.hypot(v.y)
+}
+
+#[test]
+fn before_any_measurement_the_estimate_says_it_knows_nothing() {
+    let e = estimator().estimate(12.0);
+    assert!(!e.gps_ok && !e.attitude_ok && !e.air_data_ok);
+    assert_eq!(e.gps_age_s, f64::INFINITY);
+    assert!(e.position_sigma_m.iter().all(|s| s.is_infinite()));
+    assert!(e.wind_sigma_mps.x.is_infinite() && e.heading_sigma_rad.is_infinite());
+    assert!(e.position_ned_m.iter().all(|v| v.is_finite()));
+}
+
+#[test]
+fn straight_flight_tracks_position_velocity_and_a_wind_consistent_with_its_uncertainty() {
+    let flight = Flight::straight(250.0, 4.0);
+    let mut est = estimator();
+    let history = feed(&mut est, &deliveries(&flight, 0.0, 60.0, USUAL, |_| true));
+    let (t, e) = history.last().expect("estimates");
+    assert!((e.position_ned_m - flight.position_ned(*t)).norm() < 0.3);
+    assert!((e.velocity_ned_mps - flight.velocity_ned(*t)).norm() < 0.05);
+    assert!((e.airspeed_mps - flight.air_ned(*t).norm()).abs() < 0.5);
+    assert!((e.sink_rate_mps - flight.sink_mps).abs() < 0.05);
+    assert!(e.gps_ok && e.attitude_ok && e.air_data_ok);
+    // Without a turn the wind is only as good as the heading and the pitot scale the filter
+    // starts with; whatever it says must be honest.
+    let error = e.wind_ned_mps - flight.wind_ned_mps;
+    for k in 0..2 {
+        assert!(
+            error[k].abs() < 3.0 * e.wind_sigma_mps[k],
+            "component {k}: error {} vs σ {}",
+            error[k],
+            e.wind_sigma_mps[k]
+        );
+    }
+    assert!(e.wind_sigma_mps.x < 1.0 && e.wind_sigma_mps.y < 1.0);
+}
+
+#[test]
+fn a_constant_rate_turn_reveals_the_wind_and_the_pitot_scale() {
+    for (from_deg, speed, rate) in [(0.0, 4.0, 0.5), (135.0, 2.0, -0.3), (290.0, 5.0, 0.9)] {
+        let mut flight = Flight::turning(from_deg, speed, rate);
+        flight.pitot_scale = 0.95;
+        let mut est = estimator();
+        let history = feed(&mut est, &deliveries(&flight, 0.0, 40.0, USUAL, |_| true));
+        let (t, e) = history.last().expect("estimates");
+        let label = format!("wind {speed} m/s from {from_deg}°, turning {rate} rad/s");
+        let wind_error = horizontal(e.wind_ned_mps - flight.wind_ned_mps);
+        assert!(wind_error < 0.1, "{label}: wind error {wind_error}");
+        assert!(e.wind_sigma_mps.x < 0.3 && e.wind_sigma_mps.y < 0.3);
+        assert!(
+            (e.airspeed_mps - flight.air_ned(*t).norm()).abs() < 0.1,
+            "{label}: airspeed {} vs {}",
+            e.airspeed_mps,
+            flight.air_ned(*t).norm()
+        );
+        assert!((e.heading_rate_rad_s - rate).abs() < 0.02, "{label}");
+        let v = flight.velocity_ned(*t);
+        assert!(
+            wrap_pi(e.course_rad - v.y.atan2(v.x)).abs() < 0.02,
+            "{label}"
+        );
+        let glide = flight.airspeed_h_mps / flight.sink_mps;
+        assert!((e.glide_ratio_air - glide).abs() < 0.05 * glide, "{label}");
+        assert!(
+            (e.position_ned_m - flight.position_ned(*t)).norm() < 0.5,
+            "{label}"
+        );
+    }
+}
+
+#[test]
+fn headings_through_plus_minus_180_degrees_do_not_jump() {
+    // Flying due south, where AHRS jitter flips the reading between +180° and −180° at
+    // almost every sample, then two turns, one each way, crossing ±180° several times.
+    for rate in [0.0, 0.7, -0.7] {
+        let mut flight = Flight::turning(90.0, 3.0, rate);
+        flight.track0_rad = if rate == 0.0 { PI } else { 2.8 };
+        // AHRS jitter of ±1° puts measurement and prediction on opposite sides of ±180° now
+        // and then, which is where an unwrapped innovation would be off by 2π.
+        let jittered: Vec<(f64, Measurement)> = deliveries(&flight, 0.0, 30.0, ON_TIME, |_| true)
+            .into_iter()
+            .enumerate()
+            .map(|(i, (arrival, mut m))| {
+                if let Measurement::Attitude(a) = &mut m {
+                    a.yaw_rad = wrap_pi(a.yaw_rad + 0.0175 * (i as f64 * 2.39).sin());
+                }
+                (arrival, m)
+            })
+            .collect();
+        let mut est = estimator();
+        let history = feed(&mut est, &jittered);
+        let mut crossings = 0;
+        for pair in history.windows(2) {
+            let ((_, a), (t, b)) = (&pair[0], &pair[1]);
+            assert!(b.heading_rad > -PI && b.heading_rad <= PI);
+            if (b.heading_rad - a.heading_rad).abs() > PI {
+                crossings += 1;
+            }
+            if *t > 3.0 {
+                let error = wrap_pi(b.heading_rad - flight.yaw_rad(*t));
+                assert!(error.abs() < 0.03, "heading error {error} at {t}");
+                assert!((b.heading_rate_rad_s - rate).abs() < 0.1);
+                assert!(wrap_pi(b.course_rad - a.course_rad).abs() < 0.1);
+                assert!(
+                    b.heading_sigma_rad < 0.15,
+                    "σ {} at {t} (rate {rate})",
+                    b.heading_sigma_rad
+                );
+            }
+        }
+        assert!(crossings >= 3, "the test must cross ±180°: {crossings}");
+        assert!((history.last().expect("estimates").1.heading_rate_rad_s - rate).abs() < 0.1);
+    }
+}
+
+#[test]
+fn late_and_shuffled_arrivals_give_the_same_estimate_as_timely_ones() {
+    let flight = Flight::turning(200.0, 4.0, 0.6);
+    let timely = deliveries(&flight, 0.0, 30.0, ON_TIME, |_| true);
+    // GPS 0.4 s late, the AHRS 0.1 s and the pitot on time: every fix arrives after samples
+    // of later instants.
+    let late = deliveries(&flight, 0.0, 30.0, Latency([0.1, 0.4, 0.0]), |_| true);
+    // The same measurements in a scrambled order within each half second.
+    let mut scrambled = timely.clone();
+    for (i, chunk) in scrambled.chunks_mut(6).enumerate() {
+        chunk.rotate_left(i % 5 + 1);
+        chunk.reverse();
+    }
+    let scrambled: Vec<(f64, Measurement)> = scrambled
+        .into_iter()
+        .enumerate()
+        .map(|(i, (_, m))| (((i / 6) as f64 + 1.0) * 0.5, m))
+        .collect();
+
+    let mut a = estimator();
+    let mut b = estimator();
+    let mut c = estimator();
+    for (arrival, m) in &timely {
+        a.handle(*arrival, m);
+    }
+    for (arrival, m) in &late {
+        b.handle(*arrival, m);
+    }
+    for (arrival, m) in &scrambled {
+        assert_eq!(c.handle(*arrival, m), Disposition::Accepted);
+    }
+    let now = 31.0;
+    let (ea, eb, ec) = (a.estimate(now), b.estimate(now), c.estimate(now));
+    assert_eq!(ea, eb, "late arrivals are slotted in at their instants");
+    assert_eq!(ea, ec, "order of arrival does not matter within the window");
+    assert!(b.counters().replays > 0 && c.counters().replays > 0);
+    assert_eq!(b.counters().stale + c.counters().stale, 0);
+}
+
+#[test]
+fn latency_compensation_beats_taking_late_fixes_as_current() {
+    let flight = Flight::turning(45.0, 4.0, 0.6);
+    let late = deliveries(&flight, 0.0, 40.0, Latency([0.02, 0.4, 0.02]), |_| true);
+    let naive: Vec<(f64, Measurement)> = late
+        .iter()
+        .map(|(arrival, m)| {
+            let mut m = *m;
+            if let Measurement::Gps(g) = &mut m {
+                g.time_s = *arrival;
+            }
+            (*arrival, m)
+        })
+        .collect();
+    let position_rms = |deliveries: &[(f64, Measurement)]| {
+        let mut est = estimator();
+        let history = feed(&mut est, deliveries);
+        let errors: Vec<f64> = history
+            .iter()
+            .filter(|(t, _)| *t > 20.0)
+            .map(|(t, e)| (e.position_ned_m - flight.position_ned(*t)).norm_squared())
+            .collect();
+        (errors.iter().sum::<f64>() / errors.len() as f64).sqrt()
+    };
+    let compensated = position_rms(&late);
+    let uncompensated = position_rms(&naive);
+    assert!(compensated < 0.5, "compensated {compensated} m");
+    assert!(
+        uncompensated > 3.0 * compensated,
+        "compensated {compensated} m vs naive {uncompensated} m"
+    );
+}
+
+#[test]
+fn a_gps_gap_is_bridged_by_dead_reckoning_and_closed_when_fixes_return() {
+    let flight = Flight::turning(300.0, 4.0, 0.4);
+    let gap = 30.0..40.0;
+    let d = deliveries(&flight, 0.0, 60.0, USUAL, |m| {
+        !(matches!(m, Measurement::Gps(_)) && gap.contains(&m.time_s()))
+    });
+    let mut est = estimator();
+    let history = feed(&mut est, &d);
+    let at = |time: f64| {
+        history
+            .iter()
+            .find(|(t, _)| (*t - time).abs() < 1e-6)
+            .expect("estimate at that instant")
+            .1
+    };
+    let before = at(30.0);
+    assert!(before.gps_ok);
+    let during = at(35.0);
+    assert!(!during.gps_ok, "GPS timed out");
+    assert!(during.gps_age_s > 4.9 && during.gps_age_s < 5.3);
+    let end = at(40.0);
+    assert!(end.position_sigma_m.x > 2.0 * before.position_sigma_m.x);
+    // Exact data, exact models: dead reckoning through the turn stays within a metre.
+    let worst = history
+        .iter()
+        .filter(|(t, _)| gap.contains(t))
+        .map(|(t, e)| (e.position_ned_m - flight.position_ned(*t)).norm())
+        .fold(0.0, f64::max);
+    assert!(worst < 1.0, "worst dead-reckoning error {worst} m");
+    let after = at(45.0);
+    assert!(after.gps_ok);
+    assert!(after.position_sigma_m.x < 0.6 * end.position_sigma_m.x);
+    assert!((after.position_ned_m - flight.position_ned(45.0)).norm() < 0.5);
+}
+
+#[test]
+fn bad_input_is_refused_and_counted_without_touching_the_state() {
+    let flight = Flight::turning(0.0, 3.0, 0.3);
+    let mut est = estimator();
+    for (arrival, m) in deliveries(&flight, 0.0, 20.0, USUAL, |_| true) {
+        est.handle(arrival, &m);
+    }
+    let before = est.estimate(20.5);
+    let [attitude, gps, air] = flight.measurements(20.0);
+    let mut bad = Vec::new();
+    if let Measurement::Gps(mut g) = gps {
+        g.position_ned_m.y = f64::NAN;
+        bad.push((Measurement::Gps(g), Disposition::NonFinite));
+        g.position_ned_m.y = 0.0;
+        g.speed_accuracy_mps = f64::INFINITY;
+        bad.push((Measurement::Gps(g), Disposition::NonFinite));
+        g.speed_accuracy_mps = -1.0;
+        bad.push((Measurement::Gps(g), Disposition::Invalid));
+    }
+    if let Measurement::Attitude(mut a) = attitude {
+        a.yaw_rad = f64::NEG_INFINITY;
+        bad.push((Measurement::Attitude(a), Disposition::NonFinite));
+        a.yaw_rad = 0.0;
+        a.pitch_rad = 2.0;
+        bad.push((Measurement::Attitude(a), Disposition::Invalid));
+        a.pitch_rad = 0.0;
+        a.time_s = f64::NAN;
+        bad.push((Measurement::Attitude(a), Disposition::NonFinite));
+    }
+    if let Measurement::AirData(mut p) = air {
+        p.temperature_k = 0.0;
+        bad.push((Measurement::AirData(p), Disposition::Invalid));
+        p.temperature_k = 250.0;
+        p.static_pressure_pa = -3.0;
+        bad.push((Measurement::AirData(p), Disposition::Invalid));
+        p.static_pressure_pa = 90_000.0;
+        p.differential_pressure_pa = f64::NAN;
+        bad.push((Measurement::AirData(p), Disposition::NonFinite));
+    }
+    for (m, expected) in &bad {
+        assert_eq!(est.handle(20.3, m), *expected, "{m:?}");
+    }
+    assert_eq!(est.handle(f64::NAN, &gps), Disposition::NonFinite);
+    // A fix stamped a second after it arrived is a clock error.
+    assert_eq!(est.handle(19.0, &gps), Disposition::FromFuture);
+    let counters = est.counters();
+    assert_eq!(counters.non_finite, 6);
+    assert_eq!(counters.invalid, 4);
+    assert_eq!(counters.from_future, 1);
+    assert_eq!(est.estimate(20.5), before, "refused input changed nothing");
+    // Asking at a non-finite instant reads the newest state out rather than poisoning it.
+    let odd = est.estimate(f64::NAN);
+    assert!(odd.time_s.is_finite() && odd.position_ned_m.iter().all(|v| v.is_finite()));
+}
+
+/// A small deterministic generator for the wild-input test (xorshift64*).
+struct Wild(u64);
+
+impl Wild {
+    fn next(&mut self) -> u64 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        self.0.wrapping_mul(0x2545_f491_4f6c_dd1d)
+    }
+
+    /// A finite value from the ordinary to the absurd.
+    fn value(&mut self) -> f64 {
+        let magnitude = match self.next() % 6 {
+            0 => 0.0,
+            1 => 1e-300,
+            2 => 1.0,
+            3 => 1e3,
+            4 => 1e150,
+            _ => f64::MAX,
+        };
+        let fraction = (self.next() % 1000) as f64 / 1000.0;
+        let sign = if self.next().is_multiple_of(2) {
+            1.0
+        } else {
+            -1.0
+        };
+        sign * magnitude * fraction
+    }
+}
+
+/// A wild but finite measurement stamped `time_s`.
+fn wild_measurement(wild: &mut Wild, time_s: f64) -> Measurement {
+    let v = |w: &mut Wild| Vector3::new(w.value(), w.value(), w.value());
+    match wild.next() % 3 {
+        0 => Measurement::Gps(GpsFix {
+            time_s,
+            position_ned_m: v(wild),
+            velocity_ned_mps: v(wild),
+            horizontal_accuracy_m: wild.value().abs(),
+            vertical_accuracy_m: wild.value().abs(),
+            speed_accuracy_mps: wild.value().abs(),
+        }),
+        1 => Measurement::Attitude(AttitudeSample {
+            time_s,
+            roll_rad: wild.value(),
+            pitch_rad: wild.value().clamp(-1.5, 1.5),
+            yaw_rad: wild.value(),
+        }),
+        _ => Measurement::AirData(AirDataSample {
+            time_s,
+            differential_pressure_pa: wild.value(),
+            static_pressure_pa: wild.value().abs(),
+            temperature_k: wild.value().abs(),
+        }),
+    }
+}
+
+#[test]
+fn wild_values_never_panic_and_the_filter_recovers_once_they_stop() {
+    let mut wild = Wild(0x5eed);
+    let mut est = estimator();
+    // Ten minutes of absurd values on an ordinary clock, out of order within the window.
+    for k in 0..20_000 {
+        let time_s = k as f64 * 0.03 + (wild.next() % 10) as f64 * 0.05;
+        let m = wild_measurement(&mut wild, time_s);
+        est.handle(time_s + 0.1, &m);
+        let e = est.estimate(time_s + 0.1);
+        assert!(!e.gps_age_s.is_nan());
+    }
+    assert!(est.counters().accepted > 10_000, "{:?}", est.counters());
+    // Then an ordinary flight: whatever the wild values did, the filter finds it.
+    let mut flight = Flight::turning(60.0, 3.0, 0.4);
+    flight.start_ned_m -= flight.wind_ned_mps * 700.0;
+    flight.track0_rad -= 0.4 * 700.0;
+    let history = feed(
+        &mut est,
+        &deliveries(&flight, 700.0, 760.0, USUAL, |_| true),
+    );
+    let (t, e) = history.last().expect("estimates");
+    assert!((e.position_ned_m - flight.position_ned(*t)).norm() < 1.0);
+    assert!(wrap_pi(e.heading_rad - flight.yaw_rad(*t)).abs() < 0.05);
+    assert!(horizontal(e.wind_ned_mps - flight.wind_ned_mps) < 0.3);
+}
+
+#[test]
+fn a_gap_long_enough_to_overflow_the_covariance_restarts_the_filter() {
+    // After 1e110 s the predicted variance (∝ Δt³) overflows; the filter must not stay
+    // undefined for ever but start again from the next measurements.
+    let attitude = |time_s: f64, yaw_rad: f64| {
+        Measurement::Attitude(AttitudeSample {
+            time_s,
+            roll_rad: 0.0,
+            pitch_rad: -0.1,
+            yaw_rad,
+        })
+    };
+    let mut est = estimator();
+    est.handle(0.0, &attitude(0.0, 0.5));
+    est.handle(1e110, &attitude(1e110, 1.0));
+    est.handle(1e110, &attitude(1e110, 1.1));
+    let e = est.estimate(1e110);
+    assert!(
+        e.heading_rad.is_finite() && (e.heading_rad - 1.05).abs() < 0.1,
+        "{e:?}"
+    );
+    assert!(e.heading_sigma_rad.is_finite());
+}
+
+#[test]
+fn wild_timestamps_never_panic() {
+    let mut wild = Wild(0xc10c);
+    let mut est = estimator();
+    for _ in 0..20_000 {
+        let time_s = wild.value();
+        let arrival_s = wild.value();
+        let m = wild_measurement(&mut wild, time_s);
+        est.handle(arrival_s, &m);
+        let _ = est.estimate(wild.value());
+    }
+    let c = est.counters();
+    assert_eq!(
+        c.accepted + c.stale + c.non_finite + c.invalid + c.from_future,
+        20_000
+    );
+}
+
+#[test]
+fn measurements_older_than_the_latency_window_are_dropped_as_stale() {
+    let flight = Flight::straight(90.0, 3.0);
+    let mut est = estimator();
+    for (arrival, m) in deliveries(&flight, 0.0, 20.0, USUAL, |_| true) {
+        est.handle(arrival, &m);
+    }
+    let before = est.estimate(20.5);
+    let [_, old_fix, _] = flight.measurements(19.0);
+    // The default window is 0.6 s: a fix from 19.0 s arriving at 20.3 s is too late.
+    assert_eq!(est.handle(20.3, &old_fix), Disposition::Stale);
+    assert_eq!(est.counters().stale, 1);
+    assert_eq!(est.estimate(20.5), before);
+    // One from 19.9 s still fits and is taken.
+    let [_, recent_fix, _] = flight.measurements(19.9);
+    assert_eq!(est.handle(20.3, &recent_fix), Disposition::Accepted);
+}
+
+#[test]
+fn a_burst_beyond_the_buffer_commits_early_instead_of_failing() {
+    let flight = Flight::straight(0.0, 2.0);
+    let mut est = estimator();
+    // 200 measurements stamped within 0.2 s, all arriving at once.
+    for k in 0..200 {
+        let t = 10.0 + k as f64 * 0.001;
+        for m in flight.measurements(t) {
+            assert_eq!(est.handle(10.2, &m), Disposition::Accepted);
+        }
+    }
+    let counters = est.counters();
+    assert!(counters.early_commits >= 600 - PENDING_CAPACITY as u64);
+    assert!(
+        est.estimate(10.3)
+            .position_ned_m
+            .iter()
+            .all(|v| v.is_finite())
+    );
+}
+
+#[test]
+fn the_same_input_gives_the_same_estimates() {
+    let flight = Flight::turning(30.0, 5.0, -0.5);
+    let d = deliveries(&flight, 0.0, 30.0, USUAL, |_| true);
+    let a = feed(&mut estimator(), &d);
+    let b = feed(&mut estimator(), &d);
+    assert_eq!(a, b);
+}
+
+#[test]
+fn a_heading_offset_learnt_in_turns_keeps_the_cross_wind_on_straight_legs() {
+    // The drone flies 4° off its track (a magnetometer bias looks the same): a turn, then a
+    // long straight leg with the wind across it.
+    let mut turning = Flight::turning(0.0, 4.0, 0.5);
+    turning.heading_offset_rad = 4f64.to_radians();
+    let turn_end = 2.0 * PI / 0.5;
+    let mut straight = turning;
+    straight.turn_rate_rad_s = 0.0;
+    straight.roll_rad = 0.0;
+    // Continue from where the turn ended.
+    straight.track0_rad = turning.track_rad(turn_end);
+    straight.start_ned_m = turning.position_ned(turn_end) - straight.wind_ned_mps * turn_end;
+    let mut d = deliveries(&turning, 0.0, turn_end, USUAL, |_| true);
+    d.extend(deliveries(
+        &straight,
+        turn_end,
+        turn_end + 60.0,
+        USUAL,
+        |_| true,
+    ));
+    d.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let mut est = estimator();
+    let history = feed(&mut est, &d);
+    let worst = history
+        .iter()
+        .filter(|(t, _)| *t > turn_end + 5.0)
+        .map(|(_, e)| horizontal(e.wind_ned_mps - straight.wind_ned_mps))
+        .fold(0.0, f64::max);
+    assert!(
+        worst < 0.15,
+        "worst wind error on the straight leg {worst} m/s"
+    );
+}
+
+#[test]
+fn invalid_configuration_is_refused_with_the_field_named() {
+    let config = EstimatorConfig {
+        gps_timeout_s: -1.0,
+        ..Default::default()
+    };
+    let error = Estimator::new(config).expect_err("refused");
+    assert!(error.to_string().contains("gps_timeout_s"), "{error}");
+}
