@@ -82,7 +82,7 @@ export class ManualSender {
   /** Measured send rate over the last second, Hz. */
   rateHz(): number {
     const now = this.deps.now();
-    while (this.recent.length > 0 && (this.recent[0] ?? 0) < now - 1000) this.recent.shift();
+    while (this.recent.length > 0 && (this.recent[0] ?? 0) <= now - 1000) this.recent.shift();
     return this.recent.length;
   }
 

@@ -77,7 +77,7 @@ function build(session: Session): void {
   const station = session.station;
 
   // ---- panels
-  const map = new MapView(station);
+  const map = new MapView(station, token);
   const picks = new PickGroup((p) => map.setPicker(p));
   const attitude = new AttitudeIndicator();
   const compass = new Compass();

@@ -45,7 +45,7 @@ export class AttitudeIndicator {
     );
     this.rollText = h("span", { "data-testid": "ro-roll" });
     this.pitchText = h("span", { "data-testid": "ro-pitch" });
-    this.root = h("div", { class: "inst" }, svg as unknown as Node, h("div", { class: "inst-cap" }, "roll ", this.rollText, " · pitch ", this.pitchText));
+    this.root = h("div", { class: "inst" }, svg as unknown as Node, h("div", { class: "inst-cap" }, "roll ", this.rollText, h("br"), "pitch ", this.pitchText));
   }
 
   update(roll: N, pitch: N): void {
@@ -90,7 +90,7 @@ export class Compass {
     );
     this.headingText = h("span", { "data-testid": "ro-heading" });
     this.courseText = h("span", { "data-testid": "ro-course" });
-    this.root = h("div", { class: "inst" }, svg as unknown as Node, h("div", { class: "inst-cap" }, "hdg ", this.headingText, " · crs ", this.courseText));
+    this.root = h("div", { class: "inst" }, svg as unknown as Node, h("div", { class: "inst-cap" }, "heading ", this.headingText, h("br"), "course ", this.courseText));
   }
 
   update(heading: N, course: N, windFrom: N): void {

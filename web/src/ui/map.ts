@@ -8,10 +8,13 @@ import "leaflet/dist/leaflet.css";
 import { h, setText } from "./dom";
 import { ellipsePoints, fromLocal, gridValues, niceStep, toLocal } from "../lib/geo";
 import { fmt, fmtDir } from "../lib/format";
+import { withToken } from "../lib/token";
 import type { LandingPrediction, LatLon, State, Station, TrackPoint } from "../lib/types";
 
 const ll = (p: LatLon): L.LatLngExpression => [p.lat_deg, p.lon_deg];
 const MAX_TRACK = 20_000;
+/** Failed tiles (and none loaded) after which the tile layer is dropped for the grid alone. */
+const GIVE_UP_AFTER_FAILED_TILES = 6;
 
 export type Picker = ((p: LatLon) => void) | null;
 
@@ -42,16 +45,21 @@ export class MapView {
   private tilesFailed = 0;
   private lastTrackKey = "";
 
-  constructor(station: Station) {
+  private tiles: L.TileLayer | null = null;
+
+  constructor(station: Station, tileToken: string | null) {
     this.origin = station.origin;
     const el = h("div", { class: "map", "data-testid": "map", role: "application", "aria-label": "map" });
     this.root = el;
     this.map = L.map(el, { zoomControl: true, attributionControl: true, preferCanvas: false }).setView(ll(this.origin), 15);
     if (station.tile_url) {
-      const tiles = L.tileLayer(station.tile_url, { maxZoom: 19, attribution: station.tile_attribution, crossOrigin: false });
-      tiles.on("tileload", () => this.onTile(true));
-      tiles.on("tileerror", () => this.onTile(false));
-      tiles.addTo(this.map);
+      // Tiles are fetched by <img>, which cannot send the Authorization header: a station-relative
+      // tile URL gets the token as a query parameter, like the WebSocket.
+      const url = station.tile_url.startsWith("/") && tileToken !== null ? withToken(station.tile_url, tileToken) : station.tile_url;
+      this.tiles = L.tileLayer(url, { maxZoom: 19, attribution: station.tile_attribution });
+      this.tiles.on("tileload", () => this.onTile(true));
+      this.tiles.on("tileerror", () => this.onTile(false));
+      this.tiles.addTo(this.map);
     }
     L.control.scale({ metric: true, imperial: false, maxWidth: 160 }).addTo(this.map);
     this.grid.addTo(this.map);
@@ -191,6 +199,12 @@ export class MapView {
     if (ok) this.tilesLoaded += 1;
     else this.tilesFailed += 1;
     const offline = this.tilesLoaded === 0 && this.tilesFailed > 0;
+    // No tile source at all (offline field, no cache): stop asking, so the browser does not log
+    // a failed request for every pan; the grid carries the map. A reload tries again.
+    if (offline && this.tilesFailed >= GIVE_UP_AFTER_FAILED_TILES && this.tiles) {
+      this.tiles.remove();
+      this.tiles = null;
+    }
     this.root.classList.toggle("tiles-offline", offline);
     setText(this.tilesStatus, offline ? "tiles unavailable — metric grid" : this.tilesFailed > 0 ? `tiles: ${this.tilesFailed} failed` : "tiles OK");
     this.tilesStatus.dataset.state = offline ? "offline" : "ok";
@@ -205,8 +219,9 @@ export class MapView {
     const step = niceStep(Math.max(ne.east_m - sw.east_m, ne.north_m - sw.north_m), 8);
     const style: L.PolylineOptions = { color: "#000", weight: 1, opacity: 0.35, interactive: false };
     const pt = (east_m: number, north_m: number): L.LatLngExpression => ll(fromLocal(this.origin, { east_m, north_m }));
+    // Leaflet positions the icon element with its own transform: offsets go on the inner span.
     const label = (text: string, at: L.LatLngExpression, cls: string): L.Marker =>
-      L.marker(at, { icon: L.divIcon({ className: `grid-label ${cls}`, html: text, iconSize: [0, 0] }), interactive: false, keyboard: false });
+      L.marker(at, { icon: L.divIcon({ className: "grid-label", html: `<span class="${cls}">${text}</span>`, iconSize: [0, 0] }), interactive: false, keyboard: false });
     for (const x of gridValues(sw.east_m, ne.east_m, step)) {
       this.grid.addLayer(L.polyline([pt(x, sw.north_m), pt(x, ne.north_m)], { ...style, weight: x === 0 ? 2 : 1 }));
       this.grid.addLayer(label(`${x >= 0 ? "E" : "W"} ${Math.abs(x)} m`, pt(x, sw.north_m), "bottom"));
