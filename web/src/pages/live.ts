@@ -194,7 +194,8 @@ function build(session: Session): void {
     { id: "events", label: "Event log", content: events.root },
   ]);
   const centre = h("section", { class: "col centre" }, h("div", { class: "map-wrap vd" }, map.root), bottom.root);
-  const commandTab = h("div", {}, modes.root, target.root, guidanceInputs.root, joystick.root);
+  // Modes and the joystick first: in manual flight both must be in view without scrolling.
+  const commandTab = h("div", {}, modes.root, joystick.root, target.root, guidanceInputs.root);
   const right = tabs("control", [
     { id: "command", label: "Command", content: commandTab },
     { id: "plan", label: "Plan", content: plan.root },
@@ -248,7 +249,7 @@ function build(session: Session): void {
     map.setTrack(track);
     view3d.setTrack(track);
     events.reset(ev);
-    for (const s of states) plots.push(s);
+    plots.reset(states, latest);
   }
 
   function render(): void {

@@ -71,7 +71,7 @@ export class MapView {
     this.vehicle = L.marker(ll(this.origin), { icon: icon("mk-vehicle", VEHICLE_SVG, 40, "map-vehicle"), zIndexOffset: 1000, interactive: false });
     this.draftTarget = L.marker(ll(this.origin), { icon: icon("mk-draft", TARGET_SVG, 34, "map-draft-target"), interactive: false, opacity: 0.6 });
     for (const layer of [this.pattern, this.final, this.ellUncontrolled, this.ellPlanned, this.track, this.draftPlan, this.draftLocalizer]) layer.addTo(this.map);
-    this.finalLabel = L.tooltip({ permanent: true, direction: "right", className: "final-label" });
+    this.finalLabel = L.tooltip({ permanent: true, direction: "left", className: "final-label", interactive: false });
 
     // Controls drawn on top of the map: tiles status, wind, follow toggle.
     this.tilesStatus = h("div", { class: "map-badge", "data-testid": "map-tiles-status" }, "tiles: loading…");
@@ -140,11 +140,13 @@ export class MapView {
     this.pattern.setLatLngs(pat ? pat.corners.map(ll) : []);
     if (pat?.final_entry && g?.target) {
       this.final.setLatLngs([ll(pat.final_entry), ll(g.target)]);
-      if (!this.final.getTooltip()) this.final.bindTooltip(this.finalLabel);
-      this.final.setTooltipContent(`final ${fmtDir(pat.final_course_deg)} · from ${fmt(pat.final_approach_height_m, "m", 0)}`);
+      // A standalone label at the final entry: a tooltip bound to the line would stay where the
+      // line was when it was bound.
+      this.finalLabel.setLatLng(ll(pat.final_entry)).setContent(`final ${fmtDir(pat.final_course_deg)} · from ${fmt(pat.final_approach_height_m, "m", 0)}`);
+      if (!this.map.hasLayer(this.finalLabel)) this.finalLabel.addTo(this.map);
     } else {
       this.final.setLatLngs([]);
-      this.final.unbindTooltip();
+      this.finalLabel.remove();
     }
     this.showPrediction(this.planned, this.ellPlanned, s.prediction?.planned ?? null, "planned");
     this.showPrediction(this.uncontrolled, this.ellUncontrolled, s.prediction?.uncontrolled ?? null, "uncontrolled");

@@ -66,6 +66,17 @@ export class Plots {
     if (this.timer === null) this.timer = setInterval(() => this.redraw(), 1000);
   }
 
+  /**
+   * Starts over from `history.states`. The server sends the latest state before the history, so
+   * history cannot simply be appended (it would be older than what is already there).
+   */
+  reset(states: readonly State[], latest: State | null): void {
+    for (const c of this.charts) c.data.clear();
+    for (const s of states) this.push(s);
+    if (latest !== null) this.push(latest);
+    this.dirty = true;
+  }
+
   push(s: State): void {
     for (const c of this.charts) if (c.data.push(s.time_s, c.def.pick(s))) this.dirty = true;
   }

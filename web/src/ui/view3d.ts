@@ -33,7 +33,11 @@ export class View3D {
   private grid: THREE.GridHelper;
   private gridSize = 0;
   private pending = false;
-  private framed = false;
+  /** Scene radius at the last automatic framing, m. */
+  private framedRadius = 0;
+  /** Set once the operator orbits or zooms: automatic framing stops. */
+  private userMoved = false;
+  private updates = 0;
 
   constructor(private readonly origin: LatLon & { alt_msl_m: number | null }) {
     this.root = h("div", { class: "view3d", "data-testid": "view3d", "aria-label": "3-D view of the descent; drag to orbit, wheel to zoom" });
@@ -65,6 +69,7 @@ export class View3D {
     this.root.append(this.renderer.domElement);
     this.controls = new OrbitControls(this.camera, this.renderer.domElement);
     this.controls.addEventListener("change", () => this.requestRender());
+    this.controls.addEventListener("start", () => (this.userMoved = true));
   }
 
   /** Local frame: x east, y up (above the origin's altitude), z south (three is right-handed, y up). */
@@ -108,7 +113,7 @@ export class View3D {
     }
     const t = s.guidance?.target;
     if (t) this.target.position.copy(this.local(t, t.alt_msl_m));
-    if (!this.framed && this.count > 1) this.refit();
+    if (this.count > 1 && ++this.updates % 8 === 0) this.refit(); // every ~2 s at 4 Hz
     this.requestRender();
   }
 
@@ -124,26 +129,32 @@ export class View3D {
     this.requestRender();
   }
 
-  /** Sizes the grid to the track and aims the camera at it. */
+  /**
+   * Sizes the grid to the track and target and aims the camera at them, again whenever the scene
+   * has grown by half since the last framing — until the operator orbits, which is respected.
+   */
   private refit(): void {
     if (this.count < 2) return;
-    this.line.geometry.computeBoundingSphere();
-    const bs = this.line.geometry.boundingSphere;
-    if (!bs) return;
-    const size = Math.max(1000, Math.ceil((bs.radius * 2.5) / 500) * 500);
+    const box = new THREE.Box3();
+    for (let i = 0; i < this.count; i++) box.expandByPoint(new THREE.Vector3(this.positions[i * 3], this.positions[i * 3 + 1], this.positions[i * 3 + 2]));
+    box.expandByPoint(this.target.position);
+    box.expandByPoint(new THREE.Vector3(box.min.x, 0, box.min.z)); // down to the ground
+    const centre = box.getCenter(new THREE.Vector3());
+    const radius = Math.max(200, box.getSize(new THREE.Vector3()).length() / 2);
+    const size = Math.max(1000, Math.ceil((radius * 2.5) / 500) * 500);
     if (size !== this.gridSize) {
       this.scene.remove(this.grid);
       this.grid.dispose();
       this.grid = new THREE.GridHelper(size, Math.round(size / 100), 0x444444, 0xbbbbbb);
-      this.grid.position.set(bs.center.x, 0, bs.center.z);
-      this.scene.add(this.grid);
       this.gridSize = size;
+      this.scene.add(this.grid);
     }
-    if (!this.framed && this.controls) {
-      this.controls.target.set(bs.center.x, bs.center.y / 2, bs.center.z);
-      this.camera.position.set(bs.center.x - bs.radius * 1.6, bs.radius * 1.4, bs.center.z + bs.radius * 1.6);
+    this.grid.position.set(centre.x, 0, centre.z);
+    if (this.controls && !this.userMoved && radius > this.framedRadius * 1.5) {
+      this.controls.target.copy(centre);
+      this.camera.position.set(centre.x - radius * 1.3, centre.y + radius * 0.9, centre.z + radius * 1.3);
       this.controls.update();
-      this.framed = true;
+      this.framedRadius = radius;
     }
   }
 
