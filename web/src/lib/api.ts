@@ -1,0 +1,63 @@
+// HTTP calls to the station, with the token on every request. Errors carry the API's
+// `{error, reason}` so the page can say exactly why a command was refused.
+
+import { isObj } from "./parse";
+
+export class ApiError extends Error {
+  constructor(
+    readonly status: number,
+    readonly error: string,
+    readonly reason: string,
+  ) {
+    super(status === 0 ? reason : `${status} ${error}: ${reason}`);
+  }
+}
+
+export type FetchLike = (input: string, init?: RequestInit) => Promise<Response>;
+
+export class Api {
+  constructor(
+    private readonly token: string | null,
+    private readonly fetchFn: FetchLike = (i, init) => fetch(i, init),
+  ) {}
+
+  get<T = unknown>(path: string): Promise<T> {
+    return this.request<T>("GET", path);
+  }
+
+  post<T = unknown>(path: string, body: unknown): Promise<T> {
+    return this.request<T>("POST", path, body);
+  }
+
+  /** POST of a command: resolves to the request id of the 202. */
+  async command(path: string, body: unknown): Promise<string> {
+    const r = await this.post(path, body);
+    if (isObj(r) && typeof r.request_id === "string") return r.request_id;
+    throw new ApiError(200, "bad_response", "no request_id in the station's answer");
+  }
+
+  private async request<T>(method: string, path: string, body?: unknown): Promise<T> {
+    const headers: Record<string, string> = { Accept: "application/json" };
+    if (this.token !== null) headers.Authorization = `Bearer ${this.token}`;
+    if (body !== undefined) headers["Content-Type"] = "application/json";
+    let res: Response;
+    try {
+      res = await this.fetchFn(path, { method, headers, body: body === undefined ? null : JSON.stringify(body), cache: "no-store" });
+    } catch (e) {
+      throw new ApiError(0, "network", `station unreachable (${e instanceof Error ? e.message : String(e)})`);
+    }
+    const text = await res.text();
+    let json: unknown = null;
+    try {
+      json = text === "" ? null : JSON.parse(text);
+    } catch {
+      json = null;
+    }
+    if (!res.ok) {
+      const err = isObj(json) && typeof json.error === "string" ? json.error : "http_error";
+      const reason = isObj(json) && typeof json.reason === "string" ? json.reason : text.slice(0, 120) || res.statusText;
+      throw new ApiError(res.status, err, reason);
+    }
+    return json as T;
+  }
+}

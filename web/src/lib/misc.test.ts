@@ -1,0 +1,132 @@
+// Small pure helpers: backoff, token handling, time series, wind interpolation, recovery point,
+// plan body, input validation.
+import { describe, expect, it } from "vitest";
+import { backoffMs, BACKOFF_MAX_MS, BACKOFF_MIN_MS } from "./backoff";
+import { resolveToken, searchWithoutToken, TOKEN_KEY, withToken } from "./token";
+import { breakWraps, Series } from "./series";
+import { forecastAt } from "./wind";
+import { isLanded, recoveryPoint } from "./recovery";
+import { planBody } from "./plan";
+import { all, parseLat, parseNumber } from "./inputs";
+import { decodeMessage } from "./parse";
+import type { State } from "./types";
+
+describe("backoff", () => {
+  it("doubles from the minimum to the cap, jitter ±20 %", () => {
+    const mid = () => 0.5;
+    expect(backoffMs(0, mid)).toBe(BACKOFF_MIN_MS);
+    expect(backoffMs(1, mid)).toBe(2 * BACKOFF_MIN_MS);
+    expect(backoffMs(50, mid)).toBe(BACKOFF_MAX_MS);
+    expect(backoffMs(0, () => 0)).toBe(0.8 * BACKOFF_MIN_MS);
+    expect(backoffMs(0, () => 0.999999)).toBeLessThanOrEqual(1.2 * BACKOFF_MIN_MS);
+  });
+});
+
+describe("token", () => {
+  const store = () => {
+    const m = new Map<string, string>();
+    return { getItem: (k: string) => m.get(k) ?? null, setItem: (k: string, v: string) => void m.set(k, v), m };
+  };
+  it("takes ?token=, stores it, and finds it again after a reload without it", () => {
+    const s = store();
+    expect(resolveToken("?token=op&x=1", s)).toBe("op");
+    expect(s.m.get(TOKEN_KEY)).toBe("op");
+    expect(resolveToken("", s)).toBe("op");
+    expect(resolveToken("", store())).toBeNull();
+  });
+  it("strips the token from the address and adds it to socket/KML URLs", () => {
+    expect(searchWithoutToken("?token=op&x=1")).toBe("?x=1");
+    expect(searchWithoutToken("?token=op")).toBe("");
+    expect(withToken("/kml", "a b")).toBe("/kml?token=a%20b");
+    expect(withToken("/tiles/{z}/{x}/{y}.png?v=2", "op")).toBe("/tiles/{z}/{x}/{y}.png?v=2&token=op");
+    expect(withToken("/kml", null)).toBe("/kml");
+  });
+});
+
+describe("Series", () => {
+  it("keeps a 10-minute window and drops repeats (history overlapping live data)", () => {
+    const s = new Series(["a"], 600);
+    for (let t = 0; t <= 900; t += 1) s.push(t, [t]);
+    expect(s.t[0]).toBe(300);
+    expect(s.t[s.t.length - 1]).toBe(900);
+    expect(s.push(850, [1])).toBe(false);
+    expect(s.push(900, [1])).toBe(false);
+    expect(s.cols[0]).toHaveLength(s.t.length);
+  });
+  it("starts over when the mission clock restarts", () => {
+    const s = new Series(["a"], 600);
+    s.push(5000, [1]);
+    expect(s.push(3, [2])).toBe(true);
+    expect(s.t).toEqual([3]);
+  });
+  it("breaks heading lines at the 360 → 0 wrap", () => {
+    expect(breakWraps([350, 355, 2, 8, null, 10, -10])).toEqual([350, 355, null, 8, null, 10, null]);
+  });
+});
+
+describe("forecastAt", () => {
+  const p = [
+    { alt_msl_m: 300, speed_mps: 2, from_deg: 350 },
+    { alt_msl_m: 1300, speed_mps: 6, from_deg: 30 },
+  ];
+  it("interpolates speed linearly and direction the short way round", () => {
+    const w = forecastAt(p, 800)!;
+    expect(w.speed_mps).toBeCloseTo(4);
+    expect(w.from_deg).toBeCloseTo(10);
+  });
+  it("holds the end values outside the profile", () => {
+    expect(forecastAt(p, 0)).toEqual({ speed_mps: 2, from_deg: 350 });
+    expect(forecastAt(p, 5000)).toEqual({ speed_mps: 6, from_deg: 30 });
+    expect(forecastAt([], 100)).toBeNull();
+  });
+});
+
+describe("recoveryPoint", () => {
+  const base = (over: Record<string, unknown>): State => {
+    const d = decodeMessage(JSON.stringify({
+      type: "state", time_s: 1, link: { connected: true, stale: false, age_s: 0.1, ages_s: {} },
+      vehicle: { mode: "spiral_landing", stage: "parafoil" },
+      estimate: { lat_deg: 38.6, lon_deg: -7.9, position_sigma_m: 2 },
+      guidance: { mode: "spiral_landing" },
+      prediction: { planned: { lat_deg: 38.5, lon_deg: -7.8, time_to_land_s: 100, semi_major_m: 10 }, uncontrolled: { lat_deg: 38.4, lon_deg: -7.7, time_to_land_s: 110, semi_major_m: 50 } },
+      mission: { stage: "parafoil" }, ...over,
+    }));
+    if (!d.ok || d.msg.type !== "state") throw new Error("bad fixture");
+    return d.msg;
+  };
+  it("guided: the planned prediction", () => {
+    expect(recoveryPoint(base({}))).toMatchObject({ kind: "planned", lat_deg: 38.5 });
+  });
+  it("uncontrolled or manual: the uncontrolled prediction", () => {
+    expect(recoveryPoint(base({ guidance: { mode: "uncontrolled" } }))).toMatchObject({ kind: "uncontrolled", lat_deg: 38.4 });
+    expect(recoveryPoint(base({ guidance: { mode: "manual" } }))?.kind).toBe("uncontrolled");
+  });
+  it("landed: where the vehicle is", () => {
+    const s = base({ mission: { stage: "landed" } });
+    expect(isLanded(s)).toBe(true);
+    expect(recoveryPoint(s)).toMatchObject({ kind: "actual", lat_deg: 38.6, lon_deg: -7.9 });
+  });
+  it("falls back to what exists, or null", () => {
+    expect(recoveryPoint(base({ prediction: { planned: null, uncontrolled: { lat_deg: 1, lon_deg: 2 } } }))?.kind).toBe("uncontrolled");
+    expect(recoveryPoint(base({ prediction: null }))).toBeNull();
+  });
+});
+
+describe("plan and inputs", () => {
+  it("plan body: waypoints then exactly one land item, last", () => {
+    const land = { kind: "land" as const, lat_deg: 1, lon_deg: 2, alt_msl_m: 245 };
+    const r = planBody([{ kind: "waypoint", lat_deg: 1.1, lon_deg: 2.1, alt_msl_m: 600 }], land);
+    expect(r.ok && r.body.items.map((i) => i.kind)).toEqual(["waypoint", "land"]);
+    expect(r.ok && r.body.items[1]!.approach_course_deg).toBeNull();
+    expect(planBody([], null).ok).toBe(false);
+  });
+  it("validates typed numbers, naming the field", () => {
+    expect(parseNumber(" 12,5 ", "x", 0, 20)).toEqual({ ok: true, value: 12.5 });
+    expect(parseNumber("", "heading (°)", 0, 1)).toEqual({ ok: false, error: "heading (°): required" });
+    expect(parseNumber("abc", "x", 0, 1).ok).toBe(false);
+    expect(parseLat("91").ok).toBe(false);
+    const a = all(parseLat("38.5"), parseNumber("7", "n", 0, 10));
+    expect(a.ok && a.values).toEqual([38.5, 7]);
+    expect(all(parseLat("38.5"), parseLat("x")).ok).toBe(false);
+  });
+});

@@ -1,0 +1,151 @@
+import { describe, expect, it } from "vitest";
+import { decodeMessage, MessageStats, parseSession } from "./parse";
+
+// The state example of API.md, with its elided values filled in.
+const STATE = {
+  type: "state", time_s: 123.25, wall_ms: 1700000000000,
+  link: { connected: true, stale: false, age_s: 0.21, rate_hz: 31.5, loss_percent: 0.4, crc_errors: 0, parse_errors: 0, signature_errors: 0,
+    ages_s: { HEARTBEAT: 0.4, GPS_RAW_INT: 0.2, ATTITUDE: 0.2, SCALED_PRESSURE: 0.2, SERVO_OUTPUT_RAW: 0.2, WIND_COV: 0.2 } },
+  vehicle: {
+    mode: "spiral_landing", stage: "parafoil", phase: "branch2",
+    gps: { fix: "3d", satellites: 11, lat_deg: 38.53, lon_deg: -7.88, alt_msl_m: 812.4, velocity_ned_mps: [5.1, -1.2, 2.9], h_acc_m: 1.5 },
+    attitude: { roll_deg: -12.0, pitch_deg: -3.1, yaw_deg: 141.2 },
+    air: { static_pressure_pa: 92000, differential_pressure_pa: 25.2, temperature_c: 11.2, airspeed_mps: 6.6 },
+    servos: { main_line: 0.35, brake_right: 0.0, brake_left: 0.0 },
+    power: { voltage_v: 11.9, current_a: 0.8, remaining_percent: 78 },
+    onboard_wind_ned_mps: [-1.2, 0.4, 0.0],
+  },
+  estimate: { lat_deg: 38.53, lon_deg: -7.88, alt_msl_m: 812.4, height_m: 567.4, velocity_ned_mps: [5.1, -1.2, 2.9], ground_speed_mps: 5.3, course_deg: -12.0,
+    heading_deg: -10.5, heading_rate_dps: 2.1, airspeed_mps: 6.7, sink_rate_mps: 2.95, glide_ratio_air: 2.04, glide_ratio_ground: 1.8,
+    wind_ned_mps: [-1.2, 0.4, 0.0], wind_speed_mps: 1.26, wind_from_deg: 341.6, wind_sigma_mps: 0.15, position_sigma_m: 1.8, gps_ok: true },
+  guidance: { mode: "spiral_landing", phase: "branch2", target: { lat_deg: 38.5333, lon_deg: -7.8889, alt_msl_m: 245 },
+    pattern: { corners: [[38.531, -7.889], [38.532, -7.887], [38.534, -7.888], [38.533, -7.890]], final_entry: [38.531, -7.889], final_course_deg: 161.6,
+      final_approach_height_m: 172.0, target_reachable: true, reach_ratio: 0.41 },
+    commands: { main_line: 0.35, brake: 0.0 } },
+  prediction: { planned: { lat_deg: 38.5334, lon_deg: -7.8888, time_to_land_s: 187.0, semi_major_m: 12.1, semi_minor_m: 6.0, major_axis_deg: 40.0 },
+    uncontrolled: { lat_deg: 38.52, lon_deg: -7.87, time_to_land_s: 190.0, semi_major_m: 80, semi_minor_m: 40, major_axis_deg: 100 } },
+  forecast_wind: [{ alt_msl_m: 1000, speed_mps: 4, from_deg: 280 }, { alt_msl_m: 300, speed_mps: 2.0, from_deg: 270 }],
+  mission: { stage: "parafoil", cutdown_armed_until_s: null },
+};
+const j = (v: unknown): string => JSON.stringify(v);
+
+describe("decodeMessage: the API.md example", () => {
+  it("parses a full state", () => {
+    const d = decodeMessage(j(STATE));
+    expect(d.ok).toBe(true);
+    if (!d.ok || d.msg.type !== "state") throw new Error("not a state");
+    const s = d.msg;
+    expect(s.time_s).toBe(123.25);
+    expect(s.link.ages_s.HEARTBEAT).toBe(0.4);
+    expect(s.vehicle?.servos?.main_line).toBe(0.35);
+    expect(s.estimate?.wind_from_deg).toBe(341.6);
+    expect(s.guidance?.pattern?.corners).toHaveLength(4);
+    expect(s.guidance?.pattern?.final_entry).toEqual({ lat_deg: 38.531, lon_deg: -7.889 });
+    expect(s.prediction?.planned?.semi_major_m).toBe(12.1);
+    // Forecast sorted by altitude for interpolation.
+    expect(s.forecast_wind.map((f) => f.alt_msl_m)).toEqual([300, 1000]);
+    expect(s.mission.cutdown_armed_until_s).toBeNull();
+  });
+  it("accepts null blocks before the first data", () => {
+    const d = decodeMessage(j({ ...STATE, vehicle: null, estimate: null, guidance: null, prediction: null }));
+    expect(d.ok && d.msg.type === "state" && d.msg.vehicle === null && d.msg.estimate === null).toBe(true);
+  });
+});
+
+describe("decodeMessage: malformed input never throws", () => {
+  const cases: [string, unknown][] = [
+    ["not JSON", "{not json"],
+    ["truncated frame", j(STATE).slice(0, 200)],
+    ["an array", "[1,2,3]"],
+    ["a number", "42"],
+    ["null", "null"],
+    ["no type", j({ time_s: 1 })],
+    ["state without time_s", j({ type: "state" })],
+    ["state with a string time", j({ ...STATE, time_s: "12" })],
+    ["event without text", j({ type: "event", level: "info" })],
+    ["command_result without request_id", j({ type: "command_result", outcome: "accepted" })],
+    ["command_result with an unknown outcome", j({ type: "command_result", request_id: "r", outcome: "maybe" })],
+    ["params without an array", j({ type: "params", params: 3 })],
+    ["history with nothing", j({ type: "history" })],
+    ["hello without station", j({ type: "hello", role: "operator" })],
+    ["binary frame", new ArrayBuffer(4)],
+  ];
+  for (const [name, raw] of cases) {
+    it(`rejects ${name}`, () => {
+      const d = decodeMessage(raw);
+      expect(d.ok).toBe(false);
+      if (!d.ok) expect(d.error.length).toBeGreaterThan(0);
+    });
+  }
+
+  it("wrong-typed leaves become null, not garbage", () => {
+    const bad = { ...STATE, estimate: { ...STATE.estimate, airspeed_mps: "fast", lat_deg: 200, wind_ned_mps: [1, 2] }, link: { ...STATE.link, ages_s: { HEARTBEAT: "x", GPS_RAW_INT: 0.2 } } };
+    const d = decodeMessage(j(bad));
+    if (!d.ok || d.msg.type !== "state") throw new Error("should parse");
+    expect(d.msg.estimate?.airspeed_mps).toBeNull();
+    expect(d.msg.estimate?.lat_deg).toBeNull();
+    expect(d.msg.estimate?.wind_ned_mps).toBeNull();
+    expect(d.msg.link.ages_s).toEqual({ GPS_RAW_INT: 0.2 });
+  });
+
+  it("a state without a link block is stale, never fresh", () => {
+    const { link: _drop, ...noLink } = STATE;
+    const d = decodeMessage(j(noLink));
+    expect(d.ok && d.msg.type === "state" && d.msg.link.stale).toBe(true);
+  });
+
+  it("pattern corners out of range are dropped", () => {
+    const d = decodeMessage(j({ ...STATE, guidance: { ...STATE.guidance, pattern: { ...STATE.guidance.pattern, corners: [[38.5, -7.8], [95, 0], "x", [1]] } } }));
+    expect(d.ok && d.msg.type === "state" && d.msg.guidance?.pattern?.corners.length).toBe(1);
+  });
+
+  it("unknown types are ignored, not errors (a newer daemon may add some)", () => {
+    const d = decodeMessage(j({ type: "video_frame" }));
+    expect(d).toEqual({ ok: true, msg: { type: "unknown", raw_type: "video_frame" }, dropped: 0 });
+  });
+
+  it("an unknown event level is kept, as a warning", () => {
+    const d = decodeMessage(j({ type: "event", level: "critical", source: "vehicle", text: "x" }));
+    expect(d.ok && d.msg.type === "event" && d.msg.level).toBe("warning");
+  });
+});
+
+describe("history, hello, command_result", () => {
+  it("history keeps good items and counts the bad", () => {
+    const d = decodeMessage(j({
+      type: "history",
+      track: [{ time_s: 1, lat_deg: 38.5, lon_deg: -7.8, alt_msl_m: 900 }, { time_s: "x" }, null],
+      events: [{ type: "event", level: "info", source: "link", text: "ok" }, { level: "info" }],
+      states: [STATE, { type: "state" }],
+    }));
+    if (!d.ok || d.msg.type !== "history") throw new Error("should parse");
+    expect(d.msg.track).toHaveLength(1);
+    expect(d.msg.events).toHaveLength(1);
+    expect(d.msg.states).toHaveLength(1);
+    expect(d.dropped).toBe(4);
+  });
+  it("hello, flattened (as we read API.md) or nested", () => {
+    const session = { role: "viewer", name: "v", station: { name: "s", origin: { lat_deg: 1, lon_deg: 2, alt_msl_m: 3 }, tile_url: "/t/{z}/{x}/{y}.png", modes: ["manual", 7] } };
+    for (const msg of [{ type: "hello", ...session }, { type: "hello", session }]) {
+      const d = decodeMessage(j(msg));
+      expect(d.ok && d.msg.type === "hello" && d.msg.session.role).toBe("viewer");
+      expect(d.ok && d.msg.type === "hello" && d.msg.session.station.modes).toEqual(["manual"]);
+    }
+  });
+  it("command_result with the read-back value", () => {
+    const d = decodeMessage(j({ type: "command_result", request_id: "r1", command: "set_param", outcome: "accepted", attempts: 2, detail: "HK1", value: 0.015 }));
+    expect(d.ok && d.msg.type === "command_result" && [d.msg.attempts, d.msg.value]).toEqual([2, 0.015]);
+  });
+  it("sessions with an unknown role are refused", () => {
+    expect(parseSession({ role: "admin", station: { origin: { lat_deg: 0, lon_deg: 0 } } }).ok).toBe(false);
+  });
+});
+
+describe("MessageStats", () => {
+  it("counts received, bad (including dropped items) and ignored; remembers the last error", () => {
+    const st = new MessageStats();
+    for (const raw of [j(STATE), "{oops", j({ type: "future" }), j({ type: "history", track: [null, null] })]) st.record(decodeMessage(raw));
+    expect([st.received, st.bad, st.ignored]).toEqual([4, 3, 1]);
+    expect(st.lastError).toContain("history");
+  });
+});

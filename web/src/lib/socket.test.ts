@@ -1,0 +1,95 @@
+import { afterEach, beforeEach, describe, expect, it, vi } from "vitest";
+import { LiveSocket, type SocketStatus, type WsLike } from "./socket";
+import type { ServerMessage } from "./types";
+
+class FakeWs implements WsLike {
+  readyState = 0;
+  onopen: WsLike["onopen"] = null;
+  onclose: WsLike["onclose"] = null;
+  onerror: WsLike["onerror"] = null;
+  onmessage: WsLike["onmessage"] = null;
+  sent: string[] = [];
+  constructor(readonly url: string) {}
+  send(d: string): void {
+    this.sent.push(d);
+  }
+  close(): void {
+    this.readyState = 3;
+    this.onclose?.({ code: 1000, reason: "" });
+  }
+  open(): void {
+    this.readyState = 1;
+    this.onopen?.({});
+  }
+  drop(): void {
+    this.readyState = 3;
+    this.onclose?.({ code: 1006, reason: "" });
+  }
+}
+
+describe("LiveSocket", () => {
+  let made: FakeWs[];
+  let statuses: SocketStatus[];
+  let msgs: ServerMessage[];
+  let sock: LiveSocket;
+
+  beforeEach(() => {
+    vi.useFakeTimers();
+    made = [];
+    statuses = [];
+    msgs = [];
+    sock = new LiveSocket({
+      url: () => "ws://x/api/ws?token=op",
+      create: (u) => {
+        const w = new FakeWs(u);
+        made.push(w);
+        return w;
+      },
+      onMessage: (m) => msgs.push(m),
+      onStatus: (s) => statuses.push(s),
+      random: () => 0.5,
+      now: () => 0,
+    });
+  });
+  afterEach(() => vi.useRealTimers());
+
+  it("reconnects with growing delays, and resets them after a success", () => {
+    sock.start();
+    made[0]!.drop();
+    expect(statuses.at(-1)).toMatchObject({ kind: "waiting", attempt: 1, retryAtMs: 500 });
+    vi.advanceTimersByTime(499);
+    expect(made).toHaveLength(1);
+    vi.advanceTimersByTime(1);
+    expect(made).toHaveLength(2);
+    made[1]!.drop();
+    expect(statuses.at(-1)).toMatchObject({ kind: "waiting", attempt: 2, retryAtMs: 1000 });
+    vi.advanceTimersByTime(1000);
+    made[2]!.open();
+    expect(statuses.at(-1)).toEqual({ kind: "open" });
+    made[2]!.drop();
+    expect(statuses.at(-1)).toMatchObject({ attempt: 1, retryAtMs: 500 });
+  });
+
+  it("decodes good frames, counts bad ones, never throws", () => {
+    sock.start();
+    made[0]!.open();
+    for (const data of ['{"type":"pong"}', "garbage", '{"type":"state"}', 17]) made[0]!.onmessage?.({ data });
+    expect(msgs).toEqual([{ type: "pong" }]);
+    expect([sock.stats.received, sock.stats.bad]).toEqual([4, 3]);
+  });
+
+  it("sends only while open; nothing is queued", () => {
+    sock.start();
+    expect(sock.send({ type: "ping" })).toBe(false);
+    made[0]!.open();
+    expect(sock.send({ type: "ping" })).toBe(true);
+    expect(made[0]!.sent).toEqual(['{"type":"ping"}']);
+  });
+
+  it("stop() does not reconnect", () => {
+    sock.start();
+    sock.stop();
+    vi.advanceTimersByTime(60_000);
+    expect(made).toHaveLength(1);
+  });
+});

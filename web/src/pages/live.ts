@@ -1,0 +1,321 @@
+// The live page: the operators' replacement of "STX center". This module wires the pieces:
+// session and token, the WebSocket, the panels, commands and their outcomes, staleness. The
+// logic lives in ../lib (tested); the panels in ../ui.
+
+import "../styles/common.css";
+import "../styles/live.css";
+import { Api, ApiError } from "../lib/api";
+import { CommandTracker, type CommandEntry } from "../lib/commands";
+import { fmt, fmtMissionTime, label } from "../lib/format";
+import { parseParams, parseSession, isObj } from "../lib/parse";
+import { LiveSocket, type SocketStatus } from "../lib/socket";
+import { judgeStaleness, type StaleVerdict } from "../lib/staleness";
+import { resolveToken, searchWithoutToken, withToken } from "../lib/token";
+import type { EventMsg, Level, Session, State, TrackPoint } from "../lib/types";
+import { AttitudeIndicator, Compass } from "../ui/attitude";
+import { CommandList } from "../ui/commandList";
+import { GuidanceInputs, ModeButtons, TargetEditor, type SendCommand } from "../ui/controls";
+import { CutdownButton } from "../ui/cutdownButton";
+import { h, panel, setText } from "../ui/dom";
+import { EventLog } from "../ui/eventLog";
+import { Actuators, FlightData } from "../ui/flightData";
+import { JoystickPanel } from "../ui/joystickPanel";
+import { LinkPanel } from "../ui/linkPanel";
+import { MapView } from "../ui/map";
+import { ParamEditor } from "../ui/paramEditor";
+import { PickGroup } from "../ui/pick";
+import { PlanEditor } from "../ui/planEditor";
+import { Plots } from "../ui/plots";
+import { applyRole, OPERATOR_REQUIRED } from "../ui/role";
+import { tabs } from "../ui/tabs";
+import { View3D } from "../ui/view3d";
+import { WindPanel } from "../ui/windPanel";
+
+const app = document.getElementById("app")!;
+const token = resolveToken(location.search, sessionStorage);
+if (new URLSearchParams(location.search).has("token")) history.replaceState(null, "", `${location.pathname}${searchWithoutToken(location.search)}${location.hash}`);
+const api = new Api(token);
+
+/** Seconds without any state before a silent socket is dropped and reopened. */
+const SILENT_SOCKET_S = 6;
+/** Live track points closer than this in time are not added (the history comes at ~1 Hz). */
+const TRACK_EVERY_S = 1;
+
+void start();
+
+async function start(): Promise<void> {
+  let attempt = 0;
+  for (;;) {
+    try {
+      const s = parseSession(await api.get("/api/session"));
+      if (!s.ok) throw new ApiError(200, "bad_session", s.error);
+      build(s.value);
+      return;
+    } catch (e) {
+      if (e instanceof ApiError && e.status === 401) {
+        fatal("Not authorised", `The station refused this page's token (${e.reason}). Open the page with ?token=YOUR_TOKEN in the address.`);
+        return;
+      }
+      attempt += 1;
+      fatal("Station unreachable", `${e instanceof Error ? e.message : String(e)} — retrying (attempt ${attempt})…`);
+      await new Promise((r) => setTimeout(r, Math.min(10_000, 500 * 2 ** attempt)));
+    }
+  }
+}
+
+function fatal(title: string, text: string): void {
+  app.replaceChildren(h("div", { class: "fatal", role: "alert", "data-testid": "fatal" }, h("h1", {}, title), h("p", {}, text)));
+}
+
+function build(session: Session): void {
+  let role = session.role;
+  let latest: State | null = null;
+  let receivedAtMs: number | null = null;
+  let socketStatus: SocketStatus = { kind: "connecting", attempt: 0 };
+  let verdict: StaleVerdict = judgeStaleness({ socketOpen: false, link: null, receivedAtMs: null, nowMs: Date.now() });
+  let track: TrackPoint[] = [];
+  const station = session.station;
+
+  // ---- panels
+  const map = new MapView(station, token);
+  const picks = new PickGroup((p) => map.setPicker(p));
+  const attitude = new AttitudeIndicator();
+  const compass = new Compass();
+  const flight = new FlightData();
+  const actuators = new Actuators();
+  const wind = new WindPanel();
+  const link = new LinkPanel();
+  const plots = new Plots();
+  const view3d = new View3D(station.origin);
+  const events = new EventLog();
+  const commandList = new CommandList();
+  const tracker = new CommandTracker((e) => onCommand(e));
+
+  const localEvent = (level: Level, text: string): void =>
+    events.add({ type: "event", time_s: latest?.time_s ?? null, wall_ms: Date.now(), level, source: "page", text });
+
+  const runCommand = (command: string, text: string, path: string, body: unknown): number => {
+    const id = tracker.begin(command, text, Date.now());
+    api.command(path, body).then(
+      (rid) => tracker.accepted(id, rid, Date.now()),
+      (e: unknown) => {
+        const reason = e instanceof Error ? e.message : String(e);
+        tracker.rejected(id, reason, Date.now());
+        localEvent("warning", `${text}: rejected — ${reason}`);
+      },
+    );
+    return id;
+  };
+  const send: SendCommand = (command, text, path, body) => void runCommand(command, text, path, body);
+
+  const modes = new ModeButtons(station.modes.length > 0 ? station.modes : ["uncontrolled", "manual", "heading", "course", "localizer", "spiral_landing"], send);
+  const target = new TargetEditor(send, picks, map);
+  const guidanceInputs = new GuidanceInputs(send, picks, map);
+  const plan = new PlanEditor(send, picks, map);
+  const params = new ParamEditor((name, value) => runCommand("set_param", `param ${name} → ${value}`, `/api/params/${encodeURIComponent(name)}`, { value }));
+  const socket = new LiveSocket({
+    url: () => withToken(`${location.protocol === "https:" ? "wss:" : "ws:"}//${location.host}/api/ws`, token),
+    onMessage: (m) => {
+      switch (m.type) {
+        case "hello":
+          role = m.session.role;
+          applyRoleEverywhere();
+          break;
+        case "state":
+          onState(m);
+          break;
+        case "history":
+          onHistory(m.track, m.events, m.states);
+          break;
+        case "event":
+          events.add(m);
+          break;
+        case "command_result":
+          tracker.result(m, Date.now());
+          break;
+        case "params":
+          params.setParams(m.params, m.complete);
+          break;
+        default:
+          break;
+      }
+    },
+    onStatus: (s) => {
+      socketStatus = s;
+      joystick.setSocketOpen(s.kind === "open");
+      refresh();
+    },
+  });
+  const joystick = new JoystickPanel((m) => socket.send(m));
+  const cutdown = new CutdownButton({
+    arm: async () => {
+      localEvent("warning", `cutdown: armed by ${session.name} (hold completed) at ${new Date().toISOString().slice(11, 19)}Z`);
+      const r = await api.post("/api/cutdown/arm", {});
+      if (!isObj(r) || typeof r.arm_id !== "string") throw new Error("no arm_id in the station's answer");
+      return { arm_id: r.arm_id };
+    },
+    confirm: async (armId) => {
+      const id = tracker.begin("cutdown", "CUTDOWN", Date.now());
+      try {
+        const rid = await api.command("/api/cutdown/confirm", { arm_id: armId });
+        tracker.accepted(id, rid, Date.now());
+        localEvent("warning", `cutdown: confirmed by ${session.name} at ${new Date().toISOString().slice(11, 19)}Z (request ${rid})`);
+        return { request_id: rid };
+      } catch (e) {
+        tracker.rejected(id, e instanceof Error ? e.message : String(e), Date.now());
+        throw e;
+      }
+    },
+  });
+
+  // ---- layout
+  const clock = h("span", { class: "clock", "data-testid": "mission-clock" });
+  const conn = h("span", { class: "badge", "data-testid": "conn-status" });
+  const roleBadge = h("span", { class: "badge", "data-testid": "role-badge" });
+  const hdrMode = h("span", { class: "badge", "data-testid": "hdr-mode" });
+  const hdrStage = h("span", { class: "badge", "data-testid": "hdr-stage" });
+  const hdrPhase = h("span", { class: "badge", "data-testid": "hdr-phase" });
+  const hdrLink = h("span", { class: "badge", "data-testid": "hdr-link" });
+  const hdrLanding = h("span", { class: "badge", "data-testid": "hdr-landing" });
+  const kml = h("a", { href: withToken("/kml", token), "data-testid": "kml-link", class: "linkbtn", title: "open in Google Earth: a network link that refreshes every 2 s" }, "KML (Google Earth)");
+  const recovery = h("a", { href: "recovery.html", target: "_blank", rel: "noopener", "data-testid": "recovery-link", class: "linkbtn" }, "Recovery view");
+  const header = h("header", { class: "top" },
+    h("strong", { class: "station" }, station.name), clock, conn, roleBadge,
+    h("span", { class: "hdr-group" }, "mode ", hdrMode, " stage ", hdrStage, " phase ", hdrPhase),
+    hdrLink, hdrLanding, h("span", { class: "spacer" }), kml, recovery);
+  const banner = h("div", { class: "banner", role: "alert", "data-testid": "banner", hidden: true });
+  const viewerNote = h("div", { class: "viewer-note", "data-testid": "viewer-note" }, `Viewer: you can watch everything; commanding needs the operator role (${OPERATOR_REQUIRED}).`);
+
+  const instruments = panel("Attitude · heading", "panel-attitude", h("div", { class: "insts" }, attitude.root, compass.root));
+  const left = h("aside", { class: "col left vd" }, instruments, flight.root, actuators.root, wind.root, link.root);
+  const bottom = tabs("views", [
+    { id: "plots", label: "Plots", content: plots.root, onShow: () => plots.layout() },
+    { id: "3d", label: "3-D view", content: view3d.root, onShow: () => view3d.layout() },
+    { id: "events", label: "Event log", content: events.root },
+  ]);
+  const centre = h("section", { class: "col centre" }, h("div", { class: "map-wrap vd" }, map.root), bottom.root);
+  // Modes and the joystick first: in manual flight both must be in view without scrolling.
+  const commandTab = h("div", {}, modes.root, joystick.root, target.root, guidanceInputs.root);
+  const right = tabs("control", [
+    { id: "command", label: "Command", content: commandTab },
+    { id: "plan", label: "Plan", content: plan.root },
+    { id: "params", label: "Parameters", content: params.root },
+  ]);
+  const rightCol = h("aside", { class: "col right" }, viewerNote, right.root, commandList.root, cutdown.root);
+  app.replaceChildren(header, banner, h("main", { class: "grid" }, left, centre, rightCol));
+  map.invalidate();
+  plots.layout();
+  new ResizeObserver(() => {
+    map.invalidate();
+    plots.layout();
+    view3d.layout();
+  }).observe(centre);
+
+  // ---- behaviour
+  function applyRoleEverywhere(): void {
+    const operator = role === "operator";
+    applyRole(document, operator);
+    joystick.setRole(operator);
+    setText(roleBadge, `${operator ? "OPERATOR" : "VIEWER"} ${session.name}`);
+    roleBadge.dataset.role = role;
+  }
+
+  function onCommand(e: CommandEntry): void {
+    commandList.update(e, tracker.entries);
+    params.onCommand(e);
+  }
+
+  function onState(s: State): void {
+    latest = s;
+    receivedAtMs = Date.now();
+    plots.push(s);
+    const e = s.estimate;
+    if (!s.link.stale && e?.lat_deg != null && e.lon_deg != null) {
+      const last = track[track.length - 1];
+      if (last === undefined || s.time_s - last.time_s >= TRACK_EVERY_S) {
+        const p = { time_s: s.time_s, lat_deg: e.lat_deg, lon_deg: e.lon_deg, alt_msl_m: e.alt_msl_m };
+        if (last !== undefined && s.time_s < last.time_s) track = []; // mission clock restarted
+        track.push(p);
+        if (track.length > 20_000) track = track.slice(-18_000);
+        map.setTrack(track);
+        view3d.addPoint(p);
+      }
+    }
+    render();
+  }
+
+  function onHistory(t: TrackPoint[], ev: EventMsg[], states: State[]): void {
+    track = t.slice();
+    map.setTrack(track);
+    view3d.setTrack(track);
+    events.reset(ev);
+    plots.reset(states, latest);
+  }
+
+  function render(): void {
+    refresh();
+    const s = latest;
+    if (s === null) return;
+    const e = s.estimate;
+    attitude.update(s.vehicle?.attitude?.roll_deg ?? null, s.vehicle?.attitude?.pitch_deg ?? null);
+    compass.update(e?.heading_deg ?? s.vehicle?.attitude?.yaw_deg ?? null, e?.course_deg ?? null, e?.wind_from_deg ?? null);
+    flight.update(s);
+    actuators.update(s);
+    wind.update(s);
+    map.update(s, verdict.stale);
+    view3d.update(s);
+    modes.update(s);
+    target.update(s);
+    plan.update(s);
+    cutdown.update(s.mission.cutdown_armed_until_s, s.time_s);
+    joystick.setVehicleMode(s.vehicle?.mode ?? null);
+    setText(clock, fmtMissionTime(s.time_s));
+    setText(hdrMode, label(s.vehicle?.mode ?? s.guidance?.mode));
+    setText(hdrStage, label(s.mission.stage ?? s.vehicle?.stage));
+    setText(hdrPhase, label(s.guidance?.phase ?? s.vehicle?.phase));
+    const p = s.prediction?.planned ?? s.prediction?.uncontrolled ?? null;
+    setText(hdrLanding, p ? `landing in ${fmt(p.time_to_land_s, "s", 0)}` : "landing —");
+  }
+
+  /** Staleness and connection state: runs on every state and on a timer (ages grow in silence). */
+  function refresh(): void {
+    const now = Date.now();
+    verdict = judgeStaleness({ socketOpen: socket.open, link: latest?.link ?? null, receivedAtMs, nowMs: now });
+    document.body.classList.toggle("stale", verdict.stale);
+    document.body.dataset.freshness = verdict.freshness;
+    link.update(latest?.link ?? null, verdict, socket.stats, receivedAtMs, now);
+    const st = socketStatus;
+    const connText = st.kind === "open" ? "CONNECTED" : st.kind === "connecting" ? "CONNECTING…" : `DISCONNECTED — retry in ${Math.max(0, (st.retryAtMs - now) / 1000).toFixed(0)} s`;
+    setText(conn, connText);
+    conn.dataset.state = st.kind;
+    setText(hdrLink, latest ? `link ${fmt(latest.link.rate_hz, "Hz", 0)} · loss ${fmt(latest.link.loss_percent, "%")} · age ${fmt(verdict.age_s, "s")}` : "link —");
+    hdrLink.dataset.state = verdict.freshness;
+    if (st.kind !== "open") {
+      banner.hidden = false;
+      banner.dataset.kind = "disconnected";
+      setText(banner, `DISCONNECTED from the station${st.kind === "waiting" ? ` (${st.reason}); reconnecting in ${Math.max(0, (st.retryAtMs - now) / 1000).toFixed(0)} s, attempt ${st.attempt}` : " — connecting…"}. Values shown are the last received and are NOT current.`);
+    } else if (verdict.stale) {
+      banner.hidden = false;
+      banner.dataset.kind = "stale";
+      setText(banner, `STALE — ${verdict.reasons.join("; ")}. Vehicle values are old and greyed; they are NOT current.`);
+    } else {
+      banner.hidden = true;
+      banner.dataset.kind = "none";
+    }
+    if (socket.open && receivedAtMs !== null && now - receivedAtMs > SILENT_SOCKET_S * 1000) {
+      receivedAtMs = now - SILENT_SOCKET_S * 1000; // one kick per silence, not one per tick
+      socket.kick();
+    }
+  }
+
+  applyRoleEverywhere();
+  setInterval(refresh, 250);
+  socket.start();
+  api.get("/api/params").then(
+    (r) => {
+      const p = isObj(r) ? parseParams(r) : null;
+      if (p?.ok) params.setParams(p.value.params, p.value.complete);
+    },
+    (e: unknown) => localEvent("warning", `parameters not loaded: ${e instanceof Error ? e.message : String(e)}`),
+  );
+}

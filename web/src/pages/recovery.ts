@@ -1,0 +1,177 @@
+// The recovery page, for phones in the field: where to go (predicted, or once landed, actual
+// landing point), how far and which way from the phone, and links to open the point in the
+// phone's map app. It polls /api/state (simpler than a socket over a flaky mobile link) and keeps
+// the last state in localStorage, so it still shows the last known point with no network.
+
+import "../styles/common.css";
+import "../styles/recovery.css";
+import { Api } from "../lib/api";
+import { bearingDeg, distanceM } from "../lib/geo";
+import { cardinal, fmtDir, fmtDistance, fmtDuration, fmtLatLon, fmtWallUtc, wrap360 } from "../lib/format";
+import { isObj, parseState } from "../lib/parse";
+import { recoveryPoint } from "../lib/recovery";
+import { resolveToken, searchWithoutToken } from "../lib/token";
+import type { LatLon, State } from "../lib/types";
+import { h, setText } from "../ui/dom";
+
+const POLL_MS = 2000;
+/** A point older than this is flagged: the vehicle may have moved a long way since. */
+const STALE_AFTER_S = 10;
+const CACHE_KEY = "stx.recovery.last";
+
+const token = resolveToken(location.search, sessionStorage);
+if (new URLSearchParams(location.search).has("token")) history.replaceState(null, "", `${location.pathname}${searchWithoutToken(location.search)}`);
+const api = new Api(token);
+
+let state: State | null = null;
+let stateAtMs: number | null = null; // page clock when fetched
+let fromCache = false;
+let phone: (LatLon & { accuracy_m: number }) | null = null;
+let phoneError = "";
+let deviceHeading: number | null = null;
+let fetchError = "";
+
+const el = {
+  kind: h("div", { class: "kind", "data-testid": "rec-kind" }),
+  arrow: h("div", { class: "arrow", "data-testid": "rec-arrow", "aria-hidden": "true" }, "⬆"),
+  arrowNote: h("div", { class: "muted", "data-testid": "rec-arrow-note" }),
+  distance: h("div", { class: "big", "data-testid": "rec-distance" }),
+  bearing: h("div", { class: "mid", "data-testid": "rec-bearing" }),
+  point: h("div", { class: "mid", "data-testid": "rec-point" }),
+  ttl: h("div", { "data-testid": "rec-ttl" }),
+  geo: h("a", { class: "btn", "data-testid": "rec-geo-link" }, "Open in map app"),
+  osm: h("a", { class: "btn", "data-testid": "rec-osm-link", target: "_blank", rel: "noopener" }, "OpenStreetMap"),
+  updated: h("div", { "data-testid": "rec-updated" }),
+  stale: h("div", { class: "stale-flag", role: "alert", "data-testid": "rec-stale" }),
+  phone: h("div", { class: "muted", "data-testid": "rec-phone" }),
+};
+
+document.getElementById("app")!.replaceChildren(
+  h("header", {}, h("strong", {}, "STRAPLEX recovery"), h("a", { href: "index.html", class: "muted small" }, "live page")),
+  el.stale,
+  h("main", {}, el.kind, el.arrow, el.arrowNote, el.distance, el.bearing, el.point, el.ttl, h("div", { class: "links" }, el.geo, el.osm), el.updated, el.phone),
+);
+
+loadCache();
+render();
+void poll();
+setInterval(() => void poll(), POLL_MS);
+setInterval(render, 1000);
+watchPhone();
+watchHeading();
+if ("serviceWorker" in navigator && window.isSecureContext) {
+  // Lets the page itself open with no network (sw.js caches the page's files, never the API).
+  navigator.serviceWorker.register("sw.js").catch(() => {});
+}
+
+async function poll(): Promise<void> {
+  try {
+    const raw = await api.get("/api/state");
+    const p = isObj(raw) ? parseState(raw) : null;
+    if (!p?.ok) throw new Error(p ? p.error : "not a state");
+    state = p.value;
+    stateAtMs = Date.now();
+    fromCache = false;
+    fetchError = "";
+    try {
+      localStorage.setItem(CACHE_KEY, JSON.stringify({ at: stateAtMs, state: raw }));
+    } catch {
+      // storage full or forbidden: the page still works, only without the offline copy
+    }
+  } catch (e) {
+    fetchError = e instanceof Error ? e.message : String(e);
+  }
+  render();
+}
+
+function loadCache(): void {
+  try {
+    const c: unknown = JSON.parse(localStorage.getItem(CACHE_KEY) ?? "null");
+    if (isObj(c) && typeof c.at === "number" && isObj(c.state)) {
+      const p = parseState(c.state);
+      if (p.ok) {
+        state = p.value;
+        stateAtMs = c.at;
+        fromCache = true;
+      }
+    }
+  } catch {
+    // a corrupt cache is ignored
+  }
+}
+
+function watchPhone(): void {
+  if (!window.isSecureContext) {
+    phoneError = "phone position needs HTTPS (or localhost): open this page over https";
+    return;
+  }
+  if (!("geolocation" in navigator)) {
+    phoneError = "this browser has no geolocation";
+    return;
+  }
+  navigator.geolocation.watchPosition(
+    (p) => {
+      phone = { lat_deg: p.coords.latitude, lon_deg: p.coords.longitude, accuracy_m: p.coords.accuracy };
+      phoneError = "";
+      render();
+    },
+    (e) => {
+      phoneError = `phone position unavailable: ${e.message || "permission denied"}`;
+      render();
+    },
+    { enableHighAccuracy: true, maximumAge: 5000, timeout: 30000 },
+  );
+}
+
+/** Compass heading of the phone, where the browser gives an absolute one; else the arrow is north-up. */
+function watchHeading(): void {
+  const onOrient = (e: DeviceOrientationEvent): void => {
+    const webkit = (e as DeviceOrientationEvent & { webkitCompassHeading?: number }).webkitCompassHeading;
+    if (typeof webkit === "number") deviceHeading = webkit;
+    else if (e.absolute && e.alpha !== null) deviceHeading = wrap360(360 - e.alpha);
+  };
+  window.addEventListener("deviceorientationabsolute", onOrient as EventListener);
+  window.addEventListener("deviceorientation", onOrient);
+}
+
+function render(): void {
+  const now = Date.now();
+  const pt = state ? recoveryPoint(state) : null;
+  const ageS = stateAtMs === null ? null : (now - stateAtMs) / 1000;
+  const stale = state === null || fromCache || (ageS !== null && ageS > STALE_AFTER_S) || state.link.stale;
+  const why = state === null ? "no data yet" : fromCache ? "offline — showing the last saved point" : state.link.stale ? "the station has lost the drone's link" : ageS !== null && ageS > STALE_AFTER_S ? `no update for ${fmtDuration(ageS)}` : "";
+  setText(el.stale, stale ? `STALE: ${why}${fetchError ? ` (${fetchError})` : ""}` : "");
+  el.stale.hidden = !stale;
+  document.body.classList.toggle("stale", stale);
+  if (pt === null) {
+    setText(el.kind, state === null ? "Waiting for data…" : "No landing point yet");
+    setText(el.distance, "— m");
+    setText(el.bearing, "bearing —°");
+    setText(el.point, "");
+    setText(el.ttl, "");
+    el.arrow.style.visibility = "hidden";
+  } else {
+    setText(el.kind, pt.kind === "actual" ? "LANDED — actual position" : pt.kind === "planned" ? "Predicted landing (guided)" : "Predicted landing (uncontrolled)");
+    el.kind.dataset.kind = pt.kind;
+    setText(el.point, fmtLatLon(pt.lat_deg, pt.lon_deg));
+    setText(el.ttl, pt.kind === "actual" ? "" : `lands in ${fmtDuration(pt.time_to_land_s)}${pt.semi_major_m !== null ? ` · ±${Math.round(pt.semi_major_m)} m (1σ)` : ""}`);
+    el.geo.setAttribute("href", `geo:${pt.lat_deg.toFixed(6)},${pt.lon_deg.toFixed(6)}`);
+    el.osm.setAttribute("href", `https://www.openstreetmap.org/?mlat=${pt.lat_deg.toFixed(6)}&mlon=${pt.lon_deg.toFixed(6)}#map=17/${pt.lat_deg.toFixed(6)}/${pt.lon_deg.toFixed(6)}`);
+    if (phone) {
+      const d = distanceM(phone, pt);
+      const b = bearingDeg(phone, pt);
+      setText(el.distance, fmtDistance(d));
+      setText(el.bearing, `bearing ${fmtDir(b)} (${cardinal(b)})`);
+      el.arrow.style.visibility = "visible";
+      el.arrow.style.transform = `rotate(${(deviceHeading === null ? b : wrap360(b - deviceHeading)).toFixed(0)}deg)`;
+      setText(el.arrowNote, deviceHeading === null ? "arrow: north is up (no compass)" : "arrow: relative to where the phone points");
+    } else {
+      setText(el.distance, "— m");
+      setText(el.bearing, "bearing —° (phone position unknown)");
+      el.arrow.style.visibility = "hidden";
+      setText(el.arrowNote, "");
+    }
+  }
+  setText(el.updated, state ? `last update ${fmtWallUtc(state.wall_ms ?? stateAtMs)} · ${ageS === null ? "" : `${fmtDuration(ageS)} ago`}` : "");
+  setText(el.phone, phone ? `phone ${fmtLatLon(phone.lat_deg, phone.lon_deg)} ±${Math.round(phone.accuracy_m)} m` : phoneError || "locating the phone…");
+}

@@ -1,0 +1,95 @@
+// Key flight data: speeds, sink, glide, altitudes, position, GPS, power; and the actuators as bars.
+
+import { h, panel, readout, setText, setAttr } from "./dom";
+import { fmt, fmtLatLon, label } from "../lib/format";
+import type { N, State } from "../lib/types";
+
+type Row = { value: HTMLElement; get: (s: State) => string };
+
+export class FlightData {
+  readonly root: HTMLElement;
+  private readonly rows: Row[] = [];
+
+  constructor() {
+    const grid = h("div", { class: "ro-grid" });
+    const add = (lbl: string, id: string, get: (s: State) => string, title?: string): void => {
+      const r = readout(lbl, id, title);
+      grid.append(r.root);
+      this.rows.push({ value: r.value, get });
+    };
+    add("Airspeed", "ro-airspeed", (s) => fmt(s.estimate?.airspeed_mps ?? s.vehicle?.air?.airspeed_mps, "m/s"));
+    add("Ground speed", "ro-groundspeed", (s) => fmt(s.estimate?.ground_speed_mps, "m/s"));
+    add("Sink rate", "ro-sink", (s) => fmt(s.estimate?.sink_rate_mps, "m/s"), "positive down");
+    add("Heading rate", "ro-heading-rate", (s) => fmt(s.estimate?.heading_rate_dps, "°/s"));
+    add("Glide (air)", "ro-glide-air", (s) => fmt(s.estimate?.glide_ratio_air, ": 1", 2), "horizontal air distance per metre of height");
+    add("Glide (ground)", "ro-glide-ground", (s) => fmt(s.estimate?.glide_ratio_ground, ": 1", 2), "horizontal ground distance per metre of height");
+    add("Altitude MSL", "ro-alt-msl", (s) => fmt(s.estimate?.alt_msl_m ?? s.vehicle?.gps?.alt_msl_m, "m", 0));
+    add("Height AGL", "ro-height", (s) => fmt(s.estimate?.height_m, "m", 0), "height above the ground at the station origin");
+    add("Position", "ro-position", (s) => fmtLatLon(s.estimate?.lat_deg ?? s.vehicle?.gps?.lat_deg, s.estimate?.lon_deg ?? s.vehicle?.gps?.lon_deg));
+    add("Position σ", "ro-pos-sigma", (s) => fmt(s.estimate?.position_sigma_m, "m"));
+    add("GPS", "ro-gps", (s) => {
+      const g = s.vehicle?.gps;
+      return g ? `${label(g.fix)} · ${fmt(g.satellites, "sats", 0)} · ±${fmt(g.h_acc_m, "m")}` : "—";
+    });
+    add("Air", "ro-air", (s) => {
+      const a = s.vehicle?.air;
+      return a ? `${fmt(a.static_pressure_pa, "Pa", 0)} · q ${fmt(a.differential_pressure_pa, "Pa")} · ${fmt(a.temperature_c, "°C")}` : "—";
+    });
+    add("Battery", "ro-battery", (s) => {
+      const p = s.vehicle?.power;
+      return p ? `${fmt(p.voltage_v, "V", 2)} · ${fmt(p.current_a, "A", 2)} · ${fmt(p.remaining_percent, "%", 0)}` : "—";
+    });
+    this.root = panel("Flight data", "panel-flight", grid);
+  }
+
+  update(s: State): void {
+    for (const r of this.rows) setText(r.value, r.get(s));
+  }
+}
+
+/** One actuator bar. Bipolar bars (main line −1…1) grow from the centre. */
+class Bar {
+  readonly root: HTMLElement;
+  private readonly fill: HTMLElement;
+  private readonly cmd: HTMLElement;
+  private readonly text: HTMLElement;
+
+  constructor(name: string, testid: string, private readonly bipolar: boolean) {
+    this.fill = h("div", { class: "bar-fill" });
+    this.cmd = h("div", { class: "bar-cmd", title: "commanded by guidance" });
+    this.text = h("span", { class: "bar-val", "data-testid": testid });
+    const track = h("div", { class: `bar-track${bipolar ? " bipolar" : ""}`, role: "meter", "aria-label": name, "aria-valuemin": bipolar ? -1 : 0, "aria-valuemax": 1 }, this.fill, this.cmd);
+    this.root = h("div", { class: "bar" }, h("span", { class: "bar-lbl" }, name), track, this.text);
+  }
+
+  update(v: N, commanded: N): void {
+    const x = v === null ? 0 : Math.max(this.bipolar ? -1 : 0, Math.min(1, v));
+    const [left, width] = this.bipolar ? [50 + Math.min(0, x) * 50, Math.abs(x) * 50] : [0, x * 100];
+    setAttr(this.fill, "style", `left:${left.toFixed(1)}%;width:${width.toFixed(1)}%`);
+    if (commanded === null) setAttr(this.cmd, "style", "display:none");
+    else {
+      const c = Math.max(this.bipolar ? -1 : 0, Math.min(1, commanded));
+      setAttr(this.cmd, "style", `left:${(this.bipolar ? 50 + c * 50 : c * 100).toFixed(1)}%`);
+    }
+    setText(this.text, v === null ? "—" : `${v >= 0 && this.bipolar ? "+" : ""}${v.toFixed(2)}`);
+  }
+}
+
+export class Actuators {
+  readonly root: HTMLElement;
+  private readonly main = new Bar("Main line", "act-main-line", true);
+  private readonly left = new Bar("Brake L", "act-brake-left", false);
+  private readonly right = new Bar("Brake R", "act-brake-right", false);
+
+  constructor() {
+    this.root = panel("Actuators (−1…1, 0…1; tick: commanded)", "panel-actuators", this.main.root, this.left.root, this.right.root);
+  }
+
+  update(s: State): void {
+    const sv = s.vehicle?.servos ?? null;
+    const c = s.guidance?.commands ?? null;
+    this.main.update(sv?.main_line ?? null, c?.main_line ?? null);
+    this.left.update(sv?.brake_left ?? null, c?.brake ?? null);
+    this.right.update(sv?.brake_right ?? null, c?.brake ?? null);
+  }
+}

@@ -1,0 +1,52 @@
+// Link quality: rate, loss, age of the last message, error counters (the station's and this
+// page's own count of malformed WebSocket messages), and per-message ages in a details popover.
+
+import { h, panel, readout, setText } from "./dom";
+import { fmt } from "../lib/format";
+import { messageAges, type StaleVerdict } from "../lib/staleness";
+import type { MessageStats } from "../lib/parse";
+import type { Link } from "../lib/types";
+
+export class LinkPanel {
+  readonly root: HTMLElement;
+  private readonly rate: HTMLElement;
+  private readonly loss: HTMLElement;
+  private readonly age: HTMLElement;
+  private readonly errors: HTMLElement;
+  private readonly bad: HTMLElement;
+  private readonly state: HTMLElement;
+  private readonly agesBody: HTMLTableSectionElement;
+
+  constructor() {
+    const r = readout("Rate", "link-rate");
+    const l = readout("Loss", "link-loss");
+    const a = readout("Last message", "link-age");
+    const e = readout("CRC / parse / sig errors", "link-errors");
+    const b = readout("Bad station messages", "link-bad-messages", "messages from the station this page could not read");
+    const st = readout("Link", "link-state");
+    [this.rate, this.loss, this.age, this.errors, this.bad, this.state] = [r.value, l.value, a.value, e.value, b.value, st.value];
+    this.agesBody = h("tbody");
+    const details = h("details", { class: "ages", "data-testid": "link-details" },
+      h("summary", { "data-testid": "link-details-toggle" }, "Per-message ages"),
+      h("table", { "data-testid": "link-ages-table" }, h("thead", {}, h("tr", {}, h("th", {}, "message"), h("th", {}, "age"))), this.agesBody));
+    this.root = panel("Link", "panel-link", h("div", { class: "ro-grid" }, st.root, r.root, l.root, a.root, e.root, b.root), details);
+  }
+
+  update(link: Link | null, verdict: StaleVerdict, stats: MessageStats, receivedAtMs: number | null, nowMs: number): void {
+    setText(this.state, verdict.freshness === "fresh" ? "OK" : verdict.freshness === "stale" ? "STALE" : verdict.freshness === "disconnected" ? "DISCONNECTED" : "NO DATA");
+    this.state.dataset.state = verdict.freshness;
+    setText(this.rate, fmt(link?.rate_hz, "Hz"));
+    setText(this.loss, fmt(link?.loss_percent, "%"));
+    setText(this.age, fmt(verdict.age_s, "s", 1));
+    setText(this.errors, link ? `${link.crc_errors ?? "—"} / ${link.parse_errors ?? "—"} / ${link.signature_errors ?? "—"}` : "—");
+    setText(this.bad, `${stats.bad}${stats.lastError ? ` (last: ${stats.lastError})` : ""}`);
+    this.bad.classList.toggle("warn", stats.bad > 0);
+    if (link === null || receivedAtMs === null) {
+      this.agesBody.replaceChildren();
+      return;
+    }
+    const rows = messageAges(link, receivedAtMs, nowMs).map((m) =>
+      h("tr", { class: m.old ? "old" : "", "data-testid": `link-age-${m.name}` }, h("td", {}, m.name), h("td", {}, `${m.age_s.toFixed(1)} s${m.old ? " OLD" : ""}`)));
+    this.agesBody.replaceChildren(...rows);
+  }
+}

@@ -1,0 +1,241 @@
+// The map: track, vehicle (oriented by heading), target, planned pattern and final approach,
+// predicted landing points with their 1-σ ellipses, wind arrow, and drafts being edited. Tiles
+// come from the station's `tile_url`; a metric grid around the session origin and a scale bar
+// are always drawn, so positions stay readable when no tile loads (offline field, no cache).
+
+import L from "leaflet";
+import "leaflet/dist/leaflet.css";
+import { h, setText } from "./dom";
+import { ellipsePoints, fromLocal, gridValues, niceStep, toLocal } from "../lib/geo";
+import { fmt, fmtDir } from "../lib/format";
+import { withToken } from "../lib/token";
+import type { LandingPrediction, LatLon, State, Station, TrackPoint } from "../lib/types";
+
+const ll = (p: LatLon): L.LatLngExpression => [p.lat_deg, p.lon_deg];
+const MAX_TRACK = 20_000;
+/** Failed tiles (and none loaded) after which the tile layer is dropped for the grid alone. */
+const GIVE_UP_AFTER_FAILED_TILES = 6;
+
+export type Picker = ((p: LatLon) => void) | null;
+
+export class MapView {
+  readonly root: HTMLElement;
+  private readonly map: L.Map;
+  private origin: LatLon;
+  private readonly grid = L.layerGroup();
+  private readonly track = L.polyline([], { color: "#0b2f8a", weight: 3 });
+  private readonly pattern = L.polygon([], { color: "#c000c0", weight: 2, dashArray: "6 5", fill: false });
+  private readonly final = L.polyline([], { color: "#c000c0", weight: 4 });
+  private readonly ellPlanned = L.polygon([], { color: "#006400", weight: 2, fillOpacity: 0.12 });
+  private readonly ellUncontrolled = L.polygon([], { color: "#c05800", weight: 2, fillOpacity: 0.08, dashArray: "4 4" });
+  private readonly planned: L.Marker;
+  private readonly uncontrolled: L.Marker;
+  private readonly target: L.Marker;
+  private readonly vehicle: L.Marker;
+  private readonly draftTarget: L.Marker;
+  private readonly draftPlan = L.polyline([], { color: "#000", weight: 2, dashArray: "2 6" });
+  private readonly draftLocalizer = L.polyline([], { color: "#006b8f", weight: 3, dashArray: "10 6" });
+  private readonly tilesStatus: HTMLElement;
+  private readonly windText: HTMLElement;
+  private readonly windArrow: HTMLElement;
+  private readonly finalLabel: L.Tooltip;
+  private picker: Picker = null;
+  private follow = true;
+  private tilesLoaded = 0;
+  private tilesFailed = 0;
+  private lastTrackKey = "";
+
+  private tiles: L.TileLayer | null = null;
+
+  constructor(station: Station, tileToken: string | null) {
+    this.origin = station.origin;
+    const el = h("div", { class: "map", "data-testid": "map", role: "application", "aria-label": "map" });
+    this.root = el;
+    this.map = L.map(el, { zoomControl: true, attributionControl: true, preferCanvas: false }).setView(ll(this.origin), 15);
+    if (station.tile_url) {
+      // Tiles are fetched by <img>, which cannot send the Authorization header: a station-relative
+      // tile URL gets the token as a query parameter, like the WebSocket.
+      const url = station.tile_url.startsWith("/") && tileToken !== null ? withToken(station.tile_url, tileToken) : station.tile_url;
+      this.tiles = L.tileLayer(url, { maxZoom: 19, attribution: station.tile_attribution });
+      this.tiles.on("tileload", () => this.onTile(true));
+      this.tiles.on("tileerror", () => this.onTile(false));
+      this.tiles.addTo(this.map);
+    }
+    L.control.scale({ metric: true, imperial: false, maxWidth: 160 }).addTo(this.map);
+    this.grid.addTo(this.map);
+    const icon = (cls: string, html: string, size: number, testid: string): L.DivIcon =>
+      L.divIcon({ className: `mk ${cls}`, html: `<div data-testid="${testid}">${html}</div>`, iconSize: [size, size], iconAnchor: [size / 2, size / 2] });
+    this.target = L.marker(ll(this.origin), { icon: icon("mk-target", TARGET_SVG, 34, "map-target"), keyboard: false, interactive: false });
+    this.planned = L.marker(ll(this.origin), { icon: icon("mk-planned", DOT_SVG("#006400"), 18, "map-pred-planned"), interactive: false });
+    this.uncontrolled = L.marker(ll(this.origin), { icon: icon("mk-uncontrolled", DOT_SVG("#c05800"), 18, "map-pred-uncontrolled"), interactive: false });
+    this.vehicle = L.marker(ll(this.origin), { icon: icon("mk-vehicle", VEHICLE_SVG, 40, "map-vehicle"), zIndexOffset: 1000, interactive: false });
+    this.draftTarget = L.marker(ll(this.origin), { icon: icon("mk-draft", TARGET_SVG, 34, "map-draft-target"), interactive: false, opacity: 0.6 });
+    for (const layer of [this.pattern, this.final, this.ellUncontrolled, this.ellPlanned, this.track, this.draftPlan, this.draftLocalizer]) layer.addTo(this.map);
+    this.finalLabel = L.tooltip({ permanent: true, direction: "left", className: "final-label", interactive: false });
+
+    // Controls drawn on top of the map: tiles status, wind, follow toggle.
+    this.tilesStatus = h("div", { class: "map-badge", "data-testid": "map-tiles-status" }, "tiles: loading…");
+    this.windArrow = h("div", { class: "wind-arrow", "aria-hidden": "true" }, "➜");
+    this.windText = h("span", { "data-testid": "map-wind" }, "wind —");
+    const followBtn = h("button", { type: "button", class: "small on", "data-testid": "map-follow", "aria-pressed": "true", title: "keep the vehicle in view" }, "Follow vehicle");
+    followBtn.addEventListener("click", () => {
+      this.follow = !this.follow;
+      followBtn.classList.toggle("on", this.follow);
+      followBtn.setAttribute("aria-pressed", String(this.follow));
+    });
+    const overlay = h("div", { class: "map-overlay" }, this.tilesStatus, h("div", { class: "map-badge wind" }, this.windArrow, this.windText), followBtn);
+    L.DomEvent.disableClickPropagation(overlay);
+    el.append(overlay);
+
+    this.map.on("moveend zoomend", () => this.drawGrid());
+    this.map.on("click", (e: L.LeafletMouseEvent) => {
+      if (this.picker) this.picker({ lat_deg: e.latlng.lat, lon_deg: e.latlng.lng });
+    });
+    // A drag means the operator wants to look elsewhere: stop following until asked again.
+    this.map.on("dragstart", () => {
+      this.follow = false;
+      followBtn.classList.remove("on");
+      followBtn.setAttribute("aria-pressed", "false");
+    });
+  }
+
+  /** Leaflet measures its container: call once the element is in the document and when it resizes. */
+  invalidate(): void {
+    this.map.invalidateSize();
+    this.drawGrid();
+  }
+
+  setPicker(p: Picker): void {
+    this.picker = p;
+    this.root.classList.toggle("picking", p !== null);
+  }
+
+  setTrack(points: readonly TrackPoint[]): void {
+    const last = points[points.length - 1];
+    const key = `${points.length}:${last?.time_s ?? ""}`;
+    if (key === this.lastTrackKey) return;
+    this.lastTrackKey = key;
+    this.track.setLatLngs(points.slice(-MAX_TRACK).map((p) => [p.lat_deg, p.lon_deg] as L.LatLngTuple));
+  }
+
+  update(s: State, stale: boolean): void {
+    const e = s.estimate;
+    const lat = e?.lat_deg ?? s.vehicle?.gps?.lat_deg ?? null;
+    const lon = e?.lon_deg ?? s.vehicle?.gps?.lon_deg ?? null;
+    if (lat !== null && lon !== null) {
+      this.vehicle.setLatLng([lat, lon]);
+      if (!this.map.hasLayer(this.vehicle)) this.vehicle.addTo(this.map);
+      const hd = e?.heading_deg ?? s.vehicle?.attitude?.yaw_deg ?? 0;
+      const el = this.vehicle.getElement()?.querySelector<HTMLElement>("[data-testid=map-vehicle]");
+      if (el) {
+        el.style.transform = `rotate(${hd.toFixed(1)}deg)`;
+        el.classList.toggle("stale", stale);
+        el.dataset.heading = hd.toFixed(1);
+      }
+      if (this.follow && !this.map.getBounds().pad(-0.2).contains([lat, lon])) this.map.panTo([lat, lon], { animate: false });
+    }
+    const g = s.guidance;
+    this.show(this.target, g?.target ?? null);
+    const pat = g?.pattern ?? null;
+    this.pattern.setLatLngs(pat ? pat.corners.map(ll) : []);
+    if (pat?.final_entry && g?.target) {
+      this.final.setLatLngs([ll(pat.final_entry), ll(g.target)]);
+      // A standalone label at the final entry: a tooltip bound to the line would stay where the
+      // line was when it was bound.
+      this.finalLabel.setLatLng(ll(pat.final_entry)).setContent(`final ${fmtDir(pat.final_course_deg)} · from ${fmt(pat.final_approach_height_m, "m", 0)}`);
+      if (!this.map.hasLayer(this.finalLabel)) this.finalLabel.addTo(this.map);
+    } else {
+      this.final.setLatLngs([]);
+      this.finalLabel.remove();
+    }
+    this.showPrediction(this.planned, this.ellPlanned, s.prediction?.planned ?? null, "planned");
+    this.showPrediction(this.uncontrolled, this.ellUncontrolled, s.prediction?.uncontrolled ?? null, "uncontrolled");
+    if (e?.wind_from_deg != null) {
+      this.windArrow.style.transform = `rotate(${(e.wind_from_deg + 90).toFixed(0)}deg)`;
+      setText(this.windText, `wind ${fmt(e.wind_speed_mps, "m/s")} from ${fmtDir(e.wind_from_deg)}`);
+    } else setText(this.windText, "wind —");
+  }
+
+  showDraftTarget(p: LatLon | null): void {
+    this.show(this.draftTarget, p);
+  }
+
+  showDraftPlan(points: readonly LatLon[]): void {
+    this.draftPlan.setLatLngs(points.map(ll));
+  }
+
+  /** The localizer line: a point and a course, drawn 2 km each way. */
+  showDraftLocalizer(p: LatLon | null, course_deg: number | null): void {
+    if (p === null || course_deg === null) {
+      this.draftLocalizer.setLatLngs([]);
+      return;
+    }
+    const o = toLocal(this.origin, p);
+    const c = (course_deg * Math.PI) / 180;
+    const at = (d: number): L.LatLngExpression => ll(fromLocal(this.origin, { east_m: o.east_m + d * Math.sin(c), north_m: o.north_m + d * Math.cos(c) }));
+    this.draftLocalizer.setLatLngs([at(-2000), at(2000)]);
+  }
+
+  private show(m: L.Marker, p: LatLon | null): void {
+    if (p === null) {
+      m.remove();
+      return;
+    }
+    m.setLatLng(ll(p));
+    if (!this.map.hasLayer(m)) m.addTo(this.map);
+  }
+
+  private showPrediction(m: L.Marker, ell: L.Polygon, p: LandingPrediction | null, name: string): void {
+    this.show(m, p);
+    if (p === null || p.semi_major_m === null || p.semi_minor_m === null) {
+      ell.setLatLngs([]);
+      return;
+    }
+    ell.setLatLngs(ellipsePoints(p, p.semi_major_m, p.semi_minor_m, p.major_axis_deg ?? 0).map(ll));
+    const tip = `predicted landing (${name}) · 1σ ${fmt(p.semi_major_m, "m", 0)} × ${fmt(p.semi_minor_m, "m", 0)} · in ${fmt(p.time_to_land_s, "s", 0)}`;
+    if (!ell.getTooltip()) ell.bindTooltip(tip, { sticky: true });
+    else ell.setTooltipContent(tip);
+  }
+
+  private onTile(ok: boolean): void {
+    if (ok) this.tilesLoaded += 1;
+    else this.tilesFailed += 1;
+    const offline = this.tilesLoaded === 0 && this.tilesFailed > 0;
+    // No tile source at all (offline field, no cache): stop asking, so the browser does not log
+    // a failed request for every pan; the grid carries the map. A reload tries again.
+    if (offline && this.tilesFailed >= GIVE_UP_AFTER_FAILED_TILES && this.tiles) {
+      this.tiles.remove();
+      this.tiles = null;
+    }
+    this.root.classList.toggle("tiles-offline", offline);
+    setText(this.tilesStatus, offline ? "tiles unavailable — metric grid" : this.tilesFailed > 0 ? `tiles: ${this.tilesFailed} failed` : "tiles OK");
+    this.tilesStatus.dataset.state = offline ? "offline" : "ok";
+  }
+
+  /** Grid lines every 1/2/5×10^k m east and north of the origin, labelled in metres. */
+  private drawGrid(): void {
+    this.grid.clearLayers();
+    const b = this.map.getBounds();
+    const sw = toLocal(this.origin, { lat_deg: b.getSouth(), lon_deg: b.getWest() });
+    const ne = toLocal(this.origin, { lat_deg: b.getNorth(), lon_deg: b.getEast() });
+    const step = niceStep(Math.max(ne.east_m - sw.east_m, ne.north_m - sw.north_m), 8);
+    const style: L.PolylineOptions = { color: "#000", weight: 1, opacity: 0.35, interactive: false };
+    const pt = (east_m: number, north_m: number): L.LatLngExpression => ll(fromLocal(this.origin, { east_m, north_m }));
+    // Leaflet positions the icon element with its own transform: offsets go on the inner span.
+    const label = (text: string, at: L.LatLngExpression, cls: string): L.Marker =>
+      L.marker(at, { icon: L.divIcon({ className: "grid-label", html: `<span class="${cls}">${text}</span>`, iconSize: [0, 0] }), interactive: false, keyboard: false });
+    for (const x of gridValues(sw.east_m, ne.east_m, step)) {
+      this.grid.addLayer(L.polyline([pt(x, sw.north_m), pt(x, ne.north_m)], { ...style, weight: x === 0 ? 2 : 1 }));
+      this.grid.addLayer(label(`${x >= 0 ? "E" : "W"} ${Math.abs(x)} m`, pt(x, sw.north_m), "bottom"));
+    }
+    for (const y of gridValues(sw.north_m, ne.north_m, step)) {
+      this.grid.addLayer(L.polyline([pt(sw.east_m, y), pt(ne.east_m, y)], { ...style, weight: y === 0 ? 2 : 1 }));
+      this.grid.addLayer(label(`${y >= 0 ? "N" : "S"} ${Math.abs(y)} m`, pt(sw.east_m, y), "left"));
+    }
+  }
+}
+
+const TARGET_SVG = `<svg viewBox="-17 -17 34 34" width="34" height="34"><circle r="13" fill="none" stroke="#fff" stroke-width="6"/><circle r="13" fill="none" stroke="#d00000" stroke-width="3"/><circle r="5" fill="#d00000" stroke="#fff" stroke-width="1.5"/></svg>`;
+const DOT_SVG = (c: string): string => `<svg viewBox="-9 -9 18 18" width="18" height="18"><circle r="7" fill="${c}" stroke="#fff" stroke-width="2.5"/></svg>`;
+// Points up (north) at rotation 0; rotated by the heading.
+const VEHICLE_SVG = `<svg viewBox="-20 -20 40 40" width="40" height="40"><path d="M0 -18 L11 14 L0 7 L-11 14 Z" fill="#ffd400" stroke="#000" stroke-width="2.5" stroke-linejoin="round"/></svg>`;

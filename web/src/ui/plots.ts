@@ -1,0 +1,110 @@
+// Plots over time (uPlot): altitude; airspeed and sink rate; heading and course; main line and
+// brakes. Fed by `history.states`, then by live states; 10 minutes kept (series.ts). Redrawn at
+// most once a second: the data come at 4 Hz but the eye does not need it, and the cores are shared.
+
+import uPlot from "uplot";
+import "uplot/dist/uPlot.min.css";
+import { h } from "./dom";
+import { breakWraps, Series } from "../lib/series";
+import { wrap360 } from "../lib/format";
+import type { State } from "../lib/types";
+
+interface ChartDef {
+  id: string;
+  title: string;
+  unit: string;
+  series: { label: string; color: string; dash?: number[] }[];
+  pick: (s: State) => (number | null)[];
+  angles?: boolean;
+  range?: [number, number];
+}
+
+const DEFS: ChartDef[] = [
+  { id: "plot-altitude", title: "Altitude", unit: "m MSL", series: [{ label: "altitude m", color: "#0b2f8a" }], pick: (s) => [s.estimate?.alt_msl_m ?? null] },
+  {
+    id: "plot-speeds", title: "Airspeed, sink rate", unit: "m/s",
+    series: [{ label: "airspeed m/s", color: "#0b2f8a" }, { label: "sink m/s", color: "#c05800" }],
+    pick: (s) => [s.estimate?.airspeed_mps ?? null, s.estimate?.sink_rate_mps ?? null],
+  },
+  {
+    id: "plot-heading", title: "Heading, course", unit: "°", angles: true, range: [0, 360],
+    series: [{ label: "heading °", color: "#0b2f8a" }, { label: "course °", color: "#c000c0" }],
+    pick: (s) => [s.estimate?.heading_deg == null ? null : wrap360(s.estimate.heading_deg), s.estimate?.course_deg == null ? null : wrap360(s.estimate.course_deg)],
+  },
+  {
+    id: "plot-actuators", title: "Main line, brakes", unit: "−1…1", range: [-1, 1],
+    series: [{ label: "main line", color: "#0b2f8a" }, { label: "brake L", color: "#006400" }, { label: "brake R", color: "#c05800", dash: [6, 4] }],
+    pick: (s) => [s.vehicle?.servos?.main_line ?? null, s.vehicle?.servos?.brake_left ?? null, s.vehicle?.servos?.brake_right ?? null],
+  },
+];
+
+export class Plots {
+  readonly root: HTMLElement;
+  private readonly charts: { def: ChartDef; data: Series; plot: uPlot | null; box: HTMLElement }[];
+  private dirty = false;
+  private timer: ReturnType<typeof setInterval> | null = null;
+
+  constructor() {
+    this.root = h("div", { class: "plots", "data-testid": "plots" });
+    this.charts = DEFS.map((def) => {
+      const box = h("div", { class: "plot", "data-testid": def.id });
+      this.root.append(box);
+      return { def, data: new Series(def.series.map((x) => x.label)), plot: null, box };
+    });
+  }
+
+  /** Creates the charts once the container has a size; safe to call again on resize or tab show. */
+  layout(): void {
+    for (const c of this.charts) {
+      const w = Math.max(200, c.box.clientWidth);
+      const hgt = Math.max(120, c.box.clientHeight - 4);
+      if (c.box.clientWidth === 0) continue; // hidden tab: try again when shown
+      if (c.plot === null) {
+        c.plot = new uPlot(this.options(c.def, w, hgt), this.columns(c), c.box);
+      } else c.plot.setSize({ width: w, height: hgt });
+    }
+    if (this.timer === null) this.timer = setInterval(() => this.redraw(), 1000);
+  }
+
+  /**
+   * Starts over from `history.states`. The server sends the latest state before the history, so
+   * history cannot simply be appended (it would be older than what is already there).
+   */
+  reset(states: readonly State[], latest: State | null): void {
+    for (const c of this.charts) c.data.clear();
+    for (const s of states) this.push(s);
+    if (latest !== null) this.push(latest);
+    this.dirty = true;
+  }
+
+  push(s: State): void {
+    for (const c of this.charts) if (c.data.push(s.time_s, c.def.pick(s))) this.dirty = true;
+  }
+
+  private redraw(): void {
+    if (!this.dirty) return;
+    this.dirty = false;
+    for (const c of this.charts) c.plot?.setData(this.columns(c));
+  }
+
+  private columns(c: { def: ChartDef; data: Series }): uPlot.AlignedData {
+    const cols = c.data.cols.map((col) => (c.def.angles ? breakWraps(col) : col));
+    return [c.data.t.slice(), ...cols.map((x) => x.slice())] as uPlot.AlignedData;
+  }
+
+  private options(def: ChartDef, width: number, height: number): uPlot.Options {
+    return {
+      width,
+      height,
+      title: `${def.title} (${def.unit})`,
+      legend: { show: true, live: true },
+      cursor: { drag: { x: false, y: false } },
+      scales: { x: { time: false }, y: def.range ? { range: def.range } : { auto: true } },
+      axes: [
+        { label: "mission time, s", stroke: "#000", grid: { stroke: "#ccc" }, size: 34, labelSize: 14 },
+        { stroke: "#000", grid: { stroke: "#ccc" }, size: 48, ...(def.angles ? { splits: () => [0, 90, 180, 270, 360] } : {}) },
+      ],
+      series: [{ label: "T s" }, ...def.series.map((x) => ({ label: x.label, stroke: x.color, width: 2, spanGaps: false, ...(x.dash ? { dash: x.dash } : {}) }))],
+    };
+  }
+}
