@@ -45,7 +45,7 @@ impl Default for ControlGains {
             vk1: 3.0,
             vk2_per_m: 0.05,
             brake_trim: 0.4,
-            main_line_limit_m: 0.03,
+            main_line_limit_m: 0.015,
         }
     }
 }

@@ -17,14 +17,21 @@ pub struct Estimate {
     pub velocity_ned_mps: Vector3<f64>,
     /// 1-σ of each velocity component, m/s.
     pub velocity_sigma_mps: Vector3<f64>,
-    /// Heading of the drone's x axis from north, rad in (−π, π].
+    /// Heading of the vehicle, rad in (−π, π]: the direction of its horizontal velocity
+    /// through the air. Guidance steers on it, not on the drone's yaw: the drone swings and
+    /// twists about its lines by tens of degrees in turns.
     pub heading_rad: f64,
     /// 1-σ of the heading, rad.
     pub heading_sigma_rad: f64,
-    /// Heading rate, rad/s (positive turning right).
+    /// Heading rate (turn rate through the air), rad/s (positive turning right).
     pub heading_rate_rad_s: f64,
     /// 1-σ of the heading rate, rad/s.
     pub heading_rate_sigma_rad_s: f64,
+    /// Yaw of the drone's x axis from north as its AHRS reports it (filtered), rad in
+    /// (−π, π].
+    pub drone_yaw_rad: f64,
+    /// Rate of the drone's yaw, rad/s.
+    pub drone_yaw_rate_rad_s: f64,
     /// Course over the ground, rad in (−π, π].
     pub course_rad: f64,
     /// 1-σ of the course, rad.

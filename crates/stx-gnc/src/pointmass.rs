@@ -126,6 +126,8 @@ impl PointMass {
             heading_sigma_rad: 0.0,
             heading_rate_rad_s: self.turn_rate_rad_s,
             heading_rate_sigma_rad_s: 0.0,
+            drone_yaw_rad: self.heading_rad,
+            drone_yaw_rate_rad_s: self.turn_rate_rad_s,
             course_rad: if v.x.hypot(v.y) > 1e-9 {
                 v.y.atan2(v.x)
             } else {

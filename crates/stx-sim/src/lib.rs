@@ -8,6 +8,9 @@
 //!
 //! Pure: no sockets, no clocks other than the wall time a run reports about itself.
 
+pub mod closed_loop;
+pub mod guided;
+pub mod montecarlo;
 pub mod open_loop;
 pub mod scenario;
 pub mod sensors;

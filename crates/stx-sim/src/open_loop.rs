@@ -28,8 +28,11 @@ pub enum RunError {
     #[error(transparent)]
     Scenario(#[from] ScenarioError),
     /// The integrator could not follow the solution.
-    #[error("integration failed: {0}")]
+    #[error("integration failed")]
     Integrate(#[from] IntegrateError),
+    /// Navigation could not be set up.
+    #[error(transparent)]
+    Navigation(#[from] crate::closed_loop::NavigationError),
 }
 
 /// A finished run.
@@ -75,8 +78,11 @@ pub fn lowest_point(vehicle: &Vehicle, k: &Kinematics) -> (Body, f64) {
         })
 }
 
-/// Runs `scenario` with `vehicle`.
+/// Runs `scenario` with `vehicle`: open loop, or closed loop when it has guidance.
 pub fn run(scenario: &Scenario, vehicle: &Vehicle) -> Result<Run, RunError> {
+    if scenario.guidance.is_some() {
+        return crate::guided::run(scenario, vehicle);
+    }
     let started = Instant::now();
     let wind: Arc<dyn WindField> = match &scenario.environment.wind {
         Some(w) => Arc::from(w.build().map_err(ScenarioError::from)?),
@@ -178,6 +184,9 @@ pub fn run(scenario: &Scenario, vehicle: &Vehicle) -> Result<Run, RunError> {
             y_m: p.y,
             time_s: t,
             body: body.name(),
+            vertical_speed_mps: k.velocity_ned_mps(body).z,
+            miss_m: None,
+            heading_vs_upwind_deg: None,
         }
     });
     let summary = summarise(

@@ -8,7 +8,13 @@ use serde::Deserialize;
 use stx_dynamics::integrate::{DormandPrince54, Rk4};
 use stx_dynamics::state::{Controls, Pose};
 use stx_dynamics::wind::WindConfig;
+use stx_gnc::control::Localizer;
+use stx_gnc::estimator::EstimatorConfig;
+use stx_gnc::guidance::{GuidanceConfig, Plan};
+use stx_gnc::mission::FlightMode;
 use thiserror::Error;
+
+use crate::sensors::SensorConfig;
 
 /// The scenarios shipped with stx, by name.
 pub const BUILTIN: &[(&str, &str)] = &[
@@ -23,6 +29,18 @@ pub const BUILTIN: &[(&str, &str)] = &[
     (
         "stratospheric",
         include_str!("../../../config/scenarios/stratospheric.toml"),
+    ),
+    (
+        "localizer",
+        include_str!("../../../config/scenarios/localizer.toml"),
+    ),
+    (
+        "vertical",
+        include_str!("../../../config/scenarios/vertical.toml"),
+    ),
+    (
+        "spiral-landing",
+        include_str!("../../../config/scenarios/spiral-landing.toml"),
     ),
 ];
 
@@ -49,6 +67,94 @@ pub enum ScenarioError {
     /// The wind description is invalid.
     #[error("scenario wind is invalid: {0}")]
     Wind(#[from] stx_dynamics::wind::WindError),
+    /// The sensor description is invalid.
+    #[error("scenario sensors are invalid: {0}")]
+    Sensors(#[from] crate::sensors::SensorConfigError),
+    /// The estimator description is invalid.
+    #[error("scenario estimator is invalid: {0}")]
+    Estimator(#[from] stx_gnc::estimator::EstimatorConfigError),
+}
+
+/// A localizer as written in a scenario.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LocalizerSpec {
+    /// A point of the line (north, east), m.
+    pub point_ne_m: [f64; 2],
+    /// Its course, degrees from north.
+    pub course_deg: f64,
+}
+
+/// Onboard guidance flying the scenario in closed loop (seed chapter 5).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GuidanceScenario {
+    /// Mode guidance flies: heading, course, localizer or spiral_landing.
+    pub mode: FlightMode,
+    /// When guidance takes over, s from the start (the open-loop commands fly before).
+    #[serde(default)]
+    pub start_s: f64,
+    /// Landing target, local NED, m (z = 0 is the ground).
+    #[serde(default)]
+    pub target_ned_m: [f64; 3],
+    /// Heading held in heading mode, degrees.
+    #[serde(default)]
+    pub heading_deg: f64,
+    /// Course held in course mode, degrees.
+    #[serde(default)]
+    pub course_deg: f64,
+    /// Line followed in localizer mode.
+    pub localizer: Option<LocalizerSpec>,
+    /// Glide slope (sink over ground speed) down the localizer to its point, if any.
+    pub glide_slope: Option<f64>,
+    /// Final-approach course of a spiral landing, degrees; absent lands into the wind.
+    pub approach_course_deg: Option<f64>,
+    /// Gains, performance model and spiral settings; the defaults unless given.
+    #[serde(default)]
+    pub config: GuidanceConfig,
+    /// Seed of the sensors' noise.
+    #[serde(default = "default_seed")]
+    pub seed: u64,
+    /// The drone's sensors.
+    #[serde(default)]
+    pub sensors: SensorConfig,
+    /// The onboard estimator.
+    #[serde(default)]
+    pub estimator: EstimatorConfig,
+}
+
+fn default_seed() -> u64 {
+    1
+}
+
+impl GuidanceScenario {
+    /// The plan guidance is given.
+    pub fn plan(&self) -> Plan {
+        let localizer = self.localizer.map(|l| Localizer {
+            point_ne_m: l.point_ne_m,
+            course_rad: l.course_deg.to_radians(),
+        });
+        Plan {
+            target_ned_m: nalgebra::Vector3::from(self.target_ned_m),
+            approach_course_rad: self.approach_course_deg.map(f64::to_radians),
+            heading_rad: self.heading_deg.to_radians(),
+            course_rad: self.course_deg.to_radians(),
+            localizer: localizer.unwrap_or(Plan::default().localizer),
+            localizer_glide_slope: self.glide_slope,
+        }
+    }
+
+    /// The point landings are measured against: the spiral's target, or the localizer's point
+    /// when a glide slope leads down to it.
+    pub fn aim_ne_m(&self) -> Option<[f64; 2]> {
+        match self.mode {
+            FlightMode::SpiralLanding => Some([self.target_ned_m[0], self.target_ned_m[1]]),
+            FlightMode::Localizer if self.glide_slope.is_some() => {
+                self.localizer.map(|l| l.point_ne_m)
+            }
+            _ => None,
+        }
+    }
 }
 
 /// Which integrator flies the scenario.
@@ -274,6 +380,8 @@ pub struct Scenario {
     /// Steady-flight detection for the summary.
     #[serde(default)]
     pub steady: SteadyConfig,
+    /// Closed-loop guidance, if the scenario is flown by the onboard software.
+    pub guidance: Option<GuidanceScenario>,
 }
 
 impl Scenario {
@@ -362,6 +470,25 @@ impl Scenario {
         self.integrator.build()?;
         if let Some(wind) = &self.environment.wind {
             wind.build()?;
+        }
+        if let Some(g) = &self.guidance {
+            g.sensors.validate()?;
+            g.estimator.validate()?;
+            if !(g.start_s >= 0.0 && g.start_s.is_finite()) {
+                return invalid("guidance.start_s", g.start_s, "must be ≥ 0");
+            }
+            if g.mode == FlightMode::Localizer && g.localizer.is_none() {
+                return Err(ScenarioError::Invalid {
+                    field: "guidance.localizer".into(),
+                    value: "absent".into(),
+                    rule: "localizer mode needs a localizer",
+                });
+            }
+            if let Some(slope) = g.glide_slope
+                && !(slope > 0.0 && slope.is_finite())
+            {
+                return invalid("guidance.glide_slope", slope, "must be a finite number > 0");
+            }
         }
         Ok(())
     }

@@ -72,6 +72,22 @@ pub struct Landing {
     pub time_s: f64,
     /// Which body touched first (the lowest hanging one).
     pub body: &'static str,
+    /// Its vertical speed at contact, m/s (positive down).
+    pub vertical_speed_mps: f64,
+    /// Distance from the guidance target, m, when the scenario has one.
+    pub miss_m: Option<f64>,
+    /// Canopy heading at contact minus the direction the wind comes from, degrees; absent in
+    /// calm air.
+    pub heading_vs_upwind_deg: Option<f64>,
+}
+
+/// A phase of guidance (or of a control law) and when it began.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PhaseStart {
+    /// Phase name.
+    pub phase: String,
+    /// Its start, s.
+    pub start_time_s: f64,
 }
 
 /// The run in numbers (printed by `stx sim --summary-json`).
@@ -107,6 +123,8 @@ pub struct Summary {
     pub landing: Option<Landing>,
     /// Seconds the run was extended past the scenario's duration to find a steady stretch.
     pub extended_s: f64,
+    /// Guidance phases in order with their start times (closed-loop scenarios).
+    pub phases: Vec<PhaseStart>,
 }
 
 /// The last stretch of `window_s` with every step settled and no command change inside.
@@ -206,5 +224,6 @@ pub fn summarise(
         yaw_rate_settle_s,
         landing,
         extended_s,
+        phases: Vec::new(),
     }
 }

@@ -5,6 +5,7 @@
 //! file or flag).
 
 mod bench;
+mod montecarlo;
 mod sim;
 
 use std::process::ExitCode;
@@ -28,6 +29,8 @@ enum Command {
     Sim(sim::SimArgs),
     /// Measure the flight model's speed.
     Bench(bench::BenchArgs),
+    /// Many spiral landings from random releases and winds: landing statistics.
+    Montecarlo(montecarlo::MonteCarloArgs),
 }
 
 /// An error that is the user's input, not the program's failure (exit code 2).
@@ -54,6 +57,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Sim(args) => sim::run(args),
         Command::Bench(args) => bench::run(args),
+        Command::Montecarlo(args) => montecarlo::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -755,6 +755,8 @@ impl NavFilter {
             heading_sigma_rad: yaw.angle_sigma_rad(),
             heading_rate_rad_s: yaw.rate_rad_s,
             heading_rate_sigma_rad_s: yaw.rate_sigma_rad_s(),
+            drone_yaw_rad: yaw.angle_rad,
+            drone_yaw_rate_rad_s: yaw.rate_rad_s,
             course_rad: 0.0,
             course_sigma_rad: f64::INFINITY,
             roll_rad: roll.angle_rad,
@@ -826,6 +828,19 @@ impl NavFilter {
         };
         e.glide_ratio_air = glide(air.x.hypot(air.y), air.z);
         e.glide_ratio_ground = glide(ground_speed, velocity.z);
+        // The vehicle's heading is where the stack flies through the air, not where the
+        // swinging drone points: the direction of the horizontal air velocity, turning at ω.
+        // Guidance steers on it; the drone's own yaw stays in the angle filters.
+        let horizontal_air = air.x.hypot(air.y);
+        if horizontal_air > 0.5 {
+            e.heading_rad = wrap_pi(air.y.atan2(air.x));
+            let g = Vector2::new(-air.y, air.x) / (horizontal_air * horizontal_air);
+            let cov = air_cov.fixed_view::<2, 2>(0, 0);
+            e.heading_sigma_rad =
+                sigma((g.transpose() * cov * g)[(0, 0)]).min(std::f64::consts::PI);
+            e.heading_rate_rad_s = nav.x[ix::TURN];
+            e.heading_rate_sigma_rad_s = sigma(nav.p[(ix::TURN, ix::TURN)]);
+        }
         e.wind_ned_mps = Vector3::new(nav.x[ix::WIND], nav.x[ix::WIND + 1], 0.0);
         e.wind_sigma_mps = Vector3::new(
             sigma(nav.p[(ix::WIND, ix::WIND)]),

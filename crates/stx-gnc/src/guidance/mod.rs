@@ -204,8 +204,16 @@ impl Guidance {
         });
     }
 
-    /// Commands for the estimate `est` in air of density `density_kg_per_m3`.
+    /// Commands for the estimate `est` in air of density `density_kg_per_m3`. Until the
+    /// estimator has a navigation solution (its position uncertainty is not finite) guidance
+    /// holds the servos neutral and decides nothing.
     pub fn update(&mut self, est: &Estimate, density_kg_per_m3: f64) -> Command {
+        if !est.position_sigma_m.iter().all(|s| s.is_finite()) {
+            return Command {
+                controls: Controls::default(),
+                phase: self.phase(),
+            };
+        }
         let g = &self.config.gains;
         let position = [est.position_ned_m.x, est.position_ned_m.y];
         let neutral = Controls::default();

@@ -43,6 +43,9 @@ pub struct SpiralConfig {
     pub hang_height_m: f64,
     /// Height of the lowest body above the ground at which the flare starts, m.
     pub flare_height_m: f64,
+    /// Whether to flare at all; without, the final approach's last brake setting is held to
+    /// the ground (to measure what the flare is worth).
+    pub flare: bool,
     /// Turn rate planned for the corners, rad/s.
     pub planned_turn_rate_rad_s: f64,
     /// Height kept in hand above the planned glide when leaving the spiral, m.
@@ -71,6 +74,7 @@ impl Default for SpiralConfig {
             min_final_m: 40.0,
             hang_height_m: 8.4,
             flare_height_m: 6.0,
+            flare: true,
             planned_turn_rate_rad_s: 0.35,
             final_margin_m: 0.0,
             calm_wind_mps: 0.3,
@@ -123,6 +127,7 @@ pub struct Spiral {
     downwind_y_m: Option<f64>,
     extending: bool,
     weave_right: bool,
+    last_final_brake: f64,
     status: SpiralStatus,
 }
 
@@ -152,6 +157,12 @@ type Change = Option<(GuidancePhase, GuidancePhase, String)>;
 
 /// Height below the direct glide-in need at which guidance stops the pattern, m.
 const LOW_MARGIN_M: f64 = 10.0;
+/// Wind uncertainty (1-σ per component) below which guidance trusts the wind for its energy
+/// decisions, m/s.
+const WIND_KNOWN_SIGMA_MPS: f64 = 0.6;
+/// Below this height of the lowest body the reach check is off: the terminal phases are
+/// planned to use all the height there is, so the glide's reach is always just enough.
+const REACH_CHECK_MIN_HEIGHT_M: f64 = 60.0;
 /// Height above the steepest glide on final at which S-turns start, m.
 const S_TURN_EXCESS_M: f64 = 10.0;
 /// Height above the steepest glide on final at which guidance goes back downwind, m.
@@ -175,6 +186,7 @@ impl Spiral {
             downwind_y_m: None,
             extending: false,
             weave_right: true,
+            last_final_brake: 0.0,
             status: SpiralStatus::default(),
         }
     }
@@ -345,6 +357,9 @@ impl Spiral {
             f64::NEG_INFINITY
         };
 
+        // Energy decisions wait until the wind is known: the estimator's first seconds can be
+        // metres per second off, and a pattern abandoned on a wrong wind is not recovered.
+        let wind_known = est.wind_sigma_mps.x.max(est.wind_sigma_mps.y) < WIND_KNOWN_SIGMA_MPS;
         let mut change: Change = None;
         let lowest_body_height = height - sc.hang_height_m;
         let mut set = |s: &mut Self, to: GuidancePhase, reason: String| {
@@ -357,7 +372,7 @@ impl Spiral {
         match self.phase {
             GuidancePhase::Idle | GuidancePhase::Landed => {}
             GuidancePhase::Flare => {}
-            _ if lowest_body_height <= sc.flare_height_m => {
+            _ if sc.flare && lowest_body_height <= sc.flare_height_m => {
                 set(
                     self,
                     GuidancePhase::Flare,
@@ -389,7 +404,12 @@ impl Spiral {
                     );
                 }
             }
-            _ if !reachable && self.base_x_m.is_none() => {
+            _ if wind_known
+                && !reachable
+                && self.base_x_m.is_none()
+                && !self.extending
+                && lowest_body_height > REACH_CHECK_MIN_HEIGHT_M =>
+            {
                 let miss = best_rel[0].hypot(best_rel[1]);
                 set(
                     self,
@@ -400,9 +420,11 @@ impl Spiral {
                     ),
                 );
             }
-            _ if self.base_x_m.is_none()
+            _ if wind_known
+                && self.base_x_m.is_none()
                 && !self.extending
                 && self.phase != GuidancePhase::Branch1
+                && self.phase != GuidancePhase::BestReachable
                 && height <= needed_direct + LOW_MARGIN_M =>
             {
                 if x >= sc.min_final_m {
@@ -433,9 +455,11 @@ impl Spiral {
                 }
             }
             GuidancePhase::Approximation => {
-                if self.approach_from_ne_m.is_none() {
+                {
                     // Enter at the start corner reached soonest: with the wind, a downwind
-                    // corner is cheaper than a nearer upwind one.
+                    // corner is cheaper than a nearer upwind one. Re-chosen as the wind
+                    // estimate firms up, keeping the current one unless another is clearly
+                    // sooner.
                     let time_to = |k: usize| {
                         let c = corner_xy(k, a);
                         let (dx, dy) = (c[0] - x, c[1] - y);
@@ -450,8 +474,13 @@ impl Spiral {
                     let soonest = (0..4)
                         .min_by(|i, j| time_to(*i).total_cmp(&time_to(*j)))
                         .unwrap_or(0);
-                    self.entry_branch = BRANCHES[soonest];
-                    self.approach_from_ne_m = Some(position);
+                    let current = branch_index(self.entry_branch).unwrap_or(0);
+                    if self.approach_from_ne_m.is_none()
+                        || (soonest != current && time_to(soonest) < 0.8 * time_to(current))
+                    {
+                        self.entry_branch = BRANCHES[soonest];
+                        self.approach_from_ne_m = Some(position);
+                    }
                 }
                 let k = branch_index(self.entry_branch).unwrap_or(0);
                 let corner = corner_xy(k, a);
@@ -591,7 +620,7 @@ impl Spiral {
                 // The aim is the flare's start: the flare's own glide, at full brake, carries
                 // the stack the rest of the way.
                 let brake = if height_to_flare <= 0.0 || to_go_before_flare <= 0.0 {
-                    1.0
+                    if sc.flare { 1.0 } else { self.last_final_brake }
                 } else {
                     perf.brake_for_ground_glide(
                         to_go_before_flare / height_to_flare,
@@ -601,6 +630,7 @@ impl Spiral {
                 };
                 // Horizontal: the final line; while far too high for even full brakes to
                 // bring it down in time, S-turns across the line burn the height.
+                self.last_final_brake = brake;
                 let weave = final_excess_m > S_TURN_EXCESS_M;
                 let main_line_m = if weave {
                     let ct = final_line.cross_track_m(position);

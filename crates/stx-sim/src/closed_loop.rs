@@ -1,0 +1,333 @@
+//! A guided flight: the 14-DOF model in the loop with navigation and the onboard guidance, one
+//! control period (4 Hz, the drone's measurement rate) at a time.
+//!
+//! Each [`GuidedFlight::advance`] integrates the model over one period with the servo commands
+//! held, stops exactly at ground contact, then lets navigation produce an estimate and guidance
+//! the next commands. Navigation is a [`Navigator`]: the sensors and the estimator in every
+//! scenario and Monte Carlo run; [`PerfectNavigation`] exists only to measure what navigation
+//! errors cost.
+
+use stx_dynamics::integrate::{Hooks, IntegrateError, Rk4, integrate};
+use stx_dynamics::model::{Body, Kinematics, ParafoilModel};
+use stx_dynamics::rotation::{euler_from_t, euler_rates, wrap_pi};
+use stx_dynamics::state::{StateVector, idx, vec3_at};
+use stx_gnc::control::LawPhase;
+use stx_gnc::estimate::Estimate;
+use stx_gnc::estimator::{Estimator, EstimatorConfig, EstimatorConfigError};
+use stx_gnc::guidance::{Guidance, PhaseEvent};
+use stx_gnc::mission::{FlightMode, GuidancePhase};
+
+use crate::open_loop::{height_above_ground_m, lowest_point};
+use crate::sensors::{DeliveryQueue, SensorConfig, SensorConfigError, SensorSuite, Truth};
+
+/// Navigation as the drone does it: its sensors sample the truth, their measurements reach the
+/// estimator after their latencies, and the estimator's output is what guidance sees.
+#[derive(Debug, Clone)]
+pub struct SensedNavigation {
+    sensors: SensorSuite,
+    in_flight: DeliveryQueue,
+    estimator: Estimator,
+}
+
+/// Why navigation could not be set up.
+#[derive(Debug, thiserror::Error)]
+pub enum NavigationError {
+    /// Bad sensor settings.
+    #[error(transparent)]
+    Sensors(#[from] SensorConfigError),
+    /// Bad estimator settings.
+    #[error(transparent)]
+    Estimator(#[from] EstimatorConfigError),
+}
+
+impl SensedNavigation {
+    /// Sensors with `sensors` settings and noise seed `seed`, feeding an estimator.
+    pub fn new(
+        sensors: &SensorConfig,
+        estimator: EstimatorConfig,
+        seed: u64,
+    ) -> Result<Self, NavigationError> {
+        Ok(Self {
+            sensors: SensorSuite::new(sensors, seed)?,
+            in_flight: DeliveryQueue::new(),
+            estimator: Estimator::new(estimator)?,
+        })
+    }
+
+    /// The estimator, for its counters.
+    pub fn estimator(&self) -> &Estimator {
+        &self.estimator
+    }
+}
+
+impl Navigator for SensedNavigation {
+    fn navigate(&mut self, model: &ParafoilModel, time_s: f64, x: &StateVector) -> Estimate {
+        let truth = Truth::from_model(model, time_s, x);
+        for delivery in self.sensors.sample(time_s, &truth) {
+            self.in_flight.push(delivery);
+        }
+        while let Some(delivery) = self.in_flight.pop_due(time_s) {
+            self.estimator
+                .handle(delivery.arrival_s, &delivery.measurement);
+        }
+        self.estimator.estimate(time_s)
+    }
+}
+
+/// Produces the estimate guidance flies on.
+pub trait Navigator {
+    /// The estimate at `time_s`, given the true state (from which sensors measure).
+    fn navigate(&mut self, model: &ParafoilModel, time_s: f64, x: &StateVector) -> Estimate;
+}
+
+/// The estimate read straight from the simulator's truth. Never used by scenarios or the Monte
+/// Carlo: only to measure how much the real estimator costs in accuracy.
+#[derive(Debug, Default, Clone, Copy)]
+pub struct PerfectNavigation;
+
+impl Navigator for PerfectNavigation {
+    fn navigate(&mut self, model: &ParafoilModel, time_s: f64, x: &StateVector) -> Estimate {
+        truth_estimate(model, time_s, x)
+    }
+}
+
+/// What a perfect estimator would report, with zero uncertainty: the drone's position,
+/// velocity, roll and pitch (where the GPS and AHRS are), the canopy's heading and heading rate
+/// (the vehicle's, which the drone's twisting yaw only approximates), the air-relative speed.
+pub fn truth_estimate(model: &ParafoilModel, time_s: f64, x: &StateVector) -> Estimate {
+    let k = Kinematics::new(&model.vehicle, x, model.controls().main_line_m);
+    let p = k.position_ned_m[Body::Drone as usize];
+    let v = k.velocity_ned_mps(Body::Drone);
+    let euler = euler_from_t(&k.t_i_body[Body::Drone as usize]);
+    let canopy_rates = euler_rates(
+        &vec3_at(x, idx::CANOPY_EULER),
+        &vec3_at(x, idx::CANOPY_RATES),
+    );
+    let wind = model.environment.wind.wind_ned_mps(time_s, &p);
+    let v_air = v - wind;
+    let horizontal_air = v_air.x.hypot(v_air.y);
+    let sink = v.z;
+    Estimate {
+        time_s,
+        position_ned_m: p,
+        position_sigma_m: Default::default(),
+        velocity_ned_mps: v,
+        velocity_sigma_mps: Default::default(),
+        // The vehicle's heading is the canopy's: the drone twists about its lines by tens of
+        // degrees in turns, which an estimator filters out of the AHRS yaw.
+        heading_rad: wrap_pi(x[idx::CANOPY_EULER + 2]),
+        heading_sigma_rad: 0.0,
+        heading_rate_rad_s: canopy_rates.z,
+        heading_rate_sigma_rad_s: 0.0,
+        drone_yaw_rad: wrap_pi(euler.z),
+        drone_yaw_rate_rad_s: 0.0,
+        course_rad: v.y.atan2(v.x),
+        course_sigma_rad: 0.0,
+        roll_rad: euler.x,
+        pitch_rad: euler.y,
+        airspeed_mps: v_air.norm(),
+        airspeed_sigma_mps: 0.0,
+        sink_rate_mps: sink,
+        sink_rate_sigma_mps: 0.0,
+        glide_ratio_air: if sink > 0.1 {
+            horizontal_air / sink
+        } else {
+            f64::INFINITY
+        },
+        glide_ratio_ground: if sink > 0.1 {
+            v.x.hypot(v.y) / sink
+        } else {
+            f64::INFINITY
+        },
+        wind_ned_mps: nalgebra::Vector3::new(wind.x, wind.y, 0.0),
+        wind_sigma_mps: Default::default(),
+        gps_ok: true,
+        gps_age_s: 0.0,
+        attitude_ok: true,
+        air_data_ok: true,
+    }
+}
+
+/// Where and how the stack met the ground.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct Touchdown {
+    /// Time of first contact, s.
+    pub time_s: f64,
+    /// Body that touched first.
+    pub body: Body,
+    /// Its position (north, east), m.
+    pub position_ne_m: [f64; 2],
+    /// Its vertical speed at contact, m/s (positive down).
+    pub vertical_speed_mps: f64,
+    /// Canopy heading at contact, rad.
+    pub heading_rad: f64,
+    /// Direction the wind came from at the ground at contact, rad (NaN in calm air).
+    pub upwind_rad: f64,
+}
+
+/// One guided flight.
+pub struct GuidedFlight<N: Navigator> {
+    /// The flight model with its environment.
+    pub model: ParafoilModel,
+    /// The true state.
+    pub state: StateVector,
+    /// Time, s.
+    pub time_s: f64,
+    /// Onboard guidance.
+    pub guidance: Guidance,
+    /// Navigation.
+    pub navigator: N,
+    step_s: f64,
+    control_period_s: f64,
+    /// Latest estimate guidance used.
+    pub estimate: Option<Estimate>,
+    /// Every phase entered, with its start time: guidance phases, and in localizer mode the
+    /// phases of its laws (`localizer_approach`, `glide_slope_following`, …).
+    pub phases: Vec<(String, f64)>,
+    /// Every phase event, with its reason.
+    pub events: Vec<PhaseEvent>,
+}
+
+impl<N: Navigator> GuidedFlight<N> {
+    /// A flight starting at `state` at `time_s`, integrated with RK4 steps of `step_s` and
+    /// guided every `control_period_s`.
+    pub fn new(
+        model: ParafoilModel,
+        state: StateVector,
+        time_s: f64,
+        guidance: Guidance,
+        navigator: N,
+        step_s: f64,
+        control_period_s: f64,
+    ) -> Self {
+        let phase = guidance.phase();
+        Self {
+            model,
+            state,
+            time_s,
+            guidance,
+            navigator,
+            step_s,
+            control_period_s,
+            estimate: None,
+            phases: vec![(phase_name(phase), time_s)],
+            events: Vec::new(),
+        }
+    }
+
+    /// Navigates and guides at the current instant: new servo commands.
+    pub fn guide(&mut self) {
+        let est = self
+            .navigator
+            .navigate(&self.model, self.time_s, &self.state);
+        let density = self
+            .model
+            .environment
+            .atmosphere
+            .air_at(self.model.environment.ground_altitude_msl_m - est.position_ned_m.z)
+            .density_kg_per_m3;
+        let command = self.guidance.update(&est, density);
+        self.model.set_controls(command.controls);
+        for event in self.guidance.drain_events() {
+            self.phases.push((phase_name(event.to), event.time_s));
+            self.events.push(event);
+        }
+        if self.guidance.mode() == FlightMode::Localizer
+            && let Some((horizontal, vertical)) = self.guidance.law_phases()
+        {
+            let mut note = |name: String| {
+                let seen = self
+                    .phases
+                    .iter()
+                    .rev()
+                    .find(|(n, _)| n.starts_with(name.split('_').next().unwrap_or_default()));
+                if seen.map(|(n, _)| n != &name).unwrap_or(true) {
+                    self.phases.push((name, self.time_s));
+                }
+            };
+            note(format!("localizer_{}", law_name(horizontal)));
+            if let Some(v) = vertical {
+                note(format!("glide_slope_{}", law_name(v)));
+            }
+        }
+        self.estimate = Some(est);
+    }
+
+    /// Flies one control period (guiding first); `Some` when the stack touched down in it.
+    ///
+    /// The period is integrated with fixed RK4 steps; if they fail (hard main-line reversals
+    /// can spin the drone about its lines faster than a 0.05 s step follows), the same period
+    /// is flown again from the same state with steps four and then sixteen times shorter, so a
+    /// run is deterministic and only its rare violent seconds cost more.
+    pub fn advance(&mut self) -> Result<Option<Touchdown>, IntegrateError> {
+        self.guide();
+        let vehicle = self.model.vehicle.clone();
+        let mut event = |_t: f64, x: &StateVector| height_above_ground_m(&vehicle, x);
+        let end_s = self.time_s + self.control_period_s;
+        let mut outcome = Err(IntegrateError::InvalidSpan {
+            start_time_s: self.time_s,
+            end_time_s: end_s,
+        });
+        for refinement in [1.0, 4.0, 16.0] {
+            outcome = integrate(
+                &mut Rk4::new(self.step_s / refinement),
+                &mut self.model,
+                self.time_s,
+                &self.state,
+                end_s,
+                Hooks {
+                    event: Some(&mut event),
+                    observer: None,
+                },
+            );
+            if !matches!(outcome, Err(IntegrateError::NonFiniteStep { .. })) {
+                break;
+            }
+        }
+        let outcome = outcome?;
+        self.time_s = outcome.time_s;
+        self.state = outcome.state;
+        Ok(outcome.event_time_s.map(|t| self.touchdown(t)))
+    }
+
+    fn touchdown(&self, time_s: f64) -> Touchdown {
+        let k = Kinematics::new(
+            &self.model.vehicle,
+            &self.state,
+            self.model.controls().main_line_m,
+        );
+        let (body, _) = lowest_point(&self.model.vehicle, &k);
+        let p = k.position_ned_m[body as usize];
+        let v = k.velocity_ned_mps(body);
+        let wind = self.model.environment.wind.wind_ned_mps(time_s, &p);
+        let upwind = if wind.x.hypot(wind.y) > 1e-6 {
+            (-wind.y).atan2(-wind.x)
+        } else {
+            f64::NAN
+        };
+        let heading = euler_from_t(&k.t_i_body[Body::Canopy as usize]).z;
+        Touchdown {
+            time_s,
+            body,
+            position_ne_m: [p.x, p.y],
+            vertical_speed_mps: v.z,
+            heading_rad: heading,
+            upwind_rad: upwind,
+        }
+    }
+}
+
+/// Snake-case name of a guidance phase.
+pub fn phase_name(phase: GuidancePhase) -> String {
+    serde_json::to_value(phase)
+        .ok()
+        .and_then(|v| v.as_str().map(String::from))
+        .unwrap_or_else(|| format!("{phase:?}"))
+}
+
+fn law_name(phase: LawPhase) -> &'static str {
+    match phase {
+        LawPhase::Approach => "approach",
+        LawPhase::Following => "following",
+    }
+}
