@@ -1,3 +1,19 @@
-//! The stx ground station: holds the drone link(s), runs the same estimator, guidance and
-//! landing predictor as the drone on the live telemetry, keeps the mission's state and serves
-//! the dashboard and the API described in `API.md`.
+//! The stx ground station: holds the drone link, runs the same estimator, guidance and landing
+//! predictor as the drone on the live telemetry, keeps the mission's state and serves the
+//! dashboard and the API described in `API.md`.
+//!
+//! - [`config`]: the station's TOML, validated before anything starts;
+//! - [`core`]: the station's state and logic, pure (events and the mission clock in, messages
+//!   and link actions out);
+//! - [`messages`]: the API's JSON; [`kml`]: the Google Earth feed; [`params`]: what the station
+//!   knows about the drone's parameters;
+//! - [`http`]: the axum routes (auth, REST, WebSocket, static files);
+//! - [`daemon`]: the tokio wiring of link, core and HTTP, with graceful shutdown.
+
+pub mod config;
+pub mod core;
+pub mod daemon;
+pub mod http;
+pub mod kml;
+pub mod messages;
+pub mod params;

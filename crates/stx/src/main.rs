@@ -6,6 +6,7 @@
 
 mod bench;
 mod montecarlo;
+mod serve;
 mod sim;
 
 use std::process::ExitCode;
@@ -31,6 +32,8 @@ enum Command {
     Bench(bench::BenchArgs),
     /// Many spiral landings from random releases and winds: landing statistics.
     Montecarlo(montecarlo::MonteCarloArgs),
+    /// Run the ground station: drone link, dashboard and API.
+    Serve(serve::ServeArgs),
 }
 
 /// An error that is the user's input, not the program's failure (exit code 2).
@@ -58,6 +61,7 @@ fn main() -> ExitCode {
         Command::Sim(args) => sim::run(args),
         Command::Bench(args) => bench::run(args),
         Command::Montecarlo(args) => montecarlo::run(args),
+        Command::Serve(args) => serve::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

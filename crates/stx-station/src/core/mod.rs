@@ -1,0 +1,755 @@
+//! The station's state and logic, free of I/O: telemetry and link events in, JSON messages and
+//! link actions out, the mission clock (`now_s`, seconds since the station started) passed in.
+//!
+//! - telemetry updates the latest of each kind and feeds the station's own estimator (the same
+//!   code as onboard) with the GPS, AHRS and pitot measurements;
+//! - a guidance replica follows the drone's mode and the plan the operators sent, to draw the
+//!   pattern and predict the landing ([`stx_gnc::predict`]) the way the drone will fly it;
+//! - operators' requests become [`LinkAction`]s for the daemon to apply to the link, each with a
+//!   request id whose outcome comes back as a `command_result`.
+
+mod commands;
+mod views;
+
+use std::collections::{HashMap, VecDeque};
+
+use nalgebra::Vector3;
+use stx_dynamics::atmosphere::{Atmosphere, StandardAtmosphere};
+use stx_gnc::estimate::Estimate;
+use stx_gnc::estimator::{Estimator, EstimatorConfig};
+use stx_gnc::geo::LocalFrame;
+use stx_gnc::guidance::{Guidance, Plan};
+use stx_gnc::measurement::{AirDataSample, AttitudeSample, GpsFix, Measurement};
+use stx_gnc::mission::FlightMode;
+use stx_gnc::predict::{LandingPrediction, PredictorConfig, predict};
+use stx_link::endpoint::{GroundEvent, LinkEvent, LinkStats};
+use stx_link::telemetry::{Severity, Telemetry};
+use stx_link::transport::IoEvent;
+
+use crate::config::StationConfig;
+use crate::messages::{EventMsg, Level, StateMsg, TrackPoint};
+
+pub use commands::{ApiError, CommandRequest, CutdownArm, LinkAction};
+
+/// Most events kept for the log.
+const MAX_EVENTS: usize = 10_000;
+/// States kept for the plots of a newly connected page: 5 minutes at 1 Hz.
+const MAX_HISTORY: usize = 300;
+/// Seconds between track points.
+const TRACK_PERIOD_S: f64 = 1.0;
+
+/// Everything a landing prediction needs, detached from the station so it can run on another
+/// thread while telemetry keeps flowing.
+pub struct PredictionJob {
+    estimate: Estimate,
+    guidance: Guidance,
+    performance: stx_gnc::performance::GlidePerformance,
+    ground_altitude_msl_m: f64,
+    config: PredictorConfig,
+}
+
+impl PredictionJob {
+    /// Flies the plan and the uncontrolled glide from the estimate (milliseconds).
+    pub fn run(&self) -> LandingPrediction {
+        predict(
+            &self.estimate,
+            &self.guidance,
+            &self.performance,
+            &StandardAtmosphere,
+            self.ground_altitude_msl_m,
+            &self.config,
+        )
+    }
+}
+
+/// Latest telemetry of each kind with the mission time it arrived.
+#[derive(Debug, Default, Clone)]
+pub(crate) struct Latest {
+    pub status: Option<(stx_link::telemetry::VehicleStatus, f64)>,
+    pub gps: Option<(stx_link::telemetry::GpsRaw, f64)>,
+    pub position: Option<(stx_link::telemetry::GlobalPosition, f64)>,
+    pub attitude: Option<(stx_link::telemetry::Attitude, f64)>,
+    pub air: Option<(stx_link::telemetry::AirData, f64)>,
+    pub actuators: Option<(stx_link::telemetry::Actuators, f64)>,
+    pub system: Option<(stx_link::telemetry::SystemStatus, f64)>,
+    pub battery: Option<(stx_link::telemetry::BatteryStatus, f64)>,
+    pub wind: Option<(stx_link::telemetry::Wind, f64)>,
+    pub any_s: Option<f64>,
+}
+
+/// Something for the dashboards: broadcast to every WebSocket.
+#[derive(Debug, Clone)]
+pub enum Outbound {
+    /// An `event`.
+    Event(EventMsg),
+    /// A `command_result`.
+    CommandResult(crate::messages::CommandResultMsg),
+    /// A `params` message.
+    Params(crate::messages::ParamsMsg),
+}
+
+/// The station.
+pub struct StationCore {
+    pub(crate) config: StationConfig,
+    pub(crate) frame: LocalFrame,
+    /// Unix time at mission time 0, ms.
+    wall_origin_ms: u64,
+    pub(crate) latest: Latest,
+    estimator: Estimator,
+    pub(crate) estimate: Option<Estimate>,
+    pub(crate) guidance: Guidance,
+    pub(crate) prediction: Option<LandingPrediction>,
+    pub(crate) track: Vec<TrackPoint>,
+    next_track_s: f64,
+    pub(crate) events: VecDeque<EventMsg>,
+    pub(crate) history: VecDeque<StateMsg>,
+    next_history_s: f64,
+    pub(crate) link: LinkStats,
+    pub(crate) commands: commands::Commands,
+    outbound: Vec<Outbound>,
+    last_connected: Option<bool>,
+    /// What the guidance replica commands now (for the dashboard's comparison).
+    pub(crate) replica_command: stx_dynamics::state::Controls,
+    /// The vehicle's main-line servo travel, m: telemetry reports the servo in −1…1 of it.
+    pub(crate) main_line_travel_m: f64,
+}
+
+impl StationCore {
+    /// A station that has heard nothing yet; `wall_origin_ms` is the Unix time of mission
+    /// time 0.
+    pub fn new(config: StationConfig, wall_origin_ms: u64) -> Self {
+        let frame = config.origin;
+        let guidance = Guidance::new(config.guidance);
+        let estimator = match Estimator::new(EstimatorConfig::default()) {
+            Ok(e) => e,
+            // The default configuration is validated by the estimator's own tests.
+            Err(e) => panic!("default estimator configuration is invalid: {e}"),
+        };
+        Self {
+            frame,
+            wall_origin_ms,
+            latest: Latest::default(),
+            estimator,
+            estimate: None,
+            guidance,
+            prediction: None,
+            track: Vec::new(),
+            next_track_s: 0.0,
+            events: VecDeque::new(),
+            history: VecDeque::new(),
+            next_history_s: 0.0,
+            link: LinkStats::default(),
+            commands: commands::Commands::new(config.cutdown_window_s),
+            outbound: Vec::new(),
+            last_connected: None,
+            replica_command: stx_dynamics::state::Controls::default(),
+            main_line_travel_m: stx_dynamics::vehicle::Vehicle::straplex().main_line_travel_m,
+            config,
+        }
+    }
+
+    /// The configuration.
+    pub fn config(&self) -> &StationConfig {
+        &self.config
+    }
+
+    pub(crate) fn wall_ms(&self, now_s: f64) -> u64 {
+        self.wall_origin_ms + (now_s.max(0.0) * 1000.0) as u64
+    }
+
+    /// Logs an event and queues it for the dashboards.
+    pub fn log(&mut self, now_s: f64, level: Level, source: &'static str, text: String) {
+        let event = EventMsg {
+            kind: "event",
+            time_s: now_s,
+            wall_ms: self.wall_ms(now_s),
+            level,
+            source,
+            text,
+        };
+        match level {
+            Level::Info => tracing::info!(source, "{}", event.text),
+            Level::Warning => tracing::warn!(source, "{}", event.text),
+            Level::Error => tracing::error!(source, "{}", event.text),
+        }
+        if self.events.len() >= MAX_EVENTS {
+            self.events.pop_front();
+        }
+        self.events.push_back(event.clone());
+        self.outbound.push(Outbound::Event(event));
+    }
+
+    /// Takes what must be broadcast since the last call.
+    pub fn drain_outbound(&mut self) -> Vec<Outbound> {
+        std::mem::take(&mut self.outbound)
+    }
+
+    /// Link statistics sampled by the daemon.
+    pub fn set_link_stats(&mut self, now_s: f64, stats: LinkStats) {
+        if self.last_connected != Some(stats.connected) {
+            let was = self.last_connected;
+            self.last_connected = Some(stats.connected);
+            if was.is_some() || stats.connected {
+                let (level, text) = if stats.connected {
+                    (Level::Info, "link to the drone up".to_string())
+                } else {
+                    (
+                        Level::Warning,
+                        "link to the drone lost: its data are stale".to_string(),
+                    )
+                };
+                self.log(now_s, level, "link", text);
+            }
+        }
+        self.link = stats;
+    }
+
+    /// Reports what happened on the drone link's socket, worded for the operators. Waiting
+    /// for the drone is said once, not at every heartbeat.
+    pub fn on_io_event(&mut self, now_s: f64, event: IoEvent) {
+        let (level, text) = match event {
+            IoEvent::QueuedWithoutPeer { queued: 1 } => (
+                Level::Info,
+                "waiting for the drone: nothing heard on the link yet".to_string(),
+            ),
+            IoEvent::QueuedWithoutPeer { .. } => return,
+            IoEvent::DroppedWithoutPeer { dropped_total } => {
+                tracing::debug!(
+                    dropped_total,
+                    "uplink frames dropped while no drone is heard"
+                );
+                return;
+            }
+            IoEvent::PeerChanged { peer } => (Level::Info, format!("drone heard from {peer}")),
+            IoEvent::Connected { peer } => (Level::Info, format!("link connected to {peer}")),
+            IoEvent::Disconnected { reason } => {
+                (Level::Warning, format!("link disconnected: {reason}"))
+            }
+            IoEvent::RecvError { error, count } => (
+                Level::Warning,
+                format!("link read failed ({count} so far): {error}"),
+            ),
+            IoEvent::SendError { error, count } => (
+                Level::Warning,
+                format!("link write failed ({count} so far): {error}"),
+            ),
+            IoEvent::PersistFailed { path, error } => (
+                Level::Error,
+                format!("signing timestamp not saved to {}: {error}", path.display()),
+            ),
+        };
+        self.log(now_s, level, "link", text);
+    }
+
+    /// Handles one event of the ground endpoint.
+    pub fn on_link_event(&mut self, now_s: f64, event: GroundEvent) {
+        match event {
+            GroundEvent::Telemetry { telemetry, .. } => self.on_telemetry(now_s, telemetry),
+            GroundEvent::StatusText { severity, text, .. } => {
+                let level = match severity {
+                    Severity::Emergency
+                    | Severity::Alert
+                    | Severity::Critical
+                    | Severity::Error => Level::Error,
+                    Severity::Warning => Level::Warning,
+                    _ => Level::Info,
+                };
+                self.log(now_s, level, "vehicle", text);
+            }
+            GroundEvent::Command(e) => {
+                if let Some(msg) = self.commands.on_command_event(now_s, &e) {
+                    self.after_command_result(now_s, &msg);
+                }
+            }
+            GroundEvent::Param(e) => {
+                let (results, changed) = self.commands.on_param_event(&e);
+                for r in results {
+                    self.after_command_result(now_s, &r);
+                }
+                if changed {
+                    let params = self.params_msg(now_s);
+                    self.outbound.push(Outbound::Params(params));
+                }
+            }
+            GroundEvent::Plan(e) => {
+                if let Some(msg) = self.commands.on_plan_event(&e) {
+                    self.after_command_result(now_s, &msg);
+                }
+            }
+            GroundEvent::Link(LinkEvent::FrameError(e)) => {
+                tracing::debug!(error = %e, "frame dropped (counted in the link statistics)");
+            }
+            GroundEvent::Link(LinkEvent::Connected { system_id, .. }) => {
+                tracing::info!(system_id, "drone heartbeat");
+            }
+            GroundEvent::Link(LinkEvent::Lost { .. }) => {}
+            GroundEvent::Link(LinkEvent::PersistSigningTimestamp(_)) => {}
+            GroundEvent::Other(_) => {}
+        }
+    }
+
+    fn after_command_result(&mut self, now_s: f64, msg: &crate::messages::CommandResultMsg) {
+        let level = match msg.outcome {
+            crate::messages::Outcome::Accepted | crate::messages::Outcome::InProgress => {
+                Level::Info
+            }
+            _ => Level::Warning,
+        };
+        if msg.outcome != crate::messages::Outcome::InProgress {
+            self.log(
+                now_s,
+                level,
+                "command",
+                format!("{} {:?}: {}", msg.command, msg.outcome, msg.detail),
+            );
+        }
+        // The replica flies the plan the drone accepted.
+        if msg.outcome == crate::messages::Outcome::Accepted
+            && let Some(plan_change) = self.commands.take_accepted_plan(&msg.request_id)
+        {
+            self.apply_plan_change(now_s, plan_change);
+        }
+        self.outbound.push(Outbound::CommandResult(msg.clone()));
+    }
+
+    fn apply_plan_change(&mut self, now_s: f64, change: commands::PlanChange) {
+        let mut plan: Plan = *self.guidance.plan();
+        match change {
+            commands::PlanChange::Target {
+                target_ned_m,
+                approach_course_rad,
+            } => {
+                plan.target_ned_m = target_ned_m;
+                plan.approach_course_rad = approach_course_rad;
+            }
+            commands::PlanChange::Heading(h) => plan.heading_rad = h,
+            commands::PlanChange::Course(c) => plan.course_rad = c,
+            commands::PlanChange::Localizer { line, glide_slope } => {
+                plan.localizer = line;
+                plan.localizer_glide_slope = glide_slope;
+            }
+        }
+        self.guidance.set_plan(plan, now_s);
+    }
+
+    fn on_telemetry(&mut self, now_s: f64, telemetry: Telemetry) {
+        let l = &mut self.latest;
+        l.any_s = Some(now_s);
+        match telemetry {
+            Telemetry::Status(s) => {
+                let previous = l.status.map(|(p, _)| p);
+                l.status = Some((s, now_s));
+                if previous.map(|p| p.mode) != Some(s.mode) {
+                    self.guidance.set_mode(s.mode, now_s);
+                }
+                if let Some(p) = previous
+                    && p.stage != s.stage
+                {
+                    self.log(
+                        now_s,
+                        Level::Info,
+                        "vehicle",
+                        format!("stage: {:?} → {:?}", p.stage, s.stage),
+                    );
+                }
+            }
+            Telemetry::GpsRaw(g) => {
+                l.gps = Some((g, now_s));
+                if let Some(m) = self.gps_measurement(now_s, &g) {
+                    self.estimator.handle(now_s, &m);
+                }
+            }
+            Telemetry::Position(p) => l.position = Some((p, now_s)),
+            Telemetry::Attitude(a) => {
+                l.attitude = Some((a, now_s));
+                let m = Measurement::Attitude(AttitudeSample {
+                    time_s: now_s,
+                    roll_rad: a.roll_rad,
+                    pitch_rad: a.pitch_rad,
+                    yaw_rad: a.yaw_rad,
+                });
+                self.estimator.handle(now_s, &m);
+            }
+            Telemetry::AirData(a) => {
+                l.air = Some((a, now_s));
+                let m = Measurement::AirData(AirDataSample {
+                    time_s: now_s,
+                    differential_pressure_pa: a.diff_pressure_pa,
+                    static_pressure_pa: a.abs_pressure_pa,
+                    temperature_k: a.temperature_c + 273.15,
+                });
+                self.estimator.handle(now_s, &m);
+            }
+            Telemetry::Actuators(a) => l.actuators = Some((a, now_s)),
+            Telemetry::System(s) => l.system = Some((s, now_s)),
+            Telemetry::Battery(b) => l.battery = Some((b, now_s)),
+            Telemetry::Wind(w) => l.wind = Some((w, now_s)),
+            Telemetry::Hud(_)
+            | Telemetry::StatusText(_)
+            | Telemetry::Guidance(_)
+            | Telemetry::PredictedLanding(_) => {}
+        }
+    }
+
+    /// A GPS measurement for the estimator. GPS_RAW_INT carries no vertical velocity: the
+    /// drone's own estimate (GLOBAL_POSITION_INT) stands in for it when it is recent.
+    fn gps_measurement(&self, now_s: f64, g: &stx_link::telemetry::GpsRaw) -> Option<Measurement> {
+        use stx_link::telemetry::GpsFix as Fix;
+        if !matches!(
+            g.fix,
+            Fix::Fix3d | Fix::Dgps | Fix::RtkFloat | Fix::RtkFixed | Fix::Static | Fix::Ppp
+        ) {
+            return None;
+        }
+        let position = self.frame.to_ned(g.lat_deg, g.lon_deg, g.alt_msl_m);
+        let speed = g.ground_speed_mps?;
+        let course = g.course_deg.unwrap_or(0.0).to_radians();
+        let down = self
+            .latest
+            .position
+            .filter(|(_, t)| now_s - t < 1.0)
+            .map_or(0.0, |(p, _)| p.v_down_mps);
+        Some(Measurement::Gps(GpsFix {
+            time_s: now_s,
+            position_ned_m: position,
+            velocity_ned_mps: Vector3::new(speed * course.cos(), speed * course.sin(), down),
+            horizontal_accuracy_m: g.h_acc_m.unwrap_or(2.5),
+            vertical_accuracy_m: g.v_acc_m.unwrap_or(5.0),
+            speed_accuracy_mps: 0.3,
+        }))
+    }
+
+    /// Runs navigation and the guidance replica and returns the `state` message for `now_s`.
+    /// The landing prediction is not run here (it flies the plan in fast time, too slow for the
+    /// telemetry path): see [`StationCore::prediction_job`].
+    pub fn tick(&mut self, now_s: f64) -> StateMsg {
+        let est = self.estimator.estimate(now_s);
+        let usable = est.position_sigma_m.iter().all(|s| s.is_finite());
+        if usable {
+            let density = StandardAtmosphere
+                .air_at(self.frame.alt_msl_m - est.position_ned_m.z)
+                .density_kg_per_m3;
+            self.replica_command = self.guidance.update(&est, density).controls;
+            for e in self.guidance.drain_events() {
+                self.log(
+                    now_s,
+                    Level::Info,
+                    "guidance",
+                    format!("{:?} → {:?}: {}", e.from, e.to, e.reason),
+                );
+            }
+            if now_s >= self.next_track_s {
+                self.next_track_s = now_s + TRACK_PERIOD_S;
+                let (lat, lon, alt) = self.frame.to_geodetic(&est.position_ned_m);
+                self.track.push(TrackPoint {
+                    time_s: now_s,
+                    lat_deg: lat,
+                    lon_deg: lon,
+                    alt_msl_m: alt,
+                });
+            }
+            self.estimate = Some(est);
+        } else {
+            self.estimate = None;
+        }
+        if let Some(expired) = self.commands.expire_cutdown(now_s) {
+            self.log(now_s, Level::Info, "command", expired);
+        }
+        let state = self.state_msg_now(now_s);
+        if now_s >= self.next_history_s {
+            self.next_history_s = now_s + 1.0;
+            if self.history.len() >= MAX_HISTORY {
+                self.history.pop_front();
+            }
+            self.history.push_back(state.clone());
+        }
+        state
+    }
+
+    /// A landing prediction from the current estimate and plan, to be run away from the
+    /// telemetry path; `None` until navigation has a solution.
+    pub fn prediction_job(&self) -> Option<PredictionJob> {
+        let estimate = self.estimate?;
+        Some(PredictionJob {
+            estimate,
+            guidance: self.guidance.clone(),
+            performance: self.config.guidance.performance,
+            ground_altitude_msl_m: self.frame.alt_msl_m,
+            config: PredictorConfig {
+                hang_height_m: self.config.guidance.spiral.hang_height_m,
+                ..PredictorConfig::default()
+            },
+        })
+    }
+
+    /// Takes the result of a [`PredictionJob`].
+    pub fn set_prediction(&mut self, prediction: LandingPrediction) {
+        self.prediction = Some(prediction);
+    }
+
+    /// The mode the drone reports (uncontrolled before the first heartbeat).
+    pub fn vehicle_mode(&self) -> FlightMode {
+        self.latest
+            .status
+            .map_or(FlightMode::Uncontrolled, |(s, _)| s.mode)
+    }
+
+    /// Operator requests: validates and records them, returning the request id and what the
+    /// daemon must do on the link.
+    pub fn request(
+        &mut self,
+        now_s: f64,
+        who: &str,
+        request: CommandRequest,
+    ) -> Result<(String, LinkAction), ApiError> {
+        let (id, action, text) = self.commands.request(now_s, &self.frame, request)?;
+        self.log(now_s, Level::Info, "command", format!("{who}: {text}"));
+        Ok((id, action))
+    }
+
+    /// Arms the cutdown for the window of the configuration.
+    pub fn arm_cutdown(&mut self, now_s: f64, who: &str) -> CutdownArm {
+        let arm = self.commands.arm_cutdown(now_s, who);
+        self.log(
+            now_s,
+            Level::Warning,
+            "command",
+            format!(
+                "{who} armed the cutdown ({} s to confirm)",
+                arm.expires_in_s
+            ),
+        );
+        arm
+    }
+
+    /// Confirms an armed cutdown: the request id and the action to send.
+    pub fn confirm_cutdown(
+        &mut self,
+        now_s: f64,
+        who: &str,
+        arm_id: &str,
+    ) -> Result<(String, LinkAction), ApiError> {
+        let (id, action) = self.commands.confirm_cutdown(now_s, who, arm_id)?;
+        self.log(
+            now_s,
+            Level::Warning,
+            "command",
+            format!("{who} confirmed the CUTDOWN"),
+        );
+        Ok((id, action))
+    }
+
+    /// A request the link could not queue (e.g. the same command is still waiting).
+    pub fn refuse(&mut self, now_s: f64, request_id: &str, reason: String) {
+        if let Some(msg) = self.commands.refuse(request_id, reason) {
+            self.after_command_result(now_s, &msg);
+        }
+    }
+
+    /// The outcome of a request, if it is known.
+    pub fn command_result(&self, request_id: &str) -> Option<crate::messages::CommandResultMsg> {
+        self.commands.result(request_id)
+    }
+
+    /// Events since `since_s`.
+    pub fn events_since(&self, since_s: f64) -> Vec<EventMsg> {
+        self.events
+            .iter()
+            .filter(|e| e.time_s >= since_s)
+            .cloned()
+            .collect()
+    }
+
+    /// The track, one point every `every_s` at most.
+    pub fn track(&self, every_s: f64) -> Vec<TrackPoint> {
+        let mut out: Vec<TrackPoint> = Vec::new();
+        for p in &self.track {
+            if out.last().is_none_or(|l| p.time_s - l.time_s >= every_s) {
+                out.push(*p);
+            }
+        }
+        out
+    }
+
+    /// The last states kept for plots.
+    pub fn history(&self) -> Vec<StateMsg> {
+        self.history.iter().cloned().collect()
+    }
+
+    /// Known requests by id (for tests).
+    pub fn pending_requests(&self) -> HashMap<String, String> {
+        self.commands.pending()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::config::DEFAULT_STATION_TOML;
+    use stx_link::telemetry::{
+        AirData, Attitude, GpsFix as Fix, GpsRaw, SystemState, VehicleStatus,
+    };
+
+    fn core() -> StationCore {
+        StationCore::new(
+            StationConfig::from_toml_str(DEFAULT_STATION_TOML).expect("config"),
+            0,
+        )
+    }
+
+    /// Telemetry of a parafoil gliding north in still air at 6 m/s, sinking 3 m/s, from 800 m
+    /// above the origin, as the drone sends it at 4 Hz.
+    fn glide(core: &mut StationCore, from_s: f64, to_s: f64) -> Vector3<f64> {
+        let air = StandardAtmosphere;
+        let mut t = from_s;
+        let mut truth = Vector3::zeros();
+        while t < to_s {
+            truth = Vector3::new(6.0 * t, 0.0, -800.0 + 3.0 * t);
+            let (lat, lon, alt) = core.frame.to_geodetic(&truth);
+            let ms = (t * 1000.0) as u32;
+            let state = air.air_at(alt);
+            let airspeed = (6.0_f64.powi(2) + 3.0_f64.powi(2)).sqrt();
+            let pitch = -(3.0_f64 / 6.0).atan();
+            for telemetry in [
+                Telemetry::Status(VehicleStatus {
+                    mode: FlightMode::Heading,
+                    stage: stx_gnc::mission::FlightStage::Parafoil,
+                    phase: stx_gnc::mission::GuidancePhase::Idle,
+                    state: SystemState::Active,
+                }),
+                Telemetry::Position(stx_link::telemetry::GlobalPosition {
+                    time_boot_ms: ms,
+                    lat_deg: lat,
+                    lon_deg: lon,
+                    alt_msl_m: alt,
+                    alt_rel_m: alt - core.frame.alt_msl_m,
+                    v_north_mps: 6.0,
+                    v_east_mps: 0.0,
+                    v_down_mps: 3.0,
+                    heading_deg: Some(0.0),
+                }),
+                Telemetry::GpsRaw(GpsRaw {
+                    time_usec: u64::from(ms) * 1000,
+                    fix: Fix::Fix3d,
+                    lat_deg: lat,
+                    lon_deg: lon,
+                    alt_msl_m: alt,
+                    ground_speed_mps: Some(6.0),
+                    course_deg: Some(0.0),
+                    satellites: Some(10),
+                    h_acc_m: Some(1.5),
+                    v_acc_m: Some(3.0),
+                }),
+                Telemetry::Attitude(Attitude {
+                    time_boot_ms: ms,
+                    roll_rad: 0.0,
+                    pitch_rad: pitch,
+                    yaw_rad: 0.0,
+                    roll_rate_radps: 0.0,
+                    pitch_rate_radps: 0.0,
+                    yaw_rate_radps: 0.0,
+                }),
+                Telemetry::AirData(AirData {
+                    time_boot_ms: ms,
+                    abs_pressure_pa: state.pressure_pa,
+                    diff_pressure_pa: 0.5 * state.density_kg_per_m3 * airspeed * airspeed,
+                    temperature_c: state.temperature_k - 273.15,
+                    diff_temperature_c: None,
+                }),
+            ] {
+                core.on_link_event(
+                    t,
+                    GroundEvent::Telemetry {
+                        from: (1, 1),
+                        telemetry,
+                    },
+                );
+            }
+            core.set_link_stats(
+                t,
+                LinkStats {
+                    connected: true,
+                    ..LinkStats::default()
+                },
+            );
+            core.tick(t);
+            t += 0.25;
+        }
+        truth
+    }
+
+    #[test]
+    fn live_telemetry_becomes_an_estimate_with_still_air_and_a_prediction() {
+        let mut core = core();
+        assert!(
+            core.tick(0.0).estimate.is_none(),
+            "no estimate before telemetry"
+        );
+        let truth = glide(&mut core, 0.0, 40.0);
+        let est = core.estimate.expect("an estimate");
+        assert!(
+            (est.position_ned_m - truth).norm() < 5.0,
+            "{:?} vs {truth:?}",
+            est.position_ned_m
+        );
+        assert!(
+            est.wind_ned_mps.xy().norm() < 0.5,
+            "still air: {:?}",
+            est.wind_ned_mps
+        );
+        let state = core.state_msg_now(40.0);
+        assert_eq!(
+            state
+                .vehicle
+                .as_ref()
+                .and_then(|v| v.mode.clone())
+                .as_deref(),
+            Some("heading")
+        );
+        assert!(
+            state.prediction.is_none(),
+            "the prediction runs only when asked"
+        );
+        let job = core.prediction_job().expect("a prediction can run");
+        core.set_prediction(job.run());
+        let prediction = core.state_msg_now(40.0).prediction.expect("a prediction");
+        // Uncontrolled, straight north: lands north of where it is now, about 2:1 further on.
+        let uncontrolled = prediction.uncontrolled;
+        let (lat_now, _, _) = core.frame.to_geodetic(&truth);
+        assert!(uncontrolled.lat_deg > lat_now, "{uncontrolled:?}");
+    }
+
+    #[test]
+    fn silence_turns_the_vehicle_stale_and_the_stage_change_is_logged() {
+        let mut core = core();
+        glide(&mut core, 0.0, 5.0);
+        assert!(!core.state_msg_now(5.0).link.stale);
+        let stale_after = core.config.link.stale_after_s;
+        assert!(core.state_msg_now(5.0 + stale_after + 0.5).link.stale);
+        core.on_link_event(
+            6.0,
+            GroundEvent::Telemetry {
+                from: (1, 1),
+                telemetry: Telemetry::Status(VehicleStatus {
+                    mode: FlightMode::Heading,
+                    stage: stx_gnc::mission::FlightStage::Landed,
+                    phase: stx_gnc::mission::GuidancePhase::Landed,
+                    state: SystemState::Standby,
+                }),
+            },
+        );
+        assert!(core.events.iter().any(|e| e.text.contains("Landed")));
+    }
+
+    #[test]
+    fn waiting_for_the_drone_is_said_once() {
+        let mut core = core();
+        for queued in 1..10 {
+            core.on_io_event(
+                f64::from(queued as u32),
+                IoEvent::QueuedWithoutPeer { queued },
+            );
+        }
+        assert_eq!(core.events.len(), 1);
+    }
+}

@@ -1,0 +1,239 @@
+//! The dashboard's view of the station's state: the `state` and `params` messages.
+
+use stx_dynamics::rotation::wrap_pi;
+use stx_gnc::mission::GuidancePhase;
+use stx_gnc::predict::PredictedTouchdown;
+
+use super::StationCore;
+use crate::messages::{
+    AirView, AttitudeView, CommandsView, EstimateView, GpsView, GuidanceView, LatLonAlt, LinkView,
+    MissionView, ParamView, ParamsMsg, PatternView, PowerView, PredictionView, ServosView,
+    StateMsg, TouchdownView, VehicleView,
+};
+
+fn snake<T: serde::Serialize + std::fmt::Debug>(v: T) -> String {
+    serde_json::to_value(&v)
+        .ok()
+        .and_then(|j| j.as_str().map(String::from))
+        .unwrap_or_else(|| format!("{v:?}"))
+}
+
+fn finite(v: f64) -> Option<f64> {
+    v.is_finite().then_some(v)
+}
+
+impl StationCore {
+    /// The `state` message for `now_s` from what the station knows (no side effects).
+    pub fn state_msg_now(&self, now_s: f64) -> StateMsg {
+        let stale_after = self.config.link.stale_after_s;
+        let age_s = self.latest.any_s.map(|t| (now_s - t).max(0.0));
+        let link = LinkView {
+            connected: self.link.connected,
+            stale: age_s.is_none_or(|a| a > stale_after) || !self.link.connected,
+            age_s,
+            rate_hz: self.link.messages_per_s,
+            loss_percent: self.link.packet_loss_pct,
+            crc_errors: self.link.crc_errors,
+            parse_errors: self.link.parse_errors,
+            signature_errors: self.link.signature_failures,
+            ages_s: self.link.last_message_age_s.clone(),
+        };
+        let l = &self.latest;
+        let vehicle = l.any_s.map(|_| VehicleView {
+            mode: l.status.map(|(s, _)| snake(s.mode)),
+            stage: l.status.map(|(s, _)| snake(s.stage)),
+            phase: l.status.map(|(s, _)| snake(s.phase)),
+            gps: l.gps.map(|(g, _)| {
+                let speed = g.ground_speed_mps.unwrap_or(0.0);
+                let course = g.course_deg.unwrap_or(0.0).to_radians();
+                let down = l.position.map_or(0.0, |(p, _)| p.v_down_mps);
+                GpsView {
+                    fix: snake(g.fix),
+                    satellites: g.satellites,
+                    lat_deg: g.lat_deg,
+                    lon_deg: g.lon_deg,
+                    alt_msl_m: g.alt_msl_m,
+                    velocity_ned_mps: [speed * course.cos(), speed * course.sin(), down],
+                    h_acc_m: g.h_acc_m,
+                }
+            }),
+            attitude: l.attitude.map(|(a, _)| AttitudeView {
+                time_boot_ms: a.time_boot_ms,
+                roll_deg: a.roll_rad.to_degrees(),
+                pitch_deg: a.pitch_rad.to_degrees(),
+                yaw_deg: a.yaw_rad.to_degrees(),
+            }),
+            air: l.air.map(|(a, _)| {
+                let sample = stx_gnc::measurement::AirDataSample {
+                    time_s: 0.0,
+                    differential_pressure_pa: a.diff_pressure_pa,
+                    static_pressure_pa: a.abs_pressure_pa,
+                    temperature_k: a.temperature_c + 273.15,
+                };
+                AirView {
+                    static_pressure_pa: a.abs_pressure_pa,
+                    differential_pressure_pa: a.diff_pressure_pa,
+                    temperature_c: a.temperature_c,
+                    airspeed_mps: sample.indicated_airspeed_mps(),
+                }
+            }),
+            servos: l.actuators.map(|(a, _)| ServosView {
+                main_line: a.main_line,
+                brake_right: a.brake_right,
+                brake_left: a.brake_left,
+            }),
+            power: l
+                .battery
+                .map(|(b, _)| PowerView {
+                    voltage_v: b.voltage_v,
+                    current_a: b.current_a,
+                    remaining_percent: b.remaining_pct,
+                })
+                .or_else(|| {
+                    l.system.map(|(s, _)| PowerView {
+                        voltage_v: s.battery_voltage_v,
+                        current_a: s.battery_current_a,
+                        remaining_percent: s.battery_remaining_pct,
+                    })
+                }),
+            onboard_wind_ned_mps: l.wind.and_then(|(w, _)| {
+                Some([
+                    w.wind_north_mps?,
+                    w.wind_east_mps?,
+                    w.wind_down_mps.unwrap_or(0.0),
+                ])
+            }),
+        });
+        let estimate = self.estimate.map(|e| {
+            let (lat, lon, alt) = self.frame.to_geodetic(&e.position_ned_m);
+            let w = e.wind_ned_mps;
+            EstimateView {
+                lat_deg: lat,
+                lon_deg: lon,
+                alt_msl_m: alt,
+                height_m: e.height_m(),
+                velocity_ned_mps: [
+                    e.velocity_ned_mps.x,
+                    e.velocity_ned_mps.y,
+                    e.velocity_ned_mps.z,
+                ],
+                ground_speed_mps: e.ground_speed_mps(),
+                course_deg: e.course_rad.to_degrees(),
+                heading_deg: e.heading_rad.to_degrees(),
+                heading_rate_dps: e.heading_rate_rad_s.to_degrees(),
+                airspeed_mps: e.airspeed_mps,
+                sink_rate_mps: e.sink_rate_mps,
+                glide_ratio_air: finite(e.glide_ratio_air),
+                glide_ratio_ground: finite(e.glide_ratio_ground),
+                wind_ned_mps: [w.x, w.y, w.z],
+                wind_speed_mps: e.wind_speed_mps(),
+                wind_from_deg: (-w.y).atan2(-w.x).to_degrees().rem_euclid(360.0),
+                wind_sigma_mps: e.wind_sigma_mps.x.max(e.wind_sigma_mps.y),
+                position_sigma_m: e.position_sigma_m.x.hypot(e.position_sigma_m.y),
+                gps_ok: e.gps_ok,
+            }
+        });
+        let plan = self.guidance.plan();
+        let to_pair = |ne: [f64; 2]| {
+            let (lat, lon, _) = self
+                .frame
+                .to_geodetic(&nalgebra::Vector3::new(ne[0], ne[1], 0.0));
+            [lat, lon]
+        };
+        let target = {
+            let (lat, lon, alt) = self.frame.to_geodetic(&plan.target_ned_m);
+            LatLonAlt {
+                lat_deg: lat,
+                lon_deg: lon,
+                alt_msl_m: alt,
+            }
+        };
+        let phase = self.guidance.phase();
+        let spiral = self.guidance.spiral_status();
+        let guidance = Some(GuidanceView {
+            mode: snake(self.guidance.mode()),
+            phase: snake(phase),
+            target: Some(target),
+            pattern: (phase != GuidancePhase::Idle).then(|| PatternView {
+                corners: spiral.corners_ne_m.iter().map(|c| to_pair(*c)).collect(),
+                final_entry: to_pair(spiral.final_entry_ne_m),
+                final_course_deg: wrap_pi(spiral.final_course_rad)
+                    .to_degrees()
+                    .rem_euclid(360.0),
+                final_approach_height_m: spiral.final_approach_height_m,
+                target_reachable: spiral.target_reachable,
+                reach_ratio: if spiral.reach_ratio.is_finite() {
+                    spiral.reach_ratio
+                } else {
+                    -1.0
+                },
+            }),
+            commands: CommandsView {
+                main_line: (self.replica_command.main_line_m / self.main_line_travel_m)
+                    .clamp(-1.0, 1.0),
+                brake: 0.5 * (self.replica_command.brake_right + self.replica_command.brake_left),
+            },
+        });
+        let touchdown = |t: &PredictedTouchdown| {
+            let (lat, lon, _) = self.frame.to_geodetic(&nalgebra::Vector3::new(
+                t.position_ne_m[0],
+                t.position_ne_m[1],
+                0.0,
+            ));
+            TouchdownView {
+                lat_deg: lat,
+                lon_deg: lon,
+                time_to_land_s: t.time_to_land_s,
+                semi_major_m: t.semi_major_m,
+                semi_minor_m: t.semi_minor_m,
+                major_axis_deg: t.major_axis_rad.to_degrees().rem_euclid(180.0),
+            }
+        };
+        let prediction = self.prediction.map(|p| PredictionView {
+            planned: touchdown(&p.planned),
+            uncontrolled: touchdown(&p.uncontrolled),
+        });
+        StateMsg {
+            kind: "state",
+            time_s: now_s,
+            wall_ms: self.wall_ms(now_s),
+            link,
+            vehicle,
+            estimate,
+            guidance,
+            prediction,
+            forecast_wind: self.config.forecast_wind.clone(),
+            mission: MissionView {
+                stage: self.latest.status.map(|(s, _)| snake(s.stage)),
+                cutdown_armed_until_s: self.commands.armed_until(),
+            },
+        }
+    }
+
+    /// The parameter table as the dashboard shows it.
+    pub fn params_msg(&self, now_s: f64) -> ParamsMsg {
+        let params = self
+            .commands
+            .table
+            .values
+            .values()
+            .map(|p| {
+                let spec = crate::params::describe(&p.name);
+                ParamView {
+                    name: p.name.clone(),
+                    value: f64::from(p.value),
+                    min: spec.map(|s| s.min),
+                    max: spec.map(|s| s.max),
+                    units: spec.map_or(String::new(), |s| s.units.to_string()),
+                    description: spec.map_or(String::new(), |s| s.description.to_string()),
+                }
+            })
+            .collect();
+        ParamsMsg {
+            kind: "params",
+            params,
+            complete: self.commands.table.complete,
+            time_s: now_s,
+        }
+    }
+}

@@ -1,0 +1,739 @@
+//! The HTTP side (axum): authentication and roles, the REST endpoints and the WebSocket of
+//! `API.md`, the KML feed, offline tiles and the built dashboard.
+//!
+//! Handlers only lock the core for a moment, build their answer, and hand link work to the
+//! daemon's link task through [`Shared::link`]; nothing here waits on the radio.
+
+use std::sync::{Arc, Mutex};
+use std::time::Instant;
+
+use axum::Json;
+use axum::Router;
+use axum::extract::rejection::JsonRejection;
+use axum::extract::ws::{Message, Utf8Bytes, WebSocket, WebSocketUpgrade};
+use axum::extract::{FromRequestParts, Path, Query, State};
+use axum::http::request::Parts;
+use axum::http::{StatusCode, header};
+use axum::response::{IntoResponse, Response};
+use axum::routing::{get, post};
+use serde::Deserialize;
+use serde::de::DeserializeOwned;
+use stx_gnc::mission::FlightMode;
+use stx_link::manual::Sticks;
+use stx_link::plan::PlanItem;
+use tokio::sync::{broadcast, mpsc};
+use tower_http::services::{ServeDir, ServeFile};
+
+use crate::config::{Role, StationConfig};
+use crate::core::{ApiError, CommandRequest, LinkAction, StationCore};
+use crate::messages::{ErrorBody, Session, StationInfo};
+
+/// What the daemon's link task is asked to do.
+#[derive(Debug, Clone, PartialEq)]
+pub enum LinkRequest {
+    /// An operator's request with its id.
+    Action {
+        request_id: String,
+        action: LinkAction,
+    },
+    /// Joystick sticks from an operator's page (streamed while held).
+    Manual(Sticks),
+    /// The sticks were released or went silent.
+    ManualRelease,
+}
+
+/// The latest joystick message, to stop streaming when it goes silent.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct ManualState {
+    /// Mission time of the last `manual` message, s.
+    pub last_s: Option<f64>,
+}
+
+/// State shared by every handler.
+pub struct Shared {
+    /// The station.
+    pub core: Mutex<StationCore>,
+    /// Configuration (immutable).
+    pub config: StationConfig,
+    /// Mission clock origin.
+    pub started: Instant,
+    /// To the link task.
+    pub link: mpsc::Sender<LinkRequest>,
+    /// Pre-serialised messages for every WebSocket (shared bytes: one copy for all pages).
+    pub broadcast: broadcast::Sender<Utf8Bytes>,
+    /// Joystick liveness.
+    pub manual: Mutex<ManualState>,
+}
+
+impl Shared {
+    /// Seconds on the mission clock.
+    pub fn now_s(&self) -> f64 {
+        self.started.elapsed().as_secs_f64()
+    }
+
+    fn core(&self) -> std::sync::MutexGuard<'_, StationCore> {
+        // A panic while holding the lock would be a bug in the core; keep serving.
+        self.core.lock().unwrap_or_else(|e| e.into_inner())
+    }
+}
+
+type AppState = Arc<Shared>;
+
+/// An error answered as `{error, reason}`.
+pub struct HttpError(StatusCode, ErrorBody);
+
+impl IntoResponse for HttpError {
+    fn into_response(self) -> Response {
+        (self.0, Json(self.1)).into_response()
+    }
+}
+
+impl From<ApiError> for HttpError {
+    fn from(e: ApiError) -> Self {
+        HttpError(
+            StatusCode::from_u16(e.status).unwrap_or(StatusCode::BAD_REQUEST),
+            ErrorBody {
+                error: e.error,
+                reason: e.reason,
+            },
+        )
+    }
+}
+
+fn error(status: StatusCode, kind: &'static str, reason: impl Into<String>) -> HttpError {
+    HttpError(
+        status,
+        ErrorBody {
+            error: kind,
+            reason: reason.into(),
+        },
+    )
+}
+
+/// The authenticated caller.
+pub struct Caller {
+    /// Name from the station config.
+    pub name: String,
+    /// Role.
+    pub role: Role,
+}
+
+impl Caller {
+    fn operator(&self) -> Result<(), HttpError> {
+        match self.role {
+            Role::Operator => Ok(()),
+            Role::Viewer => Err(error(
+                StatusCode::FORBIDDEN,
+                "forbidden",
+                "viewers cannot command: operator role required",
+            )),
+        }
+    }
+}
+
+fn token_from(parts: &Parts) -> Option<String> {
+    if let Some(value) = parts.headers.get(header::AUTHORIZATION)
+        && let Ok(text) = value.to_str()
+        && let Some(token) = text.strip_prefix("Bearer ")
+    {
+        return Some(token.trim().to_string());
+    }
+    parts.uri.query().and_then(|q| {
+        q.split('&').find_map(|pair| {
+            let (k, v) = pair.split_once('=')?;
+            (k == "token").then(|| percent_decode(v))
+        })
+    })
+}
+
+fn percent_decode(s: &str) -> String {
+    let bytes = s.as_bytes();
+    let mut out = Vec::with_capacity(bytes.len());
+    let mut i = 0;
+    while i < bytes.len() {
+        match bytes[i] {
+            b'%' if i + 2 < bytes.len() => {
+                let hex = std::str::from_utf8(&bytes[i + 1..i + 3]).ok();
+                match hex.and_then(|h| u8::from_str_radix(h, 16).ok()) {
+                    Some(b) => {
+                        out.push(b);
+                        i += 3;
+                    }
+                    None => {
+                        out.push(b'%');
+                        i += 1;
+                    }
+                }
+            }
+            b'+' => {
+                out.push(b' ');
+                i += 1;
+            }
+            b => {
+                out.push(b);
+                i += 1;
+            }
+        }
+    }
+    String::from_utf8_lossy(&out).into_owned()
+}
+
+impl FromRequestParts<AppState> for Caller {
+    type Rejection = HttpError;
+
+    async fn from_request_parts(parts: &mut Parts, state: &AppState) -> Result<Self, HttpError> {
+        let Some(token) = token_from(parts) else {
+            return Err(error(
+                StatusCode::UNAUTHORIZED,
+                "unauthorized",
+                "a token is needed: Authorization: Bearer <token> or ?token=",
+            ));
+        };
+        match state.config.authenticate(&token) {
+            Some((name, role)) => Ok(Caller {
+                name: name.to_string(),
+                role,
+            }),
+            None => Err(error(
+                StatusCode::UNAUTHORIZED,
+                "unauthorized",
+                "unknown token",
+            )),
+        }
+    }
+}
+
+fn json_body<T>(body: Result<Json<T>, JsonRejection>) -> Result<T, HttpError> {
+    body.map(|Json(v)| v).map_err(|e| {
+        error(
+            StatusCode::BAD_REQUEST,
+            "bad_request",
+            format!("malformed request body: {}", e.body_text()),
+        )
+    })
+}
+
+/// The router of the whole station.
+pub fn router(state: AppState) -> Router {
+    let web_dir = state.config.web_dir.clone();
+    let index = web_dir.join("index.html");
+    let mut app = Router::new()
+        .route("/api/session", get(session))
+        .route("/api/state", get(state_now))
+        .route("/api/params", get(params))
+        .route("/api/params/{name}", post(set_param))
+        .route("/api/events", get(events))
+        .route("/api/track", get(track))
+        .route("/api/commands/{id}", get(command_result))
+        .route("/api/commands/mode", post(command::<ModeBody>))
+        .route("/api/commands/heading", post(command::<HeadingBody>))
+        .route("/api/commands/course", post(command::<CourseBody>))
+        .route("/api/commands/localizer", post(command::<LocalizerBody>))
+        .route("/api/commands/target", post(command::<TargetBody>))
+        .route("/api/commands/plan", post(command::<PlanBody>))
+        .route("/api/cutdown/arm", post(arm_cutdown))
+        .route("/api/cutdown/confirm", post(confirm_cutdown))
+        .route("/api/ws", get(websocket))
+        .route("/kml", get(kml_link))
+        .route("/kml/live", get(kml_live));
+    if let Some(tiles) = &state.config.tiles_dir {
+        app = app.nest_service("/tiles", ServeDir::new(tiles));
+    }
+    app.fallback_service(ServeDir::new(web_dir).fallback(ServeFile::new(index)))
+        .with_state(state)
+}
+
+fn session_of(state: &Shared, caller: &Caller) -> Session {
+    let c = &state.config;
+    Session {
+        role: caller.role,
+        name: caller.name.clone(),
+        station: StationInfo {
+            name: c.name.clone(),
+            origin: crate::messages::LatLonAlt {
+                lat_deg: c.origin.lat_deg,
+                lon_deg: c.origin.lon_deg,
+                alt_msl_m: c.origin.alt_msl_m,
+            },
+            tile_url: c.tile_url.clone(),
+            tile_attribution: c.tile_attribution.clone(),
+            offline_tiles: c.tiles_dir.is_some(),
+            modes: FlightMode::ALL
+                .iter()
+                .map(|m| {
+                    serde_json::to_value(m)
+                        .ok()
+                        .and_then(|v| v.as_str().map(String::from))
+                        .unwrap_or_default()
+                })
+                .collect(),
+        },
+    }
+}
+
+async fn session(State(state): State<AppState>, caller: Caller) -> Json<Session> {
+    Json(session_of(&state, &caller))
+}
+
+async fn state_now(State(state): State<AppState>, _caller: Caller) -> Response {
+    let now = state.now_s();
+    let msg = state.core().state_msg_now(now);
+    Json(msg).into_response()
+}
+
+async fn params(State(state): State<AppState>, _caller: Caller) -> Response {
+    let now = state.now_s();
+    Json(state.core().params_msg(now)).into_response()
+}
+
+#[derive(Deserialize)]
+struct SinceQuery {
+    since_s: Option<f64>,
+}
+
+async fn events(
+    State(state): State<AppState>,
+    _caller: Caller,
+    Query(q): Query<SinceQuery>,
+) -> Response {
+    let events = state
+        .core()
+        .events_since(q.since_s.unwrap_or(f64::NEG_INFINITY));
+    Json(serde_json::json!({ "events": events })).into_response()
+}
+
+#[derive(Deserialize)]
+struct EveryQuery {
+    every_s: Option<f64>,
+}
+
+async fn track(
+    State(state): State<AppState>,
+    _caller: Caller,
+    Query(q): Query<EveryQuery>,
+) -> Response {
+    let points = state.core().track(q.every_s.unwrap_or(0.0).max(0.0));
+    Json(serde_json::json!({ "points": points })).into_response()
+}
+
+async fn command_result(
+    State(state): State<AppState>,
+    _caller: Caller,
+    Path(id): Path<String>,
+) -> Result<Response, HttpError> {
+    match state.core().command_result(&id) {
+        Some(r) => Ok(Json(r).into_response()),
+        None => Err(error(
+            StatusCode::NOT_FOUND,
+            "not_found",
+            format!("no request `{id}`"),
+        )),
+    }
+}
+
+/// Records a request in the core and queues it for the link; answers 202 with its id.
+async fn submit(
+    state: &Shared,
+    caller: &Caller,
+    request: CommandRequest,
+) -> Result<Response, HttpError> {
+    caller.operator()?;
+    let now = state.now_s();
+    let (request_id, action) = state.core().request(now, &caller.name, request)?;
+    queue(state, request_id, action).await
+}
+
+async fn queue(
+    state: &Shared,
+    request_id: String,
+    action: LinkAction,
+) -> Result<Response, HttpError> {
+    state
+        .link
+        .send(LinkRequest::Action {
+            request_id: request_id.clone(),
+            action,
+        })
+        .await
+        .map_err(|_| {
+            error(
+                StatusCode::SERVICE_UNAVAILABLE,
+                "link_down",
+                "the link task has stopped",
+            )
+        })?;
+    Ok((
+        StatusCode::ACCEPTED,
+        Json(serde_json::json!({ "request_id": request_id, "status": "sent" })),
+    )
+        .into_response())
+}
+
+/// A command endpoint's body: checked JSON that becomes a [`CommandRequest`].
+trait CommandBody: DeserializeOwned + Send {
+    fn into_request(self) -> CommandRequest;
+}
+
+/// Every command endpoint but parameters and cutdown: operator only, body checked, sent.
+async fn command<B: CommandBody>(
+    State(state): State<AppState>,
+    caller: Caller,
+    body: Result<Json<B>, JsonRejection>,
+) -> Result<Response, HttpError> {
+    caller.operator()?;
+    let request = json_body(body)?.into_request();
+    submit(&state, &caller, request).await
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ModeBody {
+    mode: FlightMode,
+}
+
+impl CommandBody for ModeBody {
+    fn into_request(self) -> CommandRequest {
+        CommandRequest::Mode(self.mode)
+    }
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct HeadingBody {
+    heading_deg: f64,
+}
+
+impl CommandBody for HeadingBody {
+    fn into_request(self) -> CommandRequest {
+        CommandRequest::Heading {
+            heading_deg: self.heading_deg,
+        }
+    }
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct CourseBody {
+    course_deg: f64,
+}
+
+impl CommandBody for CourseBody {
+    fn into_request(self) -> CommandRequest {
+        CommandRequest::Course {
+            course_deg: self.course_deg,
+        }
+    }
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct LocalizerBody {
+    lat_deg: f64,
+    lon_deg: f64,
+    course_deg: f64,
+    #[serde(default)]
+    glide_slope: Option<f64>,
+}
+
+impl CommandBody for LocalizerBody {
+    fn into_request(self) -> CommandRequest {
+        CommandRequest::Localizer {
+            lat_deg: self.lat_deg,
+            lon_deg: self.lon_deg,
+            course_deg: self.course_deg,
+            glide_slope: self.glide_slope,
+        }
+    }
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct TargetBody {
+    lat_deg: f64,
+    lon_deg: f64,
+    alt_msl_m: f64,
+    #[serde(default)]
+    approach_course_deg: Option<f64>,
+}
+
+impl CommandBody for TargetBody {
+    fn into_request(self) -> CommandRequest {
+        CommandRequest::Target {
+            lat_deg: self.lat_deg,
+            lon_deg: self.lon_deg,
+            alt_msl_m: self.alt_msl_m,
+            approach_course_deg: self.approach_course_deg,
+        }
+    }
+}
+
+/// A plan item as the API spells it (`approach_course_deg`, like the target endpoint).
+#[derive(Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+enum PlanItemBody {
+    Waypoint {
+        lat_deg: f64,
+        lon_deg: f64,
+        alt_msl_m: f64,
+    },
+    Land {
+        lat_deg: f64,
+        lon_deg: f64,
+        alt_msl_m: f64,
+        #[serde(default)]
+        approach_course_deg: Option<f64>,
+    },
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct PlanBody {
+    items: Vec<PlanItemBody>,
+}
+
+impl CommandBody for PlanBody {
+    fn into_request(self) -> CommandRequest {
+        let items = self
+            .items
+            .into_iter()
+            .map(|item| match item {
+                PlanItemBody::Waypoint {
+                    lat_deg,
+                    lon_deg,
+                    alt_msl_m,
+                } => PlanItem::Waypoint {
+                    lat_deg,
+                    lon_deg,
+                    alt_msl_m,
+                },
+                PlanItemBody::Land {
+                    lat_deg,
+                    lon_deg,
+                    alt_msl_m,
+                    approach_course_deg,
+                } => PlanItem::Land {
+                    lat_deg,
+                    lon_deg,
+                    alt_msl_m,
+                    approach_heading_deg: approach_course_deg,
+                },
+            })
+            .collect();
+        CommandRequest::Plan(items)
+    }
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ParamBody {
+    value: f64,
+}
+
+async fn set_param(
+    State(state): State<AppState>,
+    caller: Caller,
+    Path(name): Path<String>,
+    body: Result<Json<ParamBody>, JsonRejection>,
+) -> Result<Response, HttpError> {
+    caller.operator()?;
+    let b = json_body(body)?;
+    submit(
+        &state,
+        &caller,
+        CommandRequest::ParamSet {
+            name,
+            value: b.value,
+        },
+    )
+    .await
+}
+
+async fn arm_cutdown(State(state): State<AppState>, caller: Caller) -> Result<Response, HttpError> {
+    caller.operator()?;
+    let now = state.now_s();
+    let arm = state.core().arm_cutdown(now, &caller.name);
+    Ok(Json(arm).into_response())
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ConfirmBody {
+    arm_id: String,
+}
+
+async fn confirm_cutdown(
+    State(state): State<AppState>,
+    caller: Caller,
+    body: Result<Json<ConfirmBody>, JsonRejection>,
+) -> Result<Response, HttpError> {
+    caller.operator()?;
+    let b = json_body(body)?;
+    let now = state.now_s();
+    let (request_id, action) = state.core().confirm_cutdown(now, &caller.name, &b.arm_id)?;
+    queue(&state, request_id, action).await
+}
+
+async fn kml_link(
+    State(state): State<AppState>,
+    caller: Caller,
+    parts: axum::http::Uri,
+) -> Response {
+    let token = state
+        .config
+        .tokens
+        .iter()
+        .find(|t| t.name == caller.name)
+        .map(|t| t.token.clone())
+        .unwrap_or_default();
+    let _ = parts;
+    let body = crate::kml::network_link(
+        &state.config.name,
+        &format!("http://{}/kml/live?token={token}", state.config.listen),
+        2.0,
+    );
+    (
+        [(header::CONTENT_TYPE, "application/vnd.google-earth.kml+xml")],
+        body,
+    )
+        .into_response()
+}
+
+async fn kml_live(State(state): State<AppState>, _caller: Caller) -> Response {
+    let now = state.now_s();
+    let core = state.core();
+    let body = crate::kml::live(
+        &state.config.name,
+        &core.track(1.0),
+        &core.state_msg_now(now),
+    );
+    drop(core);
+    (
+        [(header::CONTENT_TYPE, "application/vnd.google-earth.kml+xml")],
+        body,
+    )
+        .into_response()
+}
+
+async fn websocket(
+    State(state): State<AppState>,
+    caller: Caller,
+    upgrade: WebSocketUpgrade,
+) -> Response {
+    upgrade.on_upgrade(move |socket| serve_socket(state, caller, socket))
+}
+
+#[derive(Deserialize)]
+#[serde(tag = "type", rename_all = "snake_case")]
+enum ClientMessage {
+    Manual {
+        #[serde(default)]
+        x: f64,
+        #[serde(default)]
+        y: f64,
+        #[serde(default)]
+        z: f64,
+        #[serde(default)]
+        r: f64,
+        #[serde(default)]
+        buttons: u32,
+    },
+    Ping,
+}
+
+async fn serve_socket(state: AppState, caller: Caller, mut socket: WebSocket) {
+    let mut updates = state.broadcast.subscribe();
+    let greeting = {
+        let now = state.now_s();
+        let core = state.core();
+        let hello = serde_json::json!({ "type": "hello", "session": session_of(&state, &caller),
+            "role": caller.role, "name": caller.name });
+        let history = serde_json::json!({
+            "type": "history",
+            "track": core.track(1.0),
+            "events": core.events_since(f64::NEG_INFINITY).into_iter().rev().take(500).rev().collect::<Vec<_>>(),
+            "states": core.history(),
+        });
+        let state_msg = core.state_msg_now(now);
+        [
+            hello.to_string(),
+            serde_json::to_string(&state_msg).unwrap_or_default(),
+            history.to_string(),
+        ]
+    };
+    for text in greeting {
+        if socket.send(Message::Text(text.into())).await.is_err() {
+            return;
+        }
+    }
+    loop {
+        tokio::select! {
+            update = updates.recv() => match update {
+                Ok(text) => {
+                    if socket.send(Message::Text(text)).await.is_err() {
+                        break;
+                    }
+                }
+                // A slow page misses some states; it gets the next ones.
+                Err(broadcast::error::RecvError::Lagged(_)) => continue,
+                Err(broadcast::error::RecvError::Closed) => break,
+            },
+            incoming = socket.recv() => match incoming {
+                Some(Ok(Message::Text(text))) => {
+                    handle_client(&state, &caller, &mut socket, text.as_str()).await;
+                }
+                Some(Ok(Message::Close(_))) | None | Some(Err(_)) => break,
+                Some(Ok(_)) => {}
+            },
+        }
+    }
+}
+
+async fn handle_client(state: &Shared, caller: &Caller, socket: &mut WebSocket, text: &str) {
+    match serde_json::from_str::<ClientMessage>(text) {
+        Ok(ClientMessage::Ping) => {
+            let _ = socket
+                .send(Message::Text(r#"{"type":"pong"}"#.into()))
+                .await;
+        }
+        Ok(ClientMessage::Manual {
+            x,
+            y,
+            z,
+            r,
+            buttons,
+        }) => {
+            if caller.role != Role::Operator {
+                let reply = serde_json::json!({"type":"event","time_s":state.now_s(),"wall_ms":0,
+                    "level":"error","source":"station","text":"viewers cannot fly the drone: operator role required"});
+                let _ = socket.send(Message::Text(reply.to_string().into())).await;
+                return;
+            }
+            let clamp = |v: f64| {
+                if v.is_finite() {
+                    v.clamp(-1.0, 1.0)
+                } else {
+                    0.0
+                }
+            };
+            {
+                let mut m = state.manual.lock().unwrap_or_else(|e| e.into_inner());
+                m.last_s = Some(state.now_s());
+            }
+            let _ = state
+                .link
+                .send(LinkRequest::Manual(Sticks {
+                    x: clamp(x),
+                    y: clamp(y),
+                    z: clamp(z),
+                    r: clamp(r),
+                    buttons,
+                }))
+                .await;
+        }
+        Err(e) => {
+            let reply = serde_json::json!({"type":"event","time_s":state.now_s(),"wall_ms":0,
+                "level":"error","source":"station","text":format!("malformed message refused: {e}")});
+            let _ = socket.send(Message::Text(reply.to_string().into())).await;
+        }
+    }
+}

@@ -1,0 +1,427 @@
+//! The JSON messages of the API (`API.md`): what the dashboard reads. Plain serde structs; the
+//! station's core fills them.
+
+use std::collections::BTreeMap;
+
+use serde::{Deserialize, Serialize};
+
+use crate::config::{ForecastRow, Role};
+
+/// `GET /api/session` and the WebSocket's `hello`.
+#[derive(Debug, Clone, Serialize)]
+pub struct Session {
+    /// The caller's role.
+    pub role: Role,
+    /// The caller's name.
+    pub name: String,
+    /// The station.
+    pub station: StationInfo,
+}
+
+/// What the dashboard needs to know about the station.
+#[derive(Debug, Clone, Serialize)]
+pub struct StationInfo {
+    /// Display name.
+    pub name: String,
+    /// Origin of the local frame.
+    pub origin: LatLonAlt,
+    /// Tile URL template, if any.
+    pub tile_url: Option<String>,
+    /// Tile attribution.
+    pub tile_attribution: String,
+    /// Tiles are served by the station itself (no internet needed).
+    pub offline_tiles: bool,
+    /// Modes the operator may select.
+    pub modes: Vec<String>,
+}
+
+/// A geodetic position.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct LatLonAlt {
+    /// Latitude, degrees.
+    pub lat_deg: f64,
+    /// Longitude, degrees.
+    pub lon_deg: f64,
+    /// Altitude above mean sea level, m.
+    pub alt_msl_m: f64,
+}
+
+/// Link quality.
+#[derive(Debug, Clone, Default, Serialize)]
+pub struct LinkView {
+    /// Heartbeats arriving.
+    pub connected: bool,
+    /// The vehicle's data are old: show them as stale.
+    pub stale: bool,
+    /// Seconds since the last message from the vehicle.
+    pub age_s: Option<f64>,
+    /// Messages per second.
+    pub rate_hz: f64,
+    /// Packet loss from sequence numbers, %.
+    pub loss_percent: f64,
+    /// Checksum failures.
+    pub crc_errors: u64,
+    /// Parse failures.
+    pub parse_errors: u64,
+    /// Signature failures.
+    pub signature_errors: u64,
+    /// Age of the last message of each kind, s.
+    pub ages_s: BTreeMap<String, f64>,
+}
+
+/// GPS as the drone's receiver reports it.
+#[derive(Debug, Clone, Serialize)]
+pub struct GpsView {
+    /// Fix type.
+    pub fix: String,
+    /// Satellites used.
+    pub satellites: Option<u8>,
+    /// Latitude, degrees.
+    pub lat_deg: f64,
+    /// Longitude, degrees.
+    pub lon_deg: f64,
+    /// Altitude MSL, m.
+    pub alt_msl_m: f64,
+    /// Velocity NED, m/s.
+    pub velocity_ned_mps: [f64; 3],
+    /// Horizontal accuracy, m.
+    pub h_acc_m: Option<f64>,
+}
+
+/// Attitude from the AHRS.
+#[derive(Debug, Clone, Serialize)]
+pub struct AttitudeView {
+    /// The drone's clock when the attitude was measured (ms since its boot): which sample
+    /// this is.
+    pub time_boot_ms: u32,
+    /// Roll, degrees.
+    pub roll_deg: f64,
+    /// Pitch, degrees.
+    pub pitch_deg: f64,
+    /// Yaw, degrees.
+    pub yaw_deg: f64,
+}
+
+/// Pitot and static pressure.
+#[derive(Debug, Clone, Serialize)]
+pub struct AirView {
+    /// Static pressure, Pa.
+    pub static_pressure_pa: f64,
+    /// Differential pressure, Pa.
+    pub differential_pressure_pa: f64,
+    /// Temperature, °C.
+    pub temperature_c: f64,
+    /// Indicated airspeed from them, m/s.
+    pub airspeed_mps: f64,
+}
+
+/// Servo positions.
+#[derive(Debug, Clone, Serialize)]
+pub struct ServosView {
+    /// Main line, −1…1.
+    pub main_line: f64,
+    /// Right brake, 0…1.
+    pub brake_right: f64,
+    /// Left brake, 0…1.
+    pub brake_left: f64,
+}
+
+/// Battery.
+#[derive(Debug, Clone, Serialize)]
+pub struct PowerView {
+    /// Voltage, V.
+    pub voltage_v: Option<f64>,
+    /// Current, A.
+    pub current_a: Option<f64>,
+    /// Remaining, %.
+    pub remaining_percent: Option<u8>,
+}
+
+/// What the drone reports about itself.
+#[derive(Debug, Clone, Default, Serialize)]
+pub struct VehicleView {
+    /// Mode.
+    pub mode: Option<String>,
+    /// Stage.
+    pub stage: Option<String>,
+    /// Guidance phase (onboard).
+    pub phase: Option<String>,
+    /// GPS.
+    pub gps: Option<GpsView>,
+    /// Attitude.
+    pub attitude: Option<AttitudeView>,
+    /// Air data.
+    pub air: Option<AirView>,
+    /// Servos.
+    pub servos: Option<ServosView>,
+    /// Power.
+    pub power: Option<PowerView>,
+    /// The onboard estimate of the wind, NED, m/s.
+    pub onboard_wind_ned_mps: Option<[f64; 3]>,
+}
+
+/// The station's own estimate.
+#[derive(Debug, Clone, Serialize)]
+pub struct EstimateView {
+    /// Latitude, degrees.
+    pub lat_deg: f64,
+    /// Longitude, degrees.
+    pub lon_deg: f64,
+    /// Altitude MSL, m.
+    pub alt_msl_m: f64,
+    /// Height above the launch site's ground, m.
+    pub height_m: f64,
+    /// Velocity NED, m/s.
+    pub velocity_ned_mps: [f64; 3],
+    /// Ground speed, m/s.
+    pub ground_speed_mps: f64,
+    /// Course, degrees.
+    pub course_deg: f64,
+    /// Vehicle heading (air track), degrees.
+    pub heading_deg: f64,
+    /// Heading rate, degrees/s.
+    pub heading_rate_dps: f64,
+    /// Airspeed, m/s.
+    pub airspeed_mps: f64,
+    /// Sink rate, m/s.
+    pub sink_rate_mps: f64,
+    /// Glide through the air.
+    pub glide_ratio_air: Option<f64>,
+    /// Glide over the ground.
+    pub glide_ratio_ground: Option<f64>,
+    /// Wind NED, m/s.
+    pub wind_ned_mps: [f64; 3],
+    /// Wind speed, m/s.
+    pub wind_speed_mps: f64,
+    /// Direction the wind blows from, degrees.
+    pub wind_from_deg: f64,
+    /// 1-σ of the wind (largest component), m/s.
+    pub wind_sigma_mps: f64,
+    /// 1-σ of the horizontal position, m.
+    pub position_sigma_m: f64,
+    /// GPS in use.
+    pub gps_ok: bool,
+}
+
+/// The spiral's plan on the map.
+#[derive(Debug, Clone, Serialize)]
+pub struct PatternView {
+    /// Corners `[lat, lon]`.
+    pub corners: Vec<[f64; 2]>,
+    /// Where the base leg meets the final line `[lat, lon]`.
+    pub final_entry: [f64; 2],
+    /// Final-approach course, degrees.
+    pub final_course_deg: f64,
+    /// Height needed to turn base and glide in, m.
+    pub final_approach_height_m: f64,
+    /// The target is within the glide's reach.
+    pub target_reachable: bool,
+    /// Drift distance over reach.
+    pub reach_ratio: f64,
+}
+
+/// The guidance replica's view.
+#[derive(Debug, Clone, Serialize)]
+pub struct GuidanceView {
+    /// Mode.
+    pub mode: String,
+    /// Phase.
+    pub phase: String,
+    /// Landing target.
+    pub target: Option<LatLonAlt>,
+    /// Spiral plan, in spiral landing.
+    pub pattern: Option<PatternView>,
+    /// What the replica would command.
+    pub commands: CommandsView,
+}
+
+/// Servo commands of the replica.
+#[derive(Debug, Clone, Serialize)]
+pub struct CommandsView {
+    /// Main line, −1…1 of its travel.
+    pub main_line: f64,
+    /// Symmetric brake, 0…1.
+    pub brake: f64,
+}
+
+/// A predicted touchdown.
+#[derive(Debug, Clone, Serialize)]
+pub struct TouchdownView {
+    /// Latitude, degrees.
+    pub lat_deg: f64,
+    /// Longitude, degrees.
+    pub lon_deg: f64,
+    /// Seconds to touchdown.
+    pub time_to_land_s: f64,
+    /// 1-σ ellipse semi-major axis, m.
+    pub semi_major_m: f64,
+    /// 1-σ ellipse semi-minor axis, m.
+    pub semi_minor_m: f64,
+    /// Direction of the major axis, degrees clockwise from north.
+    pub major_axis_deg: f64,
+}
+
+/// Both predictions.
+#[derive(Debug, Clone, Serialize)]
+pub struct PredictionView {
+    /// Flying the plan.
+    pub planned: TouchdownView,
+    /// Servos neutral.
+    pub uncontrolled: TouchdownView,
+}
+
+/// Mission state.
+#[derive(Debug, Clone, Default, Serialize)]
+pub struct MissionView {
+    /// Stage.
+    pub stage: Option<String>,
+    /// When an armed cutdown expires, s.
+    pub cutdown_armed_until_s: Option<f64>,
+}
+
+/// The `state` message.
+#[derive(Debug, Clone, Serialize)]
+pub struct StateMsg {
+    /// Always `state`.
+    #[serde(rename = "type")]
+    pub kind: &'static str,
+    /// Mission clock, s.
+    pub time_s: f64,
+    /// Unix time, ms.
+    pub wall_ms: u64,
+    /// Link.
+    pub link: LinkView,
+    /// Vehicle.
+    pub vehicle: Option<VehicleView>,
+    /// Estimate.
+    pub estimate: Option<EstimateView>,
+    /// Guidance.
+    pub guidance: Option<GuidanceView>,
+    /// Prediction.
+    pub prediction: Option<PredictionView>,
+    /// Forecast wind.
+    pub forecast_wind: Vec<ForecastRow>,
+    /// Mission.
+    pub mission: MissionView,
+}
+
+/// Event levels.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Level {
+    /// Information.
+    Info,
+    /// Needs attention.
+    Warning,
+    /// Something failed.
+    Error,
+}
+
+/// The `event` message.
+#[derive(Debug, Clone, Serialize)]
+pub struct EventMsg {
+    /// Always `event`.
+    #[serde(rename = "type")]
+    pub kind: &'static str,
+    /// Mission clock, s.
+    pub time_s: f64,
+    /// Unix time, ms.
+    pub wall_ms: u64,
+    /// Level.
+    pub level: Level,
+    /// Where it comes from: guidance, link, command, station, vehicle.
+    pub source: &'static str,
+    /// Text.
+    pub text: String,
+}
+
+/// Outcomes of commands.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Outcome {
+    /// Still waiting.
+    InProgress,
+    /// Done.
+    Accepted,
+    /// Refused.
+    Denied,
+    /// Tried and failed.
+    Failed,
+    /// Not supported.
+    Unsupported,
+    /// No answer.
+    TimedOut,
+}
+
+/// The `command_result` message (and `GET /api/commands/{id}`).
+#[derive(Debug, Clone, Serialize)]
+pub struct CommandResultMsg {
+    /// Always `command_result`.
+    #[serde(rename = "type")]
+    pub kind: &'static str,
+    /// The request.
+    pub request_id: String,
+    /// Which command.
+    pub command: String,
+    /// Outcome.
+    pub outcome: Outcome,
+    /// Transmissions.
+    pub attempts: u32,
+    /// Details for people.
+    pub detail: String,
+    /// Value read back, for parameter writes.
+    pub value: Option<f64>,
+}
+
+/// A parameter as the dashboard shows it.
+#[derive(Debug, Clone, Serialize)]
+pub struct ParamView {
+    /// Name.
+    pub name: String,
+    /// Value.
+    pub value: f64,
+    /// Smallest allowed, if known.
+    pub min: Option<f64>,
+    /// Largest allowed, if known.
+    pub max: Option<f64>,
+    /// Units.
+    pub units: String,
+    /// What it does.
+    pub description: String,
+}
+
+/// The `params` message and `GET /api/params`.
+#[derive(Debug, Clone, Serialize)]
+pub struct ParamsMsg {
+    /// Always `params`.
+    #[serde(rename = "type")]
+    pub kind: &'static str,
+    /// The table.
+    pub params: Vec<ParamView>,
+    /// Every parameter arrived.
+    pub complete: bool,
+    /// Mission clock, s.
+    pub time_s: f64,
+}
+
+/// A point of the track.
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct TrackPoint {
+    /// Mission clock, s.
+    pub time_s: f64,
+    /// Latitude, degrees.
+    pub lat_deg: f64,
+    /// Longitude, degrees.
+    pub lon_deg: f64,
+    /// Altitude MSL, m.
+    pub alt_msl_m: f64,
+}
+
+/// Error bodies.
+#[derive(Debug, Clone, Serialize)]
+pub struct ErrorBody {
+    /// Machine-readable kind.
+    pub error: &'static str,
+    /// For people: what is wrong.
+    pub reason: String,
+}
