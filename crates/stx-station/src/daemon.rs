@@ -50,7 +50,7 @@ const STATS_PERIOD: Duration = Duration::from_millis(500);
 /// Telemetry frames arriving within this window of the first one are answered with one
 /// `state` message: the drone sends its sensors in bursts, and one message per burst keeps
 /// pages current without flooding them.
-const COALESCE: Duration = Duration::from_millis(2);
+const COALESCE: Duration = Duration::from_millis(1);
 /// Landing predictions run this often, off the station loop.
 const PREDICTION_PERIOD: Duration = Duration::from_secs(1);
 /// Sticks silent this long stop the uplink of MANUAL_CONTROL.

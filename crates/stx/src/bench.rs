@@ -37,6 +37,24 @@ enum BenchWhat {
         #[arg(long, default_value_t = 2.0)]
         eval_seconds: f64,
     },
+    /// The station's latencies on loopback: telemetry → WebSocket pages, command → MAVLink.
+    Station {
+        /// Print one JSON object instead of a table.
+        #[arg(long)]
+        json: bool,
+        /// WebSocket pages connected while telemetry flows.
+        #[arg(long, default_value_t = 50)]
+        clients: usize,
+        /// Telemetry frames timed.
+        #[arg(long, default_value_t = 400)]
+        frames: usize,
+        /// Telemetry frames per second.
+        #[arg(long, default_value_t = 20.0)]
+        frame_rate_hz: f64,
+        /// Commands timed.
+        #[arg(long, default_value_t = 200)]
+        commands: usize,
+    },
 }
 
 /// An integrator setting: a tolerance or a step.
@@ -177,6 +195,42 @@ fn evals_per_second(seconds: f64) -> f64 {
 
 pub fn run(args: BenchArgs) -> anyhow::Result<()> {
     match args.what {
+        BenchWhat::Station {
+            json,
+            clients,
+            frames,
+            frame_rate_hz,
+            commands,
+        } => {
+            let report = crate::bench_station::run(&crate::bench_station::StationBenchOptions {
+                clients,
+                frames,
+                frame_rate_hz,
+                commands,
+            })?;
+            if json {
+                println!("{}", serde_json::to_string_pretty(&report)?);
+            } else {
+                let t = &report.telemetry_to_websocket;
+                let c = &report.command_to_mavlink;
+                println!(
+                    "telemetry → WebSocket, {} pages, {} frames at {} Hz: p50 {:.2} ms, p99 {:.2} ms, max {:.2} ms ({} samples, {} missed)",
+                    t.clients,
+                    t.frames_sent,
+                    t.frame_rate_hz,
+                    t.latency.p50_ms,
+                    t.latency.p99_ms,
+                    t.latency.max_ms,
+                    t.latency.samples,
+                    t.missed
+                );
+                println!(
+                    "command → MAVLink bytes, {} commands: p50 {:.2} ms, p99 {:.2} ms, max {:.2} ms ({} lost)",
+                    c.commands_sent, c.latency.p50_ms, c.latency.p99_ms, c.latency.max_ms, c.lost
+                );
+            }
+            Ok(())
+        }
         BenchWhat::Dynamics { json, eval_seconds } => {
             let rate = evals_per_second(eval_seconds);
             // Per integrator, loosest first; the first setting that holds the landing within

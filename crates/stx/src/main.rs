@@ -5,6 +5,7 @@
 //! file or flag).
 
 mod bench;
+mod bench_station;
 mod montecarlo;
 mod serve;
 mod sim;

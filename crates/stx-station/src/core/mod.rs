@@ -38,6 +38,17 @@ const MAX_HISTORY: usize = 300;
 /// Seconds between track points.
 const TRACK_PERIOD_S: f64 = 1.0;
 
+/// Seconds the drone's clock may step back before the station takes it for a reboot.
+const REBOOT_STEP_BACK_S: f64 = 5.0;
+
+fn new_estimator() -> Estimator {
+    match Estimator::new(EstimatorConfig::default()) {
+        Ok(e) => e,
+        // The default configuration is validated by the estimator's own tests.
+        Err(e) => panic!("default estimator configuration is invalid: {e}"),
+    }
+}
+
 /// Everything a landing prediction needs, detached from the station so it can run on another
 /// thread while telemetry keeps flowing.
 pub struct PredictionJob {
@@ -96,6 +107,9 @@ pub struct StationCore {
     wall_origin_ms: u64,
     pub(crate) latest: Latest,
     estimator: Estimator,
+    /// The drone's clock (s since its boot) from the newest time-stamped telemetry:
+    /// navigation runs on it, so radio delays and accelerated rehearsals do not distort it.
+    drone_time_s: Option<f64>,
     pub(crate) estimate: Option<Estimate>,
     pub(crate) guidance: Guidance,
     pub(crate) prediction: Option<LandingPrediction>,
@@ -120,16 +134,13 @@ impl StationCore {
     pub fn new(config: StationConfig, wall_origin_ms: u64) -> Self {
         let frame = config.origin;
         let guidance = Guidance::new(config.guidance);
-        let estimator = match Estimator::new(EstimatorConfig::default()) {
-            Ok(e) => e,
-            // The default configuration is validated by the estimator's own tests.
-            Err(e) => panic!("default estimator configuration is invalid: {e}"),
-        };
+        let estimator = new_estimator();
         Self {
             frame,
             wall_origin_ms,
             latest: Latest::default(),
             estimator,
+            drone_time_s: None,
             estimate: None,
             guidance,
             prediction: None,
@@ -329,18 +340,41 @@ impl StationCore {
                 plan.localizer_glide_slope = glide_slope;
             }
         }
-        self.guidance.set_plan(plan, now_s);
+        self.guidance
+            .set_plan(plan, self.drone_time_s.unwrap_or(now_s));
+    }
+
+    /// Advances the drone's clock with a message's time stamp; a clock that steps far back
+    /// means the drone restarted, and navigation starts over.
+    fn observe_drone_clock(&mut self, now_s: f64, time_boot_ms: u32) -> f64 {
+        let t = f64::from(time_boot_ms) / 1000.0;
+        match self.drone_time_s {
+            Some(last) if last - t > REBOOT_STEP_BACK_S => {
+                self.estimator = new_estimator();
+                self.estimate = None;
+                self.log(
+                    now_s,
+                    Level::Warning,
+                    "vehicle",
+                    format!("the drone's clock went back from {last:.1} s to {t:.1} s: it restarted; navigation starts over"),
+                );
+                self.drone_time_s = Some(t);
+            }
+            Some(last) => self.drone_time_s = Some(last.max(t)),
+            None => self.drone_time_s = Some(t),
+        }
+        t
     }
 
     fn on_telemetry(&mut self, now_s: f64, telemetry: Telemetry) {
-        let l = &mut self.latest;
-        l.any_s = Some(now_s);
+        self.latest.any_s = Some(now_s);
         match telemetry {
             Telemetry::Status(s) => {
-                let previous = l.status.map(|(p, _)| p);
-                l.status = Some((s, now_s));
+                let previous = self.latest.status.map(|(p, _)| p);
+                self.latest.status = Some((s, now_s));
                 if previous.map(|p| p.mode) != Some(s.mode) {
-                    self.guidance.set_mode(s.mode, now_s);
+                    let at = self.drone_time_s.unwrap_or(0.0);
+                    self.guidance.set_mode(s.mode, at);
                 }
                 if let Some(p) = previous
                     && p.stage != s.stage
@@ -354,36 +388,45 @@ impl StationCore {
                 }
             }
             Telemetry::GpsRaw(g) => {
-                l.gps = Some((g, now_s));
-                if let Some(m) = self.gps_measurement(now_s, &g) {
-                    self.estimator.handle(now_s, &m);
+                self.latest.gps = Some((g, now_s));
+                // GPS_RAW_INT's time may be the receiver's (Unix) clock: it is stamped with
+                // the drone's clock of the burst it came in.
+                if let Some(t) = self.drone_time_s
+                    && let Some(m) = self.gps_measurement(t, now_s, &g)
+                {
+                    self.estimator.handle(t, &m);
                 }
             }
-            Telemetry::Position(p) => l.position = Some((p, now_s)),
+            Telemetry::Position(p) => {
+                self.observe_drone_clock(now_s, p.time_boot_ms);
+                self.latest.position = Some((p, now_s));
+            }
             Telemetry::Attitude(a) => {
-                l.attitude = Some((a, now_s));
+                let t = self.observe_drone_clock(now_s, a.time_boot_ms);
+                self.latest.attitude = Some((a, now_s));
                 let m = Measurement::Attitude(AttitudeSample {
-                    time_s: now_s,
+                    time_s: t,
                     roll_rad: a.roll_rad,
                     pitch_rad: a.pitch_rad,
                     yaw_rad: a.yaw_rad,
                 });
-                self.estimator.handle(now_s, &m);
+                self.estimator.handle(self.drone_time_s.unwrap_or(t), &m);
             }
             Telemetry::AirData(a) => {
-                l.air = Some((a, now_s));
+                let t = self.observe_drone_clock(now_s, a.time_boot_ms);
+                self.latest.air = Some((a, now_s));
                 let m = Measurement::AirData(AirDataSample {
-                    time_s: now_s,
+                    time_s: t,
                     differential_pressure_pa: a.diff_pressure_pa,
                     static_pressure_pa: a.abs_pressure_pa,
                     temperature_k: a.temperature_c + 273.15,
                 });
-                self.estimator.handle(now_s, &m);
+                self.estimator.handle(self.drone_time_s.unwrap_or(t), &m);
             }
-            Telemetry::Actuators(a) => l.actuators = Some((a, now_s)),
-            Telemetry::System(s) => l.system = Some((s, now_s)),
-            Telemetry::Battery(b) => l.battery = Some((b, now_s)),
-            Telemetry::Wind(w) => l.wind = Some((w, now_s)),
+            Telemetry::Actuators(a) => self.latest.actuators = Some((a, now_s)),
+            Telemetry::System(s) => self.latest.system = Some((s, now_s)),
+            Telemetry::Battery(b) => self.latest.battery = Some((b, now_s)),
+            Telemetry::Wind(w) => self.latest.wind = Some((w, now_s)),
             Telemetry::Hud(_)
             | Telemetry::StatusText(_)
             | Telemetry::Guidance(_)
@@ -393,7 +436,12 @@ impl StationCore {
 
     /// A GPS measurement for the estimator. GPS_RAW_INT carries no vertical velocity: the
     /// drone's own estimate (GLOBAL_POSITION_INT) stands in for it when it is recent.
-    fn gps_measurement(&self, now_s: f64, g: &stx_link::telemetry::GpsRaw) -> Option<Measurement> {
+    fn gps_measurement(
+        &self,
+        drone_s: f64,
+        now_s: f64,
+        g: &stx_link::telemetry::GpsRaw,
+    ) -> Option<Measurement> {
         use stx_link::telemetry::GpsFix as Fix;
         if !matches!(
             g.fix,
@@ -410,7 +458,7 @@ impl StationCore {
             .filter(|(_, t)| now_s - t < 1.0)
             .map_or(0.0, |(p, _)| p.v_down_mps);
         Some(Measurement::Gps(GpsFix {
-            time_s: now_s,
+            time_s: drone_s,
             position_ned_m: position,
             velocity_ned_mps: Vector3::new(speed * course.cos(), speed * course.sin(), down),
             horizontal_accuracy_m: g.h_acc_m.unwrap_or(2.5),
@@ -423,9 +471,9 @@ impl StationCore {
     /// The landing prediction is not run here (it flies the plan in fast time, too slow for the
     /// telemetry path): see [`StationCore::prediction_job`].
     pub fn tick(&mut self, now_s: f64) -> StateMsg {
-        let est = self.estimator.estimate(now_s);
-        let usable = est.position_sigma_m.iter().all(|s| s.is_finite());
-        if usable {
+        let est = self.drone_time_s.map(|t| self.estimator.estimate(t));
+        let usable = est.filter(|e| e.position_sigma_m.iter().all(|s| s.is_finite()));
+        if let Some(est) = usable {
             let density = StandardAtmosphere
                 .air_at(self.frame.alt_msl_m - est.position_ned_m.z)
                 .density_kg_per_m3;
@@ -438,8 +486,9 @@ impl StationCore {
                     format!("{:?} → {:?}: {}", e.from, e.to, e.reason),
                 );
             }
-            if now_s >= self.next_track_s {
-                self.next_track_s = now_s + TRACK_PERIOD_S;
+            // One point per second of flight, also when a rehearsal runs faster than real time.
+            if est.time_s >= self.next_track_s {
+                self.next_track_s = est.time_s + TRACK_PERIOD_S;
                 let (lat, lon, alt) = self.frame.to_geodetic(&est.position_ned_m);
                 self.track.push(TrackPoint {
                     time_s: now_s,
@@ -600,6 +649,12 @@ mod tests {
     /// Telemetry of a parafoil gliding north in still air at 6 m/s, sinking 3 m/s, from 800 m
     /// above the origin, as the drone sends it at 4 Hz.
     fn glide(core: &mut StationCore, from_s: f64, to_s: f64) -> Vector3<f64> {
+        glide_at_speed(core, from_s, to_s, 1.0)
+    }
+
+    /// As [`glide`], with the drone's clock running `speed` times faster than the station's
+    /// (an accelerated rehearsal).
+    fn glide_at_speed(core: &mut StationCore, from_s: f64, to_s: f64, speed: f64) -> Vector3<f64> {
         let air = StandardAtmosphere;
         let mut t = from_s;
         let mut truth = Vector3::zeros();
@@ -672,7 +727,7 @@ mod tests {
                     ..LinkStats::default()
                 },
             );
-            core.tick(t);
+            core.tick(t / speed);
             t += 0.25;
         }
         truth
@@ -717,6 +772,42 @@ mod tests {
         let uncontrolled = prediction.uncontrolled;
         let (lat_now, _, _) = core.frame.to_geodetic(&truth);
         assert!(uncontrolled.lat_deg > lat_now, "{uncontrolled:?}");
+    }
+
+    #[test]
+    fn navigation_runs_on_the_drones_clock_in_accelerated_rehearsals() {
+        let mut core = core();
+        let truth = glide_at_speed(&mut core, 0.0, 40.0, 20.0);
+        let est = core.estimate.expect("an estimate");
+        assert!(
+            (est.position_ned_m - truth).norm() < 5.0,
+            "{:?} vs {truth:?}",
+            est.position_ned_m
+        );
+        assert!(
+            (est.velocity_ned_mps - Vector3::new(6.0, 0.0, 3.0)).norm() < 0.5,
+            "{:?}",
+            est.velocity_ned_mps
+        );
+        assert!(
+            (core.track.len() as f64 - 40.0).abs() <= 1.0,
+            "one track point per flight second"
+        );
+    }
+
+    #[test]
+    fn a_drone_restart_starts_navigation_over() {
+        let mut core = core();
+        glide(&mut core, 30.0, 60.0);
+        assert!(core.estimate.is_some());
+        glide(&mut core, 0.0, 0.5);
+        assert!(core.events.iter().any(|e| e.text.contains("restarted")));
+        let est = core.estimate.expect("estimate after restart");
+        assert!(
+            est.time_s < 1.0,
+            "navigation on the new clock: {}",
+            est.time_s
+        );
     }
 
     #[test]
