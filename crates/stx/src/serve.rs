@@ -17,6 +17,10 @@ pub struct ServeArgs {
     /// Listen on this address instead of the configuration's (e.g. 127.0.0.1:8080).
     #[arg(long)]
     listen: Option<std::net::SocketAddr>,
+    /// The drone link instead of the configuration's (e.g. udpin:0.0.0.0:14550,
+    /// serial:/dev/ttyUSB0:57600, tcpout:192.168.1.20:5760).
+    #[arg(long)]
+    link: Option<String>,
 }
 
 /// Reads and validates the station configuration.
@@ -41,6 +45,10 @@ pub fn run(args: ServeArgs) -> anyhow::Result<()> {
     let mut config = load_config(args.config.as_deref())?;
     if let Some(listen) = args.listen {
         config.listen = listen;
+    }
+    if let Some(link) = args.link {
+        config.link.address = link;
+        config.validate().context("--link").map_err(BadInput)?;
     }
     if !config.web_dir.join("index.html").exists() {
         tracing::warn!(
