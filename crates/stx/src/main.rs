@@ -4,9 +4,11 @@
 //! Exit codes: 0 success, 1 a failure while running, 2 bad input (unknown scenario, invalid
 //! file or flag).
 
+mod analyze;
 mod bench;
 mod montecarlo;
 mod sim;
+mod tune;
 
 use std::process::ExitCode;
 
@@ -31,6 +33,10 @@ enum Command {
     Bench(bench::BenchArgs),
     /// Many spiral landings from random releases and winds: landing statistics.
     Montecarlo(montecarlo::MonteCarloArgs),
+    /// Trim, linearise, eigenvalues and ranks beside the seed's (seed chapter 6).
+    Analyze(analyze::AnalyzeArgs),
+    /// Tune one controller's gains and write the gains file guidance uses.
+    Tune(tune::TuneArgs),
 }
 
 /// An error that is the user's input, not the program's failure (exit code 2).
@@ -58,6 +64,8 @@ fn main() -> ExitCode {
         Command::Sim(args) => sim::run(args),
         Command::Bench(args) => bench::run(args),
         Command::Montecarlo(args) => montecarlo::run(args),
+        Command::Analyze(args) => analyze::run(args),
+        Command::Tune(args) => tune::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
