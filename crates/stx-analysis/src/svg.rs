@@ -290,10 +290,19 @@ fn draw_panel(out: &mut String, p: &Panel, ox: f64, oy: f64, w: f64, h: f64) {
         Corner::TopRight | Corner::TopLeft => oy + top + 18.0,
         Corner::BottomRight => oy + top + ph - 16.0 * rows + 8.0,
     };
+    // Wide enough for the longest label (about 7 px a character at 12 px), no wider, so the
+    // box hides as little data as it can.
+    let box_w = 40.0
+        + 7.0
+            * p.series
+                .iter()
+                .map(|s| s.label.chars().count())
+                .max()
+                .unwrap_or(0) as f64;
     for s in &p.series {
         let x = match p.legend {
             Corner::TopLeft => ox + left + 10.0,
-            _ => ox + left + pw - 210.0,
+            _ => ox + left + pw - box_w - 10.0,
         };
         let sample = match s.style {
             Style::Line => format!(
@@ -331,7 +340,7 @@ fn draw_panel(out: &mut String, p: &Panel, ox: f64, oy: f64, w: f64, h: f64) {
         };
         let _ = writeln!(
             out,
-            r#"<rect x="{}" y="{}" width="196" height="16" fill="white" fill-opacity="0.8"/>{sample}<text x="{}" y="{y}">{}</text>"#,
+            r#"<rect x="{}" y="{}" width="{box_w}" height="16" fill="white" fill-opacity="0.8"/>{sample}<text x="{}" y="{y}">{}</text>"#,
             x - 4.0,
             y - 13.0,
             x + 28.0,

@@ -249,7 +249,7 @@ fn plot(r: &TuneReport) -> String {
     let reference = r.current.responses.0.reference * scale;
     let panels = [
         Panel {
-            title: format!("{} step response", c.name()),
+            title: r.experiment.clone(),
             x_label: "time, s".into(),
             y_label: c.response_label().into(),
             series: outputs,
@@ -270,7 +270,7 @@ fn plot(r: &TuneReport) -> String {
         },
     ];
     render(
-        &format!("stx tune --controller {}: {}", c.name(), r.experiment),
+        &format!("stx tune --controller {}: step responses", c.name()),
         &panels,
         1,
         900.0,
