@@ -34,16 +34,21 @@ pub struct ControlGains {
 }
 
 impl Default for ControlGains {
-    /// Gains tuned on the 14-DOF model (see `stx tune`; the seed's appendix A.13 vectors were
-    /// the starting point).
+    /// Gains tuned by `stx tune` on the 14-DOF model's linearised closed loop and checked on
+    /// the nonlinear model, controller by controller (heading, course, localizer, vertical;
+    /// heading and course share HK1/HK2, so the course's values are the ones kept), the same
+    /// as `config/gains.toml`. They replaced hand-set gains (HK1 0.012, HK2 0.012, HK3 0.0004,
+    /// VK1 3, VK2 0.05) after the Monte Carlo of 100 spiral landings improved with them; the
+    /// figures and the seed's appendix A.13 vectors are compared in
+    /// `crates/stx-analysis/ANALYSIS_NOTES.md`.
     fn default() -> Self {
         Self {
-            hk1_m_per_rad: 0.012,
-            hk2_m_s_per_rad: 0.012,
-            hk3_m_per_m: 0.0004,
+            hk1_m_per_rad: 0.00881,
+            hk2_m_s_per_rad: 0.0168,
+            hk3_m_per_m: 0.000226,
             convergence_distance_m: 40.0,
-            vk1: 3.0,
-            vk2_per_m: 0.05,
+            vk1: 1.67,
+            vk2_per_m: 0.466,
             brake_trim: 0.4,
             main_line_limit_m: 0.015,
         }
