@@ -26,6 +26,7 @@
 use nalgebra::{DMatrix, DVector, Vector3};
 use serde::Serialize;
 use stx_dynamics::model::ParafoilModel;
+use stx_dynamics::rotation::wrap_pi;
 use stx_dynamics::state::{Controls, StateVector, idx};
 use stx_dynamics::vehicle::Vehicle;
 use stx_gnc::control::{ControlGains, GlidePath, Localizer};
@@ -144,11 +145,23 @@ impl Controller {
         }
     }
 
+    /// Size of its large experiment: a 90° turn (a spiral corner, the law saturated), a
+    /// 40 m offset (the convergence distance: the localizer's approach phase, then its
+    /// following phase), 10 m above the glide path (its approach phase, the brake saturated).
+    pub fn large_step(self) -> f64 {
+        match self {
+            Controller::Heading | Controller::Course => 90f64.to_radians(),
+            Controller::Localizer => 40.0,
+            Controller::Vertical => 10.0,
+        }
+    }
+
     /// Length of its experiment, s.
     pub fn duration_s(self) -> f64 {
         match self {
             Controller::Heading | Controller::Course => 40.0,
-            Controller::Localizer | Controller::Vertical => 60.0,
+            Controller::Localizer => 60.0,
+            Controller::Vertical => 80.0,
         }
     }
 
@@ -317,6 +330,8 @@ pub enum TuneError {
 pub struct Experiment {
     /// The controller.
     pub controller: Controller,
+    /// Size of the step, in the response's unit (rad or m).
+    pub step: f64,
     /// The vehicle.
     pub vehicle: Vehicle,
     /// The linear model about the experiment's trim.
@@ -334,12 +349,14 @@ pub struct Experiment {
 
 impl Experiment {
     /// Trims at `altitude_m` (brakes at `gains.brake_trim` for the vertical law, released
-    /// otherwise, as guidance commands them), linearises, and sets the step up.
+    /// otherwise, as guidance commands them), linearises, and sets the step of size `step`
+    /// up ([`Controller::step`] or [`Controller::large_step`]).
     pub fn new(
         controller: Controller,
         vehicle: &Vehicle,
         altitude_m: f64,
         base: GuidanceConfig,
+        step: f64,
     ) -> Result<Self, TuneError> {
         let brake = if controller == Controller::Vertical {
             base.gains.brake_trim
@@ -350,13 +367,14 @@ impl Experiment {
         let linear = linearize(vehicle, &t);
         let outputs_at_trim = crate::linearize::outputs(vehicle, &t.state, 0.0);
         let drone_velocity = Vector3::from(t.drone_velocity_ned_mps);
-        let (plan, mode) = plan_for(controller, &outputs_at_trim, &drone_velocity);
+        let (plan, mode) = plan_for(controller, step, &outputs_at_trim, &drone_velocity);
         let model = ParafoilModel::new(vehicle.clone(), calm_environment());
         let mut template = truth_estimate(&model, 0.0, &t.state);
         template.position_sigma_m = Vector3::zeros();
         let heading_rate_row = linear.system.a.rows(idx::CANOPY_EULER + 2, 1).into_owned();
         Ok(Self {
             controller,
+            step,
             vehicle: vehicle.clone(),
             discrete: DiscreteSystem::new(&linear.system.a, &linear.system.b, STEP_S),
             linear,
@@ -386,22 +404,53 @@ impl Experiment {
 
     /// The estimate perfect navigation would give for the linear state `dx` at `time_s`
     /// with the command `u_held` held (it moves the drone through `D`).
-    fn linear_estimate(&self, time_s: f64, dx: &DVector<f64>, du_held: &DVector<f64>) -> Estimate {
+    ///
+    /// The dynamics do not depend on x, y or ψ, so the linear model is exact in them: the
+    /// velocity is the linear one at heading 0 turned by the heading, and, in a simulation,
+    /// the position is its integral (`position_ne_m`), so a 90° turn or a 45° intercept is
+    /// represented as well as a small step. Without `position_ne_m` (small deviations, for
+    /// the closed-loop Jacobian) the position is the linear output.
+    fn linear_estimate(
+        &self,
+        time_s: f64,
+        dx: &DVector<f64>,
+        du_held: &DVector<f64>,
+        position_ne_m: Option<[f64; 2]>,
+    ) -> Estimate {
         let sys = &self.linear.system;
-        let mut y = &self.outputs_at_trim + &sys.c * dx + &sys.d * du_held;
-        for k in 0..3 {
-            y[k] += self.drone_velocity[k] * time_s;
-        }
+        let psi = self.linear.trim.state[idx::CANOPY_EULER + 2] + dx[idx::CANOPY_EULER + 2];
+        let y = &self.outputs_at_trim + &sys.c * dx + &sys.d * du_held;
         let mut est = self.template;
         est.time_s = time_s;
-        est.position_ned_m = Vector3::new(y[0], y[1], y[2]);
-        est.velocity_ned_mps = Vector3::new(y[3], y[4], y[5]);
+        let z = y[2] + self.drone_velocity.z * time_s;
+        let (v_n, v_e) = match position_ne_m {
+            Some(_) => {
+                // The velocity without the heading's own first-order turn, then turned by it.
+                let psi_column = sys.c.column(idx::CANOPY_EULER + 2);
+                let (n0, e0) = (
+                    y[3] - psi_column[3] * dx[idx::CANOPY_EULER + 2],
+                    y[4] - psi_column[4] * dx[idx::CANOPY_EULER + 2],
+                );
+                let (s, c) = psi.sin_cos();
+                (c * n0 - s * e0, s * n0 + c * e0)
+            }
+            None => (y[3], y[4]),
+        };
+        est.position_ned_m = match position_ne_m {
+            Some([n, e]) => Vector3::new(n, e, z),
+            None => Vector3::new(
+                y[0] + self.drone_velocity.x * time_s,
+                y[1] + self.drone_velocity.y * time_s,
+                z,
+            ),
+        };
+        est.velocity_ned_mps = Vector3::new(v_n, v_e, y[5]);
         est.roll_rad = y[6];
         est.pitch_rad = y[7];
         est.drone_yaw_rad = y[8];
-        est.heading_rad = self.linear.trim.state[idx::CANOPY_EULER + 2] + dx[idx::CANOPY_EULER + 2];
+        est.heading_rad = wrap_pi(psi);
         est.heading_rate_rad_s = (&self.heading_rate_row * dx)[0];
-        est.course_rad = y[4].atan2(y[3]);
+        est.course_rad = v_e.atan2(v_n);
         est.sink_rate_mps = y[5];
         est
     }
@@ -433,10 +482,8 @@ impl Experiment {
     /// Where the step starts and ends.
     fn initial_and_reference(&self) -> (f64, f64) {
         match self.controller {
-            Controller::Heading | Controller::Course => (0.0, self.controller.step()),
-            Controller::Localizer | Controller::Vertical => {
-                (self.controller.step() * self.sign(), 0.0)
-            }
+            Controller::Heading | Controller::Course => (0.0, self.step),
+            Controller::Localizer | Controller::Vertical => (self.step * self.sign(), 0.0),
         }
     }
 
@@ -473,9 +520,10 @@ impl Experiment {
         let mut du = DVector::zeros(2);
         let substeps = (CONTROL_PERIOD_S / STEP_S).round() as usize;
         let (periods, mut r) = self.empty_response();
+        let mut position = [self.outputs_at_trim[0], self.outputs_at_trim[1]];
         for k in 0..periods {
             let t = k as f64 * CONTROL_PERIOD_S;
-            let est = self.linear_estimate(t, &dx, &du);
+            let est = self.linear_estimate(t, &dx, &du, Some(position));
             let command = guidance
                 .update(&est, self.linear.trim.density_kg_per_m3)
                 .controls;
@@ -483,8 +531,16 @@ impl Experiment {
             r.time_s.push(t);
             r.output.push(self.response(&est));
             r.command.push(self.command_of(&command));
-            for _ in 0..substeps {
+            for j in 0..substeps {
+                // The position integrates the turned velocity (trapezoidal over the step).
+                let before = self.linear_estimate(t + j as f64 * STEP_S, &dx, &du, Some(position));
                 dx = self.discrete.step(&dx, &du);
+                let after =
+                    self.linear_estimate(t + (j + 1) as f64 * STEP_S, &dx, &du, Some(position));
+                position[0] +=
+                    0.5 * STEP_S * (before.velocity_ned_mps.x + after.velocity_ned_mps.x);
+                position[1] +=
+                    0.5 * STEP_S * (before.velocity_ned_mps.y + after.velocity_ned_mps.y);
             }
             if !dx.iter().all(|v| v.is_finite() && v.abs() < 1e6) {
                 // Diverged: the rest of the run is as bad as its last sample.
@@ -555,7 +611,7 @@ impl Experiment {
         let k = jacobian(
             |dx: &DVector<f64>| {
                 let mut g = self.guidance(gains, plan);
-                let est = self.linear_estimate(0.0, dx, &zero_u);
+                let est = self.linear_estimate(0.0, dx, &zero_u, None);
                 input_vector(&g.update(&est, self.linear.trim.density_kg_per_m3).controls) - &u0
             },
             &DVector::zeros(n),
@@ -572,7 +628,7 @@ impl Experiment {
             Controller::Heading => plan.heading_rad = 0.0,
             Controller::Course => plan.course_rad = 0.0,
             Controller::Localizer => plan.localizer.point_ne_m[1] = self.outputs_at_trim[1],
-            Controller::Vertical => plan.target_ned_m.z -= self.controller.step(),
+            Controller::Vertical => plan.target_ned_m.z -= self.step,
         }
         plan
     }
@@ -582,6 +638,7 @@ impl Experiment {
 /// at trim.
 fn plan_for(
     controller: Controller,
+    step: f64,
     y0: &DVector<f64>,
     v_drone: &Vector3<f64>,
 ) -> (Plan, FlightMode) {
@@ -592,29 +649,65 @@ fn plan_for(
     let mut plan = Plan::default();
     match controller {
         Controller::Heading => {
-            plan.heading_rad = controller.step();
+            plan.heading_rad = step;
             (plan, FlightMode::Heading)
         }
         Controller::Course => {
-            plan.course_rad = controller.step();
+            plan.course_rad = step;
             (plan, FlightMode::Course)
         }
         Controller::Localizer => {
-            // The line 6 m to the right: the vehicle starts left of it (cross-track −6 m,
-            // inside CD/5 = 8 m with the default CD, so the following phase of eq. 5.11).
+            // The line `step` to the right: the vehicle starts left of it. 6 m is inside CD/5
+            // = 8 m with the default CD (the following phase of eq. 5.11); 40 m starts in the
+            // approach phase.
             plan.localizer = Localizer {
-                point_ne_m: [y0[0], y0[1] + controller.step()],
+                point_ne_m: [y0[0], y0[1] + step],
                 ..on_track
             };
             (plan, FlightMode::Localizer)
         }
         Controller::Vertical => {
-            // Along the trimmed track at the trimmed glide slope, 5 m below the vehicle.
+            // Along the trimmed track at the trimmed glide slope, `step` below the vehicle.
             plan.localizer = on_track;
             plan.localizer_glide_slope = Some(v_drone.z / v_drone.x);
             let height = -y0[2];
-            plan.target_ned_m = Vector3::new(0.0, 0.0, -(height - controller.step()));
+            plan.target_ned_m = Vector3::new(0.0, 0.0, -(height - step));
             (plan, FlightMode::Localizer)
+        }
+    }
+}
+
+/// One experiment flown with one gain set.
+#[derive(Debug, Clone, Serialize)]
+pub struct Trial {
+    /// Step size, rad or m.
+    pub step: f64,
+    /// Linear closed-loop step metrics.
+    pub linear: StepMetrics,
+    /// Nonlinear step metrics (None if the flight failed).
+    pub nonlinear: Option<StepMetrics>,
+    /// Why the nonlinear flight failed, if it did.
+    pub nonlinear_error: Option<String>,
+    /// Step responses (linear, nonlinear), for plots.
+    #[serde(skip)]
+    pub responses: (StepResponse, Option<StepResponse>),
+}
+
+impl Trial {
+    fn fly(experiment: &Experiment, g: &ControlGains) -> Self {
+        let linear_response = experiment.linear_response(g);
+        let linear = experiment.score(&linear_response, g);
+        let (nonlinear, nonlinear_error, nonlinear_response) =
+            match experiment.nonlinear_response(g) {
+                Ok(r) => (Some(experiment.score(&r, g)), None, Some(r)),
+                Err(e) => (None, Some(e.to_string()), None),
+            };
+        Self {
+            step: experiment.step,
+            linear,
+            nonlinear,
+            nonlinear_error,
+            responses: (linear_response, nonlinear_response),
         }
     }
 }
@@ -628,19 +721,18 @@ pub struct Candidate {
     pub gains: ControlGains,
     /// The tuned gains' values, in the order of [`Controller::gain_names`].
     pub values: Vec<f64>,
-    /// Linear closed-loop step metrics.
-    pub linear: StepMetrics,
-    /// Nonlinear step metrics (None if the flight failed).
-    pub nonlinear: Option<StepMetrics>,
-    /// Why the nonlinear flight failed, if it did.
-    pub nonlinear_error: Option<String>,
+    /// The small step (the law's linear range).
+    pub small: Trial,
+    /// The large step (saturation, approach phases).
+    pub large: Trial,
+    /// Mean of the two linear costs: what the optimiser minimised.
+    pub linear_cost: f64,
+    /// Mean of the two nonlinear costs (None if a flight failed): what adoption is judged on.
+    pub nonlinear_cost: Option<f64>,
     /// Largest real part of the closed-loop eigenvalues other than the invariances, s⁻¹.
     pub closed_loop_max_real_part: f64,
     /// The closed-loop eigenvalues `[re, im]`.
     pub closed_loop_eigenvalues: Vec<[f64; 2]>,
-    /// Step responses, for plots.
-    #[serde(skip)]
-    pub responses: (StepResponse, Option<StepResponse>),
 }
 
 /// What `stx tune` reports.
@@ -656,7 +748,7 @@ pub struct TuneReport {
     pub trim_airspeed_mps: f64,
     /// Symmetric brake at trim.
     pub trim_brake: f64,
-    /// The experiment.
+    /// The two experiments, in words.
     pub experiment: String,
     /// Before tuning.
     pub current: Candidate,
@@ -699,7 +791,18 @@ pub fn tune(
     mut progress: impl FnMut(usize, usize),
 ) -> Result<TuneReport, TuneError> {
     let current = base.gains;
-    let experiment = Experiment::new(controller, vehicle, altitude_m, base)?;
+    let small = Experiment::new(controller, vehicle, altitude_m, base, controller.step())?;
+    let large = Experiment::new(
+        controller,
+        vehicle,
+        altitude_m,
+        base,
+        controller.large_step(),
+    )?;
+    let linear_cost = |g: &ControlGains| {
+        0.5 * (small.score(&small.linear_response(g), g).cost
+            + large.score(&large.linear_response(g), g).cost)
+    };
     let start = controller.get(&current);
     // The logarithm of each gain, relative to where it starts (a zero gain starts at 10⁻⁴ of
     // a unit so that it can grow).
@@ -721,10 +824,7 @@ pub fn tune(
     let mut used = 0usize;
     let mut run = |from: &[f64], used_before: usize| {
         minimize(
-            |p| {
-                let g = gains_at(p);
-                experiment.score(&experiment.linear_response(&g), &g).cost
-            },
+            |p| linear_cost(&gains_at(p)),
             from,
             &NelderMeadOptions {
                 initial_step: 0.7,
@@ -760,14 +860,13 @@ pub fn tune(
         .collect();
     let tuned_gains = controller.with(&current, &rounded);
     let candidate = |label: &str, g: ControlGains| -> Candidate {
-        let linear_response = experiment.linear_response(&g);
-        let linear = experiment.score(&linear_response, &g);
-        let (nonlinear, nonlinear_error, nonlinear_response) =
-            match experiment.nonlinear_response(&g) {
-                Ok(r) => (Some(experiment.score(&r, &g)), None, Some(r)),
-                Err(e) => (None, Some(e.to_string()), None),
-            };
-        let cl = experiment.closed_loop_eigenvalues(&g);
+        let small_trial = Trial::fly(&small, &g);
+        let large_trial = Trial::fly(&large, &g);
+        let nonlinear_cost = match (small_trial.nonlinear, large_trial.nonlinear) {
+            (Some(a), Some(b)) => Some(0.5 * (a.cost + b.cost)),
+            _ => None,
+        };
+        let cl = small.closed_loop_eigenvalues(&g);
         let max_real = cl
             .iter()
             .filter(|e| e.0.hypot(e.1) >= crate::analysis::ZERO_EIGENVALUE_TOLERANCE)
@@ -777,12 +876,12 @@ pub fn tune(
             label: label.into(),
             gains: g,
             values: controller.get(&g),
-            linear,
-            nonlinear,
-            nonlinear_error,
+            linear_cost: 0.5 * (small_trial.linear.cost + large_trial.linear.cost),
+            nonlinear_cost,
+            small: small_trial,
+            large: large_trial,
             closed_loop_max_real_part: max_real,
             closed_loop_eigenvalues: cl.iter().map(|&(re, im)| [re, im]).collect(),
-            responses: (linear_response, nonlinear_response),
         }
     };
     let current_c = candidate("current", current);
@@ -791,7 +890,7 @@ pub fn tune(
     progress(total - 3, total);
     let seed_c = candidate("seed A.13", controller.seed_gains(&current));
     progress(total, total);
-    let nonlinear_cost = |c: &Candidate| c.nonlinear.map_or(f64::INFINITY, |m| m.cost);
+    let nonlinear_cost = |c: &Candidate| c.nonlinear_cost.unwrap_or(f64::INFINITY);
     let (adopted, verdict) = if nonlinear_cost(&tuned_c) < nonlinear_cost(&current_c) {
         (
             true,
@@ -812,7 +911,7 @@ pub fn tune(
             ),
         )
     };
-    let t = experiment.trim();
+    let t = small.trim();
     Ok(TuneReport {
         controller,
         gain_names: controller.gain_names().to_vec(),
@@ -820,13 +919,14 @@ pub fn tune(
         trim_airspeed_mps: t.airspeed_mps,
         trim_brake: t.controls.brake_right,
         experiment: match controller {
-            Controller::Heading => "heading step of 30° from a trimmed glide".into(),
-            Controller::Course => "course step of 30° from a trimmed glide".into(),
+            Controller::Heading => "heading steps of 30° and 90° from a trimmed glide".into(),
+            Controller::Course => "course steps of 30° and 90° from a trimmed glide".into(),
             Controller::Localizer => {
-                "cross-track offset of 6 m onto a localizer (following phase)".into()
+                "6 m (following phase) and 40 m (approach, then following) off a localizer".into()
             }
             Controller::Vertical => format!(
-                "5 m above a glide path at the slope trimmed with brake {:.2} (following phase)",
+                "5 m (following phase) and 10 m (approach) above a glide path at the slope \
+                 trimmed with brake {:.2}",
                 t.controls.brake_right
             ),
         },
@@ -972,6 +1072,36 @@ mod tests {
     }
 
     #[test]
+    fn the_linear_loop_turns_through_90_degrees_like_the_nonlinear_one() {
+        // The dynamics do not depend on the heading, so the linear estimate turns the velocity
+        // by it: a 90° course change must settle in the linear loop as in the 14-DOF one.
+        let vehicle = Vehicle::straplex();
+        let g = ControlGains::default();
+        let exp = Experiment::new(
+            Controller::Course,
+            &vehicle,
+            600.0,
+            GuidanceConfig::default(),
+            Controller::Course.large_step(),
+        )
+        .expect("trim");
+        let linear = exp.score(&exp.linear_response(&g), &g);
+        let nonlinear = exp.score(&exp.nonlinear_response(&g).expect("flies"), &g);
+        let (l, n) = (
+            linear.settling_time_s.expect("linear settles"),
+            nonlinear.settling_time_s.expect("nonlinear settles"),
+        );
+        // Settling is a threshold crossing: the 14-DOF loop crosses the 5 % band on a
+        // swing the linear one takes one more to damp (7.75 s against 6.0 s here).
+        assert!((l - n).abs() < 2.5, "settling {l} against {n}");
+        let (l, n) = (
+            linear.rise_time_s.expect("rises"),
+            nonlinear.rise_time_s.expect("rises"),
+        );
+        assert!((l - n).abs() < 1.0, "rise {l} against {n}");
+    }
+
+    #[test]
     fn rounding_keeps_three_significant_figures() {
         assert_eq!(round_significant(0.010502721, 3), 0.0105);
         assert_eq!(round_significant(6.54321, 3), 6.54);
@@ -999,17 +1129,20 @@ mod tests {
         .expect("tunes");
         assert!(calls > 10);
         assert!(report.adopted, "{}", report.verdict);
-        let before = report.current.nonlinear.expect("flies").cost;
-        let after = report.tuned.nonlinear.expect("flies").cost;
-        assert!(after < 0.7 * before, "{before} → {after}");
-        assert!(report.tuned.linear.cost < report.current.linear.cost);
+        let before = report.current.nonlinear_cost.expect("flies");
+        let after = report.tuned.nonlinear_cost.expect("flies");
+        assert!(after < 0.8 * before, "{before} → {after}");
+        assert!(report.tuned.linear_cost < report.current.linear_cost);
         assert!(report.tuned.closed_loop_max_real_part < 0.0);
         // The other gains are untouched.
         assert_eq!(report.gains_out.hk3_m_per_m, bad.hk3_m_per_m);
         assert_eq!(report.gains_out.vk1, bad.vk1);
         // And the linear closed loop predicts the nonlinear one: same metrics within a few
         // tenths of a second and per cent.
-        let (l, n) = (report.tuned.linear, report.tuned.nonlinear.expect("flies"));
+        let (l, n) = (
+            report.tuned.small.linear,
+            report.tuned.small.nonlinear.expect("flies"),
+        );
         let (lr, nr) = (l.rise_time_s.expect("rises"), n.rise_time_s.expect("rises"));
         assert!((lr - nr).abs() < 0.5, "{lr} vs {nr}");
         assert!((l.overshoot_pct - n.overshoot_pct).abs() < 3.0);
@@ -1018,13 +1151,14 @@ mod tests {
     #[test]
     fn the_seed_localizer_gains_saturate_and_destabilise_our_loop() {
         // Regression pin for ANALYSIS_NOTES: K_H3b read literally (HK1 = 0.56 m/rad …) is
-        // 30–50 times our gains and drives the main line from stop to stop.
+        // 20 to 1000 times our gains and drives the main line from stop to stop.
         let vehicle = Vehicle::straplex();
         let exp = Experiment::new(
             Controller::Localizer,
             &vehicle,
             600.0,
             GuidanceConfig::default(),
+            Controller::Localizer.step(),
         )
         .expect("trim");
         let seed = Controller::Localizer.seed_gains(&ControlGains::default());

@@ -9,7 +9,7 @@ use anyhow::{Context, anyhow};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use stx_analysis::svg::{COLORS, Corner, Panel, Series, Style, render};
-use stx_analysis::tune::{Candidate, Controller, StepMetrics, TuneReport, tune};
+use stx_analysis::tune::{Candidate, Controller, StepMetrics, Trial, TuneReport, tune};
 use stx_gnc::control::ControlGains;
 use stx_gnc::guidance::GuidanceConfig;
 
@@ -123,7 +123,7 @@ pub fn run(args: TuneArgs) -> anyhow::Result<()> {
 }
 
 fn gains_file(r: &TuneReport, source: &str) -> String {
-    let cost = |c: &Candidate| c.nonlinear.map_or(f64::NAN, |m| m.cost);
+    let cost = |c: &Candidate| c.nonlinear_cost.unwrap_or(f64::NAN);
     format!(
         "# Control gains read by guidance (`stx sim --gains`, `stx montecarlo --gains`).\n\
          # Written by `stx tune --controller {}` at a {:.0} m trim ({}).\n\
@@ -164,7 +164,7 @@ fn print_report(r: &TuneReport) {
         r.altitude_m,
         r.trim_airspeed_mps
     );
-    println!("experiment: {}", r.experiment);
+    println!("experiments: {}", r.experiment);
     println!(
         "Nelder–Mead: {} linear simulations{}",
         r.evaluations,
@@ -175,18 +175,13 @@ fn print_report(r: &TuneReport) {
         }
     );
     println!(
-        "\n{:<10} {:<26} {:<7} {:>7} {:>8} {:>7} {:>7} {:>6} {:>7} {:>9}",
-        "gains",
-        "values",
-        "model",
-        "rise s",
-        "over %",
-        "settle",
-        "use",
-        "sat %",
-        "cost",
-        "max Re λ"
+        "\n{:<10} {:<24} {:<6} {:<7} {:>7} {:>8} {:>7} {:>7} {:>6} {:>7}",
+        "gains", "values", "step", "model", "rise s", "over %", "settle", "use", "sat %", "cost"
     );
+    let (scale, unit) = match r.controller {
+        Controller::Heading | Controller::Course => (180.0 / std::f64::consts::PI, "°"),
+        _ => (1.0, " m"),
+    };
     for c in [&r.current, &r.tuned, &r.seed] {
         let values = c
             .values
@@ -194,19 +189,40 @@ fn print_report(r: &TuneReport) {
             .map(|v| format!("{v:.4}"))
             .collect::<Vec<_>>()
             .join(", ");
+        let mut first = true;
+        for trial in [&c.small, &c.large] {
+            let step = format!("{:.0}{unit}", trial.step * scale);
+            let (label, vals) = if first {
+                (c.label.as_str(), values.as_str())
+            } else {
+                ("", "")
+            };
+            first = false;
+            println!(
+                "{label:<10} {vals:<24} {step:<6} {:<7} {}",
+                "linear",
+                metrics_row(&trial.linear)
+            );
+            match (&trial.nonlinear, &trial.nonlinear_error) {
+                (Some(m), _) => println!(
+                    "{:<10} {:<24} {:<6} {:<7} {}",
+                    "",
+                    "",
+                    "",
+                    "14-DOF",
+                    metrics_row(m)
+                ),
+                (None, Some(e)) => println!("{:<10} {:<24} {:<6} 14-DOF  failed: {e}", "", "", ""),
+                _ => {}
+            }
+        }
         println!(
-            "{:<10} {:<26} {:<7} {} {:>9.3}",
-            c.label,
-            values,
-            "linear",
-            metrics_row(&c.linear),
+            "{:<10} mean cost: linear {:.3}, 14-DOF {}; closed-loop max Re λ {:.3} 1/s",
+            "",
+            c.linear_cost,
+            c.nonlinear_cost.map_or("-".into(), |v| format!("{v:.3}")),
             c.closed_loop_max_real_part
         );
-        match (&c.nonlinear, &c.nonlinear_error) {
-            (Some(m), _) => println!("{:<10} {:<26} {:<7} {}", "", "", "14-DOF", metrics_row(m)),
-            (None, Some(e)) => println!("{:<10} {:<26} 14-DOF  failed: {e}", "", ""),
-            _ => {}
-        }
     }
     println!("\n{}", r.verdict);
 }
@@ -218,51 +234,71 @@ fn plot(r: &TuneReport) -> String {
         Controller::Localizer => (1.0, 100.0),
         Controller::Vertical => (1.0, 1.0),
     };
-    let mut outputs = Vec::new();
-    let mut commands = Vec::new();
-    for (k, cand) in [&r.current, &r.tuned, &r.seed].into_iter().enumerate() {
-        let (linear, nonlinear) = &cand.responses;
-        let color = COLORS[k];
-        let pts =
-            |t: &[f64], y: &[f64], s: f64| t.iter().zip(y).map(|(t, y)| (*t, y * s)).collect();
-        if let Some(n) = nonlinear {
-            outputs.push(Series {
-                label: format!("{} 14-DOF", cand.label),
-                points: pts(&n.time_s, &n.output, scale),
-                color,
-                style: Style::Line,
-            });
-            commands.push(Series {
-                label: format!("{} 14-DOF", cand.label),
-                points: pts(&n.time_s, &n.command, command_scale),
-                color,
-                style: Style::Line,
+    let pts = |t: &[f64], y: &[f64], s: f64| -> Vec<(f64, f64)> {
+        t.iter().zip(y).map(|(t, y)| (*t, y * s)).collect()
+    };
+    let candidates = [&r.current, &r.tuned, &r.seed];
+    let response_panel = |pick: fn(&Candidate) -> &Trial, title: String| {
+        let mut series = Vec::new();
+        for (k, cand) in candidates.iter().enumerate() {
+            let (linear, nonlinear) = &pick(cand).responses;
+            if let Some(n) = nonlinear {
+                series.push(Series {
+                    label: format!("{} 14-DOF", cand.label),
+                    points: pts(&n.time_s, &n.output, scale),
+                    color: COLORS[k],
+                    style: Style::Line,
+                });
+            }
+            series.push(Series {
+                label: format!("{} linear", cand.label),
+                points: pts(&linear.time_s, &linear.output, scale),
+                color: COLORS[k],
+                style: Style::Dashed,
             });
         }
-        outputs.push(Series {
-            label: format!("{} linear", cand.label),
-            points: pts(&linear.time_s, &linear.output, scale),
-            color,
-            style: Style::Dashed,
-        });
-    }
-    let reference = r.current.responses.0.reference * scale;
-    let panels = [
+        let first = &pick(&r.current).responses.0;
         Panel {
-            title: r.experiment.clone(),
+            title,
             x_label: "time, s".into(),
             y_label: c.response_label().into(),
-            series: outputs,
-            h_lines: vec![reference],
-            legend: if reference > r.current.responses.0.initial * scale {
+            series,
+            h_lines: vec![first.reference * scale],
+            legend: if first.reference > first.initial {
                 Corner::BottomRight
             } else {
                 Corner::TopRight
             },
             ..Default::default()
-        },
+        }
+    };
+    let commands = candidates
+        .iter()
+        .enumerate()
+        .filter_map(|(k, cand)| {
+            cand.large.responses.1.as_ref().map(|n| Series {
+                label: format!("{} 14-DOF", cand.label),
+                points: pts(&n.time_s, &n.command, command_scale),
+                color: COLORS[k],
+                style: Style::Line,
+            })
+        })
+        .collect();
+    let unit = |step: f64| match c {
+        Controller::Heading | Controller::Course => format!("{:.0}°", step * scale),
+        _ => format!("{step:.0} m"),
+    };
+    let panels = [
+        response_panel(
+            |c| &c.small,
+            format!("small step ({})", unit(r.current.small.step)),
+        ),
+        response_panel(
+            |c| &c.large,
+            format!("large step ({})", unit(r.current.large.step)),
+        ),
         Panel {
-            title: "actuator (nonlinear runs)".into(),
+            title: "actuator in the large step (nonlinear runs)".into(),
             x_label: "time, s".into(),
             y_label: c.command_label().into(),
             series: commands,
@@ -274,6 +310,6 @@ fn plot(r: &TuneReport) -> String {
         &panels,
         1,
         900.0,
-        380.0,
+        340.0,
     )
 }

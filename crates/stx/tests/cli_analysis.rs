@@ -141,9 +141,16 @@ fn tune_writes_a_gains_file_that_sim_and_montecarlo_read() {
         serde_json::from_str(String::from_utf8_lossy(&out.stdout).trim()).expect("JSON");
     assert_eq!(v["controller"], "localizer");
     for who in ["current", "tuned", "seed"] {
-        assert!(v[who]["linear"]["cost"].as_f64().is_some(), "{who}");
-        assert!(v[who]["nonlinear"]["cost"].as_f64().is_some(), "{who}");
+        for step in ["small", "large"] {
+            assert!(
+                v[who][step]["linear"]["cost"].as_f64().is_some(),
+                "{who} {step}"
+            );
+        }
+        assert!(v[who]["nonlinear_cost"].as_f64().is_some(), "{who}");
     }
+    // The localizer's large step starts in the approach phase: 40 m off the line.
+    assert_eq!(v["current"]["large"]["step"], 40.0);
     let text = std::fs::read_to_string(&gains).expect("gains file");
     assert!(text.starts_with("# "), "header comment");
     assert!(text.contains("stx tune --controller localizer"));
