@@ -365,6 +365,14 @@ mod tests {
     }
 
     #[test]
+    fn the_shipped_gains_file_holds_the_defaults() {
+        // config/gains.toml is documented as the built-in defaults: keep them one.
+        let shipped =
+            ControlGains::from_toml_str(include_str!("../../../config/gains.toml")).expect("valid");
+        assert_eq!(shipped, ControlGains::default());
+    }
+
+    #[test]
     fn invalid_gains_name_the_field() {
         let err = ControlGains::from_toml_str("vk1 = -1.0\n").unwrap_err();
         assert!(
