@@ -4,11 +4,13 @@
 //! Exit codes: 0 success, 1 a failure while running, 2 bad input (unknown scenario, invalid
 //! file or flag).
 
+mod analyze;
 mod bench;
 mod bench_station;
 mod montecarlo;
 mod serve;
 mod sim;
+mod tune;
 
 use std::process::ExitCode;
 
@@ -35,6 +37,10 @@ enum Command {
     Montecarlo(montecarlo::MonteCarloArgs),
     /// Run the ground station: drone link, dashboard and API.
     Serve(serve::ServeArgs),
+    /// Trim, linearise, eigenvalues and ranks beside the seed's (seed chapter 6).
+    Analyze(analyze::AnalyzeArgs),
+    /// Tune one controller's gains and write the gains file guidance uses.
+    Tune(tune::TuneArgs),
 }
 
 /// An error that is the user's input, not the program's failure (exit code 2).
@@ -63,6 +69,8 @@ fn main() -> ExitCode {
         Command::Bench(args) => bench::run(args),
         Command::Montecarlo(args) => montecarlo::run(args),
         Command::Serve(args) => serve::run(args),
+        Command::Analyze(args) => analyze::run(args),
+        Command::Tune(args) => tune::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -37,6 +37,9 @@ pub struct MonteCarloArgs {
     /// Include every run in the JSON.
     #[arg(long)]
     details: bool,
+    /// Control gains file (as `stx tune` writes; default: the built-in gains).
+    #[arg(long)]
+    gains: Option<std::path::PathBuf>,
 }
 
 pub fn run(args: MonteCarloArgs) -> anyhow::Result<()> {
@@ -52,7 +55,7 @@ pub fn run(args: MonteCarloArgs) -> anyhow::Result<()> {
     let threads = args
         .threads
         .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
-    let config = MonteCarloConfig {
+    let mut config = MonteCarloConfig {
         runs: args.runs,
         seed: args.seed,
         wind_max_mps: args.wind_max,
@@ -61,6 +64,9 @@ pub fn run(args: MonteCarloArgs) -> anyhow::Result<()> {
         threads,
         ..MonteCarloConfig::default()
     };
+    if let Some(path) = &args.gains {
+        config.guidance.gains = crate::tune::load_gains(path)?;
+    }
     let sensors = SensorConfig::default();
     let estimator = EstimatorConfig::default();
     // Fail on bad settings before any thread starts.

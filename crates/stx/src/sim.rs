@@ -27,6 +27,9 @@ pub struct SimArgs {
     /// Print the summary as one JSON object on stdout.
     #[arg(long)]
     summary_json: bool,
+    /// Control gains file (as `stx tune` writes) replacing the scenario's guidance gains.
+    #[arg(long)]
+    gains: Option<PathBuf>,
 }
 
 /// Reads a scenario by built-in name or path.
@@ -58,7 +61,20 @@ pub fn load_vehicle(path: Option<&Path>) -> anyhow::Result<Vehicle> {
 }
 
 pub fn run(args: SimArgs) -> anyhow::Result<()> {
-    let scenario = load_scenario(&args.scenario)?;
+    let mut scenario = load_scenario(&args.scenario)?;
+    if let Some(path) = &args.gains {
+        let gains = crate::tune::load_gains(path)?;
+        match scenario.guidance.as_mut() {
+            Some(guidance) => guidance.config.gains = gains,
+            None => {
+                return Err(BadInput(anyhow!(
+                    "--gains: scenario {} flies open loop (no [guidance] section)",
+                    scenario.name
+                ))
+                .into());
+            }
+        }
+    }
     let vehicle = load_vehicle(args.vehicle.as_deref())?;
     let format = match &args.out {
         None => None,

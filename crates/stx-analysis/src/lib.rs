@@ -1,0 +1,28 @@
+//! Stability analysis and gain tuning of the STRAPLEX parafoil (seed chapter 6).
+//!
+//! How the parts fit:
+//! - [`trim`] finds the steady glide of the nonlinear 31-state model (`stx-dynamics`) for
+//!   held servo commands, pinning the states the dynamics do not depend on;
+//! - [`linearize`] differentiates the model about it numerically ([`jacobian`]): `A`, `B` for
+//!   the two inputs (differential main line, symmetric brake), `C`, `D` for the drone's
+//!   measured outputs (seed eq. 6.4);
+//! - [`lti`] gives eigenvalues, controllability and observability ranks (orthogonal staircase
+//!   with an SVD tolerance) and exact discretisation;
+//! - [`analysis`] assembles the report `stx analyze` prints, side by side with the seed's
+//!   published values ([`seed`]);
+//! - [`tune`] closes the loop with the onboard control laws of `stx-gnc` on the linear model,
+//!   optimises the gains of one controller with [`nelder_mead`], and checks them with step
+//!   responses of the nonlinear model flown by `stx-sim`;
+//! - [`svg`] draws the eigenvalue map and the step responses.
+//!
+//! Pure: no files, no clocks, no randomness. The `stx` binary reads and writes files.
+
+pub mod analysis;
+pub mod jacobian;
+pub mod linearize;
+pub mod lti;
+pub mod nelder_mead;
+pub mod seed;
+pub mod svg;
+pub mod trim;
+pub mod tune;

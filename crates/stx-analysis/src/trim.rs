@@ -1,0 +1,411 @@
+//! Trim: the steady glide of the nonlinear model for held servo commands, in still air.
+//!
+//! A glide is not an equilibrium of all 31 states: the position moves at the glide's
+//! velocity. Calm air and a flat Earth make the dynamics independent of the north and east
+//! position and of the heading, so those are pinned (x = y = 0, ψ = 0); the altitude is pinned
+//! to the one asked for (density depends on it, so it is not free, but the glide's slow drift
+//! through the density gradient is not part of a trim either). The servo states equal their
+//! commands (`Δ̇ = K(U − Δ)` vanishes nowhere else). The other 24 states are solved for so
+//! that the 25 remaining derivatives vanish — the Euler-angle rates (heading rate included:
+//! a straight glide), the 14 generalized accelerations and the relative angle rates. That is
+//! one equation more than unknowns, consistent because the vehicle is left–right symmetric;
+//! Levenberg–Marquardt solves it in the least-squares sense and the residual shows that it
+//! was solved exactly.
+
+use std::sync::Arc;
+
+use nalgebra::{DMatrix, DVector};
+use stx_dynamics::atmosphere::{Atmosphere, StandardAtmosphere, US76_MAX_ALTITUDE_M, UniformAir};
+use stx_dynamics::integrate::{Hooks, Rk4, integrate};
+use stx_dynamics::model::{Body, Environment, Kinematics, ParafoilModel, Tensions};
+use stx_dynamics::state::{Controls, N_STATES, Pose, StateVector, idx};
+use stx_dynamics::vehicle::Vehicle;
+use stx_dynamics::wind::Calm;
+use thiserror::Error;
+
+use crate::jacobian::{Step, jacobian};
+
+/// Lowest altitude a trim is computed at, m: the standard atmosphere's own lower end.
+pub const MIN_ALTITUDE_M: f64 = -5_000.0;
+/// Highest, m: the standard atmosphere's upper end (above it the air is extrapolated).
+pub const MAX_ALTITUDE_M: f64 = US76_MAX_ALTITUDE_M;
+/// Largest derivative left at a converged trim, in state-derivative units (rad/s, m/s², …).
+pub const RESIDUAL_TOLERANCE: f64 = 1e-9;
+
+/// Why no trim was found.
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum TrimError {
+    /// The altitude is outside the atmosphere model's range.
+    #[error("altitude {altitude_m} m is outside the trim range {min_m} … {max_m} m")]
+    AltitudeOutOfRange {
+        altitude_m: f64,
+        min_m: f64,
+        max_m: f64,
+    },
+    /// A command is outside what the servos can do.
+    #[error("trim command `{field}` = {value} is outside {rule}")]
+    BadCommand {
+        field: &'static str,
+        value: f64,
+        rule: &'static str,
+    },
+    /// Newton's iteration did not bring the derivatives to zero.
+    #[error(
+        "trim did not converge: largest derivative {residual:.3e} after {iterations} iterations \
+         (tolerance {RESIDUAL_TOLERANCE:e})"
+    )]
+    NotConverged { iterations: usize, residual: f64 },
+    /// It converged to a state in which a line pushes: not a glide this model can fly.
+    #[error("trim has a slack line (tension {tension_n:.3} N): not a glide")]
+    SlackLine { tension_n: f64 },
+}
+
+/// A steady glide.
+#[derive(Debug, Clone)]
+pub struct Trim {
+    /// The trimmed state (x = y = 0, z = −altitude, ψ = 0).
+    pub state: StateVector,
+    /// The held commands.
+    pub controls: Controls,
+    /// Altitude, m above mean sea level.
+    pub altitude_m: f64,
+    /// Air density there, kg/m³.
+    pub density_kg_per_m3: f64,
+    /// Ẋ at the trim: zero but for the position rates.
+    pub derivative: StateVector,
+    /// Largest derivative other than the position rates, at the end.
+    pub residual: f64,
+    /// Levenberg–Marquardt iterations.
+    pub iterations: usize,
+    /// Line tensions, N.
+    pub tensions: Tensions,
+    /// Canopy airspeed, m/s.
+    pub airspeed_mps: f64,
+    /// Canopy angle of attack, rad.
+    pub alpha_rad: f64,
+    /// Horizontal speed of the canopy CM, m/s.
+    pub horizontal_speed_mps: f64,
+    /// Sink rate, m/s (positive down).
+    pub sink_rate_mps: f64,
+    /// Drone velocity, inertial NED, m/s.
+    pub drone_velocity_ned_mps: [f64; 3],
+}
+
+impl Trim {
+    /// Glide ratio, horizontal over vertical distance.
+    pub fn glide_ratio(&self) -> f64 {
+        self.horizontal_speed_mps / self.sink_rate_mps
+    }
+}
+
+/// The still-air environment of a trim.
+pub fn calm_environment() -> Environment {
+    Environment {
+        atmosphere: Arc::new(StandardAtmosphere),
+        wind: Arc::new(Calm),
+        ground_altitude_msl_m: 0.0,
+    }
+}
+
+/// Calm air whose density is held at `altitude_m`'s everywhere: the environment in which a
+/// trim is an exact relative equilibrium. In the standard atmosphere a glide sinks into
+/// denser air and slows by about 0.3 % a minute, a drift no linearisation about a point
+/// contains; comparisons of the linear and nonlinear models use this air so that they
+/// measure the linearisation alone.
+pub fn uniform_environment(altitude_m: f64) -> Environment {
+    Environment {
+        atmosphere: Arc::new(UniformAir(StandardAtmosphere.air_at(altitude_m))),
+        wind: Arc::new(Calm),
+        ground_altitude_msl_m: 0.0,
+    }
+}
+
+/// The states solved for: all but x, y, z, ψ and the three servos.
+fn free_states() -> Vec<usize> {
+    (0..N_STATES)
+        .filter(|&i| !(i < 3 || i == idx::CANOPY_EULER + 2 || i >= idx::MAIN_LINE))
+        .collect()
+}
+
+/// The derivatives that must vanish: all but the position rates and the servo rates (zero by
+/// construction).
+fn residual_rows() -> Vec<usize> {
+    (3..idx::MAIN_LINE).collect()
+}
+
+/// The seed's Table 6.1 glide read in km/h (flight-model.md item 4), with speeds scaled by
+/// `√(ρ₀/ρ)` so that the dynamic pressure, and so the angles, stay those of sea level.
+fn initial_guess(altitude_m: f64, density: f64, controls: &Controls) -> StateVector {
+    let scale = (1.225 / density).sqrt();
+    let mut x = Pose {
+        position_ned_m: [0.0, 0.0, -altitude_m],
+        canopy_euler_deg: [0.0, -8.1, 0.0],
+        canopy_velocity_mps: [22.0 / 3.6 * scale, 0.0, 11.0 / 3.6 * scale],
+        line_pitch_deg: -5.3,
+        drone_euler_deg: [0.0, 6.1, 0.0],
+        capsule_angles_deg: [0.0, -7.1],
+        transponder_angles_deg: [0.0, 5.4],
+        ..Default::default()
+    }
+    .to_state();
+    x[idx::MAIN_LINE] = controls.main_line_m;
+    x[idx::BRAKE_RIGHT] = controls.brake_right;
+    x[idx::BRAKE_LEFT] = controls.brake_left;
+    x
+}
+
+/// Trims `vehicle` at `altitude_m` with the servos held at `controls` (symmetric brakes, no
+/// main line: a straight glide).
+pub fn trim(vehicle: &Vehicle, altitude_m: f64, controls: Controls) -> Result<Trim, TrimError> {
+    if !(MIN_ALTITUDE_M..=MAX_ALTITUDE_M).contains(&altitude_m) {
+        return Err(TrimError::AltitudeOutOfRange {
+            altitude_m,
+            min_m: MIN_ALTITUDE_M,
+            max_m: MAX_ALTITUDE_M,
+        });
+    }
+    if controls.main_line_m != 0.0 {
+        return Err(TrimError::BadCommand {
+            field: "main_line_m",
+            value: controls.main_line_m,
+            rule: "{0}: a straight glide has the main lines centred",
+        });
+    }
+    for (field, value) in [
+        ("brake_right", controls.brake_right),
+        ("brake_left", controls.brake_left),
+    ] {
+        if !(0.0..1.0).contains(&value) {
+            return Err(TrimError::BadCommand {
+                field,
+                value,
+                rule: "[0, 1)",
+            });
+        }
+    }
+    let env = calm_environment();
+    let density = env.atmosphere.air_at(altitude_m).density_kg_per_m3;
+    let mut model = ParafoilModel::new(vehicle.clone(), env);
+    model.set_controls(controls);
+
+    let guess = initial_guess(altitude_m, density, &controls);
+    let solved = match levenberg_marquardt(&model, &guess) {
+        Ok(done) => Ok(done),
+        // Far from sea level, or for an unusual vehicle, the guess may lie outside Newton's
+        // basin: let the model fly itself towards its glide for a minute, then polish.
+        Err(_) => {
+            let settled = integrate(
+                &mut Rk4::new(0.01),
+                &mut model.clone(),
+                0.0,
+                &guess,
+                60.0,
+                Hooks::default(),
+            );
+            match settled {
+                Ok(outcome) if outcome.state.iter().all(|v| v.is_finite()) => {
+                    let mut x = outcome.state;
+                    for i in 0..3 {
+                        x[i] = guess[i];
+                    }
+                    x[idx::CANOPY_EULER + 2] = 0.0;
+                    levenberg_marquardt(&model, &x)
+                }
+                _ => levenberg_marquardt(&model, &guess),
+            }
+        }
+    };
+    let (state, iterations, residual) = solved?;
+    let evaluation = model.evaluate(0.0, &state);
+    let tensions = evaluation.tensions;
+    if tensions.min() <= 0.0 {
+        return Err(TrimError::SlackLine {
+            tension_n: tensions.min(),
+        });
+    }
+    let derivative = evaluation.derivative;
+    let kin = Kinematics::new(vehicle, &state, controls.main_line_m);
+    let v_canopy = kin.velocity_ned_mps(Body::Canopy);
+    let v_drone = kin.velocity_ned_mps(Body::Drone);
+    Ok(Trim {
+        state,
+        controls,
+        altitude_m,
+        density_kg_per_m3: density,
+        derivative,
+        residual,
+        iterations,
+        tensions,
+        airspeed_mps: evaluation.canopy_air.airspeed_mps,
+        alpha_rad: evaluation.canopy_air.alpha_rad,
+        horizontal_speed_mps: v_canopy.x.hypot(v_canopy.y),
+        sink_rate_mps: v_canopy.z,
+        drone_velocity_ned_mps: [v_drone.x, v_drone.y, v_drone.z],
+    })
+}
+
+/// Largest |derivative| over the residual rows.
+fn residual_of(model: &ParafoilModel, x: &StateVector) -> (DVector<f64>, f64) {
+    let dx = model.evaluate(0.0, x).derivative;
+    let rows = residual_rows();
+    let r = DVector::from_iterator(rows.len(), rows.iter().map(|&i| dx[i]));
+    let max = r.iter().map(|v| v.abs()).fold(0.0, f64::max);
+    (r, if max.is_nan() { f64::INFINITY } else { max })
+}
+
+/// Levenberg–Marquardt on the free states: `(JᵀJ + λ diag JᵀJ) δ = −Jᵀr`, λ shrunk after a
+/// step that lowers ‖r‖ and grown after one that does not.
+fn levenberg_marquardt(
+    model: &ParafoilModel,
+    start: &StateVector,
+) -> Result<(StateVector, usize, f64), TrimError> {
+    const MAX_ITERATIONS: usize = 100;
+    let free = free_states();
+    let mut x = *start;
+    let (mut r, mut worst) = residual_of(model, &x);
+    let mut cost = r.norm_squared();
+    let mut lambda = 1e-3;
+    let scales = vec![1.0; free.len()];
+    let steps = vec![Step::Central; free.len()];
+    for iteration in 0..MAX_ITERATIONS {
+        if worst < RESIDUAL_TOLERANCE {
+            return Ok((x, iteration, worst));
+        }
+        let base = x;
+        let j = jacobian(
+            |z: &DVector<f64>| {
+                let mut y = base;
+                for (k, &i) in free.iter().enumerate() {
+                    y[i] = z[k];
+                }
+                residual_of(model, &y).0
+            },
+            &DVector::from_iterator(free.len(), free.iter().map(|&i| x[i])),
+            &scales,
+            &steps,
+        );
+        let jtj = j.transpose() * &j;
+        let g = j.transpose() * &r;
+        let mut improved = false;
+        for _ in 0..12 {
+            let mut lhs: DMatrix<f64> = jtj.clone();
+            for k in 0..free.len() {
+                lhs[(k, k)] += lambda * jtj[(k, k)].max(1e-12);
+            }
+            let Some(delta) = lhs.lu().solve(&(-&g)) else {
+                lambda *= 10.0;
+                continue;
+            };
+            let mut trial = x;
+            for (k, &i) in free.iter().enumerate() {
+                trial[i] += delta[k];
+            }
+            let (r_trial, worst_trial) = residual_of(model, &trial);
+            let cost_trial = r_trial.norm_squared();
+            if cost_trial.is_finite() && cost_trial < cost {
+                x = trial;
+                r = r_trial;
+                worst = worst_trial;
+                cost = cost_trial;
+                lambda = (lambda / 10.0).max(1e-12);
+                improved = true;
+                break;
+            }
+            lambda *= 10.0;
+        }
+        if !improved {
+            return if worst < RESIDUAL_TOLERANCE {
+                Ok((x, iteration, worst))
+            } else {
+                Err(TrimError::NotConverged {
+                    iterations: iteration,
+                    residual: worst,
+                })
+            };
+        }
+    }
+    if worst < RESIDUAL_TOLERANCE {
+        Ok((x, MAX_ITERATIONS, worst))
+    } else {
+        Err(TrimError::NotConverged {
+            iterations: MAX_ITERATIONS,
+            residual: worst,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sea_level_glide_has_vanishing_derivatives_and_taut_lines() {
+        let v = Vehicle::straplex();
+        let t = trim(&v, 100.0, Controls::default()).expect("trim");
+        assert!(t.residual < RESIDUAL_TOLERANCE, "{}", t.residual);
+        // The full derivative, not just the rows solved: only the position moves.
+        for i in 3..N_STATES {
+            assert!(
+                t.derivative[i].abs() < 1e-8,
+                "{} = {}",
+                idx::NAMES[i],
+                t.derivative[i]
+            );
+        }
+        assert!(t.tensions.min() > 0.0);
+        // Symmetric: no lateral state.
+        for i in [3, 7, 9, 11, 14, 16, 17, 19, 20, 22, 24, 26] {
+            assert!(
+                t.state[i].abs() < 1e-8,
+                "{} = {}",
+                idx::NAMES[i],
+                t.state[i]
+            );
+        }
+        // Flight tests (seed §3.2.2): about 18 km/h forward, 10 km/h down, glide ≈ 2.
+        assert!((4.0..8.0).contains(&t.horizontal_speed_mps), "{t:?}");
+        assert!((1.5..4.5).contains(&t.sink_rate_mps), "{t:?}");
+        assert!((1.5..3.5).contains(&t.glide_ratio()), "{}", t.glide_ratio());
+    }
+
+    #[test]
+    fn thin_air_glides_faster_at_the_same_angle_of_attack() {
+        let v = Vehicle::straplex();
+        let low = trim(&v, 0.0, Controls::default()).expect("trim at sea level");
+        let high = trim(&v, 20_000.0, Controls::default()).expect("trim at 20 km");
+        let expected = (low.density_kg_per_m3 / high.density_kg_per_m3).sqrt();
+        let ratio = high.airspeed_mps / low.airspeed_mps;
+        // Apparent mass and the pendants' drag scale the same way with density, so the
+        // airspeed goes with 1/√ρ to within a few per cent.
+        assert!(
+            (ratio / expected - 1.0).abs() < 0.05,
+            "{ratio} vs {expected}"
+        );
+        assert!((high.alpha_rad - low.alpha_rad).abs() < 0.02);
+    }
+
+    #[test]
+    fn brakes_steepen_the_glide() {
+        let v = Vehicle::straplex();
+        let free = trim(&v, 100.0, Controls::default()).expect("trim");
+        let braked = trim(&v, 100.0, Controls::symmetric_brake(0.4)).expect("braked trim");
+        assert!(braked.glide_ratio() < free.glide_ratio());
+    }
+
+    #[test]
+    fn refuses_altitudes_outside_the_atmosphere_and_bad_commands() {
+        let v = Vehicle::straplex();
+        assert!(matches!(
+            trim(&v, 120_000.0, Controls::default()),
+            Err(TrimError::AltitudeOutOfRange { .. })
+        ));
+        assert!(matches!(
+            trim(&v, f64::NAN, Controls::default()),
+            Err(TrimError::AltitudeOutOfRange { .. })
+        ));
+        assert!(matches!(
+            trim(&v, 100.0, Controls::symmetric_brake(1.5)),
+            Err(TrimError::BadCommand { .. })
+        ));
+    }
+}

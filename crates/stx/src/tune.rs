@@ -1,0 +1,315 @@
+//! `stx tune`: optimise one controller's gains on the linearised closed loop, check them on
+//! the nonlinear model, write the gains file guidance reads, and plot the step responses.
+
+use std::fs;
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, anyhow};
+use clap::Args;
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use stx_analysis::svg::{COLORS, Corner, Panel, Series, Style, render};
+use stx_analysis::tune::{Candidate, Controller, StepMetrics, Trial, TuneReport, tune};
+use stx_gnc::control::ControlGains;
+use stx_gnc::guidance::GuidanceConfig;
+
+use crate::BadInput;
+use crate::sim::load_vehicle;
+
+#[derive(Args)]
+pub struct TuneArgs {
+    /// The controller: heading, course, localizer or vertical.
+    #[arg(long)]
+    controller: Controller,
+    /// Vehicle file (default: the shipped STRAPLEX vehicle).
+    #[arg(long)]
+    vehicle: Option<PathBuf>,
+    /// Altitude of the trim the loop is tuned at, m (the Monte Carlo releases at 600 m).
+    #[arg(long, default_value_t = 600.0)]
+    altitude: f64,
+    /// Gains to start from and keep for the other controllers (default: the --out file if it
+    /// exists, else the built-in defaults).
+    #[arg(long)]
+    gains: Option<PathBuf>,
+    /// The gains file written.
+    #[arg(long, default_value = "config/gains.toml")]
+    out: PathBuf,
+    /// Where tune-CONTROLLER.json and step-CONTROLLER.svg are written.
+    #[arg(long, default_value = "target/analysis")]
+    out_dir: PathBuf,
+    /// Print the report as one JSON object on stdout.
+    #[arg(long)]
+    json: bool,
+}
+
+/// Reads and validates a gains file (`stx tune` writes them).
+pub fn load_gains(path: &Path) -> anyhow::Result<ControlGains> {
+    let text = fs::read_to_string(path)
+        .with_context(|| format!("cannot read gains file {}", path.display()))
+        .map_err(BadInput)?;
+    ControlGains::from_toml_str(&text)
+        .with_context(|| format!("gains file {}", path.display()))
+        .map_err(|e| BadInput(e).into())
+}
+
+pub fn run(args: TuneArgs) -> anyhow::Result<()> {
+    let vehicle = load_vehicle(args.vehicle.as_deref())?;
+    let (start, source) = match (&args.gains, args.out.exists()) {
+        (Some(path), _) => (load_gains(path)?, path.display().to_string()),
+        (None, true) => (load_gains(&args.out)?, args.out.display().to_string()),
+        (None, false) => (ControlGains::default(), "the built-in defaults".to_string()),
+    };
+    let base = GuidanceConfig {
+        gains: start,
+        ..GuidanceConfig::default()
+    };
+    let bar = ProgressBar::with_draw_target(
+        None,
+        if std::io::stderr().is_terminal() {
+            ProgressDrawTarget::stderr()
+        } else {
+            ProgressDrawTarget::hidden()
+        },
+    );
+    bar.set_style(
+        ProgressStyle::with_template("{bar:40} {pos}/{len} simulations, {elapsed} elapsed")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    let report = tune(
+        args.controller,
+        &vehicle,
+        args.altitude,
+        base,
+        |done, total| {
+            bar.set_length(total as u64);
+            bar.set_position(done as u64);
+        },
+    )
+    .map_err(|e| match e {
+        stx_analysis::tune::TuneError::Trim(t) => {
+            BadInput(anyhow!(t).context(format!("trim at {} m", args.altitude))).into()
+        }
+        other => anyhow!(other),
+    })?;
+    bar.finish_and_clear();
+
+    if let Some(parent) = args.out.parent().filter(|p| !p.as_os_str().is_empty()) {
+        fs::create_dir_all(parent).with_context(|| format!("creating {}", parent.display()))?;
+    }
+    fs::write(&args.out, gains_file(&report, &source))
+        .with_context(|| format!("writing {}", args.out.display()))?;
+    fs::create_dir_all(&args.out_dir)
+        .with_context(|| format!("creating {}", args.out_dir.display()))?;
+    let name = args.controller.name();
+    let json_path = args.out_dir.join(format!("tune-{name}.json"));
+    fs::write(&json_path, serde_json::to_string_pretty(&report)?)
+        .with_context(|| format!("writing {}", json_path.display()))?;
+    let svg_path = args.out_dir.join(format!("step-{name}.svg"));
+    fs::write(&svg_path, plot(&report))
+        .with_context(|| format!("writing {}", svg_path.display()))?;
+
+    if args.json {
+        println!("{}", serde_json::to_string(&report)?);
+    } else {
+        print_report(&report);
+        println!(
+            "\nwrote {} (from {source}), {}, {}",
+            args.out.display(),
+            json_path.display(),
+            svg_path.display()
+        );
+    }
+    Ok(())
+}
+
+fn gains_file(r: &TuneReport, source: &str) -> String {
+    let cost = |c: &Candidate| c.nonlinear_cost.unwrap_or(f64::NAN);
+    format!(
+        "# Control gains read by guidance (`stx sim --gains`, `stx montecarlo --gains`).\n\
+         # Written by `stx tune --controller {}` at a {:.0} m trim ({}).\n\
+         # {}: nonlinear step cost {:.3} before, {:.3} tuned, {:.3} with the seed's A.13 gains.\n\
+         # Gains of the other controllers carried over from {source}.\n{}",
+        r.controller.name(),
+        r.altitude_m,
+        r.experiment,
+        r.verdict,
+        cost(&r.current),
+        cost(&r.tuned),
+        cost(&r.seed),
+        r.gains_out.to_toml_string()
+    )
+}
+
+fn fmt_opt(v: Option<f64>) -> String {
+    v.map_or("never".into(), |t| format!("{t:.1}"))
+}
+
+fn metrics_row(m: &StepMetrics) -> String {
+    format!(
+        "{:>7} {:>8.1} {:>7} {:>7.2} {:>6.0} {:>7.3}",
+        fmt_opt(m.rise_time_s),
+        m.overshoot_pct,
+        fmt_opt(m.settling_time_s),
+        m.command_use,
+        100.0 * m.saturated_fraction,
+        m.cost
+    )
+}
+
+fn print_report(r: &TuneReport) {
+    println!(
+        "Tuning {} ({}) at a {:.0} m trim, airspeed {:.2} m/s",
+        r.controller.name(),
+        r.gain_names.join(", "),
+        r.altitude_m,
+        r.trim_airspeed_mps
+    );
+    println!("experiments: {}", r.experiment);
+    println!(
+        "Nelder–Mead: {} linear simulations{}",
+        r.evaluations,
+        if r.converged {
+            ", converged"
+        } else {
+            ", budget used up"
+        }
+    );
+    println!(
+        "\n{:<10} {:<24} {:<6} {:<7} {:>7} {:>8} {:>7} {:>7} {:>6} {:>7}",
+        "gains", "values", "step", "model", "rise s", "over %", "settle", "use", "sat %", "cost"
+    );
+    let (scale, unit) = match r.controller {
+        Controller::Heading | Controller::Course => (180.0 / std::f64::consts::PI, "°"),
+        _ => (1.0, " m"),
+    };
+    for c in [&r.current, &r.tuned, &r.seed] {
+        let values = c
+            .values
+            .iter()
+            .map(|v| format!("{v:.4}"))
+            .collect::<Vec<_>>()
+            .join(", ");
+        let mut first = true;
+        for trial in [&c.small, &c.large] {
+            let step = format!("{:.0}{unit}", trial.step * scale);
+            let (label, vals) = if first {
+                (c.label.as_str(), values.as_str())
+            } else {
+                ("", "")
+            };
+            first = false;
+            println!(
+                "{label:<10} {vals:<24} {step:<6} {:<7} {}",
+                "linear",
+                metrics_row(&trial.linear)
+            );
+            match (&trial.nonlinear, &trial.nonlinear_error) {
+                (Some(m), _) => println!(
+                    "{:<10} {:<24} {:<6} {:<7} {}",
+                    "",
+                    "",
+                    "",
+                    "14-DOF",
+                    metrics_row(m)
+                ),
+                (None, Some(e)) => println!("{:<10} {:<24} {:<6} 14-DOF  failed: {e}", "", "", ""),
+                _ => {}
+            }
+        }
+        println!(
+            "{:<10} mean cost: linear {:.3}, 14-DOF {}; closed-loop max Re λ {:.3} 1/s",
+            "",
+            c.linear_cost,
+            c.nonlinear_cost.map_or("-".into(), |v| format!("{v:.3}")),
+            c.closed_loop_max_real_part
+        );
+    }
+    println!("\n{}", r.verdict);
+}
+
+fn plot(r: &TuneReport) -> String {
+    let c = r.controller;
+    let (scale, command_scale) = match c {
+        Controller::Heading | Controller::Course => (180.0 / std::f64::consts::PI, 100.0),
+        Controller::Localizer => (1.0, 100.0),
+        Controller::Vertical => (1.0, 1.0),
+    };
+    let pts = |t: &[f64], y: &[f64], s: f64| -> Vec<(f64, f64)> {
+        t.iter().zip(y).map(|(t, y)| (*t, y * s)).collect()
+    };
+    let candidates = [&r.current, &r.tuned, &r.seed];
+    let response_panel = |pick: fn(&Candidate) -> &Trial, title: String| {
+        let mut series = Vec::new();
+        for (k, cand) in candidates.iter().enumerate() {
+            let (linear, nonlinear) = &pick(cand).responses;
+            if let Some(n) = nonlinear {
+                series.push(Series {
+                    label: format!("{} 14-DOF", cand.label),
+                    points: pts(&n.time_s, &n.output, scale),
+                    color: COLORS[k],
+                    style: Style::Line,
+                });
+            }
+            series.push(Series {
+                label: format!("{} linear", cand.label),
+                points: pts(&linear.time_s, &linear.output, scale),
+                color: COLORS[k],
+                style: Style::Dashed,
+            });
+        }
+        let first = &pick(&r.current).responses.0;
+        Panel {
+            title,
+            x_label: "time, s".into(),
+            y_label: c.response_label().into(),
+            series,
+            h_lines: vec![first.reference * scale],
+            legend: if first.reference > first.initial {
+                Corner::BottomRight
+            } else {
+                Corner::TopRight
+            },
+            ..Default::default()
+        }
+    };
+    let commands = candidates
+        .iter()
+        .enumerate()
+        .filter_map(|(k, cand)| {
+            cand.large.responses.1.as_ref().map(|n| Series {
+                label: format!("{} 14-DOF", cand.label),
+                points: pts(&n.time_s, &n.command, command_scale),
+                color: COLORS[k],
+                style: Style::Line,
+            })
+        })
+        .collect();
+    let unit = |step: f64| match c {
+        Controller::Heading | Controller::Course => format!("{:.0}°", step * scale),
+        _ => format!("{step:.0} m"),
+    };
+    let panels = [
+        response_panel(
+            |c| &c.small,
+            format!("small step ({})", unit(r.current.small.step)),
+        ),
+        response_panel(
+            |c| &c.large,
+            format!("large step ({})", unit(r.current.large.step)),
+        ),
+        Panel {
+            title: "actuator in the large step (nonlinear runs)".into(),
+            x_label: "time, s".into(),
+            y_label: c.command_label().into(),
+            series: commands,
+            ..Default::default()
+        },
+    ];
+    render(
+        &format!("stx tune --controller {}: step responses", c.name()),
+        &panels,
+        1,
+        900.0,
+        340.0,
+    )
+}
