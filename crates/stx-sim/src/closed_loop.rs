@@ -18,7 +18,7 @@ use stx_gnc::guidance::{Guidance, PhaseEvent};
 use stx_gnc::mission::{FlightMode, GuidancePhase};
 
 use crate::open_loop::{height_above_ground_m, lowest_point};
-use crate::sensors::{DeliveryQueue, SensorConfig, SensorConfigError, SensorSuite, Truth};
+use crate::sensors::{Delivery, DeliveryQueue, SensorConfig, SensorConfigError, SensorSuite, Truth};
 
 /// Navigation as the drone does it: its sensors sample the truth, their measurements reach the
 /// estimator after their latencies, and the estimator's output is what guidance sees.
@@ -58,18 +58,33 @@ impl SensedNavigation {
     pub fn estimator(&self) -> &Estimator {
         &self.estimator
     }
+
+    /// Samples the sensors on `truth` and hands the estimator every measurement that has
+    /// reached it by `truth.time_s`; returns those measurements, in arrival order (the drone
+    /// also sends them to the station). Any truth will do: the simulated drone's stages
+    /// before the parafoil build theirs without the 14-DOF model.
+    pub fn sense(&mut self, truth: &Truth) -> Vec<Delivery> {
+        for delivery in self.sensors.sample(truth.time_s, truth) {
+            self.in_flight.push(delivery);
+        }
+        let mut arrived = Vec::new();
+        while let Some(delivery) = self.in_flight.pop_due(truth.time_s) {
+            self.estimator
+                .handle(delivery.arrival_s, &delivery.measurement);
+            arrived.push(delivery);
+        }
+        arrived
+    }
+
+    /// The estimate at `time_s`.
+    pub fn estimate(&self, time_s: f64) -> Estimate {
+        self.estimator.estimate(time_s)
+    }
 }
 
 impl Navigator for SensedNavigation {
     fn navigate(&mut self, model: &ParafoilModel, time_s: f64, x: &StateVector) -> Estimate {
-        let truth = Truth::from_model(model, time_s, x);
-        for delivery in self.sensors.sample(time_s, &truth) {
-            self.in_flight.push(delivery);
-        }
-        while let Some(delivery) = self.in_flight.pop_due(time_s) {
-            self.estimator
-                .handle(delivery.arrival_s, &delivery.measurement);
-        }
+        self.sense(&Truth::from_model(model, time_s, x));
         self.estimator.estimate(time_s)
     }
 }
