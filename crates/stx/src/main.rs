@@ -5,6 +5,7 @@
 //! file or flag).
 
 mod bench;
+mod drone;
 mod montecarlo;
 mod sim;
 
@@ -31,6 +32,8 @@ enum Command {
     Bench(bench::BenchArgs),
     /// Many spiral landings from random releases and winds: landing statistics.
     Montecarlo(montecarlo::MonteCarloArgs),
+    /// The simulated drone flying a whole mission over a MAVLink link.
+    Drone(drone::DroneArgs),
 }
 
 /// An error that is the user's input, not the program's failure (exit code 2).
@@ -58,6 +61,7 @@ fn main() -> ExitCode {
         Command::Sim(args) => sim::run(args),
         Command::Bench(args) => bench::run(args),
         Command::Montecarlo(args) => montecarlo::run(args),
+        Command::Drone(args) => drone::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
