@@ -18,7 +18,9 @@ use stx_gnc::guidance::{Guidance, PhaseEvent};
 use stx_gnc::mission::{FlightMode, GuidancePhase};
 
 use crate::open_loop::{height_above_ground_m, lowest_point};
-use crate::sensors::{Delivery, DeliveryQueue, SensorConfig, SensorConfigError, SensorSuite, Truth};
+use crate::sensors::{
+    Delivery, DeliveryQueue, SensorConfig, SensorConfigError, SensorSuite, Truth,
+};
 
 /// Navigation as the drone does it: its sensors sample the truth, their measurements reach the
 /// estimator after their latencies, and the estimator's output is what guidance sees.

@@ -1,7 +1,8 @@
-//! Mission scenario files (`config/scenarios/mission*.toml`): everything the simulated drone
-//! needs to fly a whole STRAPLEX mission — the launch site, the balloon, the round chute, the
-//! parafoil's deployment, the onboard plan, the wind, the sensors and estimator, the
-//! failsafes, the battery and the failures to inject.
+//! Mission scenario files (`config/scenarios/mission*.toml`, `rehearsal.toml`): everything the
+//! simulated drone needs to fly a whole STRAPLEX mission — the launch site, the balloon, the
+//! round chute, the parafoil's deployment, the onboard plan and settings (the parameters of
+//! [`stx_gnc::params`]), the wind, the sensors and estimator, the battery and the failures to
+//! inject.
 //!
 //! Staged like the rest of stx: the TOML text is parsed into [`MissionConfig`] (unknown keys
 //! refused), [`MissionConfig::validate`] checks every number before anything runs, and only
@@ -12,8 +13,8 @@ use serde::Deserialize;
 use stx_dynamics::wind::WindConfig;
 use stx_gnc::estimator::EstimatorConfig;
 use stx_gnc::geo::LocalFrame;
-use stx_gnc::guidance::GuidanceConfig;
 use stx_gnc::mission::{FlightMode, FlightStage};
+use stx_gnc::params::{OnboardSettings, ParamError};
 use thiserror::Error;
 
 use crate::drone::failures::FailureConfig;
@@ -29,6 +30,10 @@ pub const BUILTIN: &[(&str, &str)] = &[
     (
         "mission-short",
         include_str!("../../../../config/scenarios/mission-short.toml"),
+    ),
+    (
+        "rehearsal",
+        include_str!("../../../../config/scenarios/rehearsal.toml"),
     ),
 ];
 
@@ -61,6 +66,9 @@ pub enum MissionError {
     /// The estimator description is invalid.
     #[error("mission estimator is invalid: {0}")]
     Estimator(#[from] stx_gnc::estimator::EstimatorConfigError),
+    /// An onboard setting (a parameter) is out of its range or contradicts another.
+    #[error("mission onboard settings are invalid: {0}")]
+    Onboard(#[from] ParamError),
 }
 
 fn invalid(field: &str, value: impl ToString, rule: &'static str) -> MissionError {
@@ -105,8 +113,7 @@ pub struct BalloonConfig {
     /// Exponent `k` of the density ratio, 0…0.5: 1/6 for drag balance with the volume growing
     /// as 1/ρ and a constant drag coefficient; 0 for a constant ascent rate.
     pub ascent_density_exponent: f64,
-    /// Altitude at which the balloon bursts, m above mean sea level (the `MIS_BURST_M`
-    /// parameter's initial value).
+    /// Altitude at which the balloon bursts, m above mean sea level (> the site's altitude).
     pub burst_altitude_msl_m: f64,
 }
 
@@ -141,28 +148,13 @@ impl Default for RoundChuteConfig {
     }
 }
 
-/// Release of the round chute and the parafoil's deployment.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+/// How the parafoil comes out when the onboard software releases the round chute (the height
+/// is the onboard decision `onboard.mission.deploy_height_m`).
+#[derive(Debug, Clone, Default, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct ParafoilStageConfig {
-    /// Height above the launch site's ground at which the round chute is released and the
-    /// parafoil deploys, m (the `MIS_DEPLOY_M` parameter's initial value).
-    pub deploy_height_m: f64,
-    /// Time the parafoil is left to inflate and settle with neutral servos before guidance
-    /// takes over, s (≥ 0).
-    pub settle_s: f64,
     /// Heading of the canopy at deployment, degrees from north; absent: along the drift.
     pub deploy_heading_deg: Option<f64>,
-}
-
-impl Default for ParafoilStageConfig {
-    fn default() -> Self {
-        Self {
-            deploy_height_m: 2500.0,
-            settle_s: 8.0,
-            deploy_heading_deg: None,
-        }
-    }
 }
 
 /// The onboard plan: what the drone flies with no operator.
@@ -186,8 +178,6 @@ pub struct PlanConfig {
     pub localizer: Option<LocalizerSpec>,
     /// Glide slope (sink over ground speed) down the localizer, if any.
     pub glide_slope: Option<f64>,
-    /// Gains, performance model and spiral settings.
-    pub config: GuidanceConfig,
 }
 
 impl Default for PlanConfig {
@@ -201,46 +191,11 @@ impl Default for PlanConfig {
             course_deg: 0.0,
             localizer: None,
             glide_slope: None,
-            config: GuidanceConfig::default(),
         }
     }
 }
 
-/// What the drone does when it loses GPS (see `onboard.rs`, "GPS loss").
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum GpsLossAction {
-    /// Keep flying the plan on the dead-reckoned estimate.
-    Continue = 0,
-    /// Turn into the last wind estimate and hold that heading, wings level (flare near the
-    /// ground by the barometer): the slowest drift and the softest touchdown without knowing
-    /// where the vehicle is.
-    IntoWind = 1,
-}
-
-/// Failsafe settings (their parameters' initial values).
-#[derive(Debug, Clone, PartialEq, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct FailsafeConfig {
-    /// Seconds without a GPS fix before the GPS-loss action is taken (`GPS_LOSS_S`).
-    pub gps_loss_s: f64,
-    /// The action (`GPS_LOSS_ACT`: 0 continue, 1 into the wind).
-    pub gps_loss_action: GpsLossAction,
-    /// Sticks go stale after this long without MANUAL_CONTROL, s (`MAN_TIMEOUT_S`).
-    pub manual_timeout_s: f64,
-}
-
-impl Default for FailsafeConfig {
-    fn default() -> Self {
-        Self {
-            gps_loss_s: 3.0,
-            gps_loss_action: GpsLossAction::IntoWind,
-            manual_timeout_s: 0.5,
-        }
-    }
-}
-
-/// The drone's battery (see `telemetry.rs`, "Battery").
+/// The drone's battery (see [`crate::drone::telemetry::Battery`]).
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct BatteryConfig {
@@ -320,9 +275,13 @@ pub struct MissionConfig {
     /// Parafoil deployment.
     #[serde(default)]
     pub parafoil: ParafoilStageConfig,
-    /// Onboard plan and guidance settings.
+    /// Onboard plan.
     #[serde(default)]
     pub plan: PlanConfig,
+    /// Onboard settings: the initial values of the drone's parameters (gains, spiral,
+    /// failsafes, mission decisions; see `stx_gnc::params::CATALOG`).
+    #[serde(default)]
+    pub onboard: OnboardSettings,
     /// Wind over the whole height of the mission (a profile up to the burst altitude); calm
     /// if absent. Its mean (without turbulence) is also the forecast loaded onboard for the
     /// round-chute landing prediction.
@@ -333,9 +292,6 @@ pub struct MissionConfig {
     /// The onboard estimator (its `ground_altitude_msl_m` is taken from `site`).
     #[serde(default)]
     pub estimator: EstimatorConfig,
-    /// Failsafes.
-    #[serde(default)]
-    pub failsafe: FailsafeConfig,
     /// Battery.
     #[serde(default)]
     pub battery: BatteryConfig,
@@ -474,7 +430,6 @@ impl MissionConfig {
         finite_positive("round_chute.drag_area_m2", self.round_chute.drag_area_m2)?;
         finite_non_negative("round_chute.extra_mass_kg", self.round_chute.extra_mass_kg)?;
         let p = &self.parafoil;
-        finite_non_negative("parafoil.settle_s", p.settle_s)?;
         if let Some(h) = p.deploy_heading_deg
             && !h.is_finite()
         {
@@ -584,15 +539,14 @@ impl MissionConfig {
         }
         self.failures.validate()?;
         // The values that become parameters must lie in their parameters' ranges.
-        let initial = crate::drone::onboard::ParamValues::from_config(self);
-        for spec in crate::drone::onboard::param_specs(&initial, 1.0) {
-            if !(spec.min <= spec.default && spec.default <= spec.max) {
-                return Err(MissionError::Invalid {
-                    field: format!("parameter {}", spec.name),
-                    value: spec.default.to_string(),
-                    rule: "must lie in the parameter's range (see its description)",
-                });
-            }
+        self.onboard.check()?;
+        let burst = self.balloon.burst_altitude_msl_m;
+        if !(burst.is_finite() && burst > self.site.alt_msl_m + 20.0) {
+            return Err(invalid(
+                "balloon.burst_altitude_msl_m",
+                self.balloon.burst_altitude_msl_m,
+                "must be at least 20 m above site.alt_msl_m",
+            ));
         }
         Ok(())
     }
@@ -623,20 +577,31 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(err.contains("bogus"), "{err}");
-        let text = "name = \"x\"\ndescription = \"x\"\n[plan]\nmode = \"manual\"\n";
-        let err = MissionConfig::from_toml_str("x", text)
-            .unwrap_err()
-            .to_string();
-        assert!(err.contains("plan.mode"), "{err}");
-        let text = "name = \"x\"\ndescription = \"x\"\n[balloon]\nascent_rate_mps = -1\n[plan]\ntarget_ne_m = [0, 0]\n";
-        let err = MissionConfig::from_toml_str("x", text)
-            .unwrap_err()
-            .to_string();
-        assert!(err.contains("balloon.ascent_rate_mps"), "{err}");
-        let text = "name = \"x\"\ndescription = \"x\"\n[plan]\ntarget_ne_m = [0, 0]\n[parafoil]\ndeploy_height_m = 99999\n";
-        let err = MissionConfig::from_toml_str("x", text)
-            .unwrap_err()
-            .to_string();
-        assert!(err.contains("MIS_DEPLOY_M"), "{err}");
+        // Each broken field is named in the error.
+        for (tables, field) in [
+            ("[plan]\nmode = \"manual\"\n", "plan.mode"),
+            (
+                "[balloon]\nascent_rate_mps = -1\n[plan]\ntarget_ne_m = [0, 0]\n",
+                "balloon.ascent_rate_mps",
+            ),
+            (
+                "[balloon]\nburst_altitude_msl_m = 100\n[plan]\ntarget_ne_m = [0, 0]\n",
+                "balloon.burst_altitude_msl_m",
+            ),
+            (
+                "[plan]\ntarget_ne_m = [0, 0]\n[onboard.mission]\ndeploy_height_m = 99999\n",
+                "MIS_DEPLOY_M",
+            ),
+            (
+                "[plan]\ntarget_ne_m = [0, 0]\n[failures]\nlink_drop_s = [[50, 10]]\n",
+                "failures.link_drop_s[0]",
+            ),
+        ] {
+            let text = format!("name = \"x\"\ndescription = \"x\"\n{tables}");
+            let err = MissionConfig::from_toml_str("x", &text)
+                .unwrap_err()
+                .to_string();
+            assert!(err.contains(field), "{field}: {err}");
+        }
     }
 }

@@ -2,7 +2,8 @@
 //! from the scenario file's `[failures]` table and the command line.
 //!
 //! - Link drops (`link_drop_s` windows of mission time): the drone neither sends nor hears
-//!   anything — the adapter asks [`LinkFaults::drops_datagram`] for every datagram in and out.
+//!   anything — [`crate::drone::Drone`] asks [`LinkFaults::drops_datagram`] for every
+//!   datagram in (each `handle_bytes` call) and every frame out.
 //! - Packet loss (`packet_loss_pct`): each datagram, in or out, is dropped with this
 //!   probability, drawn from a generator seeded by the mission's seed, so a rehearsal is
 //!   repeatable given the same traffic.
@@ -48,20 +49,20 @@ pub struct StuckServo {
 /// A command-line failure flag that does not parse.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum FailureFlagError {
-    /// A window is not `FROM:TO` with 0 ≤ FROM < TO.
-    #[error("{text:?} is not a window FROM:TO in seconds of mission time with 0 ≤ FROM < TO")]
+    /// A window is not `FROM..TO` with 0 ≤ FROM < TO.
+    #[error("{text:?} is not a window FROM..TO in seconds of mission time with 0 ≤ FROM < TO")]
     Window { text: String },
     /// A stuck servo is not `main|right|left@T`.
     #[error("{text:?} is not SERVO@T with SERVO main, right or left and T ≥ 0 seconds")]
     StuckServo { text: String },
 }
 
-/// Parses a window `FROM:TO` (seconds of mission time).
+/// Parses a window `FROM..TO` (seconds of mission time), e.g. `100..160`.
 pub fn parse_window(text: &str) -> Result<[f64; 2], FailureFlagError> {
     let err = || FailureFlagError::Window {
         text: text.to_string(),
     };
-    let (from, to) = text.split_once(':').ok_or_else(err)?;
+    let (from, to) = text.split_once("..").ok_or_else(err)?;
     let from: f64 = from.trim().parse().map_err(|_| err())?;
     let to: f64 = to.trim().parse().map_err(|_| err())?;
     if from >= 0.0 && to > from && to.is_finite() {
@@ -272,9 +273,10 @@ mod tests {
 
     #[test]
     fn flags_parse_and_refuse_nonsense() {
-        assert_eq!(parse_window("10:20.5"), Ok([10.0, 20.5]));
-        assert!(parse_window("20:10").is_err());
-        assert!(parse_window("-1:10").is_err());
+        assert_eq!(parse_window("10..20.5"), Ok([10.0, 20.5]));
+        assert!(parse_window("20..10").is_err());
+        assert!(parse_window("-1..10").is_err());
+        assert!(parse_window("10:20").is_err());
         assert!(parse_window("10").is_err());
         assert_eq!(
             "right@12".parse::<StuckServo>(),

@@ -20,16 +20,18 @@
 //!   Standard Atmosphere 1976 at its altitude and `w` the wind, integrated with RK4 in 0.05 s
 //!   steps. The terminal speed `√(2mg/(ρ·C_D·A))` is about 6 m/s at the ground and 70 m/s
 //!   (250 km/h) at 35 km; the stack drifts with the wind.
-//! - **ParafoilDeploy**, at the deploy height above the ground: the round chute is released
-//!   and the 14-DOF [`ParafoilModel`] starts from a steady glide
+//! - **ParafoilDeploy**, when the onboard software releases the round chute
+//!   ([`MissionPhysics::deploy`], at its deploy height): the 14-DOF [`ParafoilModel`] starts
+//!   from a steady glide
 //!   ([`crate::montecarlo::steady_glide_state`]) placed with its drone at the stack's position,
 //!   heading along the drift (or a configured heading). The canopy inflates and settles for
-//!   the settle time with whatever the servos are commanded (the onboard software holds them
-//!   neutral).
+//!   the settle time ([`MissionPhysics::settle_s`]) with whatever the servos are commanded (the
+//!   onboard software holds them neutral).
 //! - **Parafoil**: the same model, steered by the onboard software through the servo
 //!   commands, integrated with RK4 by [`crate::closed_loop::fly_period`] up to the ground
 //!   contact of its lowest body.
-//! - **Landed**: on the ground where it touched down.
+//! - **Landed**: on the ground where it touched down — under the parafoil, or under the round
+//!   chute if it was never released.
 //!
 //! The drone's attitude is the model's under the parafoil. Under the balloon and the round
 //! chute it is a swing: a pendulum of the flight train's length (about 15 m under the
@@ -215,8 +217,16 @@ pub enum CutdownRefused {
     #[error("still on the ground: nothing to cut")]
     OnGround,
     /// The balloon is already gone.
-    #[error("no balloon: the stage is {0:?}")]
+    #[error("no balloon to cut: the stage is {0:?}")]
     NoBalloon(FlightStage),
+}
+
+/// Why a deployment is refused.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+#[error("no round chute to release: the stage is {stage:?}")]
+pub struct DeployRefused {
+    /// The stage at the request.
+    pub stage: FlightStage,
 }
 
 /// The true state of the whole flight.
@@ -239,12 +249,11 @@ pub struct MissionPhysics {
     chute_swing: Swing,
     launch_at_s: f64,
     deployed_at_s: Option<f64>,
-    settle_s: f64,
     deploy_heading_rad: Option<f64>,
-    /// Burst altitude MSL, m (a parameter: may change in flight).
-    pub burst_altitude_msl_m: f64,
-    /// Deploy height above the ground, m (a parameter).
-    pub deploy_height_m: f64,
+    burst_altitude_msl_m: f64,
+    /// Time from deployment to guided flight, s (the onboard `MIS_SETTLE_S`, which the station
+    /// may change).
+    pub settle_s: f64,
 }
 
 impl std::fmt::Debug for MissionPhysics {
@@ -302,10 +311,9 @@ impl MissionPhysics {
             chute_swing,
             launch_at_s: start.launch_delay_s,
             deployed_at_s: None,
-            settle_s: config.parafoil.settle_s,
+            settle_s: config.onboard.mission.settle_s,
             deploy_heading_rad: config.parafoil.deploy_heading_deg.map(f64::to_radians),
             burst_altitude_msl_m: config.balloon.burst_altitude_msl_m,
-            deploy_height_m: config.parafoil.deploy_height_m,
         };
         match start.stage {
             FlightStage::Ascent => {
@@ -319,7 +327,7 @@ impl MissionPhysics {
             }
             FlightStage::ParafoilDeploy => {
                 physics.velocity_ned_mps = physics.wind_at(&physics.position_ned_m);
-                physics.deploy();
+                physics.start_parafoil();
             }
             _ => {}
         }
@@ -334,6 +342,11 @@ impl MissionPhysics {
     /// The stage.
     pub fn stage(&self) -> FlightStage {
         self.stage
+    }
+
+    /// Altitude at which the balloon bursts, m above mean sea level.
+    pub fn burst_altitude_msl_m(&self) -> f64 {
+        self.burst_altitude_msl_m
     }
 
     /// The vehicle flown.
@@ -483,12 +496,6 @@ impl MissionPhysics {
                     self.velocity_ned_mps = Vector3::zeros();
                     self.touchdown = Some(t);
                     events.push(StageEvent::Landed(t));
-                } else if -self.position_ned_m.z <= self.deploy_height_m {
-                    let heading_rad = self.deploy();
-                    events.push(StageEvent::Deployed {
-                        height_m: -self.position_ned_m.z,
-                        heading_rad,
-                    });
                 }
             }
             FlightStage::ParafoilDeploy | FlightStage::Parafoil => {
@@ -562,9 +569,21 @@ impl MissionPhysics {
         false
     }
 
-    /// Releases the round chute: starts the parafoil model at the drone's position, heading
-    /// along the drift or as configured. Returns the heading, rad.
-    fn deploy(&mut self) -> f64 {
+    /// Releases the round chute (the onboard software's decision): the parafoil deploys at
+    /// the drone's position, heading along the drift or as configured.
+    pub fn deploy(&mut self) -> Result<StageEvent, DeployRefused> {
+        if self.stage != FlightStage::RoundChute {
+            return Err(DeployRefused { stage: self.stage });
+        }
+        let heading_rad = self.start_parafoil();
+        Ok(StageEvent::Deployed {
+            height_m: -self.position_ned_m.z,
+            heading_rad,
+        })
+    }
+
+    /// Starts the parafoil model at the drone's position. Returns the heading, rad.
+    fn start_parafoil(&mut self) -> f64 {
         let v = self.velocity_ned_mps;
         let heading = self.deploy_heading_rad.unwrap_or_else(|| {
             if v.x.hypot(v.y) > 0.1 {

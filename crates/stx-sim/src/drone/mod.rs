@@ -28,7 +28,9 @@
 //! - [`mission`]: the physics of each stage (balloon, round chute, 14-DOF parafoil);
 //! - [`onboard`]: the drone's software;
 //! - [`telemetry`]: what is sent when, and the battery model;
-//! - [`failures`]: link drops, packet loss, GPS loss and a stuck servo, for rehearsals.
+//! - [`failures`]: link drops, packet loss, GPS loss and a stuck servo, for rehearsals;
+//! - [`link`]: [`link::LinkedDrone`], the drone behind its MAVLink endpoint (still sans-io):
+//!   what `stx drone` drives over a socket and the tests drive against a ground endpoint.
 //!
 //! The estimator runs from launch so the station sees an onboard estimate all along; it is
 //! restarted when the parafoil deploys, so that guidance starts from a filter that has only
@@ -43,6 +45,7 @@
 
 pub mod config;
 pub mod failures;
+pub mod link;
 pub mod mission;
 pub mod onboard;
 pub mod telemetry;
@@ -61,6 +64,7 @@ use stx_gnc::geo::LocalFrame;
 use stx_gnc::guidance::PhaseEvent;
 use stx_gnc::measurement::{AirDataSample, AttitudeSample, Measurement};
 use stx_gnc::mission::{FlightMode, FlightStage};
+use stx_gnc::params::ParamError;
 use stx_gnc::predict::{PredictorConfig, predict};
 use stx_link::command::{Command, CommandResult};
 use stx_link::manual::Sticks;
@@ -76,7 +80,7 @@ use crate::sensors::{DeliveryQueue, SensorSuite};
 pub use config::{MissionConfig, MissionError};
 use failures::{LinkFaults, Servo, ServoFault};
 use mission::{MissionPhysics, PhysicsError, StageEvent};
-use onboard::{Onboard, mode_name};
+use onboard::{HardwareRequest, Onboard, mode_name};
 use telemetry::{Battery, Streams, msg};
 
 /// Most outputs kept for a caller that does not drain them; older ones are dropped and
@@ -207,6 +211,15 @@ impl Drone {
             None => (Arc::new(Calm), Box::new(Calm)),
         };
         let travel = vehicle.main_line_travel_m;
+        let line_max = config.onboard.guidance.gains.main_line_limit_m;
+        if line_max > travel {
+            return Err(MissionError::Invalid {
+                field: "onboard.guidance.gains.main_line_limit_m".into(),
+                value: line_max.to_string(),
+                rule: "must not exceed the vehicle's main-line servo travel",
+            }
+            .into());
+        }
         let physics = MissionPhysics::new(&config, vehicle, wind)?;
         let onboard = Onboard::new(&config, travel);
         // The table must build as the link will build it.
@@ -352,7 +365,7 @@ impl Drone {
 
     /// The stick staleness timeout in force, s (the link's receiver applies it).
     pub fn manual_timeout_s(&self) -> f64 {
-        self.onboard.values().manual_timeout_s
+        self.onboard.settings().failsafe.manual_timeout_s
     }
 
     /// Outputs dropped because nobody drained them.
@@ -387,13 +400,20 @@ impl Drone {
         }
     }
 
-    /// Sets a parameter from the station (range-checked); effective at the next period.
-    pub fn set_param(&mut self, name: &str, value: f32) -> Result<(), ParamTableError> {
-        self.onboard.set_param(name, value)?;
-        let v = self.onboard.values();
-        self.physics.burst_altitude_msl_m = v.burst_altitude_msl_m;
-        self.physics.deploy_height_m = v.deploy_height_m;
-        Ok(())
+    /// Sets a parameter from the station (checked against the shared catalog); effective at
+    /// the next period. On refusal nothing changes and the reason goes to the operator's log.
+    pub fn set_param(&mut self, name: &str, value: f32) -> Result<(), ParamError> {
+        match self.onboard.set_param(name, value) {
+            Ok(()) => {
+                self.physics.settle_s = self.onboard.settings().mission.settle_s;
+                self.say(Severity::Info, format!("parameter {name} = {value}"));
+                Ok(())
+            }
+            Err(e) => {
+                self.say(Severity::Warning, format!("parameter refused: {e}"));
+                Err(e)
+            }
+        }
     }
 
     /// The sticks as the link's receiver has them (`None` when stale): call before every
@@ -429,7 +449,7 @@ impl Drone {
                     now - lost,
                     stage_name(stage),
                     mode_name(self.onboard.mode()),
-                    -self.physics.truth().position_ned_m.z,
+                    self.estimate.map_or(f64::NAN, |e| e.height_m()),
                 ),
             );
         }
@@ -501,6 +521,22 @@ impl Drone {
                         .map_or(-truth.position_ned_m.z, |e| e.height_m()),
             )
             .density_kg_per_m3;
+        let request = self.onboard.mission_request(stage, self.estimate.as_ref());
+        // The decision first, then what the hardware did.
+        self.drain_onboard_texts();
+        match request {
+            Some(HardwareRequest::Cutdown) => match self.physics.cutdown() {
+                Ok(event) => self.stage_event(event),
+                Err(why) => self.say(Severity::Warning, format!("cutdown failed: {why}")),
+            },
+            Some(HardwareRequest::Deploy) => match self.physics.deploy() {
+                Ok(event) => self.stage_event(event),
+                Err(why) => self.say(Severity::Warning, format!("deployment failed: {why}")),
+            },
+            None => {}
+        }
+        self.drain_onboard_texts();
+        let stage = self.stage();
         let commanded = self.onboard.control(stage, self.estimate.as_ref(), density);
         for event in self.onboard.guidance_mut().drain_events() {
             self.announce_phase(&event);
@@ -575,7 +611,8 @@ impl Drone {
                 Severity::Notice,
                 format!(
                     "launched: ascending at {:.1} m/s to burst at {:.0} m",
-                    self.config.balloon.ascent_rate_mps, self.physics.burst_altitude_msl_m
+                    self.config.balloon.ascent_rate_mps,
+                    self.physics.burst_altitude_msl_m()
                 ),
             ),
             StageEvent::Burst { altitude_msl_m } => (
@@ -698,7 +735,8 @@ impl Drone {
             }
         }
         if self.streams.due(msg::SERVO_OUTPUT_RAW, t) {
-            let a = telemetry::actuators(t, &self.commanded, travel);
+            // Where the servos are (lagging their commands, or stuck), not where they were sent.
+            let a = telemetry::actuators(t, &self.physics.servo_positions(), travel);
             self.send(Telemetry::Actuators(a));
         }
         if self.streams.due(msg::SYS_STATUS, t) {

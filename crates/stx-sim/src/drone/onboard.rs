@@ -30,256 +30,82 @@
 //! # GPS loss
 //! The estimator dead-reckons through a GPS gap (air velocity, heading, barometer). When no
 //! fix has been used for the estimator's GPS timeout the drone announces the loss; after
-//! `GPS_LOSS_S` seconds it acts by `GPS_LOSS_ACT`, in parafoil flight and in the modes that
-//! steer on position (course, localizer, spiral landing):
+//! `FS_GPS_LOSS_S` seconds it acts by `FS_GPS_ACTION` ([`GpsLossAction`]), in parafoil flight
+//! and in the modes that steer on position (course, localizer, spiral landing; heading mode
+//! needs only the AHRS and goes on):
 //! - `1` (into the wind, the default): it turns to the direction the last wind estimate comes
 //!   from and holds that heading with the heading law (the heading is the AHRS's, good without
 //!   GPS), brakes released, and flares below the flare height by the barometric height. Into
 //!   the wind the vehicle drifts least over the ground and touches down slowest — the safe
 //!   choice without knowing where it is. In calm air it holds its heading.
 //! - `0`: it keeps flying the plan on the dead-reckoned estimate.
+//! - `2`: servos neutral: the parafoil glides straight and lands unflared.
 //!
 //! When fixes return it says so, and a spiral landing replans from its approximation (the
 //! dead-reckoned position may have jumped).
 //!
+//! # Mission decisions
+//! On its estimate the software cuts the balloon away at `MIS_CUTDOWN_M` (if set and the
+//! balloon has not burst) and releases the round chute at `MIS_DEPLOY_M` above the site
+//! ([`Onboard::mission_request`]); the physics carries them out.
+//!
 //! # Parameters
-//! See [`param_specs`]: the control gains of `ControlGains`, the spiral's size and flare, the
-//! burst altitude, the deploy height, the manual timeout and the GPS-loss policy. Names are at
-//! most 16 characters, units are in the descriptions, ranges are enforced, and a change takes
-//! effect at the next control period.
+//! Every parameter is described once, in `stx_gnc::params::CATALOG` (shared with the
+//! station); [`param_specs`] turns it into the link's table and [`Onboard::set_param`] applies a
+//! set through [`OnboardSettings::apply`] (range, kind and the rules between parameters; the
+//! main-line limit also by the servo travel). A change takes effect at the next control
+//! period.
 
 use std::collections::VecDeque;
 
 use nalgebra::Vector3;
 use stx_dynamics::rotation::wrap_pi;
 use stx_dynamics::state::Controls;
-use stx_gnc::control::{self, ControlGains, Localizer};
+use stx_gnc::control::{self, Localizer};
 use stx_gnc::estimate::Estimate;
 use stx_gnc::geo::LocalFrame;
-use stx_gnc::guidance::{Guidance, Plan, SpiralConfig};
+use stx_gnc::guidance::{Guidance, Plan};
 use stx_gnc::mission::{FlightMode, FlightStage, GuidancePhase};
+use stx_gnc::params::ParamError;
+use stx_gnc::params::{CATALOG, GpsLossAction, OnboardSettings};
 use stx_link::command::{Command, CommandResult};
 use stx_link::manual::Sticks;
-use stx_link::param::{ParamSpec, ParamTableError};
+use stx_link::param::ParamSpec;
 use stx_link::plan::PlanItem;
 use stx_link::telemetry::Severity;
 
-use crate::drone::config::{GpsLossAction, MissionConfig};
+use crate::drone::config::MissionConfig;
 
-/// The values behind the parameters.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ParamValues {
-    /// Control-law gains and limits.
-    pub gains: ControlGains,
-    /// Spiral settings.
-    pub spiral: SpiralConfig,
-    /// Burst altitude, m MSL.
-    pub burst_altitude_msl_m: f64,
-    /// Deploy height above the ground, m.
-    pub deploy_height_m: f64,
-    /// Stick staleness timeout, s.
-    pub manual_timeout_s: f64,
-    /// Seconds without GPS before the GPS-loss action.
-    pub gps_loss_s: f64,
-    /// The GPS-loss action.
-    pub gps_loss_action: GpsLossAction,
-}
-
-impl ParamValues {
-    /// The initial values of a mission.
-    pub fn from_config(config: &MissionConfig) -> Self {
-        Self {
-            gains: config.plan.config.gains,
-            spiral: config.plan.config.spiral,
-            burst_altitude_msl_m: config.balloon.burst_altitude_msl_m,
-            deploy_height_m: config.parafoil.deploy_height_m,
-            manual_timeout_s: config.failsafe.manual_timeout_s,
-            gps_loss_s: config.failsafe.gps_loss_s,
-            gps_loss_action: config.failsafe.gps_loss_action,
-        }
-    }
-}
-
-/// One parameter: name, range, description, and where its value lives.
-struct ParamDef {
-    name: &'static str,
-    min: f64,
-    max: f64,
-    description: &'static str,
-    get: fn(&ParamValues) -> f64,
-    set: fn(&mut ParamValues, f64),
-}
-
-fn flag(v: f64) -> bool {
-    v >= 0.5
-}
-
-/// Every parameter. The main line's limit is bounded by the vehicle's travel at run time.
-const PARAMS: &[ParamDef] = &[
-    ParamDef {
-        name: "CTL_HK1",
-        min: 0.0,
-        max: 0.2,
-        description: "HK1: main line per rad of heading/course/bearing error, m/rad",
-        get: |v| v.gains.hk1_m_per_rad,
-        set: |v, x| v.gains.hk1_m_per_rad = x,
-    },
-    ParamDef {
-        name: "CTL_HK2",
-        min: 0.0,
-        max: 0.2,
-        description: "HK2: main line per rad/s of heading rate (damping), m*s/rad",
-        get: |v| v.gains.hk2_m_s_per_rad,
-        set: |v, x| v.gains.hk2_m_s_per_rad = x,
-    },
-    ParamDef {
-        name: "CTL_HK3",
-        min: 0.0,
-        max: 0.01,
-        description: "HK3: main line per m of cross-track error (localizer following), m/m",
-        get: |v| v.gains.hk3_m_per_m,
-        set: |v, x| v.gains.hk3_m_per_m = x,
-    },
-    ParamDef {
-        name: "CTL_CD_M",
-        min: 5.0,
-        max: 1000.0,
-        description: "CD: convergence distance of localizer and glide slope, m",
-        get: |v| v.gains.convergence_distance_m,
-        set: |v, x| v.gains.convergence_distance_m = x,
-    },
-    ParamDef {
-        name: "CTL_VK1",
-        min: 0.0,
-        max: 20.0,
-        description: "VK1: brake per unit of glide-slope error, 1",
-        get: |v| v.gains.vk1,
-        set: |v, x| v.gains.vk1 = x,
-    },
-    ParamDef {
-        name: "CTL_VK2",
-        min: 0.0,
-        max: 1.0,
-        description: "VK2: brake per m of altitude error (glide-slope following), 1/m",
-        get: |v| v.gains.vk2_per_m,
-        set: |v, x| v.gains.vk2_per_m = x,
-    },
-    ParamDef {
-        name: "CTL_BRK_TRIM",
-        min: 0.0,
-        max: 1.0,
-        description: "symmetric brake held when the vertical law is centred, 0..1",
-        get: |v| v.gains.brake_trim,
-        set: |v, x| v.gains.brake_trim = x,
-    },
-    ParamDef {
-        name: "CTL_ML_LIM_M",
-        min: 0.001,
-        max: 1.0,
-        description: "largest main-line command of the control laws, m (<= servo travel)",
-        get: |v| v.gains.main_line_limit_m,
-        set: |v, x| v.gains.main_line_limit_m = x,
-    },
-    ParamDef {
-        name: "SPI_HALF_M",
-        min: 10.0,
-        max: 1000.0,
-        description: "spiral: half the side of the square pattern, m",
-        get: |v| v.spiral.half_size_m,
-        set: |v, x| v.spiral.half_size_m = x,
-    },
-    ParamDef {
-        name: "SPI_FLARE_M",
-        min: 0.0,
-        max: 50.0,
-        description: "spiral: height of the lowest body at which the flare starts, m",
-        get: |v| v.spiral.flare_height_m,
-        set: |v, x| v.spiral.flare_height_m = x,
-    },
-    ParamDef {
-        name: "SPI_FLARE",
-        min: 0.0,
-        max: 1.0,
-        description: "spiral: flare with full brakes near the ground, 1 on / 0 off",
-        get: |v| f64::from(u8::from(v.spiral.flare)),
-        set: |v, x| v.spiral.flare = flag(x),
-    },
-    ParamDef {
-        name: "SPI_AIM_M",
-        min: -100.0,
-        max: 100.0,
-        description: "spiral: touchdown aimed this far beyond the target along the final, m",
-        get: |v| v.spiral.aim_beyond_m,
-        set: |v, x| v.spiral.aim_beyond_m = x,
-    },
-    ParamDef {
-        name: "MIS_BURST_M",
-        min: 1000.0,
-        max: 50_000.0,
-        description: "balloon burst altitude above mean sea level, m",
-        get: |v| v.burst_altitude_msl_m,
-        set: |v, x| v.burst_altitude_msl_m = x,
-    },
-    ParamDef {
-        name: "MIS_DEPLOY_M",
-        min: 50.0,
-        max: 20_000.0,
-        description: "round chute released, parafoil deployed at this height above ground, m",
-        get: |v| v.deploy_height_m,
-        set: |v, x| v.deploy_height_m = x,
-    },
-    ParamDef {
-        name: "MAN_TIMEOUT_S",
-        min: 0.1,
-        max: 5.0,
-        description: "manual: sticks stale after this long without MANUAL_CONTROL, s",
-        get: |v| v.manual_timeout_s,
-        set: |v, x| v.manual_timeout_s = x,
-    },
-    ParamDef {
-        name: "GPS_LOSS_S",
-        min: 0.5,
-        max: 120.0,
-        description: "GPS loss: seconds without a fix before the GPS-loss action, s",
-        get: |v| v.gps_loss_s,
-        set: |v, x| v.gps_loss_s = x,
-    },
-    ParamDef {
-        name: "GPS_LOSS_ACT",
-        min: 0.0,
-        max: 1.0,
-        description: "GPS loss action: 0 keep flying the plan dead-reckoned, 1 hold into wind",
-        get: |v| f64::from(v.gps_loss_action as u8),
-        set: |v, x| {
-            v.gps_loss_action = if flag(x) {
-                GpsLossAction::IntoWind
-            } else {
-                GpsLossAction::Continue
-            }
-        },
-    },
-];
-
-/// The parameter table, valued at `values`; `main_line_travel_m` bounds `CTL_ML_LIM_M`.
-pub fn param_specs(values: &ParamValues, main_line_travel_m: f64) -> Vec<ParamSpec> {
-    PARAMS
+/// The parameter table of the onboard settings `settings` (their values as the table's
+/// starting values), from the shared catalog `stx_gnc::params::CATALOG`. The main line's
+/// limit is also bounded by the vehicle's servo travel `main_line_travel_m`.
+pub fn param_specs(settings: &OnboardSettings, main_line_travel_m: f64) -> Vec<ParamSpec> {
+    CATALOG
         .iter()
         .map(|p| {
-            let max = if p.name == "CTL_ML_LIM_M" {
-                main_line_travel_m
+            let max = if p.name == MAIN_LINE_LIMIT {
+                p.max.min(main_line_travel_m)
             } else {
                 p.max
             };
-            ParamSpec::new(
-                p.name,
-                (p.get)(values) as f32,
-                p.min as f32,
-                max as f32,
-                p.description,
-            )
+            let units = if p.units.is_empty() {
+                String::new()
+            } else {
+                format!(", {}", p.units)
+            };
+            ParamSpec {
+                name: p.name.to_string(),
+                default: p.get(settings) as f32,
+                min: p.min as f32,
+                max: max as f32,
+                description: format!("{}{units}", p.description),
+            }
         })
         .collect()
 }
+
+/// The parameter bounded by the servo travel.
+const MAIN_LINE_LIMIT: &str = "GN_LINE_MAX";
 
 /// Where the GPS-loss policy stands.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -290,13 +116,23 @@ pub enum GpsState {
     Lost { since_s: f64, acted: bool },
     /// Holding `heading_rad` into the wind since `since_s`.
     IntoWind { since_s: f64, heading_rad: f64 },
+    /// Servos neutral since `since_s` (`FS_GPS_ACTION` 2).
+    Neutral { since_s: f64 },
+}
+
+/// A change the onboard software asks of the vehicle's hardware.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum HardwareRequest {
+    /// Cut the balloon away.
+    Cutdown,
+    /// Release the round chute: the parafoil deploys.
+    Deploy,
 }
 
 /// The drone's software.
 #[derive(Debug, Clone)]
 pub struct Onboard {
-    values: ParamValues,
-    specs: Vec<ParamSpec>,
+    settings: OnboardSettings,
     guidance: Guidance,
     frame: LocalFrame,
     main_line_travel_m: f64,
@@ -307,6 +143,8 @@ pub struct Onboard {
     sticks: Option<Sticks>,
     gps: GpsState,
     had_fix: bool,
+    /// The automatic cutdown was asked for (once is enough).
+    cutdown_requested: bool,
     texts: VecDeque<(Severity, String)>,
 }
 
@@ -330,8 +168,7 @@ impl Onboard {
     /// The software as loaded before launch with `config`'s plan, for a vehicle of
     /// `main_line_travel_m` main-line travel.
     pub fn new(config: &MissionConfig, main_line_travel_m: f64) -> Self {
-        let values = ParamValues::from_config(config);
-        let mut guidance = Guidance::new(config.plan.config);
+        let mut guidance = Guidance::new(config.onboard.guidance);
         let target = config.target_ned_m();
         let p = &config.plan;
         let localizer = p.localizer.map(|l| Localizer {
@@ -353,8 +190,7 @@ impl Onboard {
         // The plan's initial phase changes are not news.
         guidance.drain_events();
         Self {
-            specs: param_specs(&values, main_line_travel_m),
-            values,
+            settings: config.onboard,
             guidance,
             frame: config.site,
             main_line_travel_m,
@@ -364,6 +200,7 @@ impl Onboard {
             sticks: None,
             gps: GpsState::Ok,
             had_fix: false,
+            cutdown_requested: false,
             texts: VecDeque::new(),
         }
     }
@@ -383,22 +220,19 @@ impl Onboard {
         self.guidance.mode()
     }
 
-    /// The parameter values.
-    pub fn values(&self) -> &ParamValues {
-        &self.values
+    /// The settings in force (the parameters' values).
+    pub fn settings(&self) -> &OnboardSettings {
+        &self.settings
     }
 
     /// The parameter table with the current values as defaults (for the link's table).
     pub fn param_specs(&self) -> Vec<ParamSpec> {
-        param_specs(&self.values, self.main_line_travel_m)
+        param_specs(&self.settings, self.main_line_travel_m)
     }
 
     /// A parameter's value.
     pub fn param(&self, name: &str) -> Option<f32> {
-        PARAMS
-            .iter()
-            .find(|p| p.name == name)
-            .map(|p| (p.get)(&self.values) as f32)
+        stx_gnc::params::find(name).map(|p| p.get(&self.settings) as f32)
     }
 
     /// Whether a landing target is set.
@@ -413,7 +247,10 @@ impl Onboard {
 
     /// Whether the GPS-loss action is steering now.
     pub fn gps_failsafe_active(&self) -> bool {
-        matches!(self.gps, GpsState::IntoWind { .. }) && steers_on_position(self.mode())
+        matches!(
+            self.gps,
+            GpsState::IntoWind { .. } | GpsState::Neutral { .. }
+        ) && steers_on_position(self.mode())
     }
 
     /// The current sticks (`None`: stale or never received).
@@ -430,27 +267,66 @@ impl Onboard {
         self.texts.push_back((severity, text));
     }
 
-    /// Sets a parameter (range-checked); it takes effect at the next control period.
-    pub fn set_param(&mut self, name: &str, value: f32) -> Result<(), ParamTableError> {
-        let (def, spec) = PARAMS
-            .iter()
-            .zip(&self.specs)
-            .find(|(p, _)| p.name == name)
-            .ok_or_else(|| ParamTableError::Unknown {
-                name: name.to_string(),
-            })?;
-        if !(value.is_finite() && spec.min <= value && value <= spec.max) {
-            return Err(ParamTableError::OutOfRange {
-                name: name.to_string(),
+    /// Sets a parameter: its catalog range and kind, the servo travel for `GN_LINE_MAX`, and
+    /// the rules between parameters are checked; on refusal nothing changes. It takes effect
+    /// at the next control period.
+    pub fn set_param(&mut self, name: &str, value: f32) -> Result<(), ParamError> {
+        let value = f64::from(value);
+        if name == MAIN_LINE_LIMIT && value > self.main_line_travel_m {
+            return Err(ParamError::OutOfRange {
+                name: MAIN_LINE_LIMIT,
                 value,
-                min: spec.min,
-                max: spec.max,
+                min: stx_gnc::params::find(MAIN_LINE_LIMIT).map_or(0.0, |p| p.min),
+                max: self.main_line_travel_m,
             });
         }
-        (def.set)(&mut self.values, f64::from(value));
-        self.guidance.set_gains(self.values.gains);
-        self.guidance.set_spiral_config(self.values.spiral);
+        self.settings.apply(name, value)?;
+        self.guidance.set_gains(self.settings.guidance.gains);
+        self.guidance
+            .set_spiral_config(self.settings.guidance.spiral);
         Ok(())
+    }
+
+    /// The mission decisions on the estimate, one control period: the automatic cutdown at
+    /// `MIS_CUTDOWN_M` during the ascent, the release of the round chute at `MIS_DEPLOY_M`
+    /// above the site under the round chute. `est` is `None` until the estimator has a
+    /// solution; without one nothing is decided (on the real capsule a timer would back this
+    /// up; the simulation then lands under the round chute, which the operator sees).
+    pub fn mission_request(
+        &mut self,
+        stage: FlightStage,
+        est: Option<&Estimate>,
+    ) -> Option<HardwareRequest> {
+        let est = est?;
+        let m = self.settings.mission;
+        match stage {
+            FlightStage::Ascent if m.cutdown_altitude_msl_m > 0.0 && !self.cutdown_requested => {
+                let altitude_msl_m = self.frame.alt_msl_m + est.height_m();
+                (altitude_msl_m >= m.cutdown_altitude_msl_m).then(|| {
+                    self.cutdown_requested = true;
+                    self.say(
+                        Severity::Notice,
+                        format!(
+                            "automatic cutdown at {altitude_msl_m:.0} m (MIS_CUTDOWN_M {:.0} m)",
+                            m.cutdown_altitude_msl_m
+                        ),
+                    );
+                    HardwareRequest::Cutdown
+                })
+            }
+            FlightStage::RoundChute if est.height_m() <= m.deploy_height_m => {
+                self.say(
+                    Severity::Notice,
+                    format!(
+                        "releasing the round chute at {:.0} m above the site (MIS_DEPLOY_M {:.0} m)",
+                        est.height_m(),
+                        m.deploy_height_m
+                    ),
+                );
+                Some(HardwareRequest::Deploy)
+            }
+            _ => None,
+        }
     }
 
     /// The stick state as the link's receiver has it now (`None` when stale). In manual mode,
@@ -726,13 +602,13 @@ impl Onboard {
                     );
                 } else if !acted
                     && stage == FlightStage::Parafoil
-                    && time_s - since_s >= self.values.gps_loss_s
+                    && time_s - since_s >= self.settings.failsafe.gps_loss_s
                     && let Some(est) = est
                 {
                     self.act_on_gps_loss(time_s, since_s, est);
                 }
             }
-            GpsState::IntoWind { since_s, .. } => {
+            GpsState::IntoWind { since_s, .. } | GpsState::Neutral { since_s } => {
                 if gps_ok {
                     self.gps = GpsState::Ok;
                     let mode = self.mode();
@@ -755,7 +631,14 @@ impl Onboard {
     fn act_on_gps_loss(&mut self, time_s: f64, since_s: f64, est: &Estimate) {
         let mode = self.mode();
         let lost_s = time_s - since_s;
-        if self.values.gps_loss_action == GpsLossAction::IntoWind && steers_on_position(mode) {
+        let action = self.settings.failsafe.gps_loss_action;
+        if action == GpsLossAction::Uncontrolled && steers_on_position(mode) {
+            self.gps = GpsState::Neutral { since_s };
+            self.say(
+                Severity::Critical,
+                format!("GPS lost {lost_s:.0} s: servos neutral, gliding straight"),
+            );
+        } else if action == GpsLossAction::IntoWind && steers_on_position(mode) {
             let wind = est.wind_ned_mps;
             let speed = wind.x.hypot(wind.y);
             let heading_rad = if speed > 0.5 {
@@ -815,15 +698,18 @@ impl Onboard {
         let Some(est) = est else {
             return Controls::default();
         };
+        if matches!(self.gps, GpsState::Neutral { .. }) && steers_on_position(self.mode()) {
+            return Controls::default();
+        }
         if let (GpsState::IntoWind { heading_rad, .. }, true) =
             (self.gps, steers_on_position(self.mode()))
         {
-            let spiral = &self.values.spiral;
+            let spiral = &self.settings.guidance.spiral;
             let low = est.height_m() - spiral.hang_height_m <= spiral.flare_height_m;
             let brake = if spiral.flare && low { 1.0 } else { 0.0 };
             return Controls {
                 main_line_m: control::heading(
-                    &self.values.gains,
+                    &self.settings.guidance.gains,
                     est.heading_rad,
                     est.heading_rate_rad_s,
                     heading_rad,

@@ -6,7 +6,7 @@
 //! |---|---|---|
 //! | HEARTBEAT | 1 Hz (the link's own timer) | mode, stage, phase, state ([`crate::drone::Drone::status`]) |
 //! | GPS_RAW_INT, ATTITUDE, SCALED_PRESSURE | each measurement as it reaches the drone's computer (4 Hz) | the receiver's fix (converted to latitude/longitude from the launch site), the AHRS's angles (rates by difference of successive samples), the pitot's pressures and temperature; without a fix for a second, GPS_RAW_INT says `NoFix` at 1 Hz (latitude/longitude 0) |
-//! | GLOBAL_POSITION_INT, VFR_HUD, SERVO_OUTPUT_RAW | 4 Hz | the onboard estimate (once it has a solution), the servo commands |
+//! | GLOBAL_POSITION_INT, VFR_HUD, SERVO_OUTPUT_RAW | 4 Hz | the onboard estimate (once it has a solution), the servos' positions |
 //! | WIND_COV, NAV_CONTROLLER_OUTPUT, SYS_STATUS, BATTERY_STATUS | 1 Hz | wind estimate, guidance state, health and battery |
 //! | POSITION_TARGET_GLOBAL_INT (predicted landing) | every `telemetry.prediction_period_s` (2 s) | see `Drone` |
 //! | STATUSTEXT | as they happen | stage changes, guidance phase changes with their reasons, failsafes, refusals |
