@@ -17,7 +17,7 @@ use stx_link::param::ParamEvent;
 use stx_link::plan::{PlanEvent, PlanItem};
 use stx_link::telemetry::{Actuators, Telemetry, VehicleStatus};
 use stx_sim::drone::link::{DroneEvent, LinkedDrone};
-use stx_sim::drone::{Drone, MissionConfig};
+use stx_sim::drone::{BalloonEnd, Drone, MissionConfig};
 
 /// A linked drone and a ground endpoint exchanging every frame at once.
 struct Bench {
@@ -252,6 +252,31 @@ fn the_station_sees_every_stage_of_mission_short_in_order_and_the_landing_on_the
         bench.time_s()
     );
     assert!(miss < 60.0, "missed the target by {miss} m");
+
+    // The summary tells the same story in figures.
+    let summary = bench.drone.drone().summary();
+    let (end, _, burst_msl_m) = summary.balloon_end.expect("the balloon went");
+    assert_eq!(end, BalloonEnd::Burst);
+    assert!((burst_msl_m - 3000.0).abs() < 10.0, "{burst_msl_m}");
+    assert!((summary.max_altitude_msl_m - burst_msl_m).abs() < 10.0);
+    // Released by the onboard estimate at MIS_DEPLOY_M: the truth within 30 m of it.
+    let (_, deploy_m) = summary.deployment.expect("deployed");
+    assert!((deploy_m - 1200.0).abs() < 30.0, "{deploy_m}");
+    // The round chute's terminal speed for 9 kg on 4 m² of Cd·A, 6–7 m/s in this air.
+    assert!(
+        (5.5..8.0).contains(&summary.peak_descent_mps),
+        "{}",
+        summary.peak_descent_mps
+    );
+    let landing = summary.landing.expect("landing");
+    let site = bench.drone.drone().config().site;
+    let back = site.to_ned(landing.lat_deg, landing.lon_deg, site.alt_msl_m);
+    assert!((back.x - landing.position_ne_m[0]).abs() < 0.01);
+    assert!((back.y - landing.position_ne_m[1]).abs() < 0.01);
+    let stages: Vec<&str> = summary.stages.iter().map(|s| s.stage.as_str()).collect();
+    assert_eq!(stages[0], "pre_launch");
+    assert_eq!(stages.last(), Some(&"landed"));
+    assert!(summary.phases.iter().any(|p| p.stage == "final_approach"));
 }
 
 #[test]

@@ -146,6 +146,61 @@ pub struct Landing {
     pub vertical_speed_mps: f64,
     /// Stage it landed from (parafoil, or round chute if the parafoil never deployed).
     pub under_parafoil: bool,
+    /// Where, latitude, degrees.
+    pub lat_deg: f64,
+    /// Where, longitude, degrees.
+    pub lon_deg: f64,
+}
+
+/// How the balloon stage ended.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum BalloonEnd {
+    /// It burst by itself.
+    Burst,
+    /// It was cut away (operator's command or `MIS_CUTDOWN_M`).
+    Cutdown,
+}
+
+/// A stage and when it began.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct StageStart {
+    /// The stage (snake case).
+    pub stage: String,
+    /// Mission time it began, s.
+    pub start_s: f64,
+}
+
+/// A mission in figures, from the simulator's truth: what a run is judged by and what
+/// `stx drone --summary-json` prints.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct MissionSummary {
+    /// Mission name.
+    pub mission: String,
+    /// Seed flown.
+    pub seed: u64,
+    /// Mission time reached, s.
+    pub mission_time_s: f64,
+    /// Every stage entered, in order.
+    pub stages: Vec<StageStart>,
+    /// How the balloon stage ended, when, and how high (m MSL).
+    pub balloon_end: Option<(BalloonEnd, f64, f64)>,
+    /// Highest altitude reached, m MSL.
+    pub max_altitude_msl_m: f64,
+    /// Fastest fall (under the round chute in a whole mission), m/s.
+    pub peak_descent_mps: f64,
+    /// When and how high above the site the parafoil deployed, s and m.
+    pub deployment: Option<(f64, f64)>,
+    /// The landing target, latitude and longitude, degrees.
+    pub target_lat_lon_deg: Option<[f64; 2]>,
+    /// Where and how it landed.
+    pub landing: Option<Landing>,
+    /// Guidance phases entered, with their mission time.
+    pub phases: Vec<StageStart>,
+    /// Status texts sent.
+    pub texts: u64,
+    /// Outputs dropped because nobody drained them.
+    pub outputs_dropped: u64,
 }
 
 /// The simulated drone.
@@ -173,6 +228,11 @@ pub struct Drone {
     phase_events: Vec<PhaseEvent>,
     link_lost_at_s: Option<f64>,
     landing: Option<Landing>,
+    balloon_end: Option<(BalloonEnd, f64, f64)>,
+    deployment: Option<(f64, f64)>,
+    max_altitude_msl_m: f64,
+    peak_descent_mps: f64,
+    texts_sent: u64,
     last_phase_text_s: Option<f64>,
     phase_texts_held: u32,
 }
@@ -250,6 +310,11 @@ impl Drone {
             phase_events: Vec::new(),
             link_lost_at_s: None,
             landing: None,
+            balloon_end: None,
+            deployment: None,
+            max_altitude_msl_m: f64::NEG_INFINITY,
+            peak_descent_mps: 0.0,
+            texts_sent: 0,
             last_phase_text_s: None,
             phase_texts_held: 0,
             config,
@@ -391,7 +456,42 @@ impl Drone {
     }
 
     fn say(&mut self, severity: Severity, text: String) {
+        self.texts_sent += 1;
         self.push(Output::Text { severity, text });
+    }
+
+    /// The mission in figures so far (see [`MissionSummary`]).
+    pub fn summary(&self) -> MissionSummary {
+        let start = |(name, start_s): (String, f64)| StageStart {
+            stage: name,
+            start_s,
+        };
+        MissionSummary {
+            mission: self.config.name.clone(),
+            seed: self.config.seed,
+            mission_time_s: self.time_s(),
+            stages: self
+                .stage_log
+                .iter()
+                .map(|(s, t)| start((stage_name(*s), *t)))
+                .collect(),
+            balloon_end: self.balloon_end,
+            max_altitude_msl_m: self.max_altitude_msl_m.max(self.physics.altitude_msl_m()),
+            peak_descent_mps: self.peak_descent_mps,
+            deployment: self.deployment,
+            target_lat_lon_deg: self.target_ned_m().map(|t| {
+                let (lat, lon, _) = self.frame.to_geodetic(&t);
+                [lat, lon]
+            }),
+            landing: self.landing,
+            phases: self
+                .phase_events
+                .iter()
+                .map(|e| start((phase_name(e.to), e.time_s)))
+                .collect(),
+            texts: self.texts_sent,
+            outputs_dropped: self.outputs_dropped,
+        }
     }
 
     fn drain_onboard_texts(&mut self) {
@@ -563,6 +663,11 @@ impl Drone {
         self.periodic_telemetry(t, stage);
 
         let events = self.physics.step(applied, CONTROL_PERIOD_S)?;
+        let truth = self.physics.truth();
+        self.max_altitude_msl_m = self
+            .max_altitude_msl_m
+            .max(self.frame.alt_msl_m - truth.position_ned_m.z);
+        self.peak_descent_mps = self.peak_descent_mps.max(truth.velocity_ned_mps.z);
         self.battery.draw(
             CONTROL_PERIOD_S,
             &applied,
@@ -615,18 +720,25 @@ impl Drone {
                     self.physics.burst_altitude_msl_m()
                 ),
             ),
-            StageEvent::Burst { altitude_msl_m } => (
-                Severity::Notice,
-                format!("balloon burst at {altitude_msl_m:.0} m MSL: round chute"),
-            ),
-            StageEvent::CutDown { altitude_msl_m } => (
-                Severity::Notice,
-                format!("cutdown at {altitude_msl_m:.0} m MSL: balloon released, round chute"),
-            ),
+            StageEvent::Burst { altitude_msl_m } => {
+                self.balloon_end = Some((BalloonEnd::Burst, now, altitude_msl_m));
+                (
+                    Severity::Notice,
+                    format!("balloon burst at {altitude_msl_m:.0} m MSL: round chute"),
+                )
+            }
+            StageEvent::CutDown { altitude_msl_m } => {
+                self.balloon_end = Some((BalloonEnd::Cutdown, now, altitude_msl_m));
+                (
+                    Severity::Notice,
+                    format!("cutdown at {altitude_msl_m:.0} m MSL: balloon released, round chute"),
+                )
+            }
             StageEvent::Deployed {
                 height_m,
                 heading_rad,
             } => {
+                self.deployment = Some((now, height_m));
                 // Guidance starts from a filter that has only seen the parafoil fly.
                 if let Ok(e) = Estimator::new(self.config.estimator.clone()) {
                     self.estimator = e;
@@ -648,12 +760,19 @@ impl Drone {
                 let target = self.target_ned_m();
                 let miss =
                     target.map(|p| (t.position_ne_m[0] - p.x).hypot(t.position_ne_m[1] - p.y));
+                let (lat_deg, lon_deg, _) = self.frame.to_geodetic(&Vector3::new(
+                    t.position_ne_m[0],
+                    t.position_ne_m[1],
+                    0.0,
+                ));
                 self.landing = Some(Landing {
                     time_s: t.time_s,
                     position_ne_m: t.position_ne_m,
                     miss_m: miss,
                     vertical_speed_mps: t.vertical_speed_mps,
                     under_parafoil: self.physics.parafoil().is_some(),
+                    lat_deg,
+                    lon_deg,
                 });
                 let from_target = miss
                     .map(|m| format!(", {m:.0} m from the target"))
