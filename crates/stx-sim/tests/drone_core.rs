@@ -166,7 +166,7 @@ fn a_whole_mission_flies_from_the_pad_to_the_target_with_no_operator() {
 
 #[test]
 fn the_drone_sends_its_telemetry_at_the_documented_rates() {
-    let mut d = drone(&mission("mission-short"));
+    let mut d = drone(&mission("rehearsal"));
     let mut log = Log::default();
     fly(&mut d, &mut log, |d| d.time_s() >= 70.0);
     // 60 s of parafoil flight, from 10 s on.
@@ -270,7 +270,7 @@ fn cutdown_ends_the_ascent_and_is_refused_when_there_is_no_balloon() {
 
 #[test]
 fn sticks_drive_the_servos_and_stale_sticks_return_the_drone_to_its_plan() {
-    let mut d = drone(&mission("mission-short"));
+    let mut d = drone(&mission("rehearsal"));
     let mut log = Log::default();
     fly(&mut d, &mut log, |d| d.time_s() >= 20.0);
     assert_eq!(d.mode(), FlightMode::SpiralLanding);
@@ -327,7 +327,7 @@ fn sticks_drive_the_servos_and_stale_sticks_return_the_drone_to_its_plan() {
 
 #[test]
 fn a_gps_loss_turns_the_drone_into_the_wind_and_it_resumes_when_fixes_return() {
-    let mut config = mission("mission-short");
+    let mut config = mission("rehearsal");
     config.failures.gps_loss_s = vec![[40.0, 100.0]];
     let mut d = drone(&config);
     let mut log = Log::default();
@@ -352,10 +352,10 @@ fn a_gps_loss_turns_the_drone_into_the_wind_and_it_resumes_when_fixes_return() {
     assert!((43.0..46.0).contains(&acted), "after GPS_LOSS_S = 3 s");
     assert!((100.0..102.0).contains(&back));
     assert!(critical, "the heartbeat says it is in a failsafe");
-    // Into the wind: the mission-short wind comes from about 295° near 400 m.
+    // Into the wind: the rehearsal's wind comes from about 293° at 500–700 m.
     let mean_error = headings
         .iter()
-        .map(|h| wrap_pi((h - 295.0).to_radians()).to_degrees().abs())
+        .map(|h| wrap_pi((h - 293.0).to_radians()).to_degrees().abs())
         .sum::<f64>()
         / headings.len() as f64;
     assert!(mean_error < 25.0, "mean heading error {mean_error:.0}°");
@@ -378,7 +378,7 @@ fn a_gps_loss_turns_the_drone_into_the_wind_and_it_resumes_when_fixes_return() {
 
 #[test]
 fn with_the_continue_policy_a_gps_loss_keeps_the_plan_on_dead_reckoning() {
-    let mut config = mission("mission-short");
+    let mut config = mission("rehearsal");
     config.failures.gps_loss_s = vec![[40.0, 70.0]];
     let mut d = drone(&config);
     let name = d
@@ -396,7 +396,7 @@ fn with_the_continue_policy_a_gps_loss_keeps_the_plan_on_dead_reckoning() {
 
 #[test]
 fn a_stuck_servo_stays_where_it_stuck_whatever_it_is_commanded() {
-    let mut config = mission("mission-short");
+    let mut config = mission("rehearsal");
     config.failures.stuck_servo = Some(StuckServo {
         servo: Servo::Left,
         at_s: 30.0,
@@ -429,7 +429,7 @@ fn a_stuck_servo_stays_where_it_stuck_whatever_it_is_commanded() {
 
 #[test]
 fn losing_the_link_changes_nothing_in_flight() {
-    let config = mission("mission-short");
+    let config = mission("rehearsal");
     let mut quiet = drone(&config);
     let mut cut = drone(&config);
     let (mut log_quiet, mut log_cut) = (Log::default(), Log::default());
@@ -468,7 +468,7 @@ fn losing_the_link_changes_nothing_in_flight() {
 
 #[test]
 fn a_parameter_set_changes_the_guidance_gain_at_once() {
-    let config = mission("mission-short");
+    let config = mission("rehearsal");
     let mut soft = drone(&config);
     let mut firm = drone(&config);
     let mut log = Log::default();
@@ -510,7 +510,7 @@ fn a_parameter_set_changes_the_guidance_gain_at_once() {
 
 #[test]
 fn the_same_seed_flies_the_same_mission() {
-    let config = mission("mission-short");
+    let config = mission("rehearsal");
     let (mut a, mut b) = (drone(&config), drone(&config));
     let mut log = Log::default();
     fly(&mut a, &mut log, |_| false);

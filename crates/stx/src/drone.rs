@@ -1,27 +1,25 @@
 //! `stx drone`: the simulated drone on a real MAVLink link.
 //!
-//! A thin tokio adapter around the pure [`stx_sim::drone::Drone`]: it loads and validates the
-//! mission (exit code 2 on a bad name, file or flag), opens the transport, and runs two tasks:
+//! A thin tokio adapter around the pure [`LinkedDrone`] (the drone of `stx_sim::drone` behind
+//! its stx-link `VehicleEndpoint`, with the rehearsal's link failures): it loads and validates
+//! the mission (exit code 2 on a bad name, file or flag), opens the transport and hands the
+//! linked drone to stx-link's [`drive`], which feeds it the datagrams and timers on the wall
+//! monotonic clock — heartbeats at 1 Hz, the station's liveness, stick staleness and retries
+//! all run in real time whatever the simulation's speed. The simulation's steps go in as the
+//! driver's actions, one control period (0.25 s of mission time) each:
 //!
-//! - the **link** task is stx-link's [`drive`], running a [`VehicleEndpoint`] over the
-//!   transport on the wall monotonic clock (heartbeats at 1 Hz, retries, stick staleness are
-//!   all real time, whatever the simulation's speed). The endpoint is wrapped in
-//!   [`GatedVehicle`], which applies the mission's link failures (link-drop windows, random
-//!   packet loss) to every datagram in and out;
-//! - the **simulation** task steps the drone one control period (0.25 s of mission time) at a
-//!   time, paced at `--speed N` times real time or as fast as it goes (`--speed max`), feeds it
-//!   what the endpoint reports (commands, parameter changes, plans, sticks, link state) and
-//!   hands the endpoint what the drone sends, as actions run on the driven endpoint.
-//!
-//! Commands are answered as soon as they arrive (between two steps), not at the next step.
-//! At `--speed max` the simulation yields to the runtime between steps and waits when the
-//! link falls behind (the action channel is bounded), so telemetry is paced by what the socket
-//! takes and nothing piles up.
+//! - at `--speed N` the pacing task sends a step every `0.25/N` s of real time and waits for
+//!   its report;
+//! - at `--speed max` it sends steps as fast as the driver takes them (the action channel is
+//!   bounded, so steps queue behind the socket's traffic, never ahead of it), and the driver
+//!   still serves incoming datagrams between two steps, so commands are answered within a step.
 //!
 //! The process exits 0 once the drone has landed and its last telemetry has been handed to the
-//! socket (after `--linger S` more seconds of answering on the ground, if asked), on Ctrl-C,
-//! and 1 if the simulation fails. It prints one JSON summary line on stdout at the end: the
-//! mission, whether and where it landed, mission and wall time, and the link's counters.
+//! socket (after `--linger S` more seconds of answering on the ground, at real time, if asked)
+//! or on Ctrl-C, and 1 if the simulation fails. Progress (stage, altitude, mode, phase) and the
+//! drone's texts are logged at info level; `--summary-json` prints the mission's figures
+//! ([`stx_sim::drone::MissionSummary`]) with the run's wall time and link counters as one JSON
+//! line on stdout.
 
 use std::fmt;
 use std::str::FromStr;
@@ -31,16 +29,13 @@ use anyhow::{Context, anyhow};
 use clap::Args;
 use serde::Serialize;
 use stx_dynamics::vehicle::Vehicle;
-use stx_gnc::mission::FlightStage;
-use stx_link::command::CommandResult;
-use stx_link::endpoint::{LinkEvent, VehicleConfig, VehicleEndpoint, VehicleEvent};
-use stx_link::manual::ManualEvent;
+use stx_gnc::mission::{FlightMode, FlightStage, GuidancePhase};
+use stx_link::endpoint::LinkConfig;
 use stx_link::signing::{SigningConfig, SigningKey};
-use stx_link::transport::{
-    Action, DriveOptions, DriverEvent, IoEvent, IoStats, SansIo, Transport, drive,
-};
-use stx_sim::drone::failures::{LinkFaults, StuckServo, parse_window};
-use stx_sim::drone::{Drone, MissionConfig, Output, stage_name};
+use stx_link::transport::{Action, DriveOptions, DriverEvent, IoEvent, IoStats, Transport, drive};
+use stx_sim::drone::failures::{StuckServo, parse_window};
+use stx_sim::drone::link::{DroneEvent, LinkCounters, LinkedDrone};
+use stx_sim::drone::{Drone, MissionConfig, MissionSummary, stage_name};
 use tokio::sync::mpsc;
 
 use crate::BadInput;
@@ -115,6 +110,9 @@ pub struct DroneArgs {
     /// MAVLink system id of the drone.
     #[arg(long, default_value = "1")]
     system_id: u8,
+    /// Print the mission's figures as one JSON line on stdout at the end.
+    #[arg(long)]
+    summary_json: bool,
 }
 
 /// Reads a mission by built-in name or path, with the command line's overrides applied.
@@ -178,67 +176,23 @@ fn parse_key(hex: &str) -> anyhow::Result<SigningKey> {
     Ok(SigningKey::from_bytes(bytes))
 }
 
-/// The vehicle endpoint with the mission's link failures applied to every datagram.
-pub struct GatedVehicle {
-    endpoint: VehicleEndpoint,
-    faults: LinkFaults,
-    /// Mission time of the simulation's last step, s: where the failure windows are read.
-    mission_time_s: f64,
-}
-
-impl SansIo for GatedVehicle {
-    type Event = VehicleEvent;
-
-    fn handle_bytes(&mut self, now: Duration, bytes: &[u8]) {
-        if !self.faults.drops_datagram(self.mission_time_s) {
-            self.endpoint.handle_bytes(now, bytes);
-        }
-    }
-
-    fn handle_timeout(&mut self, now: Duration) {
-        self.endpoint.handle_timeout(now);
-    }
-
-    fn poll_timeout(&self) -> Option<Duration> {
-        self.endpoint.poll_timeout()
-    }
-
-    fn poll_transmit(&mut self, now: Duration) -> Option<Vec<u8>> {
-        // Every frame is one datagram on UDP: a lost one is simply not sent.
-        loop {
-            let frame = self.endpoint.poll_transmit(now)?;
-            if !self.faults.drops_datagram(self.mission_time_s) {
-                return Some(frame);
-            }
-        }
-    }
-
-    fn poll_event(&mut self) -> Option<VehicleEvent> {
-        self.endpoint.poll_event()
-    }
-
-    fn persist_request(event: &VehicleEvent) -> Option<u64> {
-        match event {
-            VehicleEvent::Link(LinkEvent::PersistSigningTimestamp(v)) => Some(*v),
-            _ => None,
-        }
-    }
-}
-
-/// The summary printed at the end (one JSON line on stdout).
+/// What `--summary-json` prints: the mission's figures and how the run went.
 #[derive(Debug, Serialize)]
 struct RunSummary {
-    mission: String,
-    speed: String,
+    #[serde(flatten)]
+    mission: MissionSummary,
+    /// Whether the drone landed.
     landed: bool,
-    landing: Option<stx_sim::drone::Landing>,
-    mission_time_s: f64,
+    /// `--speed`.
+    speed: String,
+    /// Real time of the run, s.
     wall_time_s: f64,
-    stages: Vec<(String, f64)>,
+    /// Stopped by Ctrl-C.
     interrupted: bool,
+    /// The drone's side of the link.
+    link: Option<LinkCounters>,
+    /// The socket.
     io: Option<IoStats>,
-    datagrams_dropped_link_down: u64,
-    datagrams_dropped_random: u64,
 }
 
 pub fn run(args: DroneArgs) -> anyhow::Result<()> {
@@ -252,13 +206,47 @@ pub fn run(args: DroneArgs) -> anyhow::Result<()> {
         .enable_all()
         .build()
         .context("starting the tokio runtime")?;
+    let summary_json = args.summary_json;
     let summary = runtime.block_on(fly(args, drone, signing))?;
-    println!("{}", serde_json::to_string(&summary)?);
+    if summary_json {
+        println!("{}", serde_json::to_string(&summary)?);
+    }
     Ok(())
 }
 
-/// Steps at most this far behind the link before waiting for it (the action channel's size).
-const ACTIONS_IN_FLIGHT: usize = 64;
+/// Steps handed to the driver ahead of its progress at `--speed max`.
+const STEPS_IN_FLIGHT: usize = 16;
+
+/// What one step reports back to the pacing task.
+#[derive(Debug, Clone, Copy)]
+struct StepReport {
+    time_s: f64,
+    stage: FlightStage,
+    mode: FlightMode,
+    phase: GuidancePhase,
+    altitude_msl_m: f64,
+    landed: bool,
+}
+
+/// A step of the linked drone, run by the driver; its report (or the simulation's failure)
+/// goes back on `reports`.
+fn step_action(reports: mpsc::UnboundedSender<Result<StepReport, String>>) -> Action<LinkedDrone> {
+    Box::new(move |linked, now| {
+        let result = linked.step(now).map_err(|e| e.to_string()).map(|()| {
+            let d = linked.drone();
+            let status = d.status();
+            StepReport {
+                time_s: d.time_s(),
+                stage: status.stage,
+                mode: status.mode,
+                phase: status.phase,
+                altitude_msl_m: d.physics().altitude_msl_m(),
+                landed: linked.landed(),
+            }
+        });
+        let _ = reports.send(result);
+    })
+}
 
 async fn fly(
     args: DroneArgs,
@@ -269,25 +257,14 @@ async fn fly(
         .await
         .with_context(|| format!("opening {}", args.connect))
         .map_err(BadInput)?;
-    let mut vehicle_config = VehicleConfig::default();
-    vehicle_config.link.system_id = args.system_id;
-    vehicle_config.params = drone.param_specs();
-    vehicle_config.manual_timeout = Duration::from_secs_f64(drone.manual_timeout_s());
-    vehicle_config.initial_status = drone.status();
+    let mut link = LinkConfig::vehicle();
+    link.system_id = args.system_id;
     if let Some(key) = signing {
         let unix = SystemTime::now()
             .duration_since(UNIX_EPOCH)
             .context("the system clock is before 1970")?;
-        vehicle_config.link.signing = Some(SigningConfig::new(key, 0, unix));
+        link.signing = Some(SigningConfig::new(key, 0, unix));
     }
-    let mut endpoint = VehicleEndpoint::new(vehicle_config, Duration::ZERO)
-        .context("building the drone's parameter table")?;
-    endpoint.set_plan(drone.plan_items());
-    let gated = GatedVehicle {
-        endpoint,
-        faults: drone.link_faults(),
-        mission_time_s: drone.time_s(),
-    };
     tracing::info!(
         mission = %drone.config().name,
         connect = %args.connect,
@@ -295,291 +272,159 @@ async fn fly(
         stage = %stage_name(drone.stage()),
         "drone starting"
     );
+    let linked =
+        LinkedDrone::new(drone, link, Duration::ZERO).context("putting the drone on the link")?;
 
-    let (action_tx, action_rx) = mpsc::channel::<Action<GatedVehicle>>(ACTIONS_IN_FLIGHT);
-    let (event_tx, mut event_rx) = mpsc::channel(1024);
-    let link = tokio::spawn(drive(
+    let (action_tx, action_rx) = mpsc::channel::<Action<LinkedDrone>>(STEPS_IN_FLIGHT);
+    let (event_tx, mut event_rx) = mpsc::channel(4096);
+    let driver = tokio::spawn(drive(
         transport,
-        gated,
+        linked,
         action_rx,
         event_tx,
         DriveOptions::default(),
     ));
+    // The driver's events are the drone's log: texts, commands, parameters, link state.
+    let logger = tokio::spawn(async move {
+        while let Some(event) = event_rx.recv().await {
+            log_event(event);
+        }
+    });
 
     let started = Instant::now();
-    let mut sim = Simulation {
-        drone,
-        actions: action_tx,
-        responses: Vec::new(),
-        pending: Vec::new(),
-        last_progress: Instant::now(),
-        last_stage: None,
-    };
+    let (report_tx, mut report_rx) = mpsc::unbounded_channel();
     let period_s = stx_sim::guided::CONTROL_PERIOD_S;
-    let mission_t0 = sim.drone.time_s();
-    let mut pace_from = (tokio::time::Instant::now(), mission_t0);
+    let mut pace_from = (tokio::time::Instant::now(), 0_u64);
+    let mut sent: u64 = 0;
     let mut landed_at: Option<Instant> = None;
     let mut interrupted = false;
-    let mut steps: u64 = 0;
+    let mut last_progress = Instant::now();
+    let mut last_stage = None;
     let ctrl_c = tokio::signal::ctrl_c();
     tokio::pin!(ctrl_c);
-    loop {
+    let send_step = |tx: &mpsc::Sender<Action<LinkedDrone>>| {
+        let action = step_action(report_tx.clone());
+        let tx = tx.clone();
+        async move {
+            tx.send(action)
+                .await
+                .map_err(|_| anyhow!("the link task stopped"))
+        }
+    };
+    'flight: loop {
         if let Some(at) = landed_at
             && at.elapsed().as_secs_f64() >= args.linger
         {
             break;
         }
-        // On the ground after landing the drone answers in real time; in flight at the
-        // requested speed.
-        let speed = match (args.speed, landed_at) {
-            (_, Some(_)) => Speed::Times(1.0),
-            (s, None) => s,
+        // After landing the drone answers on the ground in real time.
+        let speed = if landed_at.is_some() {
+            Speed::Times(1.0)
+        } else {
+            args.speed
         };
         match speed {
             Speed::Max => {
-                while let Ok(event) = event_rx.try_recv() {
-                    sim.handle(event);
-                }
-                sim.flush().await?;
                 tokio::select! {
                     biased;
-                    _ = &mut ctrl_c => { interrupted = true; break; }
-                    _ = tokio::task::yield_now() => {}
+                    _ = &mut ctrl_c => { interrupted = true; break 'flight; }
+                    sent_ok = send_step(&action_tx) => { sent_ok?; sent += 1; }
                 }
-                sim.step().await?;
             }
             Speed::Times(times) => {
                 let due = pace_from.0
-                    + Duration::from_secs_f64(
-                        ((sim.drone.time_s() + period_s - pace_from.1) / times).max(0.0),
-                    );
+                    + Duration::from_secs_f64((sent - pace_from.1 + 1) as f64 * period_s / times);
                 tokio::select! {
                     biased;
-                    _ = &mut ctrl_c => { interrupted = true; break; }
-                    event = event_rx.recv() => match event {
-                        Some(e) => { sim.handle(e); sim.flush().await?; continue; }
-                        None => return Err(anyhow!("the link task stopped")),
-                    },
+                    _ = &mut ctrl_c => { interrupted = true; break 'flight; }
                     _ = tokio::time::sleep_until(due) => {}
                 }
-                sim.step().await?;
-                // A slow step (a prediction, a slow machine) is not made up for by running
-                // fast afterwards: pacing restarts from now when it falls a second behind.
+                send_step(&action_tx).await?;
+                sent += 1;
+                // A slow step is not made up for by running fast afterwards.
                 if tokio::time::Instant::now() > due + Duration::from_secs(1) {
-                    pace_from = (tokio::time::Instant::now(), sim.drone.time_s());
+                    pace_from = (tokio::time::Instant::now(), sent);
                 }
             }
         }
-        steps += 1;
-        if landed_at.is_none() && sim.drone.landing().is_some() {
-            landed_at = Some(Instant::now());
-            pace_from = (tokio::time::Instant::now(), sim.drone.time_s());
-            let l = sim.drone.landing();
-            tracing::info!(
-                mission_time_s = sim.drone.time_s(),
-                wall_time_s = started.elapsed().as_secs_f64(),
-                miss_m = ?l.and_then(|l| l.miss_m),
-                steps,
-                "landed"
-            );
+        // Reports of the steps done so far (at max speed the driver may be a few behind).
+        while let Ok(report) = report_rx.try_recv() {
+            let r = report.map_err(|e| anyhow!("simulation failed: {e}"))?;
+            if last_stage != Some(r.stage) || last_progress.elapsed() >= Duration::from_secs(5) {
+                last_stage = Some(r.stage);
+                last_progress = Instant::now();
+                tracing::info!(
+                    t = format!("{:.0}", r.time_s),
+                    stage = %stage_name(r.stage),
+                    alt_msl_m = format!("{:.0}", r.altitude_msl_m),
+                    mode = ?r.mode,
+                    phase = ?r.phase,
+                    "progress"
+                );
+            }
+            if r.landed && landed_at.is_none() {
+                landed_at = Some(Instant::now());
+                pace_from = (tokio::time::Instant::now(), sent);
+                tracing::info!(
+                    mission_time_s = format!("{:.1}", r.time_s),
+                    wall_time_s = format!("{:.2}", started.elapsed().as_secs_f64()),
+                    "landed"
+                );
+            }
         }
     }
-    sim.flush().await?;
-    let Simulation { drone, actions, .. } = sim;
-    // Closing the channel ends the link task once it has sent what it was handed.
-    drop(actions);
-    drop(event_rx);
-    let (gated, io) = match link.await {
-        Ok((gated, io)) => (Some(gated), Some(io)),
-        Err(e) => {
-            tracing::error!(error = %e, "link task failed");
-            (None, None)
-        }
-    };
+    // Closing the channel ends the driver once it has run the steps queued and sent what they
+    // produced.
+    drop(action_tx);
+    let (linked, io) = driver.await.context("the link task failed")?;
+    let _ = logger.await;
+    while let Ok(report) = report_rx.try_recv() {
+        report.map_err(|e| anyhow!("simulation failed: {e}"))?;
+    }
     if interrupted {
         tracing::info!("interrupted: stopping");
     }
+    let mission = linked.drone().summary();
     Ok(RunSummary {
-        mission: drone.config().name.clone(),
+        landed: mission.landing.is_some(),
+        mission,
         speed: args.speed.to_string(),
-        landed: drone.landing().is_some(),
-        landing: drone.landing(),
-        mission_time_s: drone.time_s(),
         wall_time_s: started.elapsed().as_secs_f64(),
-        stages: drone
-            .stage_log()
-            .iter()
-            .map(|(s, t)| (stage_name(*s), *t))
-            .collect(),
         interrupted,
-        io,
-        datagrams_dropped_link_down: gated.as_ref().map_or(0, |g| g.faults.dropped_down),
-        datagrams_dropped_random: gated.as_ref().map_or(0, |g| g.faults.dropped_random),
+        link: Some(linked.counters()),
+        io: Some(io),
     })
 }
 
-/// The simulation side: the drone, and what it owes the link.
-struct Simulation {
-    drone: Drone,
-    actions: mpsc::Sender<Action<GatedVehicle>>,
-    /// Command results not yet handed to the endpoint.
-    responses: Vec<(stx_link::command::IncomingId, CommandResult)>,
-    /// Other actions not yet handed to the endpoint, in order.
-    pending: Vec<Action<GatedVehicle>>,
-    last_progress: Instant,
-    last_stage: Option<FlightStage>,
-}
-
-impl Simulation {
-    /// Takes one event from the link.
-    fn handle(&mut self, event: DriverEvent<VehicleEvent>) {
-        match event {
-            DriverEvent::Endpoint(e) => self.endpoint_event(e),
-            DriverEvent::Io(e) => match e {
-                IoEvent::RecvError { .. } | IoEvent::SendError { .. } => {
-                    tracing::warn!(event = ?e, "link I/O error");
-                }
-                IoEvent::QueuedWithoutPeer { .. } => {}
-                other => tracing::info!(event = ?other, "link"),
-            },
+fn log_event(event: DriverEvent<DroneEvent>) {
+    match event {
+        DriverEvent::Endpoint(DroneEvent::Text {
+            time_s,
+            severity,
+            text,
+        }) => tracing::info!(t = format!("{time_s:.1}"), ?severity, "{text}"),
+        DriverEvent::Endpoint(DroneEvent::Command {
+            time_s,
+            command,
+            result,
+        }) => tracing::info!(t = format!("{time_s:.1}"), ?command, ?result, "command"),
+        DriverEvent::Endpoint(DroneEvent::Param {
+            time_s,
+            name,
+            value,
+            accepted,
+        }) => tracing::info!(t = format!("{time_s:.1}"), %name, value, accepted, "parameter"),
+        DriverEvent::Endpoint(DroneEvent::Plan { time_s, items }) => {
+            tracing::info!(t = format!("{time_s:.1}"), items, "plan received");
         }
-    }
-
-    fn endpoint_event(&mut self, event: VehicleEvent) {
-        match event {
-            VehicleEvent::Command(c) => {
-                let result = self.drone.handle_command(&c.command);
-                tracing::info!(command = ?c.command, ?result, from = ?c.from, "command");
-                self.responses.push((c.id, result));
-            }
-            VehicleEvent::ParamChanged(change) => {
-                match self.drone.set_param(&change.name, change.new) {
-                    Ok(()) => {
-                        tracing::info!(name = %change.name, value = change.new, "parameter set");
-                        if change.name == "MAN_TIMEOUT_S" {
-                            let timeout = Duration::from_secs_f64(self.drone.manual_timeout_s());
-                            self.act(move |ep, _| ep.endpoint.set_manual_timeout(timeout));
-                        }
-                    }
-                    Err(e) => {
-                        // The link's table took a value the drone refuses (a rule between
-                        // parameters): put the old one back, which announces it.
-                        tracing::warn!(name = %change.name, error = %e, "parameter refused");
-                        let text = format!("PARAM {}: {e}", change.name);
-                        self.act(move |ep, now| {
-                            let _ = ep.endpoint.params_mut().set(&change.name, change.old);
-                            ep.endpoint.send_status_text(
-                                now,
-                                stx_link::telemetry::Severity::Warning,
-                                &text,
-                            );
-                        });
-                    }
-                }
-            }
-            VehicleEvent::PlanReceived(items) => {
-                tracing::info!(items = items.len(), "plan received");
-                self.drone.handle_plan(&items);
-            }
-            VehicleEvent::Manual(ManualEvent::Sticks(s)) => self.drone.set_sticks(Some(s)),
-            VehicleEvent::Manual(ManualEvent::Stale { since_last }) => {
-                tracing::info!(?since_last, "sticks stale");
-                self.drone.set_sticks(None);
-            }
-            VehicleEvent::Link(LinkEvent::Connected {
-                system_id,
-                component_id,
-            }) => {
-                tracing::info!(system_id, component_id, "station connected");
-                self.drone.link_changed(true);
-            }
-            VehicleEvent::Link(LinkEvent::Lost {
-                system_id,
-                since_last,
-            }) => {
-                tracing::warn!(system_id, ?since_last, "station lost: flying the plan");
-                self.drone.link_changed(false);
-            }
-            VehicleEvent::Link(LinkEvent::FrameError(e)) => {
-                tracing::debug!(error = ?e, "frame dropped");
-            }
-            VehicleEvent::Link(LinkEvent::PersistSigningTimestamp(_)) => {}
-            VehicleEvent::Other(frame) => {
-                tracing::debug!(message = ?frame.message, "message not handled");
-            }
+        DriverEvent::Endpoint(DroneEvent::Link { time_s, connected }) => {
+            tracing::info!(t = format!("{time_s:.1}"), connected, "station link");
         }
-    }
-
-    /// Queues an action on the endpoint, handed over by the next [`flush`](Self::flush).
-    fn act(&mut self, f: impl FnOnce(&mut GatedVehicle, Duration) + Send + 'static) {
-        self.pending.push(Box::new(f));
-    }
-
-    /// Hands the endpoint what the drone has to send: command results first (every command
-    /// is answered at once), then telemetry and texts, and the heartbeat's status.
-    async fn flush(&mut self) -> anyhow::Result<()> {
-        let mut outputs = Vec::new();
-        while let Some(o) = self.drone.poll_output() {
-            if let Output::Text { severity, text } = &o {
-                tracing::info!(
-                    t = format!("{:.1}", self.drone.time_s()),
-                    severity = ?severity,
-                    "{text}"
-                );
-            }
-            outputs.push(o);
+        DriverEvent::Endpoint(DroneEvent::PersistSigningTimestamp(_)) => {}
+        DriverEvent::Io(e @ (IoEvent::RecvError { .. } | IoEvent::SendError { .. })) => {
+            tracing::warn!(event = ?e, "link I/O error");
         }
-        for action in std::mem::take(&mut self.pending) {
-            self.actions
-                .send(action)
-                .await
-                .map_err(|_| anyhow!("the link task stopped"))?;
-        }
-        let responses = std::mem::take(&mut self.responses);
-        let status = self.drone.status();
-        let mission_time_s = self.drone.time_s();
-        let action: Action<GatedVehicle> = Box::new(move |ep, now| {
-            ep.mission_time_s = mission_time_s;
-            for (id, result) in responses {
-                ep.endpoint.respond_command(id, result);
-            }
-            ep.endpoint.set_status(status);
-            for o in outputs {
-                match o {
-                    Output::Telemetry(t) => ep.endpoint.send_telemetry(now, &t),
-                    Output::Text { severity, text } => {
-                        ep.endpoint.send_status_text(now, severity, &text);
-                    }
-                }
-            }
-        });
-        self.actions
-            .send(action)
-            .await
-            .map_err(|_| anyhow!("the link task stopped"))
-    }
-
-    /// One control period, then what it produced goes to the link.
-    async fn step(&mut self) -> anyhow::Result<()> {
-        self.drone
-            .step()
-            .with_context(|| format!("simulation failed at t = {:.2} s", self.drone.time_s()))?;
-        self.flush().await?;
-        let stage = self.drone.stage();
-        if self.last_stage != Some(stage) || self.last_progress.elapsed() >= Duration::from_secs(5)
-        {
-            self.last_stage = Some(stage);
-            self.last_progress = Instant::now();
-            let truth = self.drone.physics().truth();
-            tracing::info!(
-                t = format!("{:.0}", self.drone.time_s()),
-                stage = %stage_name(stage),
-                mode = ?self.drone.mode(),
-                phase = ?self.drone.status().phase,
-                alt_msl_m = format!("{:.0}", self.drone.config().site.alt_msl_m - truth.position_ned_m.z),
-                "progress"
-            );
-        }
-        Ok(())
+        DriverEvent::Io(IoEvent::QueuedWithoutPeer { .. }) => {}
+        DriverEvent::Io(e) => tracing::info!(event = ?e, "link"),
     }
 }

@@ -36,7 +36,7 @@ fn pymavlink_reads_telemetry_lists_and_sets_parameters_and_gets_its_commands_ack
         .env("MAVLINK20", "1")
         .arg(&script)
         .arg(env!("CARGO_BIN_EXE_stx"))
-        .arg("mission-short")
+        .arg("rehearsal")
         .output()
         .expect("python runs");
     assert!(
