@@ -65,7 +65,10 @@ fn pymavlink_reads_telemetry_lists_and_sets_parameters_and_gets_its_commands_ack
             "{message} at {rate} Hz, expected {expected} Hz"
         );
     }
-    assert!(report["param_count"].as_u64().unwrap_or(0) >= 10, "{report}");
+    assert!(
+        report["param_count"].as_u64().unwrap_or(0) >= 10,
+        "{report}"
+    );
     assert_eq!(report["mode_after"], 2, "{report}");
     // Acknowledged within a control period even on a loaded machine.
     assert!(
