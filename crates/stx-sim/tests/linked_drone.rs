@@ -629,3 +629,51 @@ fn an_uploaded_plan_is_flown_and_downloads_as_the_drone_holds_it() {
     assert!(miss < 80.0, "landed {miss} m from the uploaded target");
     assert_eq!(landing.miss_m.map(|m| (m - miss).abs() < 0.01), Some(true));
 }
+
+#[test]
+fn the_automatic_cutdown_cuts_the_balloon_at_mis_cutdown_m_by_the_estimate() {
+    let mut bench = Bench::new("mission-short", |c| {
+        c.onboard.mission.cutdown_altitude_msl_m = 2000.0;
+    });
+    assert!(bench.run_until(1000.0, |b| b.stage() == FlightStage::RoundChute));
+    let (end, _, altitude_msl_m) = bench
+        .drone
+        .drone()
+        .summary()
+        .balloon_end
+        .expect("balloon gone");
+    assert_eq!(end, BalloonEnd::Cutdown);
+    // The estimate's altitude, a period's climb (≈1.3 m) and the GPS's error from the truth.
+    assert!((altitude_msl_m - 2000.0).abs() < 15.0, "{altitude_msl_m}");
+    bench.run_for(1.0);
+    assert!(
+        bench
+            .texts()
+            .iter()
+            .any(|t| t.starts_with("automatic cutdown at")),
+        "{:?}",
+        bench.texts()
+    );
+}
+
+#[test]
+fn without_gps_under_the_round_chute_the_parafoil_still_deploys_by_barometric_height() {
+    // mission-short releases the round chute at about 777 s; the GPS is silent from 650 s
+    // until well after.
+    let mut bench = Bench::new("mission-short", |c| {
+        c.failures.gps_loss_s = vec![[650.0, 900.0]];
+    });
+    assert!(bench.run_until(1000.0, |b| b.stage() == FlightStage::ParafoilDeploy));
+    let (at_s, height_m) = bench.drone.drone().summary().deployment.expect("deployed");
+    assert!((650.0..900.0).contains(&at_s), "deployed at {at_s} s");
+    assert!((height_m - 1200.0).abs() < 40.0, "deployed at {height_m} m");
+    bench.run_for(1.0);
+    let texts = bench.texts();
+    assert!(
+        texts
+            .iter()
+            .any(|t| t.contains("GPS lost") && t.contains("dead reckoning")),
+        "{texts:?}"
+    );
+    bench.land();
+}

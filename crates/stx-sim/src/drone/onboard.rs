@@ -564,7 +564,7 @@ impl Onboard {
         items
     }
 
-    /// Follows the GPS: announces its loss, takes the GPS-loss action after `GPS_LOSS_S`,
+    /// Follows the GPS: announces its loss, takes the GPS-loss action after `FS_GPS_LOSS_S`,
     /// and announces its return. Called every control period with the age of the last fix
     /// that reached the drone (∞ before the first), the age beyond which the GPS counts as
     /// lost (the estimator's GPS timeout) and the latest estimate.
