@@ -133,13 +133,24 @@ fn load_mission(args: &DroneArgs) -> anyhow::Result<MissionConfig> {
     if let Some(pct) = args.packet_loss {
         config.failures.packet_loss_pct = pct;
     }
+    // Windows are FROM:TO on the command line (FROM..TO, the scenario file's form, too).
+    let window = |flag: &str, w: &str| {
+        let text = if w.contains("..") {
+            w.to_string()
+        } else {
+            w.replacen(':', "..", 1)
+        };
+        parse_window(&text).map_err(|_| {
+            bad(anyhow!(
+                "{flag} {w:?}: expected FROM:TO, seconds of mission time with 0 ≤ FROM < TO"
+            ))
+        })
+    };
     for w in &args.link_drop {
-        let window = parse_window(w).map_err(|e| bad(anyhow!("--link-drop: {e}")))?;
-        config.failures.link_drop_s.push(window);
+        config.failures.link_drop_s.push(window("--link-drop", w)?);
     }
     for w in &args.gps_loss {
-        let window = parse_window(w).map_err(|e| bad(anyhow!("--gps-loss: {e}")))?;
-        config.failures.gps_loss_s.push(window);
+        config.failures.gps_loss_s.push(window("--gps-loss", w)?);
     }
     if let Some(s) = &args.stuck_servo {
         let stuck: StuckServo = s.parse().map_err(|e| bad(anyhow!("--stuck-servo: {e}")))?;

@@ -316,6 +316,38 @@ fn the_whole_mission_flies_from_launch_to_landing_at_max_speed_with_no_operator(
 }
 
 #[test]
+fn the_failure_flags_are_flown_and_counted() {
+    let socket = UdpSocket::bind("127.0.0.1:0").expect("udp socket");
+    let port = socket.local_addr().expect("bound").port();
+    let drone = spawn_drone(
+        port,
+        &[
+            "--scenario",
+            "rehearsal",
+            "--speed",
+            "max",
+            "--link-drop",
+            "20:40",
+            "--gps-loss",
+            "60:80",
+            "--stuck-servo",
+            "right@100",
+            "--packet-loss",
+            "10",
+        ],
+    );
+    let s = summary(drone);
+    println!("with failures: {s}");
+    assert_eq!(s["landed"], true);
+    let link = &s["link"];
+    assert!(
+        link["dropped_link_down"].as_u64().unwrap_or(0) > 100,
+        "{link}"
+    );
+    assert!(link["dropped_random"].as_u64().unwrap_or(0) > 100, "{link}");
+}
+
+#[test]
 fn bad_names_files_and_flags_exit_with_code_2() {
     for args in [
         vec!["--scenario", "no-such-mission"],
