@@ -326,15 +326,11 @@ impl MissionConfig {
 
     /// A built-in mission by name.
     pub fn builtin(name: &str) -> Result<Self, MissionError> {
-        match BUILTIN.iter().find(|(n, _)| *n == name) {
-            Some((n, text)) => Self::from_toml_str(n, text),
-            None => Err(MissionError::Unknown {
+        match crate::scenario::find_builtin(BUILTIN, name) {
+            Ok((n, text)) => Self::from_toml_str(n, text),
+            Err(known) => Err(MissionError::Unknown {
                 name: name.to_string(),
-                known: BUILTIN
-                    .iter()
-                    .map(|(n, _)| *n)
-                    .collect::<Vec<_>>()
-                    .join(", "),
+                known,
             }),
         }
     }
