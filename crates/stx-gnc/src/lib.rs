@@ -12,7 +12,9 @@
 //!   [`guidance`] picks and feeds them by mode, including the spiral landing;
 //! - [`performance`] summarises how the parafoil flies, [`pointmass`] flies that summary fast,
 //!   and [`predict`] uses it to say where the vehicle will land;
-//! - [`geo`] links the mission's local NED frame to latitude, longitude and altitude.
+//! - [`geo`] links the mission's local NED frame to latitude, longitude and altitude;
+//! - [`params`] describes every onboard setting the station may read and write, once, for
+//!   the drone's parameter table and the station's editor alike.
 pub mod control;
 pub mod estimate;
 pub mod estimator;
@@ -20,6 +22,7 @@ pub mod geo;
 pub mod guidance;
 pub mod measurement;
 pub mod mission;
+pub mod params;
 pub mod performance;
 pub mod pointmass;
 pub mod predict;

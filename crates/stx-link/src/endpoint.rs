@@ -866,6 +866,18 @@ impl VehicleEndpoint {
         self.plan.plan()
     }
 
+    /// Replaces the plan held (the vehicle's own, e.g. loaded before launch), so that a
+    /// download returns what the vehicle actually flies.
+    pub fn set_plan(&mut self, plan: Vec<PlanItem>) {
+        self.plan.set_plan(plan);
+    }
+
+    /// Changes how long sticks stay fresh without a MANUAL_CONTROL (a parameter the station
+    /// may edit).
+    pub fn set_manual_timeout(&mut self, timeout: Duration) {
+        self.manual.timeout = timeout;
+    }
+
     /// Current sticks; `None` when stale or never received.
     pub fn sticks(&self, now: Duration) -> Option<Sticks> {
         self.manual.sticks(now)

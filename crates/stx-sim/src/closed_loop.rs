@@ -18,7 +18,9 @@ use stx_gnc::guidance::{Guidance, PhaseEvent};
 use stx_gnc::mission::{FlightMode, GuidancePhase};
 
 use crate::open_loop::{height_above_ground_m, lowest_point};
-use crate::sensors::{DeliveryQueue, SensorConfig, SensorConfigError, SensorSuite, Truth};
+use crate::sensors::{
+    Delivery, DeliveryQueue, SensorConfig, SensorConfigError, SensorSuite, Truth,
+};
 
 /// Navigation as the drone does it: its sensors sample the truth, their measurements reach the
 /// estimator after their latencies, and the estimator's output is what guidance sees.
@@ -58,18 +60,33 @@ impl SensedNavigation {
     pub fn estimator(&self) -> &Estimator {
         &self.estimator
     }
+
+    /// Samples the sensors on `truth` and hands the estimator every measurement that has
+    /// reached it by `truth.time_s`; returns those measurements, in arrival order (the drone
+    /// also sends them to the station). Any truth will do: the simulated drone's stages
+    /// before the parafoil build theirs without the 14-DOF model.
+    pub fn sense(&mut self, truth: &Truth) -> Vec<Delivery> {
+        for delivery in self.sensors.sample(truth.time_s, truth) {
+            self.in_flight.push(delivery);
+        }
+        let mut arrived = Vec::new();
+        while let Some(delivery) = self.in_flight.pop_due(truth.time_s) {
+            self.estimator
+                .handle(delivery.arrival_s, &delivery.measurement);
+            arrived.push(delivery);
+        }
+        arrived
+    }
+
+    /// The estimate at `time_s`.
+    pub fn estimate(&self, time_s: f64) -> Estimate {
+        self.estimator.estimate(time_s)
+    }
 }
 
 impl Navigator for SensedNavigation {
     fn navigate(&mut self, model: &ParafoilModel, time_s: f64, x: &StateVector) -> Estimate {
-        let truth = Truth::from_model(model, time_s, x);
-        for delivery in self.sensors.sample(time_s, &truth) {
-            self.in_flight.push(delivery);
-        }
-        while let Some(delivery) = self.in_flight.pop_due(time_s) {
-            self.estimator
-                .handle(delivery.arrival_s, &delivery.measurement);
-        }
+        self.sense(&Truth::from_model(model, time_s, x));
         self.estimator.estimate(time_s)
     }
 }
@@ -255,65 +272,85 @@ impl<N: Navigator> GuidedFlight<N> {
 
     /// Flies one control period (guiding first); `Some` when the stack touched down in it.
     ///
-    /// The period is integrated with fixed RK4 steps; if they fail (hard main-line reversals
-    /// can spin the drone about its lines faster than a 0.05 s step follows), the same period
-    /// is flown again from the same state with steps four and then sixteen times shorter, so a
-    /// run is deterministic and only its rare violent seconds cost more.
+    /// The period is integrated by [`fly_period`].
     pub fn advance(&mut self) -> Result<Option<Touchdown>, IntegrateError> {
         self.guide();
-        let vehicle = self.model.vehicle.clone();
-        let mut event = |_t: f64, x: &StateVector| height_above_ground_m(&vehicle, x);
-        let end_s = self.time_s + self.control_period_s;
-        let mut outcome = Err(IntegrateError::InvalidSpan {
-            start_time_s: self.time_s,
-            end_time_s: end_s,
-        });
-        for refinement in [1.0, 4.0, 16.0] {
-            outcome = integrate(
-                &mut Rk4::new(self.step_s / refinement),
-                &mut self.model,
-                self.time_s,
-                &self.state,
-                end_s,
-                Hooks {
-                    event: Some(&mut event),
-                    observer: None,
-                },
-            );
-            if !matches!(outcome, Err(IntegrateError::NonFiniteStep { .. })) {
-                break;
-            }
-        }
-        let outcome = outcome?;
-        self.time_s = outcome.time_s;
-        self.state = outcome.state;
-        Ok(outcome.event_time_s.map(|t| self.touchdown(t)))
-    }
-
-    fn touchdown(&self, time_s: f64) -> Touchdown {
-        let k = Kinematics::new(
-            &self.model.vehicle,
+        let (time_s, state, contact_s) = fly_period(
+            &mut self.model,
+            self.time_s,
             &self.state,
-            self.model.controls().main_line_m,
-        );
-        let (body, _) = lowest_point(&self.model.vehicle, &k);
-        let p = k.position_ned_m[body as usize];
-        let v = k.velocity_ned_mps(body);
-        let wind = self.model.environment.wind.wind_ned_mps(time_s, &p);
-        let upwind = if wind.x.hypot(wind.y) > 1e-6 {
-            (-wind.y).atan2(-wind.x)
-        } else {
-            f64::NAN
-        };
-        let heading = euler_from_t(&k.t_i_body[Body::Canopy as usize]).z;
-        Touchdown {
+            self.step_s,
+            self.control_period_s,
+        )?;
+        self.time_s = time_s;
+        self.state = state;
+        Ok(contact_s.map(|t| touchdown(&self.model, &self.state, t)))
+    }
+}
+
+/// Integrates `model` from `state` at `time_s` over `period_s` with the servo commands held,
+/// in fixed RK4 steps of `step_s`, stopping exactly at ground contact. Returns the time
+/// reached, the state there and the contact time if the stack touched down.
+///
+/// If the steps fail (hard main-line reversals can spin the drone about its lines faster than
+/// a 0.05 s step follows), the same period is flown again from the same state with steps four
+/// and then sixteen times shorter, so a run is deterministic and only its rare violent seconds
+/// cost more.
+pub fn fly_period(
+    model: &mut ParafoilModel,
+    time_s: f64,
+    state: &StateVector,
+    step_s: f64,
+    period_s: f64,
+) -> Result<(f64, StateVector, Option<f64>), IntegrateError> {
+    let vehicle = model.vehicle.clone();
+    let mut event = |_t: f64, x: &StateVector| height_above_ground_m(&vehicle, x);
+    let end_s = time_s + period_s;
+    let mut outcome = Err(IntegrateError::InvalidSpan {
+        start_time_s: time_s,
+        end_time_s: end_s,
+    });
+    for refinement in [1.0, 4.0, 16.0] {
+        outcome = integrate(
+            &mut Rk4::new(step_s / refinement),
+            model,
             time_s,
-            body,
-            position_ne_m: [p.x, p.y],
-            vertical_speed_mps: v.z,
-            heading_rad: heading,
-            upwind_rad: upwind,
+            state,
+            end_s,
+            Hooks {
+                event: Some(&mut event),
+                observer: None,
+            },
+        );
+        if !matches!(outcome, Err(IntegrateError::NonFiniteStep { .. })) {
+            break;
         }
+    }
+    let outcome = outcome?;
+    Ok((outcome.time_s, outcome.state, outcome.event_time_s))
+}
+
+/// How the stack in `state` meets the ground at `time_s`: the lowest body, its position and
+/// vertical speed, the canopy's heading and where the wind comes from there.
+pub fn touchdown(model: &ParafoilModel, state: &StateVector, time_s: f64) -> Touchdown {
+    let k = Kinematics::new(&model.vehicle, state, model.controls().main_line_m);
+    let (body, _) = lowest_point(&model.vehicle, &k);
+    let p = k.position_ned_m[body as usize];
+    let v = k.velocity_ned_mps(body);
+    let wind = model.environment.wind.wind_ned_mps(time_s, &p);
+    let upwind = if wind.x.hypot(wind.y) > 1e-6 {
+        (-wind.y).atan2(-wind.x)
+    } else {
+        f64::NAN
+    };
+    let heading = euler_from_t(&k.t_i_body[Body::Canopy as usize]).z;
+    Touchdown {
+        time_s,
+        body,
+        position_ne_m: [p.x, p.y],
+        vertical_speed_mps: v.z,
+        heading_rad: heading,
+        upwind_rad: upwind,
     }
 }
 

@@ -44,6 +44,21 @@ pub const BUILTIN: &[(&str, &str)] = &[
     ),
 ];
 
+/// The entry `name` of a table of built-in files (name, TOML text); otherwise the names
+/// there are, comma-separated, for the error that lists them.
+pub(crate) fn find_builtin(
+    table: &'static [(&'static str, &'static str)],
+    name: &str,
+) -> Result<(&'static str, &'static str), String> {
+    table.iter().copied().find(|(n, _)| *n == name).ok_or_else(|| {
+        table
+            .iter()
+            .map(|(n, _)| *n)
+            .collect::<Vec<_>>()
+            .join(", ")
+    })
+}
+
 /// Why a scenario was refused.
 #[derive(Debug, Error)]
 pub enum ScenarioError {
@@ -397,15 +412,11 @@ impl Scenario {
 
     /// A built-in scenario by name.
     pub fn builtin(name: &str) -> Result<Self, ScenarioError> {
-        match BUILTIN.iter().find(|(n, _)| *n == name) {
-            Some((n, text)) => Self::from_toml_str(n, text),
-            None => Err(ScenarioError::Unknown {
+        match find_builtin(BUILTIN, name) {
+            Ok((n, text)) => Self::from_toml_str(n, text),
+            Err(known) => Err(ScenarioError::Unknown {
                 name: name.to_string(),
-                known: BUILTIN
-                    .iter()
-                    .map(|(n, _)| *n)
-                    .collect::<Vec<_>>()
-                    .join(", "),
+                known,
             }),
         }
     }

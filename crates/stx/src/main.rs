@@ -7,6 +7,7 @@
 mod analyze;
 mod bench;
 mod bench_station;
+mod drone;
 mod montecarlo;
 mod serve;
 mod sim;
@@ -41,6 +42,8 @@ enum Command {
     Analyze(analyze::AnalyzeArgs),
     /// Tune one controller's gains and write the gains file guidance uses.
     Tune(tune::TuneArgs),
+    /// The simulated drone flying a whole mission over a MAVLink link.
+    Drone(drone::DroneArgs),
 }
 
 /// An error that is the user's input, not the program's failure (exit code 2).
@@ -71,6 +74,7 @@ fn main() -> ExitCode {
         Command::Serve(args) => serve::run(args),
         Command::Analyze(args) => analyze::run(args),
         Command::Tune(args) => tune::run(args),
+        Command::Drone(args) => drone::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
