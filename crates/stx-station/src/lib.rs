@@ -5,8 +5,8 @@
 //! - [`config`]: the station's TOML, validated before anything starts;
 //! - [`core`]: the station's state and logic, pure (events and the mission clock in, messages
 //!   and link actions out);
-//! - [`messages`]: the API's JSON; [`kml`]: the Google Earth feed; [`params`]: what the station
-//!   knows about the drone's parameters;
+//! - [`messages`]: the API's JSON; [`kml`]: the Google Earth feed (parameter ranges, units
+//!   and meanings come from the onboard catalogue, `stx_gnc::params`, shared with the drone);
 //! - [`http`]: the axum routes (auth, REST, WebSocket, static files);
 //! - [`daemon`]: the tokio wiring of link, core and HTTP, with graceful shutdown.
 
@@ -16,4 +16,3 @@ pub mod daemon;
 pub mod http;
 pub mod kml;
 pub mod messages;
-pub mod params;

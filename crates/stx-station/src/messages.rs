@@ -388,6 +388,10 @@ pub struct ParamView {
     pub units: String,
     /// What it does.
     pub description: String,
+    /// Part of the onboard software (`gains`, `spiral`, `failsafe`, `mission`), if known.
+    pub group: Option<String>,
+    /// For flags and choices, the name of each whole value from 0 up; empty for numbers.
+    pub choices: Vec<&'static str>,
 }
 
 /// The `params` message and `GET /api/params`.

@@ -351,6 +351,24 @@ async fn a_parameter_set_is_read_back_from_the_drone() {
         assert_ne!(outcome["outcome"], "accepted", "{outcome}");
     }
     assert!(drone.seen(|s| !s.param_changes.iter().any(|(_, v)| *v > 1.0)));
+    // A parameter of the onboard catalogue out of its range: refused by the station with the
+    // range named, and nothing goes to the drone.
+    let (status, reply) = http(
+        addr,
+        "POST",
+        "/api/params/GN_HK1",
+        Some(OPERATOR),
+        Some(r#"{"value":7.5}"#),
+    )
+    .await;
+    assert_eq!(status, 400, "{reply}");
+    assert!(
+        reply["reason"]
+            .as_str()
+            .is_some_and(|r| r.contains("GN_HK1") && r.contains("0.2")),
+        "{reply}"
+    );
+    assert!(drone.seen(|s| !s.param_changes.iter().any(|(n, _)| n == "GN_HK1")));
 }
 
 #[tokio::test]

@@ -178,6 +178,11 @@ impl DroneOptions {
     }
 }
 
+/// Whether `options` name a mission that loads and validates, without flying it.
+pub fn check_mission(options: &DroneOptions) -> anyhow::Result<()> {
+    load_mission(options).map(drop)
+}
+
 /// Reads a mission by built-in name or path, with the options' overrides applied and
 /// validated. Every error is the user's input ([`BadInput`], exit code 2).
 fn load_mission(options: &DroneOptions) -> anyhow::Result<MissionConfig> {

@@ -1,6 +1,11 @@
 //! `stx serve`: the ground station daemon — the drone link, the station's estimator, guidance
 //! replica and predictor, and the dashboard on localhost.
+//!
+//! With `--sim` the simulated drone of `stx drone` flies beside the station in the same process,
+//! over a real UDP socket on loopback to the station's `udpin` link (the same bytes a radio
+//! would carry), for rehearsals and demonstrations. One shutdown (Ctrl-C or SIGTERM) stops both.
 
+use std::future::Future;
 use std::path::PathBuf;
 
 use anyhow::Context;
@@ -8,6 +13,7 @@ use clap::Args;
 use stx_station::config::{DEFAULT_STATION_TOML, StationConfig};
 
 use crate::BadInput;
+use crate::drone::{DroneOptions, Speed};
 
 #[derive(Args)]
 pub struct ServeArgs {
@@ -21,6 +27,20 @@ pub struct ServeArgs {
     /// serial:/dev/ttyUSB0:57600, tcpout:192.168.1.20:5760).
     #[arg(long)]
     link: Option<String>,
+    /// Fly the simulated drone beside the station, over loopback UDP to its link (which must
+    /// then be a `udpin:` link).
+    #[arg(long)]
+    sim: bool,
+    /// The simulated drone's mission with --sim: `mission` (the whole 3-hour flight),
+    /// `mission-short`, `rehearsal` (under the parafoil from 900 m), or a mission TOML file.
+    #[arg(long, default_value = "mission-short", requires = "sim")]
+    sim_scenario: String,
+    /// Mission time per real time for the simulated drone (a number or `max`).
+    #[arg(long, default_value = "1", requires = "sim")]
+    sim_speed: Speed,
+    /// Seed of the simulated drone's randomness (default: the mission's).
+    #[arg(long, requires = "sim")]
+    sim_seed: Option<u64>,
 }
 
 /// Reads and validates the station configuration.
@@ -46,7 +66,7 @@ pub fn run(args: ServeArgs) -> anyhow::Result<()> {
     if let Some(listen) = args.listen {
         config.listen = listen;
     }
-    if let Some(link) = args.link {
+    if let Some(link) = args.link.clone() {
         config.link.address = link;
         config.validate().context("--link").map_err(BadInput)?;
     }
@@ -56,6 +76,11 @@ pub fn run(args: ServeArgs) -> anyhow::Result<()> {
             "the dashboard is not built here: run `cd web && npm ci && npm run build` (the API works without it)"
         );
     }
+    let sim = if args.sim {
+        Some(sim_options(&config, &args)?)
+    } else {
+        None
+    };
     let runtime = tokio::runtime::Builder::new_multi_thread()
         .enable_all()
         .build()
@@ -67,15 +92,99 @@ pub fn run(args: ServeArgs) -> anyhow::Result<()> {
             .find(|t| t.role == stx_station::config::Role::Operator)
             .map(|t| t.token.clone())
             .unwrap_or_default();
-        stx_station::daemon::run(config, shutdown_signal(), move |running| {
+        let (stop_tx, stop_rx) = tokio::sync::watch::channel(false);
+        tokio::spawn(async move {
+            shutdown_signal().await;
+            let _ = stop_tx.send(true);
+        });
+        let mut drone_task = None;
+        let station = stx_station::daemon::run(config, stopped(stop_rx.clone()), |running| {
             println!(
                 "stx station: open http://{}/?token={operator}",
                 running.http
             );
+            if let (Some(mut options), Some(link)) = (sim, running.link_local) {
+                options.connect = format!("udpout:{}", loopback_if_unspecified(link));
+                drone_task = Some(tokio::spawn(fly_beside(options, stopped(stop_rx))));
+            }
         })
         .await
-        .context("station")
+        .context("station");
+        if let Some(mut task) = drone_task {
+            // After a shutdown the drone finishes its step and reports; if the station stopped
+            // on its own (an error), nobody listens to the drone any more.
+            if tokio::time::timeout(std::time::Duration::from_secs(2), &mut task)
+                .await
+                .is_err()
+            {
+                task.abort();
+            }
+        }
+        station
     })
+}
+
+/// The simulated drone's options from the command line, checked before anything starts.
+fn sim_options(config: &StationConfig, args: &ServeArgs) -> anyhow::Result<DroneOptions> {
+    if !config.link.address.starts_with("udpin:") {
+        return Err(BadInput(anyhow::anyhow!(
+            "--sim flies the drone over loopback UDP: the station's link must be `udpin:…`, not `{}`",
+            config.link.address
+        ))
+        .into());
+    }
+    let mut options = DroneOptions::new("udpout:127.0.0.1:0", &args.sim_scenario);
+    options.speed = args.sim_speed;
+    options.seed = args.sim_seed;
+    // On the ground it keeps answering (parameters, replay of the landing) until the station stops.
+    options.linger = None;
+    if let Some(hex) = &config.link.signing_key_hex {
+        let bytes = stx_station::daemon::parse_key_hex(hex)
+            .context("link.signing_key_hex must be 64 hexadecimal characters")
+            .map_err(BadInput)?;
+        options.signing_key = Some(stx_link::signing::SigningKey::from_bytes(bytes));
+    }
+    // Fail on an unknown mission now, with exit code 2, not after the dashboard is up.
+    crate::drone::check_mission(&options)?;
+    Ok(options)
+}
+
+/// The drone's flight, its outcome logged: a simulated drone that fails does not stop the
+/// station (the operator sees the link go quiet, as with a real one).
+async fn fly_beside(options: DroneOptions, shutdown: impl Future<Output = ()> + Send) {
+    tracing::info!(
+        mission = %options.scenario,
+        speed = %options.speed,
+        to = %options.connect,
+        "simulated drone taking off"
+    );
+    match crate::drone::fly(options, shutdown).await {
+        Ok(report) => tracing::info!(
+            landed = report.landed,
+            miss_m = ?report.mission.landing.as_ref().and_then(|l| l.miss_m),
+            wall_time_s = report.wall_time_s,
+            "simulated drone finished"
+        ),
+        Err(e) => tracing::error!(error = format!("{e:#}"), "simulated drone failed"),
+    }
+}
+
+/// Resolves once the shutdown has been asked for.
+async fn stopped(mut stop: tokio::sync::watch::Receiver<bool>) {
+    let _ = stop.wait_for(|stop| *stop).await;
+}
+
+/// A UDP server bound to every interface is reached on loopback.
+fn loopback_if_unspecified(address: std::net::SocketAddr) -> std::net::SocketAddr {
+    if address.ip().is_unspecified() {
+        let loopback: std::net::IpAddr = match address {
+            std::net::SocketAddr::V4(_) => std::net::Ipv4Addr::LOCALHOST.into(),
+            std::net::SocketAddr::V6(_) => std::net::Ipv6Addr::LOCALHOST.into(),
+        };
+        std::net::SocketAddr::new(loopback, address.port())
+    } else {
+        address
+    }
 }
 
 /// Ctrl-C, or SIGTERM from systemd or a container runtime.

@@ -92,3 +92,107 @@ fn a_bad_station_config_exits_2_and_names_the_field() {
         .expect("stx runs");
     assert_eq!(missing.status.code(), Some(2));
 }
+
+/// Starts `stx serve` with `args` and returns the child and the address and token it printed.
+fn serve(args: &[&str]) -> (std::process::Child, String, String) {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_stx"))
+        .arg("serve")
+        .args(args)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::null())
+        .spawn()
+        .expect("stx serve starts");
+    let mut line = String::new();
+    BufReader::new(child.stdout.take().expect("stdout"))
+        .read_line(&mut line)
+        .expect("a line");
+    let url = line.trim().rsplit(' ').next().expect("a URL").to_string();
+    let rest = url.strip_prefix("http://").expect("http URL");
+    let (address, token) = rest.split_once("/?token=").expect("address and token");
+    (child, address.to_string(), token.to_string())
+}
+
+fn get_json(address: &str, path: &str, token: &str) -> serde_json::Value {
+    let response = get(address, path, token);
+    let body = response.split_once("\r\n\r\n").map_or("", |(_, b)| b);
+    // The station answers with a content length, so the body is the JSON itself.
+    serde_json::from_str(body).unwrap_or(serde_json::Value::Null)
+}
+
+#[test]
+fn serve_sim_flies_the_simulated_drone_to_a_landing_the_station_sees() {
+    let (mut child, address, token) = serve(&[
+        "--listen",
+        "127.0.0.1:0",
+        "--link",
+        "udpin:127.0.0.1:0",
+        "--sim",
+        "--sim-scenario",
+        "rehearsal",
+        "--sim-speed",
+        "max",
+    ]);
+    let deadline = Instant::now() + Duration::from_secs(90);
+    let mut last = serde_json::Value::Null;
+    let mut phases = std::collections::BTreeSet::new();
+    while Instant::now() < deadline {
+        last = get_json(&address, "/api/state", &token);
+        if let Some(phase) = last["guidance"]["phase"].as_str() {
+            phases.insert(phase.to_string());
+        }
+        if last["vehicle"]["stage"] == "landed" {
+            break;
+        }
+        std::thread::sleep(Duration::from_millis(100));
+    }
+    assert_eq!(last["vehicle"]["stage"], "landed", "{last}");
+    // Where the station saw it land, against the target guidance was given.
+    let gps = &last["vehicle"]["gps"];
+    let target = &last["guidance"]["target"];
+    let (lat, lon) = (
+        gps["lat_deg"].as_f64().unwrap(),
+        gps["lon_deg"].as_f64().unwrap(),
+    );
+    let (target_lat, target_lon) = (
+        target["lat_deg"].as_f64().unwrap(),
+        target["lon_deg"].as_f64().unwrap(),
+    );
+    let north_m = (lat - target_lat).to_radians() * 6_371_000.0;
+    let east_m = (lon - target_lon).to_radians() * 6_371_000.0 * target_lat.to_radians().cos();
+    let miss_m = north_m.hypot(east_m);
+    assert!(
+        miss_m < 60.0,
+        "landed {miss_m:.1} m from the target: {last}"
+    );
+    assert!(
+        phases.contains("final_approach") || phases.contains("flare"),
+        "{phases:?}"
+    );
+    // The drone's parameters arrive described from the shared catalogue.
+    let params = get_json(&address, "/api/params", &token);
+    let hk1 = params["params"]
+        .as_array()
+        .and_then(|p| p.iter().find(|p| p["name"] == "GN_HK1"))
+        .unwrap_or_else(|| panic!("GN_HK1 listed: {params}"));
+    assert_eq!(hk1["units"], "m/rad", "{hk1}");
+    assert_eq!(hk1["group"], "gains", "{hk1}");
+    child.kill().expect("kill");
+    let _ = child.wait();
+}
+
+#[test]
+fn serve_sim_refuses_a_link_it_cannot_fly_on_and_an_unknown_mission() {
+    for args in [
+        vec!["serve", "--sim", "--link", "serial:/dev/ttyUSB0:57600"],
+        vec!["serve", "--sim", "--sim-scenario", "no-such-mission"],
+        vec!["serve", "--sim-speed", "4"],
+    ] {
+        let out = Command::new(env!("CARGO_BIN_EXE_stx"))
+            .args(&args)
+            .output()
+            .expect("stx runs");
+        assert_eq!(out.status.code(), Some(2), "{args:?}");
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!stderr.is_empty(), "{args:?} says why");
+    }
+}

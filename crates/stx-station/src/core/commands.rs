@@ -220,6 +220,12 @@ impl Commands {
                         "parameter names are 1–16 ASCII characters",
                     ));
                 }
+                // The drone would refuse it too, but saying so here spares a round trip
+                // over a slow radio and names the range.
+                if let Some(def) = stx_gnc::params::find(&name) {
+                    def.check(value)
+                        .map_err(|e| ApiError::bad_request(e.to_string()))?;
+                }
                 if !self.table.values.is_empty() && !self.table.values.contains_key(&name) {
                     return Err(ApiError {
                         status: 404,

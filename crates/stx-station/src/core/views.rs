@@ -2,6 +2,7 @@
 
 use stx_dynamics::rotation::wrap_pi;
 use stx_gnc::mission::GuidancePhase;
+use stx_gnc::params::ParamKind;
 use stx_gnc::predict::PredictedTouchdown;
 
 use super::StationCore;
@@ -218,7 +219,7 @@ impl StationCore {
             .values
             .values()
             .map(|p| {
-                let spec = crate::params::describe(&p.name);
+                let spec = stx_gnc::params::find(&p.name);
                 ParamView {
                     name: p.name.clone(),
                     value: f64::from(p.value),
@@ -226,6 +227,12 @@ impl StationCore {
                     max: spec.map(|s| s.max),
                     units: spec.map_or(String::new(), |s| s.units.to_string()),
                     description: spec.map_or(String::new(), |s| s.description.to_string()),
+                    group: spec.map(|s| snake(s.group)),
+                    choices: match spec.map(|s| s.kind) {
+                        Some(ParamKind::Choice(names)) => names.to_vec(),
+                        Some(ParamKind::Flag) => vec!["off", "on"],
+                        _ => Vec::new(),
+                    },
                 }
             })
             .collect();
