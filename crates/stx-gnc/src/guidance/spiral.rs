@@ -185,6 +185,8 @@ pub struct Spiral {
     /// decisions already taken (a base leg that never met its final line, a final turned
     /// from far out).
     reorient: bool,
+    /// Since when the estimator's wind uncertainty has been small, s.
+    wind_known_since_s: Option<f64>,
 }
 
 /// The branches in flying order.
@@ -230,6 +232,8 @@ const MIN_FINAL_BEFORE_REENTRY_S: f64 = 10.0;
 const LOOP_REORIENT_MAX_RAD: f64 = 0.7854;
 /// Largest turn of the final-approach course when turning final, rad (20°).
 const FINAL_REORIENT_MAX_RAD: f64 = 0.3491;
+/// Time the wind uncertainty must have stayed small before energy decisions use it, s.
+const WIND_SETTLE_S: f64 = 10.0;
 /// S-turns swing this far either side of the final line, m.
 const S_TURN_HALF_WIDTH_M: f64 = 40.0;
 /// Course offset of an S-turn leg from the final course, rad (100°: slightly back downwind).
@@ -254,6 +258,7 @@ impl Spiral {
             turn_rate: None,
             phase_since_s: 0.0,
             reorient: true,
+            wind_known_since_s: None,
         }
     }
 
@@ -452,7 +457,18 @@ impl Spiral {
 
         // Energy decisions wait until the wind is known: the estimator's first seconds can be
         // metres per second off, and a pattern abandoned on a wrong wind is not recovered.
-        let wind_known = est.wind_sigma_mps.x.max(est.wind_sigma_mps.y) < WIND_KNOWN_SIGMA_MPS;
+        // ... and have stayed good for a while: the estimator's first converged seconds still
+        // carry metres per second of error that its uncertainty does not show, and a pattern
+        // committed to a wrong wind's axis is flown across the real one.
+        let sigma_ok = est.wind_sigma_mps.x.max(est.wind_sigma_mps.y) < WIND_KNOWN_SIGMA_MPS;
+        self.wind_known_since_s = match (sigma_ok, self.wind_known_since_s) {
+            (false, _) => None,
+            (true, None) => Some(est.time_s),
+            (true, since) => since,
+        };
+        let wind_known = self
+            .wind_known_since_s
+            .is_some_and(|since| est.time_s - since >= WIND_SETTLE_S);
         let mut change: Change = None;
         let lowest_body_height = height - sc.hang_height_m;
         let now_s = est.time_s;
@@ -905,6 +921,38 @@ mod tests {
         assert_eq!(
             status_after_one_update(&config).planned_turn_rate_rad_s,
             0.5
+        );
+    }
+
+    /// Regression (Monte Carlo seed 2, run 730): eight seconds after release the estimator's
+    /// wind was 4 m/s off with a small uncertainty; guidance committed to a downwind leg on
+    /// that wind's axis at once, flew it across the real wind and landed 64 m short.
+    #[test]
+    fn energy_decisions_wait_until_the_wind_estimate_has_settled() {
+        let config = GuidanceConfig::default();
+        let plan = Plan {
+            target_ned_m: Vector3::zeros(),
+            ..Plan::default()
+        };
+        let mut spiral = Spiral::new();
+        spiral.force_phase(GuidancePhase::Approximation);
+        // Low and far: short of height, whatever the wind.
+        let wind = Vector3::new(-2.0, -3.0, 0.0);
+        let mut first_change = None;
+        for k in 0..80 {
+            let t = 0.25 * k as f64;
+            let mut est =
+                PointMass::new(t, Vector3::new(250.0, 150.0, -120.0), 2.0).estimate(&wind);
+            est.wind_sigma_mps = Vector3::new(0.3, 0.3, 0.3);
+            let (_, change) = spiral.update(&config, &plan, &est, 1.2);
+            if change.is_some() && first_change.is_none() {
+                first_change = Some(t);
+            }
+        }
+        let t = first_change.expect("guidance decides once the wind has settled");
+        assert!(
+            (WIND_SETTLE_S..WIND_SETTLE_S + 0.5).contains(&t),
+            "first decision at {t} s"
         );
     }
 }
