@@ -50,13 +50,11 @@ pub(crate) fn find_builtin(
     table: &'static [(&'static str, &'static str)],
     name: &str,
 ) -> Result<(&'static str, &'static str), String> {
-    table.iter().copied().find(|(n, _)| *n == name).ok_or_else(|| {
-        table
-            .iter()
-            .map(|(n, _)| *n)
-            .collect::<Vec<_>>()
-            .join(", ")
-    })
+    table
+        .iter()
+        .copied()
+        .find(|(n, _)| *n == name)
+        .ok_or_else(|| table.iter().map(|(n, _)| *n).collect::<Vec<_>>().join(", "))
 }
 
 /// Why a scenario was refused.
