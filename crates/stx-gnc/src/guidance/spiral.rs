@@ -229,7 +229,7 @@ const REENTER_EXCESS_M: f64 = 40.0;
 /// the first seconds after the turn onto the line still carry the turn's errors.
 const MIN_FINAL_BEFORE_REENTRY_S: f64 = 10.0;
 /// Largest turn of the pattern's axis at the start of a loop, rad (45°).
-const LOOP_REORIENT_MAX_RAD: f64 = 0.7854;
+const LOOP_REORIENT_MAX_RAD: f64 = std::f64::consts::FRAC_PI_4;
 /// Largest turn of the final-approach course when turning final, rad (20°).
 const FINAL_REORIENT_MAX_RAD: f64 = 0.3491;
 /// Time the wind uncertainty must have stayed small before energy decisions use it, s.
