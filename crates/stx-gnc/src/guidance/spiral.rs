@@ -9,6 +9,14 @@
 //! already stretch the downwind branch and shrink the upwind one in ground-speed terms, which
 //! is what the seed's wind-scaled ("slide") branches do.
 //!
+//! The pattern's axis follows the wind during the approximation; after that it turns only at
+//! the start of a loop (at most 45°) and onto the final (at most 20°), so the vehicle's place
+//! in the pattern does not move under it while decisions taken on it are being flown. Corners
+//! are started a turn radius early, at the turn rate the control gains in force actually give
+//! ([`corner_turn_rate_rad_s`]), and energy decisions wait until the wind estimate has been
+//! certain for a while. Each phase change is one decision: the final is left as too high only
+//! after some time on it, and a base leg meets its final line only out at the base leg.
+//!
 //! Leaving the spiral is an energy decision recomputed at every update. The height needed to
 //! turn base at `x` on Branch1 and glide in is `H(x) = hang + s₀·a/g_cross + s_t·x/g_up + 2·turn
 //! loss + margin`. On Branch1, at the normal corner, guidance loops again if one more loop still
