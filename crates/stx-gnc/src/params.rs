@@ -388,10 +388,10 @@ pub const CATALOG: &[ParamDef] = &[
     real!(
         "SP_TURN_RATE",
         "rad/s",
-        0.05,
+        0.0,
         1.5,
         Spiral,
-        "turn rate planned for the corners of the pattern",
+        "turn rate planned for the corners of the pattern; 0: the rate the control gains turn at",
         |s| s.guidance.spiral.planned_turn_rate_rad_s
     ),
     real!(

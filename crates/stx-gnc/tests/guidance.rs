@@ -224,3 +224,57 @@ fn a_new_plan_during_the_landing_restarts_the_approach_to_the_new_target() {
     assert_eq!(g.phase(), GuidancePhase::Approximation);
     assert!(events.iter().any(|e| e.reason.contains("new plan")));
 }
+
+/// Regression: deployed high and far from the target (the drone's `mission-short` deploys
+/// 1.1 km up, some 180 m downwind and 1.3 km to the side of it in a 3.3 m/s wind), guidance
+/// went for the final approach because the way across needed all the height, then found itself
+/// too high for the final (which left the way across out), went back downwind, turned base at
+/// once and final again: a new phase every control period. Each phase change is now one
+/// decision, with its reason.
+#[test]
+fn a_high_deployment_far_from_the_target_does_not_chatter_between_phases() {
+    for (speed, from, downwind_m, side_m, height_m) in [
+        (3.3, 290.0, 184.0, 1350.0, 1077.0),
+        (3.3, 290.0, 184.0, -1350.0, 1077.0),
+        (0.5, 0.0, 1000.0, 0.0, 2500.0),
+        (2.0, 270.0, 1000.0, 300.0, 2500.0),
+        (4.0, 45.0, 1000.0, 0.0, 2500.0),
+    ] {
+        let wind = wind_from(speed, from);
+        let along = wind.xy().normalize();
+        let across = Vector3::new(-along.y, along.x, 0.0);
+        let start = along.push(0.0) * downwind_m + across * side_m - Vector3::z() * height_m;
+        let f = fly(
+            start,
+            from + 90.0,
+            FlightMode::SpiralLanding,
+            target_plan(0.0, 0.0),
+            wind,
+            5000.0,
+        );
+        let p = phases(&f);
+        // No phase chosen by guidance lasts less than 2 s, except the last before the flare.
+        for pair in f.events.windows(2).skip(1) {
+            let dt = pair[1].time_s - pair[0].time_s;
+            assert!(
+                dt >= 2.0 || pair[1].to == GuidancePhase::Flare,
+                "wind {speed} from {from}: {:?} lasted {dt:.2} s ({}) in {p:?}",
+                pair[0].to,
+                pair[1].reason
+            );
+        }
+        let finals = p
+            .iter()
+            .filter(|x| **x == GuidancePhase::FinalApproach)
+            .count();
+        assert!(
+            finals <= 2,
+            "wind {speed} from {from}: {finals} final approaches in {p:?}"
+        );
+        let miss = f.mass.position_ned_m.xy().norm();
+        assert!(
+            miss < 15.0,
+            "wind {speed} from {from}: missed by {miss:.1} m, {p:?}"
+        );
+    }
+}

@@ -25,7 +25,7 @@ use stx_dynamics::vehicle::Vehicle;
 use stx_dynamics::wind::{
     ProfileRow, Turbulence, TurbulenceParams, WindComposite, WindField, WindProfile,
 };
-use stx_gnc::guidance::{Guidance, GuidanceConfig, Plan};
+use stx_gnc::guidance::{Guidance, GuidanceConfig, PhaseEvent, Plan};
 use stx_gnc::mission::{FlightMode, GuidancePhase};
 
 use crate::closed_loop::{GuidedFlight, Navigator};
@@ -47,6 +47,9 @@ pub struct MonteCarloConfig {
     pub flare: bool,
     /// Worker threads.
     pub threads: usize,
+    /// Fly only this run (by index), keeping its phase events and track: replays one run of a
+    /// campaign exactly, since its conditions depend only on the seed and the index.
+    pub only_run: Option<usize>,
     /// Guidance settings.
     #[serde(skip)]
     pub guidance: GuidanceConfig,
@@ -62,6 +65,7 @@ impl Default for MonteCarloConfig {
             release_radius_m: 400.0,
             flare: true,
             threads: 2,
+            only_run: None,
             guidance: GuidanceConfig::default(),
         }
     }
@@ -106,6 +110,46 @@ pub struct RunResult {
     pub long_short_m: f64,
     /// See `long_short_m`.
     pub left_right_m: f64,
+    /// Guidance phase changes with their reasons (kept only when one run is replayed).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub events: Vec<PhaseEvent>,
+    /// The flight every second (kept only when one run is replayed).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub track: Vec<TrackPoint>,
+}
+
+/// One second of a replayed run: truth and what guidance saw.
+#[derive(Debug, Clone, Serialize)]
+pub struct TrackPoint {
+    /// Time, s.
+    pub time_s: f64,
+    /// True canopy position (north, east, height above the target), m.
+    pub position_neh_m: [f64; 3],
+    /// Estimated wind (north, east), m/s.
+    pub wind_estimate_ne_mps: [f64; 2],
+    /// True wind at the canopy (north, east), m/s.
+    pub wind_ne_mps: [f64; 2],
+    /// Guidance phase.
+    pub phase: GuidancePhase,
+    /// Final-approach height the spiral plans with, m.
+    pub final_approach_height_m: f64,
+}
+
+/// A run among the worst of a campaign, enough to replay it (`only_run`).
+#[derive(Debug, Clone, Serialize)]
+pub struct WorstRun {
+    /// Index in the campaign.
+    pub index: usize,
+    /// Miss distance, m.
+    pub miss_m: f64,
+    /// Long (+) or short (−) along the upwind direction, m.
+    pub long_short_m: f64,
+    /// Right (+) or left (−) of it, m.
+    pub left_right_m: f64,
+    /// Heading at touchdown minus upwind, degrees.
+    pub heading_vs_upwind_deg: f64,
+    /// Its conditions.
+    pub conditions: RunConditions,
 }
 
 /// Median, 95th percentile, maximum and mean of a sample.
@@ -174,9 +218,14 @@ pub struct MonteCarloReport {
     pub failed_runs: Vec<(usize, String)>,
     /// Wall-clock time, s.
     pub wall_time_s: f64,
+    /// The runs with the largest misses, worst first (at most [`WORST_RUNS`]).
+    pub worst: Vec<WorstRun>,
     /// Every run.
     pub results: Vec<RunResult>,
 }
+
+/// How many of the worst runs a report names.
+pub const WORST_RUNS: usize = 5;
 
 /// A steady glide (after the seed's initial conditions settle in still air), heading north at
 /// the origin: the template every run's release state is rotated and moved from.
@@ -315,9 +364,32 @@ pub fn run_one<N: Navigator>(
     );
     let mut wind_error_sq = 0.0;
     let mut wind_samples = 0usize;
+    let replay = config.only_run == Some(index);
+    let mut track = Vec::new();
+    let mut next_track_s = 0.0;
     let touchdown = loop {
         if let Some(t) = flight.advance().map_err(|e| e.to_string())? {
             break t;
+        }
+        if replay
+            && let Some(est) = flight.estimate
+            && est.time_s >= next_track_s
+        {
+            next_track_s += 1.0;
+            let p = Vector3::new(
+                flight.state[idx::POSITION],
+                flight.state[idx::POSITION + 1],
+                flight.state[idx::POSITION + 2],
+            );
+            let truth = wind.wind_ned_mps(est.time_s, &p);
+            track.push(TrackPoint {
+                time_s: est.time_s,
+                position_neh_m: [p.x, p.y, -p.z],
+                wind_estimate_ne_mps: [est.wind_ned_mps.x, est.wind_ned_mps.y],
+                wind_ne_mps: [truth.x, truth.y],
+                phase: flight.guidance.phase(),
+                final_approach_height_m: flight.guidance.spiral_status().final_approach_height_m,
+            });
         }
         if let Some(est) = flight.estimate
             && est.time_s >= 30.0
@@ -367,6 +439,12 @@ pub fn run_one<N: Navigator>(
             0.0
         },
         conditions: c,
+        events: if replay {
+            std::mem::take(&mut flight.events)
+        } else {
+            Vec::new()
+        },
+        track,
     })
 }
 
@@ -387,8 +465,12 @@ pub fn run_all<N: Navigator>(
                 scope.spawn(|| {
                     let mut mine = Vec::new();
                     loop {
-                        let index = next.fetch_add(1, Ordering::Relaxed);
-                        if index >= config.runs {
+                        let index = match config.only_run {
+                            Some(only) if next.fetch_add(1, Ordering::Relaxed) == 0 => only,
+                            Some(_) => break mine,
+                            None => next.fetch_add(1, Ordering::Relaxed),
+                        };
+                        if index >= config.runs && config.only_run.is_none() {
                             break mine;
                         }
                         mine.push((
@@ -425,8 +507,22 @@ pub fn run_all<N: Navigator>(
     } else {
         (wind_errors.iter().map(|e| e * e).sum::<f64>() / wind_errors.len() as f64).sqrt()
     };
+    let mut by_miss: Vec<&RunResult> = results.iter().collect();
+    by_miss.sort_by(|a, b| b.miss_m.total_cmp(&a.miss_m));
+    let worst = by_miss
+        .iter()
+        .take(WORST_RUNS)
+        .map(|r| WorstRun {
+            index: r.index,
+            miss_m: r.miss_m,
+            long_short_m: r.long_short_m,
+            left_right_m: r.left_right_m,
+            heading_vs_upwind_deg: r.heading_vs_upwind_deg,
+            conditions: r.conditions.clone(),
+        })
+        .collect();
     Ok(MonteCarloReport {
-        runs: config.runs,
+        runs: results.len() + failed_runs.len(),
         seed: config.seed,
         wind_max_mps: config.wind_max_mps,
         altitude_m: config.altitude_m,
@@ -447,6 +543,7 @@ pub fn run_all<N: Navigator>(
         unreachable_runs: results.iter().filter(|r| r.unreachable).count(),
         failed_runs,
         wall_time_s: started.elapsed().as_secs_f64(),
+        worst,
         results,
     })
 }

@@ -37,6 +37,10 @@ pub struct MonteCarloArgs {
     /// Include every run in the JSON.
     #[arg(long)]
     details: bool,
+    /// Fly only run INDEX of the campaign (as listed under `worst`), and print it with its
+    /// phase events and track as JSON.
+    #[arg(long, value_name = "INDEX")]
+    replay: Option<usize>,
     /// Control gains file (as `stx tune` writes; default: the built-in gains).
     #[arg(long)]
     gains: Option<std::path::PathBuf>,
@@ -52,6 +56,15 @@ pub fn run(args: MonteCarloArgs) -> anyhow::Result<()> {
     if !(args.altitude > 20.0 && args.altitude <= 30_000.0) {
         return Err(BadInput(anyhow::anyhow!("--altitude must be in (20, 30000] m")).into());
     }
+    if let Some(index) = args.replay
+        && index >= args.runs
+    {
+        return Err(BadInput(anyhow::anyhow!(
+            "--replay {index} is not a run of a {}-run campaign",
+            args.runs
+        ))
+        .into());
+    }
     let threads = args
         .threads
         .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
@@ -62,6 +75,7 @@ pub fn run(args: MonteCarloArgs) -> anyhow::Result<()> {
         altitude_m: args.altitude,
         flare: !args.no_flare,
         threads,
+        only_run: args.replay,
         ..MonteCarloConfig::default()
     };
     if let Some(path) = &args.gains {
@@ -86,7 +100,12 @@ pub fn run(args: MonteCarloArgs) -> anyhow::Result<()> {
     if !report.failed_runs.is_empty() && report.failed_runs.len() == report.runs {
         bail!("every run failed; first: {:?}", report.failed_runs.first());
     }
-    if args.json {
+    if args.replay.is_some() {
+        match report.results.first() {
+            Some(run) => println!("{}", serde_json::to_string(run)?),
+            None => bail!("the run failed: {:?}", report.failed_runs),
+        }
+    } else if args.json {
         let mut value = serde_json::to_value(&report)?;
         if !args.details
             && let Some(object) = value.as_object_mut()
@@ -130,6 +149,19 @@ fn print_table(r: &MonteCarloReport) {
     println!("target out of reach in {} runs", r.unreachable_runs);
     if !r.failed_runs.is_empty() {
         println!("{} runs failed: {:?}", r.failed_runs.len(), r.failed_runs);
+    }
+    for w in &r.worst {
+        println!(
+            "worst: run {} missed by {:.1} m ({:+.1} m long, {:+.1} m right), heading {:+.0}° \
+             from upwind, wind {:.1} m/s (--replay {})",
+            w.index,
+            w.miss_m,
+            w.long_short_m,
+            w.left_right_m,
+            w.heading_vs_upwind_deg,
+            w.conditions.wind_speed_mps,
+            w.index
+        );
     }
     println!("wall time {:.1} s", r.wall_time_s);
 }
