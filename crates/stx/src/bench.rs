@@ -37,6 +37,21 @@ enum BenchWhat {
         #[arg(long, default_value_t = 2.0)]
         eval_seconds: f64,
     },
+    /// The station daemon's memory after an accelerated three-hour mission (`stx serve --sim`).
+    Memory {
+        /// Print one JSON object instead of a table.
+        #[arg(long)]
+        json: bool,
+        /// Length of the launch day in mission time, hours.
+        #[arg(long, default_value_t = 3.0)]
+        mission_hours: f64,
+        /// Mission time per real time.
+        #[arg(long, default_value_t = 100.0)]
+        speed: f64,
+        /// Dashboard pages connected throughout.
+        #[arg(long, default_value_t = 5)]
+        clients: usize,
+    },
     /// The station's latencies on loopback: telemetry → WebSocket pages, command → MAVLink.
     Station {
         /// Print one JSON object instead of a table.
@@ -195,6 +210,43 @@ fn evals_per_second(seconds: f64) -> f64 {
 
 pub fn run(args: BenchArgs) -> anyhow::Result<()> {
     match args.what {
+        BenchWhat::Memory {
+            json,
+            mission_hours,
+            speed,
+            clients,
+        } => {
+            let report = crate::bench_memory::run(&crate::bench_memory::MemoryBenchOptions {
+                mission_s: mission_hours * 3600.0,
+                speed,
+                clients,
+            })?;
+            if json {
+                println!("{}", serde_json::to_string_pretty(&report)?);
+            } else {
+                println!(
+                    "station daemon after {:.0} s of mission ({}, {:.0} s wall at {}x, {} pages): RSS {:.1} MB, peak {:.1} MB (after 1 min: {:.1} MB); pages received {} messages, {:.1} MB",
+                    report.mission_time_s,
+                    if report.landed {
+                        "landed"
+                    } else {
+                        "NOT landed"
+                    },
+                    report.wall_time_s,
+                    report.speed,
+                    report.clients,
+                    report.rss_after_mb,
+                    report.rss_peak_mb,
+                    report.rss_early_mb,
+                    report.page_messages,
+                    report.page_bytes as f64 / 1e6
+                );
+            }
+            if !report.landed {
+                anyhow::bail!("the simulated drone did not land in time");
+            }
+            Ok(())
+        }
         BenchWhat::Station {
             json,
             clients,
