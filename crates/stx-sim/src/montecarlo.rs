@@ -97,6 +97,9 @@ pub struct RunResult {
     pub miss_m: f64,
     /// Canopy heading at touchdown minus the upwind direction, degrees.
     pub heading_vs_upwind_deg: f64,
+    /// The mean wind where the stack touched down (gusts left out) was below
+    /// [`CALM_WIND_MPS`]: there is no upwind to land into.
+    pub calm: bool,
     /// Vertical speed of the first body to touch, m/s.
     pub touchdown_vertical_speed_mps: f64,
     /// RMS of the horizontal wind-estimate error from 30 s after release on, m/s.
@@ -206,6 +209,11 @@ pub struct MonteCarloReport {
     /// Share of touchdowns with the heading within 30° of upwind (runs in calm air, where no
     /// upwind exists, count as into the wind).
     pub into_wind_fraction: f64,
+    /// The same share with calm runs judged like the others, against the instantaneous wind
+    /// (gusts included) where they touched down.
+    pub into_wind_fraction_strict: f64,
+    /// Runs that touched down in calm air (mean wind below [`CALM_WIND_MPS`]).
+    pub calm_runs: usize,
     /// Vertical speed at touchdown, m/s.
     pub touchdown_vertical_speed_mps: Stats,
     /// RMS of the wind-estimate error from 30 s after release, over all runs, m/s.
@@ -222,6 +230,28 @@ pub struct MonteCarloReport {
     pub worst: Vec<WorstRun>,
     /// Every run.
     pub results: Vec<RunResult>,
+}
+
+/// Below this mean surface wind, m/s (about 1 kn), the air counts as calm: weather reports
+/// (METAR) give a wind under 1 kn as calm, with no direction. Below it the gusts of a run outweigh its mean
+/// wind and turn the instantaneous wind through any direction in seconds, so "upwind" at
+/// touchdown is not something guidance could have known a final approach earlier.
+pub const CALM_WIND_MPS: f64 = 0.5;
+
+/// Largest angle between heading and upwind at touchdown that counts as into the wind, degrees.
+pub const INTO_WIND_DEG: f64 = 30.0;
+
+/// Share of `results` that touched down into the wind (within [`INTO_WIND_DEG`] of upwind);
+/// with `calm_counts`, runs in calm air count as into the wind whatever their heading.
+pub fn into_wind_fraction(results: &[RunResult], calm_counts: bool) -> f64 {
+    if results.is_empty() {
+        return 0.0;
+    }
+    let into_wind = results
+        .iter()
+        .filter(|r| (calm_counts && r.calm) || r.heading_vs_upwind_deg.abs() <= INTO_WIND_DEG)
+        .count();
+    into_wind as f64 / results.len() as f64
 }
 
 /// How many of the worst runs a report names.
@@ -327,8 +357,8 @@ pub fn run_one<N: Navigator>(
     navigator: impl Fn(&RunConditions) -> Result<N, String>,
 ) -> Result<RunResult, String> {
     let c = conditions(config, index);
-    let wind: Arc<dyn WindField> =
-        Arc::new(wind_field(&c, config.altitude_m).map_err(|e| e.to_string())?);
+    let composite = Arc::new(wind_field(&c, config.altitude_m).map_err(|e| e.to_string())?);
+    let wind: Arc<dyn WindField> = composite.clone();
     let model = ParafoilModel::new(
         vehicle.clone(),
         Environment {
@@ -411,10 +441,15 @@ pub fn run_one<N: Navigator>(
     } else {
         0.0
     };
+    let mean_wind_at_touchdown = composite.mean.wind_ned_mps(
+        touchdown.time_s,
+        &Vector3::new(touchdown.position_ne_m[0], touchdown.position_ne_m[1], 0.0),
+    );
     Ok(RunResult {
         index,
         miss_m: touchdown.position_ne_m[0].hypot(touchdown.position_ne_m[1]),
         heading_vs_upwind_deg: heading_vs_upwind,
+        calm: mean_wind_at_touchdown.x.hypot(mean_wind_at_touchdown.y) < CALM_WIND_MPS,
         touchdown_vertical_speed_mps: touchdown.vertical_speed_mps,
         wind_estimate_rmse_mps: if wind_samples > 0 {
             (wind_error_sq / wind_samples as f64).sqrt()
@@ -528,15 +563,9 @@ pub fn run_all<N: Navigator>(
         altitude_m: config.altitude_m,
         flare: config.flare,
         miss_m: Stats::of(&misses),
-        into_wind_fraction: if results.is_empty() {
-            0.0
-        } else {
-            results
-                .iter()
-                .filter(|r| r.heading_vs_upwind_deg.abs() <= 30.0)
-                .count() as f64
-                / results.len() as f64
-        },
+        into_wind_fraction: into_wind_fraction(&results, true),
+        into_wind_fraction_strict: into_wind_fraction(&results, false),
+        calm_runs: results.iter().filter(|r| r.calm).count(),
         touchdown_vertical_speed_mps: Stats::of(&speeds),
         wind_estimate_rmse_mps: pooled,
         wind_estimate_rmse_per_run_mps: Stats::of(&wind_errors),
@@ -546,4 +575,47 @@ pub fn run_all<N: Navigator>(
         worst,
         results,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn landed(heading_vs_upwind_deg: f64, calm: bool) -> RunResult {
+        RunResult {
+            index: 0,
+            conditions: conditions(&MonteCarloConfig::default(), 0),
+            miss_m: 1.0,
+            heading_vs_upwind_deg,
+            calm,
+            touchdown_vertical_speed_mps: 2.5,
+            wind_estimate_rmse_mps: 0.2,
+            unreachable: false,
+            flight_time_s: 200.0,
+            long_short_m: 0.0,
+            left_right_m: 0.0,
+            events: Vec::new(),
+            track: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn into_the_wind_means_within_30_degrees_of_upwind_on_either_side() {
+        let runs = [
+            landed(29.0, false),
+            landed(-30.0, false),
+            landed(31.0, false),
+            landed(-179.0, false),
+        ];
+        assert_eq!(into_wind_fraction(&runs, true), 0.5);
+        assert_eq!(into_wind_fraction(&runs, false), 0.5);
+    }
+
+    #[test]
+    fn a_calm_touchdown_counts_as_into_the_wind_whatever_its_heading_except_when_strict() {
+        let runs = [landed(150.0, true), landed(150.0, false)];
+        assert_eq!(into_wind_fraction(&runs, true), 0.5);
+        assert_eq!(into_wind_fraction(&runs, false), 0.0);
+        assert_eq!(into_wind_fraction(&[], true), 0.0);
+    }
 }

@@ -133,8 +133,11 @@ fn print_table(r: &MonteCarloReport) {
         r.miss_m.median, r.miss_m.p95, r.miss_m.max
     );
     println!(
-        "into the wind (within 30°): {:.1} % of touchdowns",
-        100.0 * r.into_wind_fraction
+        "into the wind (within 30°): {:.1} % of touchdowns ({} in calm air, below 0.5 m/s, count \
+         as into the wind; judged like the others: {:.1} %)",
+        100.0 * r.into_wind_fraction,
+        r.calm_runs,
+        100.0 * r.into_wind_fraction_strict
     );
     println!(
         "touchdown vertical speed: median {:.2} m/s, 95th percentile {:.2} m/s",
