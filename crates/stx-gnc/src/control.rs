@@ -311,6 +311,29 @@ pub fn vertical(
     velocity_ne_mps: [f64; 2],
     sink_rate_mps: f64,
 ) -> VerticalOutput {
+    vertical_about(
+        gains,
+        path,
+        position_ne_m,
+        height_m,
+        velocity_ne_mps,
+        sink_rate_mps,
+        gains.brake_trim,
+    )
+}
+
+/// The vertical law of [`vertical`] centred on the brake `trim` (0…1) instead of the gains'
+/// fixed trim: a feed-forward, the brake expected to hold the path's slope, so the feedback
+/// only corrects what that expectation got wrong.
+pub fn vertical_about(
+    gains: &ControlGains,
+    path: &GlidePath,
+    position_ne_m: [f64; 2],
+    height_m: f64,
+    velocity_ne_mps: [f64; 2],
+    sink_rate_mps: f64,
+    trim: f64,
+) -> VerticalOutput {
     let cd = gains.convergence_distance_m;
     let a = path.altitude_error_m(position_ne_m, height_m);
     let along = velocity_ne_mps[0] * path.line.course_rad.cos()
@@ -324,13 +347,10 @@ pub fn vertical(
     let (brake, phase) = if a.abs() > cd / 5.0 {
         let beta = (a.abs().min(cd) / cd).atan() * a.signum();
         let desired = path.slope + beta.tan();
-        (
-            gains.brake_trim + gains.vk1 * (desired - measured),
-            LawPhase::Approach,
-        )
+        (trim + gains.vk1 * (desired - measured), LawPhase::Approach)
     } else {
         (
-            gains.brake_trim + gains.vk1 * (path.slope - measured) + gains.vk2_per_m * a,
+            trim + gains.vk1 * (path.slope - measured) + gains.vk2_per_m * a,
             LawPhase::Following,
         )
     };
