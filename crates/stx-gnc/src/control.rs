@@ -299,7 +299,9 @@ pub struct VerticalOutput {
     pub altitude_error_m: f64,
 }
 
-/// Vertical glide-slope control (eqs. 5.12–5.17) with the symmetric brakes. The measured slope
+/// Vertical glide-slope control (eqs. 5.12–5.17) with the symmetric brakes: flies localizer
+/// mode's glide path, and the spiral's final only with `FinalLaw::GlideSlope` (its default
+/// final inverts the glide performance instead; see the spiral module). The measured slope
 /// is the sink rate over the ground speed along the path; more brake steepens it. Approach
 /// while |A| > CD/5: aim for a slope offset by `tan β`, `β = atan(min(|A|, CD)/CD)·sign(A)`.
 /// Following: the slope error plus `VK2·A`.
