@@ -299,7 +299,9 @@ pub struct VerticalOutput {
     pub altitude_error_m: f64,
 }
 
-/// Vertical glide-slope control (eqs. 5.12–5.17) with the symmetric brakes. The measured slope
+/// Vertical glide-slope control (eqs. 5.12–5.17) with the symmetric brakes: flies localizer
+/// mode's glide path, and the spiral's final only with `FinalLaw::GlideSlope` (its default
+/// final inverts the glide performance instead; see the spiral module). The measured slope
 /// is the sink rate over the ground speed along the path; more brake steepens it. Approach
 /// while |A| > CD/5: aim for a slope offset by `tan β`, `β = atan(min(|A|, CD)/CD)·sign(A)`.
 /// Following: the slope error plus `VK2·A`.
@@ -310,6 +312,29 @@ pub fn vertical(
     height_m: f64,
     velocity_ne_mps: [f64; 2],
     sink_rate_mps: f64,
+) -> VerticalOutput {
+    vertical_about(
+        gains,
+        path,
+        position_ne_m,
+        height_m,
+        velocity_ne_mps,
+        sink_rate_mps,
+        gains.brake_trim,
+    )
+}
+
+/// The vertical law of [`vertical`] centred on the brake `trim` (0…1) instead of the gains'
+/// fixed trim: a feed-forward, the brake expected to hold the path's slope, so the feedback
+/// only corrects what that expectation got wrong.
+pub fn vertical_about(
+    gains: &ControlGains,
+    path: &GlidePath,
+    position_ne_m: [f64; 2],
+    height_m: f64,
+    velocity_ne_mps: [f64; 2],
+    sink_rate_mps: f64,
+    trim: f64,
 ) -> VerticalOutput {
     let cd = gains.convergence_distance_m;
     let a = path.altitude_error_m(position_ne_m, height_m);
@@ -324,13 +349,10 @@ pub fn vertical(
     let (brake, phase) = if a.abs() > cd / 5.0 {
         let beta = (a.abs().min(cd) / cd).atan() * a.signum();
         let desired = path.slope + beta.tan();
-        (
-            gains.brake_trim + gains.vk1 * (desired - measured),
-            LawPhase::Approach,
-        )
+        (trim + gains.vk1 * (desired - measured), LawPhase::Approach)
     } else {
         (
-            gains.brake_trim + gains.vk1 * (path.slope - measured) + gains.vk2_per_m * a,
+            trim + gains.vk1 * (path.slope - measured) + gains.vk2_per_m * a,
             LawPhase::Following,
         )
     };

@@ -50,8 +50,21 @@ pub struct Estimate {
     pub sink_rate_sigma_mps: f64,
     /// Horizontal airspeed over sink rate: the glide through the air mass.
     pub glide_ratio_air: f64,
+    /// 1-σ of the air glide ratio (∞ while the sink rate is too small to divide by).
+    #[serde(default)]
+    pub glide_ratio_air_sigma: f64,
     /// Horizontal ground speed over sink rate: the glide over the ground.
     pub glide_ratio_ground: f64,
+    /// 1-σ of the ground glide ratio.
+    #[serde(default)]
+    pub glide_ratio_ground_sigma: f64,
+    /// Air density from the pitot's static pressure and temperature (ideal gas), kg/m³; 0
+    /// before the first air-data sample. Guidance plans its speeds with it.
+    #[serde(default)]
+    pub air_density_kg_per_m3: f64,
+    /// 1-σ of the air density, kg/m³ (∞ before the first sample).
+    #[serde(default = "not_measured")]
+    pub air_density_sigma_kg_per_m3: f64,
     /// Wind (the air's velocity), NED, m/s; the vertical component is taken as zero.
     pub wind_ned_mps: Vector3<f64>,
     /// 1-σ of the wind's north and east components (and 0 for down), m/s.
@@ -64,6 +77,10 @@ pub struct Estimate {
     pub attitude_ok: bool,
     /// The pitot is reporting.
     pub air_data_ok: bool,
+}
+
+fn not_measured() -> f64 {
+    f64::INFINITY
 }
 
 impl Estimate {

@@ -9,7 +9,13 @@
 //!   wind, airspeed, heading and position with their uncertainties, onboard and in the station
 //!   alike;
 //! - [`control`] holds the seed's control laws (heading, course, localizer, glide slope);
-//!   [`guidance`] picks and feeds them by mode, including the spiral landing;
+//!   [`guidance`] picks and feeds them by mode, including the spiral landing. The spiral's
+//!   final approach sets its brakes by inverting the glide performance
+//!   ([`guidance::FinalLaw::GlideInversion`]), not with the seed's glide-slope law, which
+//!   flies localizer mode's glide path and is the final's alternative
+//!   ([`guidance::FinalLaw::GlideSlope`]): the Monte Carlo flew the inversion closer (see
+//!   `GNC_NOTES.md` beside this crate's `Cargo.toml`, which also says how the estimator,
+//!   the spiral and the landing prediction work and which seed equations they follow);
 //! - [`performance`] summarises how the parafoil flies, [`pointmass`] flies that summary fast,
 //!   and [`predict`] uses it to say where the vehicle will land;
 //! - [`geo`] links the mission's local NED frame to latitude, longitude and altitude;

@@ -150,6 +150,11 @@ impl PointMass {
             } else {
                 f64::INFINITY
             },
+            glide_ratio_air_sigma: 0.0,
+            glide_ratio_ground_sigma: 0.0,
+            // A point mass has no pitot: guidance takes the density it is given.
+            air_density_kg_per_m3: 0.0,
+            air_density_sigma_kg_per_m3: f64::INFINITY,
             wind_ned_mps: Vector3::new(wind_ned_mps.x, wind_ned_mps.y, 0.0),
             wind_sigma_mps: Vector3::zeros(),
             gps_ok: true,

@@ -270,6 +270,20 @@ mod tests {
         est
     }
 
+    /// Guidance landing on (north, east) in spiral mode.
+    fn spiral_landing_on(north_m: f64, east_m: f64) -> Guidance {
+        let mut guidance = Guidance::new(GuidanceConfig::default());
+        guidance.set_plan(
+            Plan {
+                target_ned_m: Vector3::new(north_m, east_m, 0.0),
+                ..Plan::default()
+            },
+            0.0,
+        );
+        guidance.set_mode(FlightMode::SpiralLanding, 0.0);
+        guidance
+    }
+
     fn sea_level() -> UniformAir {
         UniformAir(AirState::sea_level())
     }
@@ -309,15 +323,7 @@ mod tests {
     #[test]
     fn planned_prediction_of_a_spiral_landing_is_near_the_target() {
         let perf = GlidePerformance::default();
-        let mut guidance = Guidance::new(GuidanceConfig::default());
-        guidance.set_plan(
-            Plan {
-                target_ned_m: Vector3::new(200.0, 100.0, 0.0),
-                ..Plan::default()
-            },
-            0.0,
-        );
-        guidance.set_mode(FlightMode::SpiralLanding, 0.0);
+        let guidance = spiral_landing_on(200.0, 100.0);
         let est = still_estimate(500.0, [-1.0, 0.5], 0.2);
         let p = predict(
             &est,
@@ -335,6 +341,46 @@ mod tests {
             far > 300.0,
             "uncontrolled flies straight on: {:?}",
             p.uncontrolled
+        );
+    }
+
+    /// The planned landing's ellipse: guidance steers most of the wind's uncertainty out, so
+    /// it is much smaller than the uncontrolled one from the same estimate, and it grows when
+    /// the wind is less certain.
+    #[test]
+    fn the_planned_landing_ellipse_is_tight_and_grows_with_the_wind_uncertainty() {
+        let perf = GlidePerformance::default();
+        let guidance = spiral_landing_on(200.0, 100.0);
+        let predict_with = |wind_sigma: f64| {
+            predict(
+                &still_estimate(500.0, [-1.0, 0.5], wind_sigma),
+                &guidance,
+                &perf,
+                &sea_level(),
+                0.0,
+                &PredictorConfig::default(),
+            )
+        };
+        let sure = predict_with(0.1);
+        let unsure = predict_with(1.0);
+        let p = sure.planned;
+        assert!(p.semi_major_m.is_finite() && p.semi_major_m >= p.semi_minor_m);
+        assert!(p.semi_minor_m >= 0.0);
+        assert!(
+            p.semi_major_m < 0.25 * sure.uncontrolled.semi_major_m,
+            "planned {p:?}, uncontrolled {:?}",
+            sure.uncontrolled
+        );
+        assert!(
+            unsure.planned.semi_major_m > p.semi_major_m,
+            "{:?} vs {p:?}",
+            unsure.planned
+        );
+        assert!(unsure.uncontrolled.semi_major_m > 2.0 * sure.uncontrolled.semi_major_m);
+        // The time to land is the same flight's, not a fixed guess.
+        assert!(
+            p.time_to_land_s > 100.0 && p.time_to_land_s < 400.0,
+            "{p:?}"
         );
     }
 }

@@ -7,6 +7,7 @@
 //! scenario and Monte Carlo run; [`PerfectNavigation`] exists only to measure what navigation
 //! errors cost.
 
+use stx_dynamics::atmosphere::{Atmosphere, StandardAtmosphere};
 use stx_dynamics::integrate::{Hooks, IntegrateError, Rk4, integrate};
 use stx_dynamics::model::{Body, Kinematics, ParafoilModel};
 use stx_dynamics::rotation::{euler_from_t, euler_rates, wrap_pi};
@@ -156,6 +157,14 @@ pub fn truth_estimate(model: &ParafoilModel, time_s: f64, x: &StateVector) -> Es
         } else {
             f64::INFINITY
         },
+        glide_ratio_air_sigma: 0.0,
+        glide_ratio_ground_sigma: 0.0,
+        air_density_kg_per_m3: model
+            .environment
+            .atmosphere
+            .air_at(model.environment.ground_altitude_msl_m - p.z)
+            .density_kg_per_m3,
+        air_density_sigma_kg_per_m3: 0.0,
         wind_ned_mps: nalgebra::Vector3::new(wind.x, wind.y, 0.0),
         wind_sigma_mps: Default::default(),
         gps_ok: true,
@@ -203,6 +212,9 @@ pub struct GuidedFlight<N: Navigator> {
     pub phases: Vec<(String, f64)>,
     /// Every phase event, with its reason.
     pub events: Vec<PhaseEvent>,
+    /// Each time guidance called the target out of reach: when, and the best reachable point
+    /// (north, east, m) it announced then.
+    pub best_reachable_announced: Vec<(f64, [f64; 2])>,
 }
 
 impl<N: Navigator> GuidedFlight<N> {
@@ -229,6 +241,7 @@ impl<N: Navigator> GuidedFlight<N> {
             estimate: None,
             phases: vec![(phase_name(phase), time_s)],
             events: Vec::new(),
+            best_reachable_announced: Vec::new(),
         }
     }
 
@@ -237,16 +250,22 @@ impl<N: Navigator> GuidedFlight<N> {
         let est = self
             .navigator
             .navigate(&self.model, self.time_s, &self.state);
-        let density = self
-            .model
-            .environment
-            .atmosphere
+        // Guidance plans with the density the drone measures (in the estimate); until the
+        // pitot has reported, with the standard atmosphere at the estimated height — what the
+        // drone assumes, not the simulator's air.
+        let assumed = StandardAtmosphere
             .air_at(self.model.environment.ground_altitude_msl_m - est.position_ned_m.z)
             .density_kg_per_m3;
-        let command = self.guidance.update(&est, density);
+        let command = self.guidance.update(&est, assumed);
         self.model.set_controls(command.controls);
         for event in self.guidance.drain_events() {
             self.phases.push((phase_name(event.to), event.time_s));
+            if event.to == GuidancePhase::BestReachable {
+                self.best_reachable_announced.push((
+                    event.time_s,
+                    self.guidance.spiral_status().best_reachable_ne_m,
+                ));
+            }
             self.events.push(event);
         }
         if self.guidance.mode() == FlightMode::Localizer

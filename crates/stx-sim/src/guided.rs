@@ -99,15 +99,22 @@ pub fn run(scenario: &Scenario, vehicle: &Vehicle) -> Result<Run, RunError> {
         .iter()
         .map(|(_, state, controls)| max_line_length_error_m(vehicle, state, controls.main_line_m))
         .collect();
+    let localizer = (g.mode == stx_gnc::mission::FlightMode::Localizer).then(|| g.plan().localizer);
     let landing = touchdown.map(|t| Landing {
         x_m: t.position_ne_m[0],
         y_m: t.position_ne_m[1],
         time_s: t.time_s,
         body: t.body.name(),
         vertical_speed_mps: t.vertical_speed_mps,
-        miss_m: g
-            .aim_ne_m()
-            .map(|aim| (t.position_ne_m[0] - aim[0]).hypot(t.position_ne_m[1] - aim[1])),
+        miss_m: match (g.aim_ne_m(), localizer) {
+            (Some(aim), _) => {
+                Some((t.position_ne_m[0] - aim[0]).hypot(t.position_ne_m[1] - aim[1]))
+            }
+            (None, Some(line)) => Some(line.cross_track_m(t.position_ne_m).abs()),
+            (None, None) => None,
+        },
+        cross_track_m: localizer.map(|line| line.cross_track_m(t.position_ne_m)),
+        along_track_m: localizer.map(|line| line.along_track_m(t.position_ne_m)),
         heading_vs_upwind_deg: t
             .upwind_rad
             .is_finite()

@@ -106,6 +106,20 @@ pub struct RunResult {
     pub wind_estimate_rmse_mps: f64,
     /// Guidance found the target out of reach at some point.
     pub unreachable: bool,
+    /// The best reachable point (north, east, m) guidance announced when it first called the
+    /// target out of reach.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub best_reachable_ne_m: Option<[f64; 2]>,
+    /// Distance from that point to where the stack touched down, m.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub from_best_reachable_m: Option<f64>,
+    /// The best reachable point guidance announced last (it announces it again when it moves
+    /// as the wind estimate firms up), north and east, m.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub last_best_reachable_ne_m: Option<[f64; 2]>,
+    /// Distance from that point to the touchdown, m.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub from_last_best_reachable_m: Option<f64>,
     /// Flight time, s.
     pub flight_time_s: f64,
     /// Touchdown point relative to the target along the upwind direction (positive: beyond
@@ -136,6 +150,8 @@ pub struct TrackPoint {
     pub phase: GuidancePhase,
     /// Final-approach height the spiral plans with, m.
     pub final_approach_height_m: f64,
+    /// Symmetric brake commanded, 0…1.
+    pub brake: f64,
 }
 
 /// A run among the worst of a campaign, enough to replay it (`only_run`).
@@ -222,6 +238,11 @@ pub struct MonteCarloReport {
     pub wind_estimate_rmse_per_run_mps: Stats,
     /// Runs in which guidance found the target out of reach.
     pub unreachable_runs: usize,
+    /// Over those runs, the distance from the best reachable point guidance first announced
+    /// to the touchdown, m.
+    pub unreachable_from_best_m: Stats,
+    /// The same from the best reachable point announced last, m.
+    pub unreachable_from_last_best_m: Stats,
     /// Runs that failed to fly (integration error), with their index and reason.
     pub failed_runs: Vec<(usize, String)>,
     /// Wall-clock time, s.
@@ -419,6 +440,7 @@ pub fn run_one<N: Navigator>(
                 wind_ne_mps: [truth.x, truth.y],
                 phase: flight.guidance.phase(),
                 final_approach_height_m: flight.guidance.spiral_status().final_approach_height_m,
+                brake: flight.model.controls().brake_left,
             });
         }
         if let Some(est) = flight.estimate
@@ -445,6 +467,10 @@ pub fn run_one<N: Navigator>(
         touchdown.time_s,
         &Vector3::new(touchdown.position_ne_m[0], touchdown.position_ne_m[1], 0.0),
     );
+    let first_announced = flight.best_reachable_announced.first().map(|(_, ne)| *ne);
+    let last_announced = flight.best_reachable_announced.last().map(|(_, ne)| *ne);
+    let from_touchdown =
+        |b: [f64; 2]| (touchdown.position_ne_m[0] - b[0]).hypot(touchdown.position_ne_m[1] - b[1]);
     Ok(RunResult {
         index,
         miss_m: touchdown.position_ne_m[0].hypot(touchdown.position_ne_m[1]),
@@ -456,10 +482,11 @@ pub fn run_one<N: Navigator>(
         } else {
             0.0
         },
-        unreachable: flight
-            .events
-            .iter()
-            .any(|e| e.to == GuidancePhase::BestReachable),
+        unreachable: !flight.best_reachable_announced.is_empty(),
+        best_reachable_ne_m: first_announced,
+        from_best_reachable_m: first_announced.map(from_touchdown),
+        last_best_reachable_ne_m: last_announced,
+        from_last_best_reachable_m: last_announced.map(from_touchdown),
         flight_time_s: touchdown.time_s,
         long_short_m: if touchdown.upwind_rad.is_finite() {
             touchdown.position_ne_m[0] * touchdown.upwind_rad.cos()
@@ -570,6 +597,18 @@ pub fn run_all<N: Navigator>(
         wind_estimate_rmse_mps: pooled,
         wind_estimate_rmse_per_run_mps: Stats::of(&wind_errors),
         unreachable_runs: results.iter().filter(|r| r.unreachable).count(),
+        unreachable_from_best_m: Stats::of(
+            &results
+                .iter()
+                .filter_map(|r| r.from_best_reachable_m)
+                .collect::<Vec<_>>(),
+        ),
+        unreachable_from_last_best_m: Stats::of(
+            &results
+                .iter()
+                .filter_map(|r| r.from_last_best_reachable_m)
+                .collect::<Vec<_>>(),
+        ),
         failed_runs,
         wall_time_s: started.elapsed().as_secs_f64(),
         worst,
@@ -591,6 +630,10 @@ mod tests {
             touchdown_vertical_speed_mps: 2.5,
             wind_estimate_rmse_mps: 0.2,
             unreachable: false,
+            best_reachable_ne_m: None,
+            from_best_reachable_m: None,
+            last_best_reachable_ne_m: None,
+            from_last_best_reachable_m: None,
             flight_time_s: 200.0,
             long_short_m: 0.0,
             left_right_m: 0.0,

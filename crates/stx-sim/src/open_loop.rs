@@ -186,6 +186,8 @@ pub fn run(scenario: &Scenario, vehicle: &Vehicle) -> Result<Run, RunError> {
             body: body.name(),
             vertical_speed_mps: k.velocity_ned_mps(body).z,
             miss_m: None,
+            cross_track_m: None,
+            along_track_m: None,
             heading_vs_upwind_deg: None,
         }
     });

@@ -177,6 +177,15 @@ pub struct GpsConfig {
     pub vertical_wander_m: f64,
     /// Correlation time of the wander, s (> 0).
     pub wander_correlation_s: f64,
+    /// Constant horizontal position bias (a survey datum or antenna offset the receiver does
+    /// not know), drawn once per run per component with this 1-σ, m.
+    pub horizontal_bias_sigma_m: f64,
+    /// Constant vertical position bias, drawn once per run with this 1-σ, m.
+    pub vertical_bias_sigma_m: f64,
+    /// Constant velocity bias on each component, drawn once per run with this 1-σ, m/s. The
+    /// estimator cannot tell it from wind (both shift the ground velocity), so it shows up
+    /// whole in the wind estimate: a test of what guidance makes of a biased wind.
+    pub velocity_bias_sigma_mps: f64,
     /// White noise on each horizontal velocity component, 1-σ, m/s.
     pub velocity_noise_mps: f64,
     /// White noise on the vertical velocity, 1-σ, m/s.
@@ -202,6 +211,11 @@ impl Default for GpsConfig {
             horizontal_wander_m: 1.5,
             vertical_wander_m: 3.0,
             wander_correlation_s: 100.0,
+            // Off by default: the wander already stands for a receiver's slow errors, and the
+            // Monte Carlo figures are kept comparable; scenarios set them to test biases.
+            horizontal_bias_sigma_m: 0.0,
+            vertical_bias_sigma_m: 0.0,
+            velocity_bias_sigma_mps: 0.0,
             velocity_noise_mps: 0.1,
             vertical_velocity_noise_mps: 0.15,
             // √(noise² + wander²), rounded up: an honest receiver.
@@ -394,6 +408,9 @@ impl SensorConfig {
         non_negative("gps.horizontal_wander_m", g.horizontal_wander_m)?;
         non_negative("gps.vertical_wander_m", g.vertical_wander_m)?;
         positive("gps.wander_correlation_s", g.wander_correlation_s)?;
+        non_negative("gps.horizontal_bias_sigma_m", g.horizontal_bias_sigma_m)?;
+        non_negative("gps.vertical_bias_sigma_m", g.vertical_bias_sigma_m)?;
+        non_negative("gps.velocity_bias_sigma_mps", g.velocity_bias_sigma_mps)?;
         non_negative("gps.velocity_noise_mps", g.velocity_noise_mps)?;
         non_negative(
             "gps.vertical_velocity_noise_mps",
@@ -569,6 +586,9 @@ struct Gps {
     schedule: Schedule,
     rng: ChaCha8Rng,
     wander: [GaussMarkov; 3],
+    /// This run's constant position (m) and velocity (m/s) biases, NED.
+    position_bias_m: [f64; 3],
+    velocity_bias_mps: [f64; 3],
 }
 
 impl Gps {
@@ -584,8 +604,10 @@ impl Gps {
             } else {
                 (c.vertical_noise_m, c.vertical_velocity_noise_mps)
             };
-            position[axis] += self.wander[axis].step(due.elapsed_s, rng) + noise_m * gauss(rng);
-            velocity[axis] += vel_noise_mps * gauss(rng);
+            position[axis] += self.position_bias_m[axis]
+                + self.wander[axis].step(due.elapsed_s, rng)
+                + noise_m * gauss(rng);
+            velocity[axis] += self.velocity_bias_mps[axis] + vel_noise_mps * gauss(rng);
         }
         due.delivered.then_some(Delivery {
             arrival_s: time_s + self.schedule.latency_s,
@@ -681,6 +703,7 @@ mod stream {
     pub const GPS_DROPOUT: u64 = 11;
     pub const AHRS_DROPOUT: u64 = 12;
     pub const PITOT_DROPOUT: u64 = 13;
+    pub const GPS_BIAS: u64 = 21;
 }
 
 fn rng_for(seed: u64, stream: u64) -> ChaCha8Rng {
@@ -709,6 +732,16 @@ impl SensorSuite {
             g.vertical_wander_m,
         ]
         .map(|sigma| GaussMarkov::new(sigma, g.wander_correlation_s, &mut gps_rng));
+        // A stream of their own, so that switching the biases on changes nothing else.
+        let mut bias_rng = rng_for(seed, stream::GPS_BIAS);
+        let position_bias_m = [
+            g.horizontal_bias_sigma_m,
+            g.horizontal_bias_sigma_m,
+            g.vertical_bias_sigma_m,
+        ]
+        .map(|sigma| sigma * gauss(&mut bias_rng));
+        let velocity_bias_mps =
+            [g.velocity_bias_sigma_mps; 3].map(|sigma| sigma * gauss(&mut bias_rng));
         let gps = Gps {
             schedule: Schedule::new(
                 g.rate_hz,
@@ -721,6 +754,8 @@ impl SensorSuite {
             config: g.clone(),
             rng: gps_rng,
             wander,
+            position_bias_m,
+            velocity_bias_mps,
         };
 
         let a = &config.ahrs;
@@ -1250,5 +1285,48 @@ mod tests {
         assert!((truth.air_velocity_body_mps.norm() - speed).abs() < 1e-12);
         // The canopy yaws 30°, the drone hangs aligned with it.
         assert!((truth.euler_rad.z - 30f64.to_radians()).abs() < 1e-9);
+    }
+
+    /// The GPS's constant biases: the same offset on every fix of a run, drawn from the seed
+    /// (another seed, another offset), nothing without them.
+    #[test]
+    fn gps_bias_is_constant_over_a_run_and_drawn_from_the_seed() {
+        let mut c = noiseless();
+        let errors = |config: &SensorConfig, seed: u64| {
+            let mut suite = SensorSuite::new(config, seed).expect("valid");
+            let mut out = Vec::new();
+            for k in 0..40 {
+                let t = 0.25 * k as f64;
+                let truth = truth_at(t);
+                for d in suite.sample(t, &truth) {
+                    if let Measurement::Gps(g) = d.measurement {
+                        out.push((
+                            g.position_ned_m - truth.position_ned_m,
+                            g.velocity_ned_mps - truth.velocity_ned_mps,
+                        ));
+                    }
+                }
+            }
+            out
+        };
+        let none = errors(&c, 7);
+        assert!(none.iter().all(|(p, v)| p.norm() < 1e-9 && v.norm() < 1e-9));
+        c.gps.horizontal_bias_sigma_m = 2.0;
+        c.gps.vertical_bias_sigma_m = 3.0;
+        c.gps.velocity_bias_sigma_mps = 0.2;
+        let biased = errors(&c, 7);
+        assert!(biased.len() > 30);
+        let (p0, v0) = biased[0];
+        assert!(p0.norm() > 1e-3 && v0.norm() > 1e-4, "{p0:?} {v0:?}");
+        assert!(
+            biased
+                .iter()
+                .all(|(p, v)| (p - p0).norm() < 1e-9 && (v - v0).norm() < 1e-9),
+            "constant over the run"
+        );
+        assert_eq!(errors(&c, 7)[0].0, p0, "same seed, same bias");
+        assert_ne!(errors(&c, 8)[0].0, p0, "another seed, another bias");
+        c.gps.velocity_bias_sigma_mps = -1.0;
+        assert!(SensorSuite::new(&c, 1).is_err());
     }
 }

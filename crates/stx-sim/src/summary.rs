@@ -74,8 +74,17 @@ pub struct Landing {
     pub body: &'static str,
     /// Its vertical speed at contact, m/s (positive down).
     pub vertical_speed_mps: f64,
-    /// Distance from the guidance target, m, when the scenario has one.
+    /// How far from what guidance was asked to fly, m: from the spiral's target; from the
+    /// localizer's point when a glide slope leads down to it; and for a localizer alone,
+    /// which fixes a line but not where along it to land, the distance from that line
+    /// (`|cross_track_m|`).
     pub miss_m: Option<f64>,
+    /// In localizer mode, the touchdown's distance right (+) or left (−) of the localizer
+    /// line, m.
+    pub cross_track_m: Option<f64>,
+    /// In localizer mode, the touchdown's distance along the line past (+) or short of (−)
+    /// the localizer's point, m.
+    pub along_track_m: Option<f64>,
     /// Canopy heading at contact minus the direction the wind comes from, degrees; absent in
     /// calm air.
     pub heading_vs_upwind_deg: Option<f64>,

@@ -49,6 +49,29 @@ fn the_localizer_is_intercepted_then_followed_through_its_point() {
         let course = v[1].atan2(v[0]).to_degrees();
         assert!((course - 90.0).abs() < 20.0, "course {course}°");
     }
+    // Flown to the ground (it stopped at 120 s, 250 m up, and reported no landing): the miss
+    // of a localizer alone is the distance from its line.
+    let landing = s.landing.expect("the localizer scenario lands");
+    let cross = landing
+        .cross_track_m
+        .expect("localizer mode reports the cross-track");
+    let miss = landing.miss_m.expect("and the miss");
+    assert!((miss - cross.abs()).abs() < 1e-9);
+    assert!(miss < 8.0, "touched down {cross:.1} m off the line");
+    assert!(
+        (landing.x_m - 100.0).abs() < 8.0,
+        "north {:.1}",
+        landing.x_m
+    );
+    assert!(
+        landing.along_track_m.expect("along") > 0.0,
+        "past the point"
+    );
+    assert!(landing.vertical_speed_mps > 0.0);
+    assert!(
+        landing.heading_vs_upwind_deg.is_none(),
+        "calm air: no upwind"
+    );
 }
 
 #[test]
@@ -65,7 +88,14 @@ fn the_glide_slope_is_captured_and_flown_to_its_point() {
     let miss = landing
         .miss_m
         .expect("measured against the localizer point");
-    assert!(miss < 20.0, "landed {miss:.1} m from the localizer point");
+    // Regression: the path aimed the drone, 8.4 m above the lowest body, at the ground, and
+    // the stack touched down about 13 m short (the test had been loosened to 20 m).
+    assert!(miss < 6.0, "landed {miss:.1} m from the localizer point");
+    assert!(
+        landing.along_track_m.expect("along").abs() < 6.0,
+        "{:?}",
+        landing.along_track_m
+    );
 }
 
 #[test]
@@ -85,6 +115,19 @@ fn the_spiral_landing_loops_then_lands_on_the_target_into_the_wind() {
     }
     let branch1 = phases.iter().filter(|p| **p == "branch1").count();
     assert!(branch1 >= 2, "loops of the spiral: {phases:?}");
+    // The branches follow each other round the square, 1 → 2 → 3 → 4 → 1, every one of them
+    // flown; only Branch2 (the base leg) leaves the pattern, for the final.
+    let branch = |p: &str| p.strip_prefix("branch").and_then(|n| n.parse::<u32>().ok());
+    for pair in phases.windows(2) {
+        match (branch(pair[0]), branch(pair[1])) {
+            (Some(a), Some(b)) => assert_eq!(b, a % 4 + 1, "{phases:?}"),
+            (Some(a), None) if pair[1] == "final_approach" => assert_eq!(a, 2, "{phases:?}"),
+            _ => {}
+        }
+    }
+    for b in ["branch1", "branch2", "branch3", "branch4"] {
+        assert!(phases.contains(&b), "{b} never flown: {phases:?}");
+    }
     let landing = s.landing.expect("lands");
     let miss = landing.miss_m.expect("has a target");
     assert!(miss < 15.0, "missed the target by {miss:.1} m");
@@ -119,19 +162,16 @@ fn the_monte_carlo_gives_the_same_result_for_the_same_seed_on_any_thread_count()
     };
     let (a, b) = (campaign(1), campaign(2));
     assert!(a.failed_runs.is_empty() && b.failed_runs.is_empty());
+    // Every field of every run and every statistic, but the wall time.
     let key = |r: &stx_sim::montecarlo::MonteCarloReport| {
-        r.results
-            .iter()
-            .map(|x| {
-                (
-                    x.index,
-                    x.miss_m.to_bits(),
-                    x.touchdown_vertical_speed_mps.to_bits(),
-                )
-            })
-            .collect::<Vec<_>>()
+        let mut value = serde_json::to_value(r).expect("serialises");
+        if let Some(object) = value.as_object_mut() {
+            object.remove("wall_time_s");
+        }
+        value
     };
     assert_eq!(key(&a), key(&b));
+    assert_eq!(a.results.len(), 3);
     let other = run_all(
         &MonteCarloConfig {
             runs: 3,
@@ -146,5 +186,51 @@ fn the_monte_carlo_gives_the_same_result_for_the_same_seed_on_any_thread_count()
         |_| {},
     )
     .expect("runs");
-    assert_ne!(key(&a), key(&other), "another seed, other conditions");
+    assert_ne!(
+        key(&a)["results"],
+        key(&other)["results"],
+        "another seed, other conditions"
+    );
+}
+
+/// Regression (issue 3 audit): in winds of 8–10 m/s the 14-DOF model with the real estimator
+/// missed the target by up to 1.2 km and guidance never called it out of reach; seed 3 run 17
+/// (9.8 m/s) landed 1.18 km off. Now it says so, and lands near the best reachable point it
+/// announced last.
+#[test]
+fn a_too_strong_wind_with_the_estimator_in_the_loop_is_called_and_flown_to_the_best_point() {
+    let sensors = SensorConfig::default();
+    let config = MonteCarloConfig {
+        runs: 30,
+        seed: 3,
+        wind_max_mps: 10.0,
+        threads: 1,
+        only_run: Some(17),
+        ..MonteCarloConfig::default()
+    };
+    let report = run_all(
+        &config,
+        |c| {
+            SensedNavigation::new(&sensors, EstimatorConfig::default(), c.seed)
+                .map_err(|e| e.to_string())
+        },
+        |_| {},
+    )
+    .expect("runs");
+    let run = &report.results[0];
+    assert!(run.conditions.wind_speed_mps > 9.0);
+    assert!(run.unreachable, "{:?}", run.events);
+    let called = run
+        .events
+        .iter()
+        .find(|e| e.to == stx_gnc::mission::GuidancePhase::BestReachable)
+        .expect("an event");
+    assert!(called.reason.contains("out of reach"), "{}", called.reason);
+    let off = run.from_last_best_reachable_m.expect("announced");
+    assert!(off < 50.0, "landed {off:.0} m from the announced point");
+    assert!(
+        run.miss_m > 500.0,
+        "the wind really was too strong: {}",
+        run.miss_m
+    );
 }

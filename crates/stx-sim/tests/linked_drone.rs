@@ -9,7 +9,7 @@
 use std::time::Duration;
 
 use stx_dynamics::vehicle::Vehicle;
-use stx_gnc::mission::{FlightMode, FlightStage};
+use stx_gnc::mission::{FlightMode, FlightStage, GuidancePhase};
 use stx_link::command::{Command, CommandOutcome, RequestId};
 use stx_link::endpoint::{GroundConfig, GroundEndpoint, GroundEvent, LinkConfig};
 use stx_link::manual::Sticks;
@@ -357,8 +357,21 @@ fn a_parameter_set_over_the_link_changes_what_guidance_flies_and_reads_back() {
             .fold(0.0, f64::max)
     };
     // Turning in the pattern, guidance moves the main line well past 0.002 m (1/15 of the
-    // servo's 0.030 m travel).
-    bench.run_for(60.0);
+    // servo's 0.030 m travel). The approximation before it can be all straight.
+    let in_pattern = |b: &Bench| {
+        matches!(
+            b.drone.drone().onboard().guidance().phase(),
+            GuidancePhase::Branch1
+                | GuidancePhase::Branch2
+                | GuidancePhase::Branch3
+                | GuidancePhase::Branch4
+        )
+    };
+    assert!(
+        bench.run_until(400.0, in_pattern),
+        "never entered the pattern"
+    );
+    bench.run_for(30.0);
     let before = peak_line(&bench, 0.0);
     assert!(before > 0.1, "{before}");
 

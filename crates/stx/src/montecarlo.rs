@@ -150,6 +150,16 @@ fn print_table(r: &MonteCarloReport) {
         r.wind_estimate_rmse_per_run_mps.max
     );
     println!("target out of reach in {} runs", r.unreachable_runs);
+    if r.unreachable_runs > 0 {
+        println!(
+            "  touchdown from the best reachable point announced first: median {:.0} m, worst \
+             {:.0} m; announced last: median {:.0} m, worst {:.0} m",
+            r.unreachable_from_best_m.median,
+            r.unreachable_from_best_m.max,
+            r.unreachable_from_last_best_m.median,
+            r.unreachable_from_last_best_m.max
+        );
+    }
     if !r.failed_runs.is_empty() {
         println!("{} runs failed: {:?}", r.failed_runs.len(), r.failed_runs);
     }

@@ -99,6 +99,9 @@ pub struct EstimatorConfig {
     pub pitot_min_airspeed_mps: f64,
     /// Static-pressure noise the filter assumes, 1-σ, Pa (> 0).
     pub static_pressure_noise_pa: f64,
+    /// Uncertainty of the measured air temperature, noise and calibration together, 1-σ, K
+    /// (> 0): with the static pressure's, the uncertainty of the air density reported.
+    pub temperature_sigma_k: f64,
     /// Smallest GPS horizontal position accuracy believed, 1-σ, m (> 0): receivers can be
     /// optimistic.
     pub gps_min_horizontal_accuracy_m: f64,
@@ -168,6 +171,7 @@ impl Default for EstimatorConfig {
             pitot_airspeed_noise_floor_mps: 0.1,
             pitot_min_airspeed_mps: 2.0,
             static_pressure_noise_pa: 3.0,
+            temperature_sigma_k: 1.0,
             gps_min_horizontal_accuracy_m: 0.5,
             gps_min_vertical_accuracy_m: 1.0,
             gps_min_speed_accuracy_mps: 0.05,
@@ -268,6 +272,7 @@ impl EstimatorConfig {
         )?;
         non_negative("pitot_min_airspeed_mps", self.pitot_min_airspeed_mps)?;
         positive("static_pressure_noise_pa", self.static_pressure_noise_pa)?;
+        positive("temperature_sigma_k", self.temperature_sigma_k)?;
         positive(
             "gps_min_horizontal_accuracy_m",
             self.gps_min_horizontal_accuracy_m,
@@ -343,6 +348,7 @@ pub(crate) struct Tuning {
     pub pitot_floor_variance: f64,
     pub pitot_min_airspeed_mps: f64,
     pub static_pressure_noise_pa: f64,
+    pub temperature_sigma_k: f64,
     pub gps_min_horizontal_m: f64,
     pub gps_min_vertical_m: f64,
     pub gps_min_speed_mps: f64,
@@ -386,6 +392,7 @@ impl Tuning {
             pitot_floor_variance: c.pitot_airspeed_noise_floor_mps.powi(2),
             pitot_min_airspeed_mps: c.pitot_min_airspeed_mps,
             static_pressure_noise_pa: c.static_pressure_noise_pa,
+            temperature_sigma_k: c.temperature_sigma_k,
             gps_min_horizontal_m: c.gps_min_horizontal_accuracy_m,
             gps_min_vertical_m: c.gps_min_vertical_accuracy_m,
             gps_min_speed_mps: c.gps_min_speed_accuracy_mps,

@@ -15,7 +15,7 @@ use crate::control::{self, ControlGains, GlidePath, LawPhase, Localizer};
 use crate::estimate::Estimate;
 use crate::mission::{FlightMode, GuidancePhase};
 use crate::performance::GlidePerformance;
-pub use spiral::{SpiralConfig, SpiralStatus};
+pub use spiral::{FinalLaw, SpiralConfig, SpiralStatus};
 
 /// Everything guidance is configured with.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Default)]
@@ -139,7 +139,12 @@ impl Guidance {
     /// Selects a mode; entering spiral landing starts its plan from the approximation.
     pub fn set_mode(&mut self, mode: FlightMode, time_s: f64) {
         if mode != self.mode {
-            let reason = format!("mode set to {mode:?}");
+            let reason = match mode {
+                FlightMode::SpiralLanding => {
+                    "spiral landing selected: approaching the target from here".to_string()
+                }
+                _ => format!("mode set to {mode:?}: spiral guidance idle"),
+            };
             let to = if mode == FlightMode::SpiralLanding {
                 GuidancePhase::Approximation
             } else {
@@ -204,10 +209,18 @@ impl Guidance {
         });
     }
 
-    /// Commands for the estimate `est` in air of density `density_kg_per_m3`. Until the
-    /// estimator has a navigation solution (its position uncertainty is not finite) guidance
-    /// holds the servos neutral and decides nothing.
-    pub fn update(&mut self, est: &Estimate, density_kg_per_m3: f64) -> Command {
+    /// Commands for the estimate `est`. Speeds are planned in the air density the estimate
+    /// measured (the pitot's static pressure and temperature); `fallback_density_kg_per_m3`
+    /// (e.g. a standard atmosphere at the estimated height) stands in while it has none.
+    /// Until the estimator has a navigation solution (its position uncertainty is not finite)
+    /// guidance holds the servos neutral and decides nothing.
+    pub fn update(&mut self, est: &Estimate, fallback_density_kg_per_m3: f64) -> Command {
+        let density_kg_per_m3 =
+            if est.air_density_kg_per_m3.is_finite() && est.air_density_kg_per_m3 > 0.0 {
+                est.air_density_kg_per_m3
+            } else {
+                fallback_density_kg_per_m3
+            };
         if !est.position_sigma_m.iter().all(|s| s.is_finite()) {
             return Command {
                 controls: Controls::default(),
@@ -246,9 +259,13 @@ impl Guidance {
                 let mut vertical_phase = None;
                 let brake = match self.plan.localizer_glide_slope {
                     Some(slope) => {
+                        // The path ends at the localizer's point with the lowest body, not the
+                        // drone, on the ground: aimed with the drone, the stack touched down
+                        // the hang height's glide short of the point (13 m on `vertical`).
                         let path = GlidePath {
                             line: self.plan.localizer,
-                            aim_height_m: -self.plan.target_ned_m.z,
+                            aim_height_m: -self.plan.target_ned_m.z
+                                + self.config.spiral.hang_height_m,
                             slope,
                         };
                         let out = control::vertical(

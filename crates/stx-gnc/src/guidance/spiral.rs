@@ -1,37 +1,62 @@
 //! Spiral-landing guidance (seed §5.3, Fig. 5.4 and 5.7): approximation, a square spiral of
-//! four branches around the target, the final approach into the wind with glide-slope
-//! control, and the flare.
+//! four branches around the target, the final approach into the wind, and the flare.
 //!
 //! Geometry lives in a wind frame centred on the target: `x` points downwind, `y` to its
-//! right. The square's corners are at `(±a, ±a)`; the branches are flown clockwise with
-//! localizer-and-course control: Branch1 downwind along `y = −a`, Branch2 across at `x = +a`,
-//! Branch3 upwind along `y = +a`, Branch4 across at `x = −a`. Ground-referenced localizers
-//! already stretch the downwind branch and shrink the upwind one in ground-speed terms, which
-//! is what the seed's wind-scaled ("slide") branches do.
+//! right. The pattern's corners are at `(±ax, ±ay)`; the branches are flown clockwise with
+//! localizer-and-course control: Branch1 downwind along `y = −ay`, Branch2 across at
+//! `x = +ax`, Branch3 upwind along `y = +ay`, Branch4 across at `x = −ax`. The entry corner is
+//! the one reached soonest from where the vehicle is (the region decision of Fig. 5.4: in
+//! light wind, the corner of the quadrant it is in).
 //!
-//! The pattern's axis follows the wind during the approximation; after that it turns only at
-//! the start of a loop (at most 45°) and onto the final (at most 20°), so the vehicle's place
-//! in the pattern does not move under it while decisions taken on it are being flown. Corners
-//! are started a turn radius early, at the turn rate the control gains in force actually give
-//! ([`corner_turn_rate_rad_s`]), and energy decisions wait until the wind estimate has been
-//! certain for a while. Each phase change is one decision: the final is left as too high only
-//! after some time on it, and a base leg meets its final line only out at the base leg.
+//! **Branches scaled with the wind** (seed: "correct some wind perturbation by scaling the
+//! branches length"). The half-width across the wind is `ay = half_size_m`; the half-length
+//! along it is `ax = max(ay·(V − w)/V, r)`, with `V` the airspeed, `w` the wind along the
+//! axis and `r` the corner's turn radius. The upwind leg then takes `2ay/V`, as long as in
+//! still air, however strong the wind, and the pattern shrinks towards a weave across the wind
+//! as the wind nears the airspeed. The pattern stays centred on the target: flown on
+//! ground-referenced lines it does not slide, and the two along-wind legs, the same length
+//! over the ground, put the vehicle upwind and downwind of the target for equal times. The
+//! seed's slide spiral, flown on headings, needed one branch longer than the other to come
+//! back over the target; here that is what the ground-referenced localizers do.
+//!
+//! The pattern's axis and its half-length follow the wind during the approximation; after
+//! that they change only at the start of a loop (at most 45°) and onto the final (at most
+//! 20°), so the vehicle's place in the pattern does not move under it while decisions taken
+//! on it are being flown. Corners are started a turn radius early, at the turn rate the
+//! control gains in force actually give ([`corner_turn_rate_rad_s`]), and energy decisions
+//! wait until the wind estimate has been certain for a while. Each phase change is one
+//! decision, and its reason says where, how high, in which loop, what was decided and why.
 //!
 //! Leaving the spiral is an energy decision recomputed at every update. The height needed to
-//! turn base at `x` on Branch1 and glide in is `H(x) = hang + s₀·a/g_cross + s_t·x/g_up + 2·turn
-//! loss + margin`. On Branch1, at the normal corner, guidance loops again if one more loop still
-//! leaves at least `H(a)`; otherwise it extends the downwind leg and turns base at the first `x`
-//! where the height has fallen to `H(x)`. The base leg ends on the final-approach line through
-//! the target, flown upwind with the vertical law absorbing what the plan got wrong, and full
-//! brakes below the flare height. When the wind makes the target unreachable (the target
-//! lies outside the circle the glide can reach around the drift point), guidance says so and
-//! flies to the reachable point nearest the target instead.
+//! turn base at `x` on Branch1 and glide in is `H(x) = hang + s₀·ay/g_cross + s_t·x/g_up +
+//! 2·turn loss + margin`, planned for a little more headwind than measured. On Branch1, at the
+//! normal corner, guidance loops again if one more loop still leaves at least `H(ax)`;
+//! otherwise it extends the downwind leg and turns base at the first `x` where the height has
+//! fallen to `H(x)`. The base leg ends on the final-approach line through the target, flown
+//! upwind, and full brakes below the flare height.
+//!
+//! **Which law flies the final.** The brakes on the final approach are set by
+//! [`FinalLaw::GlideInversion`] by default: every update, the brake whose steady glide over
+//! the ground, into the planned headwind, ends on the aim point (the flare's start) from where
+//! the vehicle is — the glide performance inverted. The seed's glide-slope law (eqs.
+//! 5.12–5.17, [`control::vertical`]) down a straight path whose slope is fixed at the turn onto
+//! the final is [`FinalLaw::GlideSlope`]; the Monte Carlo comparison that decided between them
+//! is in `crates/stx-gnc/GNC_NOTES.md`.
+//!
+//! **Too strong a wind.** At every update until the flare, in every phase, guidance checks the
+//! glide's reach: the circle of radius `V·T` (T the time left to the ground at the current
+//! sink) around the drift point, where the wind alone would carry the stack. When the target
+//! lies outside it by more than the drift an error of 0.3 m/s in the wind makes over `T`
+//! (plus 20 m), guidance says so — an event with the wind, the reach and the best reachable
+//! point — and flies to that point, the one of the circle nearest the target, into the wind
+//! for the last 40 m. It announces the point again whenever it moves by 50 m (the recovery
+//! team drives to it), and goes back to the target only when it is well inside the circle.
 
 use serde::{Deserialize, Serialize};
 use stx_dynamics::rotation::wrap_pi;
 use stx_dynamics::state::Controls;
 
-use crate::control::{self, ControlGains, Localizer};
+use crate::control::{self, ControlGains, GlidePath, Localizer};
 use crate::estimate::Estimate;
 use crate::guidance::{GuidanceConfig, Plan};
 use crate::mission::GuidancePhase;
@@ -64,7 +89,7 @@ pub struct SpiralConfig {
     /// Below this wind the approach direction is held as it is, m/s.
     pub calm_wind_mps: f64,
     /// Share of the glide's still-air reach guidance counts on before calling a target out of
-    /// reach (checked until the base turn; the final glide is planned to use all of it).
+    /// reach (checked in every phase until the flare; see the module doc).
     pub reach_margin: f64,
     /// Time constant of the wind filter that orients the pattern, s.
     pub wind_filter_s: f64,
@@ -75,6 +100,24 @@ pub struct SpiralConfig {
     pub wind_margin_mps: f64,
     /// Headwind added as a share of the measured wind when planning the final.
     pub wind_margin_fraction: f64,
+    /// Which law sets the brakes on the final approach.
+    pub final_law: FinalLaw,
+    /// Whether the pattern's legs along the wind are shortened with the wind (see the module
+    /// doc); without, the pattern is the square of side `2·half_size_m` in any wind.
+    pub wind_scaled_branches: bool,
+}
+
+/// The law that sets the symmetric brakes on the final approach.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum FinalLaw {
+    /// The brake whose steady glide over the ground, into the planned headwind, ends on the
+    /// aim point from where the vehicle is: the glide performance inverted, every update.
+    #[default]
+    GlideInversion,
+    /// The seed's glide-slope law (eqs. 5.12–5.17) down a straight path through the aim point
+    /// whose slope is fixed at the turn onto the final, about a feed-forward brake.
+    GlideSlope,
 }
 
 impl Default for SpiralConfig {
@@ -94,6 +137,8 @@ impl Default for SpiralConfig {
             aim_beyond_m: 0.0,
             wind_margin_mps: 0.2,
             wind_margin_fraction: 0.1,
+            final_law: FinalLaw::GlideInversion,
+            wind_scaled_branches: true,
         }
     }
 }
@@ -195,6 +240,16 @@ pub struct Spiral {
     reorient: bool,
     /// Since when the estimator's wind uncertainty has been small, s.
     wind_known_since_s: Option<f64>,
+    /// Half-length of the pattern along the wind, m, held with the axis.
+    half_length_m: Option<f64>,
+    /// Slope of the glide path on this final approach (seed's GS0), fixed at the turn onto
+    /// it, with [`FinalLaw::GlideSlope`].
+    final_slope: Option<f64>,
+    /// The best reachable point last announced (north, east), m, and when, s.
+    announced_best_ne_m: Option<[f64; 2]>,
+    announced_at_s: f64,
+    /// Loops of the pattern begun (the first at the entry corner), for the operator's log.
+    loop_number: u32,
 }
 
 /// The branches in flying order.
@@ -210,12 +265,13 @@ fn branch_index(phase: GuidancePhase) -> Option<usize> {
 }
 
 /// Corners in wind coordinates (x downwind, y right), start of each branch.
-fn corner_xy(branch: usize, a: f64) -> [f64; 2] {
+/// `ax` is the half-length along the wind, `ay` the half-width across it.
+fn corner_xy(branch: usize, ax: f64, ay: f64) -> [f64; 2] {
     match branch % 4 {
-        0 => [-a, -a],
-        1 => [a, -a],
-        2 => [a, a],
-        _ => [-a, a],
+        0 => [-ax, -ay],
+        1 => [ax, -ay],
+        2 => [ax, ay],
+        _ => [-ax, ay],
     }
 }
 
@@ -226,9 +282,21 @@ const LOW_MARGIN_M: f64 = 10.0;
 /// Wind uncertainty (1-σ per component) below which guidance trusts the wind for its energy
 /// decisions, m/s.
 const WIND_KNOWN_SIGMA_MPS: f64 = 0.6;
-/// Below this height of the lowest body the reach check is off: the terminal phases are
-/// planned to use all the height there is, so the glide's reach is always just enough.
+/// Below this height of the lowest body the reach check is off: the last seconds are flown
+/// into the wind whatever the reach, and a changed mind there costs more than it buys.
 const REACH_CHECK_MIN_HEIGHT_M: f64 = 60.0;
+/// Least distance between the best reachable point and the target for guidance to call the
+/// target out of reach, m, to which is added the drift an error of [`WIND_ACCURACY_MPS`]
+/// makes over the time left.
+const MIN_SHORTFALL_M: f64 = 20.0;
+/// Accuracy of the wind estimate guidance counts on, m/s (the project's goal for it, RMS).
+const WIND_ACCURACY_MPS: f64 = 0.3;
+/// The best reachable point is announced again when it has moved this far, m (the recovery
+/// team drives to it).
+const BEST_POINT_MOVED_M: f64 = 50.0;
+/// Least time on the way to the best reachable point before guidance turns back to the
+/// target, s: the reach ratio hovers about its threshold in gusts.
+const MIN_BEST_REACHABLE_S: f64 = 10.0;
 /// Height above the steepest glide on final at which S-turns start, m.
 const S_TURN_EXCESS_M: f64 = 10.0;
 /// Height above the steepest glide on final at which guidance goes back downwind, m.
@@ -246,6 +314,36 @@ const WIND_SETTLE_S: f64 = 10.0;
 const S_TURN_HALF_WIDTH_M: f64 = 40.0;
 /// Course offset of an S-turn leg from the final course, rad (100°: slightly back downwind).
 const S_TURN_ANGLE_RAD: f64 = 1.7453;
+
+/// Where `position_ne` (north, east, m) is relative to `target_ne`, for the operator: "120 m
+/// NE of the target".
+fn place_of(position_ne: [f64; 2], target_ne: [f64; 2]) -> String {
+    const POINTS: [&str; 8] = ["N", "NE", "E", "SE", "S", "SW", "W", "NW"];
+    let (dn, de) = (position_ne[0] - target_ne[0], position_ne[1] - target_ne[1]);
+    let distance = dn.hypot(de);
+    if distance < 5.0 {
+        return "over the target".into();
+    }
+    let bearing = de.atan2(dn).to_degrees().rem_euclid(360.0);
+    let point = POINTS[((bearing + 22.5) / 45.0) as usize % 8];
+    format!("{distance:.0} m {point} of the target")
+}
+
+/// The loop of the pattern under way, for the operator's log.
+fn loop_tag(loop_number: u32) -> String {
+    match loop_number {
+        0 => "no loop flown".into(),
+        n => format!("loop {n}"),
+    }
+}
+
+/// Direction a horizontal wind (north, east; the air's velocity) blows from, degrees 0…360.
+fn wind_from_deg(wind_ne: [f64; 2]) -> f64 {
+    (-wind_ne[1])
+        .atan2(-wind_ne[0])
+        .to_degrees()
+        .rem_euclid(360.0)
+}
 
 impl Spiral {
     /// A spiral that has not started (phase Idle).
@@ -267,6 +365,11 @@ impl Spiral {
             phase_since_s: 0.0,
             reorient: true,
             wind_known_since_s: None,
+            half_length_m: None,
+            final_slope: None,
+            announced_best_ne_m: None,
+            announced_at_s: 0.0,
+            loop_number: 0,
         }
     }
 
@@ -312,24 +415,31 @@ impl Spiral {
         let rel = [position[0] - target_ne[0], position[1] - target_ne[1]];
         let height = est.height_m() - ground_m;
 
-        // Wind used for planning: low-passed so the pattern does not twitch with gusts.
+        // Wind used for planning: low-passed so the pattern does not twitch with gusts, but only
+        // once the estimator trusts its wind. Before, its wind starts near zero and swings by
+        // metres per second as it converges; a filter started there lagged the truth for many
+        // time constants, and in a strong wind the reach check then saw a wind too weak to
+        // call the target out of reach until the pattern had committed to it (issue 3 audit:
+        // 8–10 m/s winds missed by up to 1.2 km unflagged). So the raw estimate is followed
+        // until its uncertainty is small, and the filter starts from the estimate then.
         let measured = [est.wind_ned_mps.x, est.wind_ned_mps.y];
+        let sigma_ok = est.wind_sigma_mps.x.max(est.wind_sigma_mps.y) < WIND_KNOWN_SIGMA_MPS;
         let dt = self
             .last_time_s
             .map(|t| (est.time_s - t).clamp(0.0, 5.0))
             .unwrap_or(0.0);
         self.last_time_s = Some(est.time_s);
         let wind = match self.wind_ne_mps {
-            None => measured,
-            Some(w) => {
+            Some(w) if sigma_ok => {
                 let k = dt / (sc.wind_filter_s + dt);
                 [
                     w[0] + k * (measured[0] - w[0]),
                     w[1] + k * (measured[1] - w[1]),
                 ]
             }
+            _ => measured,
         };
-        self.wind_ne_mps = Some(wind);
+        self.wind_ne_mps = sigma_ok.then_some(wind);
         let wind_speed = wind[0].hypot(wind[1]);
 
         // The pattern's axis: downwind, unless the operator fixed the approach course; in calm
@@ -374,7 +484,7 @@ impl Spiral {
         let w_along = w_along_measured
             + sc.wind_margin_fraction * w_along_measured.abs()
             + sc.wind_margin_mps;
-        let a = sc.half_size_m;
+        let ay = sc.half_size_m;
 
         // Planning speeds.
         let v0 = perf.horizontal_airspeed(0.0, density);
@@ -399,7 +509,7 @@ impl Spiral {
         let g_up0 = (v0 - w_along).max(0.3);
         let g_up_t = (vt - w_along).max(0.3);
         let g_cross = (v0 * v0 - w_along * w_along).max(0.09).sqrt();
-        let downwind_y = self.downwind_y_m.unwrap_or(-a);
+        let downwind_y = self.downwind_y_m.unwrap_or(-ay);
         // Height needed to turn base at x from a downwind leg |lateral| off the final line.
         let needed_from = |x_base: f64, lateral: f64| {
             sc.hang_height_m
@@ -415,13 +525,30 @@ impl Spiral {
             let x_entry = x.max(sc.min_final_m);
             needed_from(x_entry, y) + s0 * (x_entry - x) / g_down
         };
-        let loop_loss =
-            s0 * (2.0 * a / g_cross * 2.0 + 2.0 * a / g_up0 + 2.0 * a / g_down) + 4.0 * turn_loss;
         let turn_distance = perf.turn_radius_m(r, 0.0, density);
+        // The branches scaled with the wind (seed §5.3): the legs along the wind are shortened
+        // in proportion to the upwind leg's ground speed, `ax = a·(V − w)/V`, so the upwind leg
+        // takes as long as in still air and the pattern shrinks to a weave across the wind as
+        // the wind nears the airspeed (at least a turn's length, or the corners overlap). Held,
+        // like the axis, from the start of a loop to its end.
+        let ax = match self.half_length_m {
+            Some(held) if frozen => held,
+            _ if !sc.wind_scaled_branches => ay,
+            _ => {
+                let w = w_along_measured.clamp(0.0, v0);
+                (ay * (v0 - w) / v0.max(1e-3)).max(turn_distance.min(ay))
+            }
+        };
+        self.half_length_m = Some(ax);
+        let loop_loss = s0 * (2.0 * ay / g_cross * 2.0 + 2.0 * ax / g_up0 + 2.0 * ax / g_down)
+            + 4.0 * turn_loss;
 
         // Reach: the glide's circle around the drift point.
         let t_land = ((height - sc.hang_height_m) / s0).max(0.0);
-        let drift = [rel[0] + wind[0] * t_land, rel[1] + wind[1] * t_land];
+        // With the estimator's wind as it is, not the planning filter's: the filter is there
+        // to keep the pattern's axis still, and its lag would hold a best reachable point
+        // announced on a wind already known to be stale.
+        let drift = [rel[0] + measured[0] * t_land, rel[1] + measured[1] * t_land];
         let drift_distance = drift[0].hypot(drift[1]);
         let reach = v0 * t_land;
         let reach_ratio = if reach > 1e-6 {
@@ -429,12 +556,17 @@ impl Spiral {
         } else {
             f64::INFINITY
         };
-        let threshold = if self.phase == GuidancePhase::BestReachable {
-            sc.reach_margin - 0.1
+        // Out of reach means beyond the glide's circle, and by more than what the wind
+        // estimate's error carries the drift point over the time left: a shortfall within
+        // that is not known to be one, and not worth the operator's attention or giving up
+        // the approach for (tight approaches touch a reach ratio of 1 on their base leg). Once
+        // called, the target counts as reachable again only well inside the circle.
+        let reachable = if self.phase == GuidancePhase::BestReachable {
+            reach_ratio <= sc.reach_margin - 0.1
         } else {
-            sc.reach_margin
+            reach_ratio <= sc.reach_margin
+                || drift_distance - reach < MIN_SHORTFALL_M + WIND_ACCURACY_MPS * t_land
         };
-        let reachable = reach_ratio <= threshold;
         let best_rel = if drift_distance > 1e-9 {
             let k = (reach / drift_distance).min(1.0);
             [drift[0] * (1.0 - k), drift[1] * (1.0 - k)]
@@ -451,7 +583,7 @@ impl Spiral {
         };
         let flare_glide = perf.ground_glide(1.0, w_along_measured, density).max(0.0);
         let to_go_before_flare =
-            -final_line.along_track_m(position) - flare_glide * sc.flare_height_m - sc.aim_beyond_m;
+            -final_line.along_track_m(position) - flare_glide * sc.flare_height_m + sc.aim_beyond_m;
         let height_to_flare = height - sc.hang_height_m - sc.flare_height_m;
         // The way across to the line, if not on it yet, is flown too (brakes released).
         let across_m = final_line.cross_track_m(position).abs();
@@ -468,7 +600,6 @@ impl Spiral {
         // ... and have stayed good for a while: the estimator's first converged seconds still
         // carry metres per second of error that its uncertainty does not show, and a pattern
         // committed to a wrong wind's axis is flown across the real one.
-        let sigma_ok = est.wind_sigma_mps.x.max(est.wind_sigma_mps.y) < WIND_KNOWN_SIGMA_MPS;
         self.wind_known_since_s = match (sigma_ok, self.wind_known_since_s) {
             (false, _) => None,
             (true, None) => Some(est.time_s),
@@ -488,6 +619,7 @@ impl Spiral {
             }
         };
 
+        let place = |p: [f64; 2]| place_of(p, target_ne);
         // Phase decisions.
         match self.phase {
             GuidancePhase::Idle | GuidancePhase::Landed => {}
@@ -496,7 +628,39 @@ impl Spiral {
                 set(
                     self,
                     GuidancePhase::Flare,
-                    format!("flare: lowest body {lowest_body_height:.1} m above the ground"),
+                    format!(
+                        "flare: lowest body {lowest_body_height:.1} m above the ground, {}: full \
+                         brakes to slow the touchdown",
+                        place(position)
+                    ),
+                );
+            }
+            // Checked in every phase until the flare, whatever has been decided: a base leg or
+            // an extended downwind leg planned on a wind that turns out too strong still
+            // cannot reach the target. (It was off once either was committed, and strong
+            // winds were flown into the ground kilometres off with no word to the operator.)
+            _ if wind_known
+                && !reachable
+                && self.phase != GuidancePhase::BestReachable
+                && lowest_body_height > REACH_CHECK_MIN_HEIGHT_M =>
+            {
+                let miss = best_rel[0].hypot(best_rel[1]);
+                let best = [target_ne[0] + best_rel[0], target_ne[1] + best_rel[1]];
+                self.base_x_m = None;
+                self.extending = false;
+                self.downwind_y_m = None;
+                set(
+                    self,
+                    GuidancePhase::BestReachable,
+                    format!(
+                        "target out of reach at {height:.0} m: wind {wind_speed:.1} m/s from \
+                         {:.0}°, the glide reaches {reach:.0} m around a drift point \
+                         {drift_distance:.0} m from the target (ratio {reach_ratio:.2}); flying to \
+                         the best reachable point ({:.0} N, {:.0} E), {miss:.0} m from the target",
+                        wind_from_deg(wind),
+                        best[0],
+                        best[1]
+                    ),
                 );
             }
             GuidancePhase::FinalApproach
@@ -508,14 +672,15 @@ impl Spiral {
                     // Downwind on a leg beside the final line, and base again from it when
                     // the height has come down to what the glide in needs.
                     let side = final_line.cross_track_m(position);
-                    self.downwind_y_m = Some(if side >= 0.0 { a } else { -a });
+                    self.downwind_y_m = Some(if side >= 0.0 { ay } else { -ay });
                     self.extending = true;
                     set(
                         self,
                         GuidancePhase::Branch1,
                         format!(
-                            "{final_excess_m:.0} m too high for the final even with full brakes: \
-                             back downwind to lose it"
+                            "{final_excess_m:.0} m too high for the final even with full brakes \
+                             ({height:.0} m, {}): back downwind to lose it",
+                            place(position)
                         ),
                     );
                 } else {
@@ -530,37 +695,57 @@ impl Spiral {
                         GuidancePhase::Approximation,
                         format!(
                             "{final_excess_m:.0} m too high for the final even with full brakes, \
-                             {x:.0} m out: back to the pattern over the target to lose it"
+                             {x:.0} m out at {height:.0} m: back to the pattern over the target \
+                             to lose it"
                         ),
                     );
                 }
             }
             GuidancePhase::FinalApproach => {}
+            GuidancePhase::BestReachable
+                if reach_ratio > sc.reach_margin
+                    && self.announced_best_ne_m.is_some_and(|a| {
+                        let moved = (a[0] - target_ne[0] - best_rel[0])
+                            .hypot(a[1] - target_ne[1] - best_rel[1]);
+                        moved > BEST_POINT_MOVED_M
+                    })
+                    && now_s - self.announced_at_s >= MIN_BEST_REACHABLE_S =>
+            {
+                // The wind estimate firmed up or the wind changed: the operator's recovery team
+                // drives to the announced point, so a point that moved is announced again.
+                let best = [target_ne[0] + best_rel[0], target_ne[1] + best_rel[1]];
+                let miss = best_rel[0].hypot(best_rel[1]);
+                change = Some((
+                    GuidancePhase::BestReachable,
+                    GuidancePhase::BestReachable,
+                    format!(
+                        "best reachable point moved: now ({:.0} N, {:.0} E), {miss:.0} m from the \
+                         target, at {height:.0} m in a wind of {wind_speed:.1} m/s from {:.0}° \
+                         (reach ratio {reach_ratio:.2})",
+                        best[0],
+                        best[1],
+                        wind_from_deg(wind)
+                    ),
+                ));
+            }
             GuidancePhase::BestReachable => {
-                if reachable {
+                // Back to the target only when it is clearly within reach again, after a while
+                // on this course, and high enough to plan an approach: near the ground a
+                // changed mind costs more than it buys.
+                if reachable
+                    && in_phase_s >= MIN_BEST_REACHABLE_S
+                    && lowest_body_height > REACH_CHECK_MIN_HEIGHT_M
+                {
                     self.approach_from_ne_m = None;
                     set(
                         self,
                         GuidancePhase::Approximation,
-                        format!("target within reach again (reach ratio {reach_ratio:.2})"),
+                        format!(
+                            "target within reach again at {height:.0} m (reach ratio \
+                             {reach_ratio:.2}, wind {wind_speed:.1} m/s): approaching it"
+                        ),
                     );
                 }
-            }
-            _ if wind_known
-                && !reachable
-                && self.base_x_m.is_none()
-                && !self.extending
-                && lowest_body_height > REACH_CHECK_MIN_HEIGHT_M =>
-            {
-                let miss = best_rel[0].hypot(best_rel[1]);
-                set(
-                    self,
-                    GuidancePhase::BestReachable,
-                    format!(
-                        "target out of reach: wind {wind_speed:.1} m/s, reach ratio \
-                         {reach_ratio:.2}; flying to the best reachable point {miss:.0} m from it"
-                    ),
-                );
             }
             _ if wind_known
                 && self.base_x_m.is_none()
@@ -618,7 +803,7 @@ impl Spiral {
                     // estimate firms up, keeping the current one unless another is clearly
                     // sooner.
                     let time_to = |k: usize| {
-                        let c = corner_xy(k, a);
+                        let c = corner_xy(k, ax, ay);
                         let (dx, dy) = (c[0] - x, c[1] - y);
                         let d = dx.hypot(dy);
                         if d < 1e-6 {
@@ -640,31 +825,44 @@ impl Spiral {
                     }
                 }
                 let k = branch_index(self.entry_branch).unwrap_or(0);
-                let corner = corner_xy(k, a);
+                let corner = corner_xy(k, ax, ay);
                 let to_corner = (corner[0] - x).hypot(corner[1] - y);
                 if to_corner < turn_distance.max(10.0) {
+                    self.loop_number = 1;
                     set(
                         self,
                         self.entry_branch,
-                        format!("reached the spiral's entry corner ({to_corner:.0} m)"),
+                        format!(
+                            "loop 1: entry corner reached {}, at {height:.0} m; the corner was \
+                             chosen as the one reached soonest from where the approach began, \
+                             the pattern {:.0} × {:.0} m with its long side across a wind of \
+                             {wind_speed:.1} m/s from {:.0}°",
+                            place(position),
+                            2.0 * ax,
+                            2.0 * ay,
+                            wind_from_deg(wind)
+                        ),
                     );
                 }
             }
             GuidancePhase::Branch1 => {
-                let to_corner = a - x;
+                let to_corner = ax - x;
                 // The turn carries the vehicle about a turn radius further downwind before it
                 // flies across: the base leg lies there, and the glide in is planned from it.
                 let x_base = x + turn_distance;
                 let needed = needed_to_turn_base(x_base.max(sc.min_final_m));
-                if x_base >= sc.min_final_m.min(a) && height <= needed {
+                if x_base >= sc.min_final_m.min(ax) && height <= needed {
                     self.base_x_m = Some(x_base);
                     self.extending = false;
                     set(
                         self,
                         GuidancePhase::Branch2,
                         format!(
-                            "turning base at {height:.0} m (needed {needed:.0} m) onto a base leg \
-                             {x_base:.0} m downwind of the target"
+                            "{}: turning base at {height:.0} m (needed {needed:.0} m to turn \
+                             base here and glide in) onto a base leg {x_base:.0} m downwind of the \
+                             target, {}",
+                            loop_tag(self.loop_number),
+                            place(position)
                         ),
                     );
                 } else if x_base >= sc.max_final_m {
@@ -673,15 +871,27 @@ impl Spiral {
                     set(
                         self,
                         GuidancePhase::Branch2,
-                        format!("turning base at the longest final approach, {x_base:.0} m"),
+                        format!(
+                            "{}: turning base at the longest final approach allowed, \
+                             {x_base:.0} m out, at {height:.0} m ({needed:.0} m needed): the \
+                             final's brakes take off the rest",
+                            self.loop_number
+                        ),
                     );
                 } else if !self.extending && to_corner < turn_distance {
-                    if height - loop_loss >= needed_to_turn_base(a) {
+                    if height - loop_loss >= needed_to_turn_base(ax) {
                         self.base_x_m = None;
                         set(
                             self,
                             GuidancePhase::Branch2,
-                            format!("another loop: {height:.0} m, a loop takes {loop_loss:.0} m"),
+                            format!(
+                                "{}: downwind corner {}, at {height:.0} m; another loop \
+                                 ({loop_loss:.0} m) still leaves the {:.0} m a final needs: across \
+                                 the wind",
+                                loop_tag(self.loop_number),
+                                place(position),
+                                needed_to_turn_base(ax)
+                            ),
                         );
                     } else {
                         self.extending = true;
@@ -701,25 +911,59 @@ impl Spiral {
                             self,
                             GuidancePhase::FinalApproach,
                             format!(
-                                "turning final into the wind at {height:.0} m, {x:.0} m from the \
-                                 target"
+                                "{}: base leg meets the final line {}, at {height:.0} m: \
+                                 turning final into a wind of {wind_speed:.1} m/s from {:.0}°",
+                                loop_tag(self.loop_number),
+                                place(position),
+                                wind_from_deg(wind)
                             ),
                         );
                     }
-                } else if a - y < turn_distance {
-                    set(self, GuidancePhase::Branch3, "branch 3".into());
+                } else if ay - y < turn_distance {
+                    set(
+                        self,
+                        GuidancePhase::Branch3,
+                        format!(
+                            "{}: across leg done {}, at {height:.0} m: upwind leg, {:.0} m",
+                            loop_tag(self.loop_number),
+                            place(position),
+                            2.0 * ax
+                        ),
+                    );
                 }
             }
             GuidancePhase::Branch3 => {
-                if x - (-a) < turn_distance {
-                    set(self, GuidancePhase::Branch4, "branch 4".into());
+                if x - (-ax) < turn_distance {
+                    set(
+                        self,
+                        GuidancePhase::Branch4,
+                        format!(
+                            "{}: upwind leg done {}, at {height:.0} m: across to the \
+                             downwind leg",
+                            loop_tag(self.loop_number),
+                            place(position)
+                        ),
+                    );
                 }
             }
             GuidancePhase::Branch4 => {
-                if y - (-a) < turn_distance {
+                if y - (-ay) < turn_distance {
                     self.downwind_y_m = None;
                     self.reorient = true;
-                    set(self, GuidancePhase::Branch1, "branch 1".into());
+                    self.loop_number += 1;
+                    set(
+                        self,
+                        GuidancePhase::Branch1,
+                        format!(
+                            "{}: begins {}, at {height:.0} m; downwind leg, {:.0} m, then \
+                             the decision to loop again or turn base (a loop takes \
+                             {loop_loss:.0} m, a final from the corner {:.0} m)",
+                            loop_tag(self.loop_number),
+                            place(position),
+                            2.0 * ax,
+                            needed_to_turn_base(ax)
+                        ),
+                    );
                 }
             }
         }
@@ -736,7 +980,7 @@ impl Spiral {
             .main_line_m
         };
         let branch_line = |k: usize| {
-            let mut start = corner_xy(k, a);
+            let mut start = corner_xy(k, ax, ay);
             let mut course = downwind + std::f64::consts::FRAC_PI_2 * k as f64;
             match (k, self.base_x_m) {
                 (0, _) => start[1] = downwind_y,
@@ -758,7 +1002,7 @@ impl Spiral {
             GuidancePhase::Idle | GuidancePhase::Landed => Controls::default(),
             GuidancePhase::Approximation => {
                 let k = branch_index(self.entry_branch).unwrap_or(0);
-                let corner = to_ne(corner_xy(k, a));
+                let corner = to_ne(corner_xy(k, ax, ay));
                 let from = self.approach_from_ne_m.unwrap_or(position);
                 let line = if (corner[0] - from[0]).hypot(corner[1] - from[1]) > 1.0 {
                     Localizer::through(from, corner)
@@ -781,18 +1025,61 @@ impl Spiral {
                 }
             }
             GuidancePhase::FinalApproach => {
-                // Vertical: the brake whose glide over the ground ends the descent on the aim
-                // point, recomputed every update (a closed loop on the predicted touchdown).
-                // The aim is the flare's start: the flare's own glide, at full brake, carries
-                // the stack the rest of the way.
                 let brake = if height_to_flare <= 0.0 || to_go_before_flare <= 0.0 {
                     if sc.flare { 1.0 } else { self.last_final_brake }
                 } else {
-                    perf.brake_for_ground_glide(
-                        to_go_before_flare / height_to_flare,
-                        w_along_measured,
-                        density,
-                    )
+                    match sc.final_law {
+                        // The brake whose glide over the ground ends the descent on the aim
+                        // point, recomputed every update (a closed loop on the predicted
+                        // touchdown). The aim is the flare's start: the flare's own glide, at
+                        // full brake, carries the stack the rest of the way. Planned for the
+                        // wind as measured: planned for the decisions' headwind margin, the
+                        // final kept height in hand and spent it late, which saved the odd
+                        // final caught by a strengthening wind but cost more elsewhere (the
+                        // Monte Carlo comparison is in GNC_NOTES.md).
+                        FinalLaw::GlideInversion => perf.brake_for_ground_glide(
+                            to_go_before_flare / height_to_flare,
+                            w_along_measured,
+                            density,
+                        ),
+                        // The seed's vertical law (eqs. 5.12–5.17): a straight glide path
+                        // through the aim point, its slope GS0 the geometry at the turn onto
+                        // the final, flown about the brake that holds GS0 in the wind planned
+                        // with (the performance model's feed-forward).
+                        FinalLaw::GlideSlope => {
+                            let slope = *self.final_slope.get_or_insert(
+                                (height_to_flare / to_go_before_flare).clamp(0.05, 20.0),
+                            );
+                            let aim_ne = [
+                                target_ne[0]
+                                    + (sc.aim_beyond_m - flare_glide * sc.flare_height_m)
+                                        * final_course.cos(),
+                                target_ne[1]
+                                    + (sc.aim_beyond_m - flare_glide * sc.flare_height_m)
+                                        * final_course.sin(),
+                            ];
+                            let path = GlidePath {
+                                line: Localizer {
+                                    point_ne_m: aim_ne,
+                                    course_rad: final_course,
+                                },
+                                aim_height_m: ground_m + sc.hang_height_m + sc.flare_height_m,
+                                slope,
+                            };
+                            let trim =
+                                perf.brake_for_ground_glide(1.0 / slope, w_along_measured, density);
+                            control::vertical_about(
+                                gains,
+                                &path,
+                                position,
+                                est.height_m(),
+                                [est.velocity_ned_mps.x, est.velocity_ned_mps.y],
+                                est.sink_rate_mps,
+                                trim,
+                            )
+                            .brake
+                        }
+                    }
                 };
                 // Horizontal: the final line; while far too high for even full brakes to
                 // bring it down in time, S-turns across the line burn the height.
@@ -848,12 +1135,25 @@ impl Spiral {
             }
         };
 
+        if self.phase != GuidancePhase::FinalApproach {
+            self.final_slope = None;
+        }
+        if self.phase != GuidancePhase::BestReachable {
+            self.announced_best_ne_m = None;
+        } else if change
+            .as_ref()
+            .is_some_and(|c| c.1 == GuidancePhase::BestReachable)
+        {
+            self.announced_best_ne_m =
+                Some([target_ne[0] + best_rel[0], target_ne[1] + best_rel[1]]);
+            self.announced_at_s = est.time_s;
+        }
         self.status = SpiralStatus {
             downwind_course_rad: downwind,
             final_course_rad: final_course,
-            corners_ne_m: [0, 1, 2, 3].map(|k| to_ne(corner_xy(k, a))),
-            final_entry_ne_m: to_ne([self.base_x_m.unwrap_or(a), 0.0]),
-            final_approach_height_m: needed_to_turn_base(self.base_x_m.unwrap_or(a)),
+            corners_ne_m: [0, 1, 2, 3].map(|k| to_ne(corner_xy(k, ax, ay))),
+            final_entry_ne_m: to_ne([self.base_x_m.unwrap_or(ax), 0.0]),
+            final_approach_height_m: needed_to_turn_base(self.base_x_m.unwrap_or(ax)),
             height_m: height,
             reach_ratio,
             target_reachable: reachable,
@@ -962,5 +1262,98 @@ mod tests {
             (WIND_SETTLE_S..WIND_SETTLE_S + 0.5).contains(&t),
             "first decision at {t} s"
         );
+    }
+
+    /// Seed Fig. 5.4: the spiral is entered at the corner of the region the vehicle is in —
+    /// in wind coordinates (x downwind, y right), a vehicle downwind and right of the target
+    /// enters at the corner (+a, +a), the start of Branch3, and so on round the square.
+    #[test]
+    fn the_entry_corner_is_the_one_of_the_region_the_vehicle_is_in() {
+        let config = GuidanceConfig::default();
+        let plan = Plan {
+            target_ned_m: Vector3::new(100.0, -50.0, 0.0),
+            ..Plan::default()
+        };
+        // 1 m/s from the north: downwind is south, and right of south is west.
+        let wind = Vector3::new(-1.0, 0.0, 0.0);
+        let cases = [
+            // (metres downwind, metres right of it) → branch entered
+            ((250.0, 250.0), GuidancePhase::Branch3),
+            ((250.0, -250.0), GuidancePhase::Branch2),
+            ((-250.0, -250.0), GuidancePhase::Branch1),
+            ((-250.0, 250.0), GuidancePhase::Branch4),
+        ];
+        for ((x, y), expected) in cases {
+            let north = plan.target_ned_m.x - x;
+            let east = plan.target_ned_m.y - y;
+            let mut spiral = Spiral::new();
+            spiral.force_phase(GuidancePhase::Approximation);
+            let est = PointMass::new(0.0, Vector3::new(north, east, -600.0), 1.0).estimate(&wind);
+            spiral.update(&config, &plan, &est, 1.2);
+            assert_eq!(
+                spiral.entry_branch, expected,
+                "vehicle {x} m downwind, {y} m right of the target"
+            );
+            // And that corner is the nearest of the pattern's corners.
+            let corners = spiral.status().corners_ne_m;
+            let nearest = (0..4)
+                .min_by(|i, j| {
+                    let d = |k: usize| (corners[k][0] - north).hypot(corners[k][1] - east);
+                    d(*i).total_cmp(&d(*j))
+                })
+                .unwrap_or(0);
+            assert_eq!(BRANCHES[nearest], expected);
+        }
+    }
+
+    /// The branches along the wind shrink as the wind grows (seed §5.3, "scaling the branches
+    /// length"): the upwind leg takes as long as in still air, down to a turn's length.
+    #[test]
+    fn the_legs_along_the_wind_shrink_with_the_wind_so_the_upwind_leg_keeps_its_duration() {
+        let config = GuidanceConfig::default();
+        let plan = Plan::default();
+        let perf = &config.performance;
+        let v0 = perf.horizontal_airspeed(0.0, 1.2);
+        let half_length = |speed: f64| {
+            let mut spiral = Spiral::new();
+            spiral.force_phase(GuidancePhase::Approximation);
+            let wind = Vector3::new(-speed, 0.0, 0.0);
+            let mut est =
+                PointMass::new(0.0, Vector3::new(300.0, 0.0, -600.0), 0.0).estimate(&wind);
+            est.wind_sigma_mps = Vector3::new(0.1, 0.1, 0.0);
+            spiral.update(&config, &plan, &est, 1.2);
+            let c = spiral.status().corners_ne_m;
+            // Branch1 runs from corner 0 to corner 1 along the wind.
+            0.5 * (c[1][0] - c[0][0]).hypot(c[1][1] - c[0][1])
+        };
+        let a = config.spiral.half_size_m;
+        assert!((half_length(0.0) - a).abs() < 1e-9);
+        for speed in [1.0, 2.0] {
+            let ax = half_length(speed);
+            assert!(
+                (ax - a * (v0 - speed) / v0).abs() < 1e-6,
+                "{speed} m/s: half-length {ax}"
+            );
+            // The upwind leg's duration is the still-air one.
+            assert!((2.0 * ax / (v0 - speed) - 2.0 * a / v0).abs() < 1e-6);
+        }
+        // Near the airspeed: a turn's length, not less.
+        let turn = spiral_turn_distance(&config);
+        assert!((half_length(0.95 * v0) - turn).abs() < 1e-6);
+        // Without the scaling, the square of any wind.
+        let mut fixed = config;
+        fixed.spiral.wind_scaled_branches = false;
+        let mut spiral = Spiral::new();
+        spiral.force_phase(GuidancePhase::Approximation);
+        let est = PointMass::new(0.0, Vector3::new(300.0, 0.0, -600.0), 0.0)
+            .estimate(&Vector3::new(-3.0, 0.0, 0.0));
+        spiral.update(&fixed, &plan, &est, 1.2);
+        let c = spiral.status().corners_ne_m;
+        assert!((0.5 * (c[1][0] - c[0][0]).hypot(c[1][1] - c[0][1]) - a).abs() < 1e-9);
+    }
+
+    fn spiral_turn_distance(config: &GuidanceConfig) -> f64 {
+        let rate = corner_turn_rate_rad_s(&config.gains, &config.performance);
+        config.performance.turn_radius_m(rate, 0.0, 1.2)
     }
 }
