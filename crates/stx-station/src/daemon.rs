@@ -16,7 +16,7 @@ use tokio::sync::{broadcast, mpsc, watch};
 
 use crate::config::StationConfig;
 use crate::core::{LinkAction, Outbound, StationCore};
-use crate::http::{LinkRequest, ManualState, Shared, router};
+use crate::http::{LinkRequest, ManualState, Shared, StateFrame, router};
 
 /// Why the daemon could not start or stopped.
 #[derive(Debug, Error)]
@@ -55,6 +55,49 @@ const COALESCE: Duration = Duration::from_millis(1);
 const PREDICTION_PERIOD: Duration = Duration::from_secs(1);
 /// Sticks silent this long stop the uplink of MANUAL_CONTROL.
 pub const MANUAL_SILENCE_S: f64 = 0.5;
+/// Events, command results and parameter tables kept for each page that has not read them
+/// yet; a page further behind is told how many it missed (`lagged`).
+pub const RELIABLE_BACKLOG: usize = 4096;
+
+/// A link request the endpoint could not start, for the core.
+#[derive(Debug)]
+enum Refusal {
+    /// An operator's request.
+    Request { request_id: String, reason: String },
+    /// The station's own plan download.
+    PlanDownload { reason: String },
+}
+
+/// The closure that applies a [`LinkAction`] on the endpoint; a refusal goes back to the
+/// core.
+fn apply_action(
+    request_id: Option<String>,
+    action: LinkAction,
+    refusals: mpsc::Sender<Refusal>,
+) -> Action<GroundEndpoint> {
+    Box::new(move |ep, now| {
+        let outcome = match action {
+            LinkAction::Command {
+                request_id: link_id,
+                command,
+            } => ep
+                .send_command(now, link_id, command)
+                .map_err(|e| e.to_string()),
+            LinkAction::ParamSet { name, value } => {
+                ep.param_set(now, &name, value).map_err(|e| e.to_string())
+            }
+            LinkAction::PlanUpload(items) => ep.plan_upload(now, items).map_err(|e| e.to_string()),
+            LinkAction::PlanDownload => ep.plan_download(now).map_err(|e| e.to_string()),
+        };
+        if let Err(reason) = outcome {
+            let refusal = match request_id {
+                Some(request_id) => Refusal::Request { request_id, reason },
+                None => Refusal::PlanDownload { reason },
+            };
+            let _ = refusals.try_send(refusal);
+        }
+    })
+}
 
 /// What a running daemon exposes to its starter (tests and `stx serve --sim`).
 #[derive(Clone)]
@@ -130,19 +173,23 @@ pub async fn run(
         .map(|d| d.as_millis() as u64)
         .unwrap_or(0);
     let (requests_tx, mut requests_rx) = mpsc::channel::<LinkRequest>(1024);
-    let (broadcast_tx, _) = broadcast::channel::<Utf8Bytes>(256);
+    let (broadcast_tx, _) = broadcast::channel::<Utf8Bytes>(RELIABLE_BACKLOG);
     let shared = Arc::new(Shared {
         core: Mutex::new(StationCore::new(config.clone(), wall_origin_ms)),
         config: config.clone(),
         started: start,
         link: requests_tx,
         broadcast: broadcast_tx.clone(),
+        states: watch::channel(StateFrame::default()).0,
         manual: Mutex::new(ManualState::default()),
+        clients: Mutex::new(Default::default()),
+        next_client: Default::default(),
     });
 
     // Operators' requests → closures on the endpoint; refusals come back to the core.
-    let (refusals_tx, refusals_rx) = mpsc::channel::<(String, String)>(256);
+    let (refusals_tx, refusals_rx) = mpsc::channel::<Refusal>(256);
     let request_actions = actions_tx.clone();
+    let request_refusals = refusals_tx.clone();
     let mut stop = stop_rx.clone();
     let requests_task = tokio::spawn(async move {
         loop {
@@ -150,27 +197,11 @@ pub async fn run(
                 r = requests_rx.recv() => match r { Some(r) => r, None => break },
                 _ = stop.changed() => break,
             };
-            let refusals = refusals_tx.clone();
+            let refusals = request_refusals.clone();
             let action: Action<GroundEndpoint> = match request {
-                LinkRequest::Action { request_id, action } => Box::new(move |ep, now| {
-                    let outcome = match action {
-                        LinkAction::Command {
-                            request_id: link_id,
-                            command,
-                        } => ep
-                            .send_command(now, link_id, command)
-                            .map_err(|e| e.to_string()),
-                        LinkAction::ParamSet { name, value } => {
-                            ep.param_set(now, &name, value).map_err(|e| e.to_string())
-                        }
-                        LinkAction::PlanUpload(items) => {
-                            ep.plan_upload(now, items).map_err(|e| e.to_string())
-                        }
-                    };
-                    if let Err(reason) = outcome {
-                        let _ = refusals.try_send((request_id, reason));
-                    }
-                }),
+                LinkRequest::Action { request_id, action } => {
+                    apply_action(Some(request_id), action, refusals)
+                }
                 LinkRequest::Manual(sticks) => Box::new(move |ep, now| ep.manual_hold(now, sticks)),
                 LinkRequest::ManualRelease => Box::new(|ep, _| ep.manual_release()),
             };
@@ -187,6 +218,7 @@ pub async fn run(
         actions: actions_tx.clone(),
         events: events_rx,
         refusals: refusals_rx,
+        refusals_tx: refusals_tx.clone(),
         stats_tx,
         stats_rx,
         stop: stop_rx.clone(),
@@ -217,7 +249,8 @@ struct StationLoop {
     shared: Arc<Shared>,
     actions: mpsc::Sender<Action<GroundEndpoint>>,
     events: mpsc::Receiver<DriverEvent<GroundEvent>>,
-    refusals: mpsc::Receiver<(String, String)>,
+    refusals: mpsc::Receiver<Refusal>,
+    refusals_tx: mpsc::Sender<Refusal>,
     stats_tx: mpsc::Sender<stx_link::endpoint::LinkStats>,
     stats_rx: mpsc::Receiver<stx_link::endpoint::LinkStats>,
     stop: watch::Receiver<bool>,
@@ -255,10 +288,17 @@ async fn station_loop(mut io: StationLoop) {
                 last_state = tokio::time::Instant::now();
                 publish(&shared, true);
             }
-            Some((request_id, reason)) = io.refusals.recv() => {
+            Some(refusal) = io.refusals.recv() => {
                 let now = shared.now_s();
-                lock(&shared).refuse(now, &request_id, reason);
-                publish(&shared, false);
+                match refusal {
+                    Refusal::Request { request_id, reason } => {
+                        lock(&shared).refuse(now, &request_id, reason);
+                        publish(&shared, false);
+                    }
+                    Refusal::PlanDownload { reason } => {
+                        lock(&shared).plan_download_refused(now, &reason);
+                    }
+                }
             }
             Some(stats) = io.stats_rx.recv() => {
                 let now = shared.now_s();
@@ -300,6 +340,15 @@ async fn station_loop(mut io: StationLoop) {
                 }
             }
             _ = io.stop.changed() => break,
+        }
+        // What the core decided to do on the link on its own (read the drone's plan).
+        let now = shared.now_s();
+        let own = lock(&shared).take_link_actions(now);
+        for action in own {
+            let _ = io
+                .actions
+                .send(apply_action(None, action, io.refusals_tx.clone()))
+                .await;
         }
     }
 }
@@ -351,8 +400,11 @@ fn publish(shared: &Shared, with_state: bool) {
     if let Some(state) = state
         && let Ok(text) = serde_json::to_string(&state)
     {
-        // No page connected is not an error.
-        let _ = shared.broadcast.send(text.into());
+        // Latest wins: a page that is behind gets the newest state, never a queue of old ones.
+        shared.states.send_modify(|frame| {
+            frame.seq += 1;
+            frame.text = text.into();
+        });
     }
 }
 
