@@ -184,6 +184,7 @@ pub async fn run(
         manual: Mutex::new(ManualState::default()),
         clients: Mutex::new(Default::default()),
         next_client: Default::default(),
+        broadcast_total: Default::default(),
     });
 
     // Operators' requests → closures on the endpoint; refusals come back to the core.
@@ -416,6 +417,10 @@ fn send_outbound(shared: &Shared, outbound: Vec<Outbound>) {
             Outbound::Params(p) => serde_json::to_string(&p),
         };
         if let Ok(text) = text {
+            shared
+                .broadcast_total
+                .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+            // No page connected is not an error.
             let _ = shared.broadcast.send(text.into());
         }
     }

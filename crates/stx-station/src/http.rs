@@ -80,6 +80,8 @@ pub struct Shared {
     pub clients: Mutex<BTreeMap<u64, Arc<ClientCounters>>>,
     /// The next page's id.
     pub next_client: AtomicU64,
+    /// Messages put on [`Shared::broadcast`] so far (to tell how far behind a page is).
+    pub broadcast_total: AtomicU64,
 }
 
 /// The newest `state`, numbered so a page can count the ones it skipped.
@@ -100,6 +102,8 @@ pub struct ClientCounters {
     pub role: Option<Role>,
     /// Mission time it connected, s.
     pub connected_s: f64,
+    /// [`Shared::broadcast_total`] when it subscribed.
+    pub base: u64,
     /// `state` messages sent.
     pub states_sent: AtomicU64,
     /// `state` messages skipped because the page was behind (a newer one was sent instead).
@@ -114,9 +118,11 @@ pub struct ClientCounters {
 }
 
 impl ClientCounters {
-    fn view(&self, id: u64) -> serde_json::Value {
+    fn view(&self, id: u64, total: u64) -> serde_json::Value {
         let n = |c: &AtomicU64| c.load(Ordering::Relaxed);
+        let done = self.base + n(&self.messages_sent) + n(&self.messages_missed);
         serde_json::json!({
+            "messages_behind": total.saturating_sub(done),
             "id": id,
             "name": self.name,
             "role": self.role,
@@ -367,7 +373,7 @@ async fn clients(State(state): State<AppState>, _caller: Caller) -> Response {
         .lock()
         .unwrap_or_else(|e| e.into_inner())
         .iter()
-        .map(|(id, c)| c.view(*id))
+        .map(|(id, c)| c.view(*id, state.broadcast_total.load(Ordering::Relaxed)))
         .collect();
     Json(serde_json::json!({ "clients": list })).into_response()
 }
@@ -776,6 +782,7 @@ enum ClientMessage {
 
 async fn serve_socket(state: AppState, caller: Caller, mut socket: WebSocket) {
     let mut updates = state.broadcast.subscribe();
+    let base = state.broadcast_total.load(Ordering::Relaxed);
     let mut states = state.states.subscribe();
     let mut last_seq = states.borrow_and_update().seq;
     let id = state.next_client.fetch_add(1, Ordering::Relaxed) + 1;
@@ -783,6 +790,7 @@ async fn serve_socket(state: AppState, caller: Caller, mut socket: WebSocket) {
         name: caller.name.clone(),
         role: Some(caller.role),
         connected_s: state.now_s(),
+        base,
         ..ClientCounters::default()
     });
     state

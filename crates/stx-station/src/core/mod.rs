@@ -1009,6 +1009,45 @@ mod tests {
     }
 
     #[test]
+    fn kml_predicted_landings_lie_on_the_ground_not_at_sea_level() {
+        let mut core = core();
+        glide(&mut core, 0.0, 10.0);
+        let job = core.prediction_job().expect("a prediction");
+        core.set_prediction(job.run());
+        core.on_link_event(
+            10.0,
+            GroundEvent::Telemetry {
+                from: (1, 1),
+                telemetry: Telemetry::PredictedLanding(stx_link::telemetry::PredictedLanding {
+                    time_boot_ms: 10_000,
+                    lat_deg: 38.54,
+                    lon_deg: -7.88,
+                    alt_msl_m: 245.0,
+                }),
+            },
+        );
+        let doc = crate::kml::live("test", &core.track(1.0), &core.state_msg_now(10.0));
+        let predicted: Vec<&str> = doc
+            .lines()
+            .filter(|l| l.contains("predicted landing"))
+            .collect();
+        assert_eq!(
+            predicted.len(),
+            3,
+            "station plan, uncontrolled, drone's own: {doc}"
+        );
+        for p in predicted {
+            // The site is 245 m above the sea: altitude 0 absolute would be underground.
+            assert!(
+                p.contains("<altitudeMode>clampToGround</altitudeMode>"),
+                "{p}"
+            );
+            assert!(!p.contains("absolute"), "{p}");
+        }
+        assert!(doc.contains("predicted landing (drone's own)"));
+    }
+
+    #[test]
     fn waiting_for_the_drone_is_said_once() {
         let mut core = core();
         for queued in 1..10 {
