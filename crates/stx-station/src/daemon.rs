@@ -1,6 +1,7 @@
 //! The daemon's tokio wiring: the link task (stx-link's driver over the configured transport),
-//! the station loop (events in, state out at 4 Hz), the joystick watchdog, and the HTTP server,
-//! all stopped together by one shutdown signal.
+//! the station loop (events in, state out at 4 Hz), the joystick watchdog, and the HTTP server
+//! (HTTPS with `[tls]`: rustls through axum-server), all stopped together by one shutdown
+//! signal.
 
 use std::future::Future;
 use std::net::SocketAddr;
@@ -14,9 +15,10 @@ use stx_link::transport::{Action, DriveOptions, DriverEvent, Transport, drive};
 use thiserror::Error;
 use tokio::sync::{broadcast, mpsc, watch};
 
-use crate::config::StationConfig;
+use crate::config::{StationConfig, TlsSettings};
 use crate::core::{LinkAction, Outbound, StationCore};
 use crate::http::{LinkRequest, ManualState, Shared, StateFrame, router};
+use axum_server::tls_rustls::RustlsConfig;
 
 /// Why the daemon could not start or stopped.
 #[derive(Debug, Error)]
@@ -41,6 +43,53 @@ pub enum DaemonError {
     /// The HTTP server failed.
     #[error("HTTP server: {0}")]
     Serve(#[source] std::io::Error),
+    /// The TLS certificate or key cannot be used.
+    #[error("TLS: `{field}` ({path}): {reason}")]
+    Tls {
+        /// The configuration field.
+        field: &'static str,
+        /// The file.
+        path: String,
+        /// What is wrong.
+        reason: String,
+    },
+}
+
+/// The rustls server configuration of `[tls]`, read and checked before anything starts.
+pub fn tls_config(tls: &TlsSettings) -> Result<RustlsConfig, DaemonError> {
+    use rustls_pki_types::pem::PemObject;
+    use rustls_pki_types::{CertificateDer, PrivateKeyDer};
+    let cert_err = |reason: String| DaemonError::Tls {
+        field: "tls.cert_path",
+        path: tls.cert_path.display().to_string(),
+        reason,
+    };
+    let certs = CertificateDer::pem_file_iter(&tls.cert_path)
+        .map_err(|e| cert_err(e.to_string()))?
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(|e| cert_err(e.to_string()))?;
+    if certs.is_empty() {
+        return Err(cert_err("no PEM certificate in the file".into()));
+    }
+    let key = PrivateKeyDer::from_pem_file(&tls.key_path).map_err(|e| DaemonError::Tls {
+        field: "tls.key_path",
+        path: tls.key_path.display().to_string(),
+        reason: e.to_string(),
+    })?;
+    let provider = Arc::new(rustls::crypto::ring::default_provider());
+    let mut server = rustls::ServerConfig::builder_with_provider(provider)
+        .with_safe_default_protocol_versions()
+        .map_err(|e| cert_err(e.to_string()))?
+        .with_no_client_auth()
+        .with_single_cert(certs, key)
+        .map_err(|e| DaemonError::Tls {
+            field: "tls.key_path",
+            path: tls.key_path.display().to_string(),
+            reason: format!("does not fit the certificate: {e}"),
+        })?;
+    // HTTP/1.1 only: the dashboard's WebSocket upgrades over it.
+    server.alpn_protocols = vec![b"http/1.1".to_vec()];
+    Ok(RustlsConfig::from_config(Arc::new(server)))
 }
 
 /// The state message period: 4 Hz, the drone's rate.
@@ -104,6 +153,8 @@ fn apply_action(
 pub struct Running {
     /// Where the dashboard and API listen.
     pub http: SocketAddr,
+    /// `https` with `[tls]`, else `http`.
+    pub scheme: &'static str,
     /// The drone link's local socket address, for UDP and TCP servers (the port the drone
     /// must send to when the config asked for port 0).
     pub link_local: Option<SocketAddr>,
@@ -137,6 +188,7 @@ pub async fn run(
     shutdown: impl Future<Output = ()> + Send + 'static,
     started: impl FnOnce(Running) + Send,
 ) -> Result<(), DaemonError> {
+    let tls = config.tls.as_ref().map(tls_config).transpose()?;
     let listener = tokio::net::TcpListener::bind(config.listen)
         .await
         .map_err(|source| DaemonError::Listen {
@@ -227,6 +279,7 @@ pub async fn run(
 
     started(Running {
         http: http_address,
+        scheme: if tls.is_some() { "https" } else { "http" },
         link_local,
         shared: shared.clone(),
     });
@@ -235,9 +288,33 @@ pub async fn run(
         shutdown.await;
         let _ = stop_tx.send(true);
     };
-    let served = axum::serve(listener, router(shared))
-        .with_graceful_shutdown(stop_http)
-        .await;
+    let served = match tls {
+        None => {
+            axum::serve(listener, router(shared))
+                .with_graceful_shutdown(stop_http)
+                .await
+        }
+        Some(tls) => {
+            let handle = axum_server::Handle::new();
+            let stopper = handle.clone();
+            tokio::spawn(async move {
+                stop_http.await;
+                stopper.graceful_shutdown(Some(Duration::from_secs(1)));
+            });
+            match listener
+                .into_std()
+                .and_then(|l| axum_server::from_tcp_rustls(l, tls))
+            {
+                Ok(server) => {
+                    server
+                        .handle(handle)
+                        .serve(router(shared).into_make_service())
+                        .await
+                }
+                Err(e) => Err(e),
+            }
+        }
+    };
     drop(actions_tx);
     station_task.abort();
     requests_task.abort();

@@ -100,8 +100,8 @@ pub fn run(args: ServeArgs) -> anyhow::Result<()> {
         let mut drone_task = None;
         let station = stx_station::daemon::run(config, stopped(stop_rx.clone()), |running| {
             println!(
-                "stx station: open http://{}/?token={operator}",
-                running.http
+                "stx station: open {}://{}/?token={operator}",
+                running.scheme, running.http
             );
             if let (Some(mut options), Some(link)) = (sim, running.link_local) {
                 options.connect = format!("udpout:{}", loopback_if_unspecified(link));
