@@ -108,11 +108,24 @@ pub const MANUAL_SILENCE_S: f64 = 0.5;
 /// yet; a page further behind is told how many it missed (`lagged`).
 pub const RELIABLE_BACKLOG: usize = 4096;
 
+/// An operator's plan upload that meets the station's own plan download on the link is tried
+/// again this often, s …
+const UPLOAD_RETRY: Duration = Duration::from_millis(250);
+/// … this many times (a download is over within a few round trips) before it is refused.
+const UPLOAD_TRIES: u32 = 40;
+
 /// A link request the endpoint could not start, for the core.
 #[derive(Debug)]
 enum Refusal {
     /// An operator's request.
     Request { request_id: String, reason: String },
+    /// An operator's plan upload found another plan transfer running: try it again.
+    UploadBusy {
+        request_id: String,
+        items: Vec<stx_link::plan::PlanItem>,
+        tries: u32,
+        reason: String,
+    },
     /// The station's own plan download.
     PlanDownload { reason: String },
 }
@@ -124,7 +137,28 @@ fn apply_action(
     action: LinkAction,
     refusals: mpsc::Sender<Refusal>,
 ) -> Action<GroundEndpoint> {
+    apply_action_try(request_id, action, refusals, 1)
+}
+
+fn apply_action_try(
+    request_id: Option<String>,
+    action: LinkAction,
+    refusals: mpsc::Sender<Refusal>,
+    tries: u32,
+) -> Action<GroundEndpoint> {
     Box::new(move |ep, now| {
+        if let (Some(id), LinkAction::PlanUpload(items)) = (&request_id, &action)
+            && let Err(e @ stx_link::plan::PlanRequestError::Busy) =
+                ep.plan_upload(now, items.clone())
+        {
+            let _ = refusals.try_send(Refusal::UploadBusy {
+                request_id: id.clone(),
+                items: items.clone(),
+                tries,
+                reason: e.to_string(),
+            });
+            return;
+        }
         let outcome = match action {
             LinkAction::Command {
                 request_id: link_id,
@@ -135,6 +169,8 @@ fn apply_action(
             LinkAction::ParamSet { name, value } => {
                 ep.param_set(now, &name, value).map_err(|e| e.to_string())
             }
+            // Sent above (or refused as busy).
+            LinkAction::PlanUpload(_) if request_id.is_some() => Ok(()),
             LinkAction::PlanUpload(items) => ep.plan_upload(now, items).map_err(|e| e.to_string()),
             LinkAction::PlanDownload => ep.plan_download(now).map_err(|e| e.to_string()),
         };
@@ -372,6 +408,25 @@ async fn station_loop(mut io: StationLoop) {
                     Refusal::Request { request_id, reason } => {
                         lock(&shared).refuse(now, &request_id, reason);
                         publish(&shared, false);
+                    }
+                    Refusal::UploadBusy { request_id, items, tries, reason } => {
+                        if tries >= UPLOAD_TRIES {
+                            lock(&shared).refuse(now, &request_id, reason);
+                            publish(&shared, false);
+                        } else {
+                            let actions = io.actions.clone();
+                            let refusals = io.refusals_tx.clone();
+                            tokio::spawn(async move {
+                                tokio::time::sleep(UPLOAD_RETRY).await;
+                                let retry = apply_action_try(
+                                    Some(request_id),
+                                    LinkAction::PlanUpload(items),
+                                    refusals,
+                                    tries + 1,
+                                );
+                                let _ = actions.send(retry).await;
+                            });
+                        }
                     }
                     Refusal::PlanDownload { reason } => {
                         lock(&shared).plan_download_refused(now, &reason);
