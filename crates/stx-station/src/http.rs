@@ -885,16 +885,21 @@ fn refusal(state: &Shared, text: &str) -> Message {
 }
 
 async fn handle_client(state: &Shared, caller: &Caller, socket: &mut WebSocket, text: &str) {
-    match serde_json::from_str::<ClientMessage>(text) {
+    let message = serde_json::from_str::<ClientMessage>(text);
+    if matches!(
+        message,
+        Ok(ClientMessage::Manual { .. } | ClientMessage::ManualRelease)
+    ) && caller.role != Role::Operator
+    {
+        let reply = refusal(
+            state,
+            "viewers cannot fly the drone: operator role required",
+        );
+        let _ = socket.send(reply).await;
+        return;
+    }
+    match message {
         Ok(ClientMessage::ManualRelease) => {
-            if caller.role != Role::Operator {
-                let reply = refusal(
-                    state,
-                    "viewers cannot fly the drone: operator role required",
-                );
-                let _ = socket.send(reply).await;
-                return;
-            }
             state
                 .manual
                 .lock()
@@ -914,14 +919,6 @@ async fn handle_client(state: &Shared, caller: &Caller, socket: &mut WebSocket, 
             r,
             buttons,
         }) => {
-            if caller.role != Role::Operator {
-                let reply = refusal(
-                    state,
-                    "viewers cannot fly the drone: operator role required",
-                );
-                let _ = socket.send(reply).await;
-                return;
-            }
             let clamp = |v: f64| {
                 if v.is_finite() {
                     v.clamp(-1.0, 1.0)

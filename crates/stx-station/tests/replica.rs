@@ -41,6 +41,12 @@ fn far_rehearsal() -> MissionConfig {
     MissionConfig::from_toml_str("rehearsal-far", &text).expect("mission")
 }
 
+/// The drone of [`far_rehearsal`] on the station's link, four times faster than real time.
+async fn far_drone(station: &Station) -> SimDrone {
+    let link = station.running.link_local.expect("link");
+    sim_drone(link, &far_rehearsal(), 4.0).await
+}
+
 fn frame() -> LocalFrame {
     config(|_| {}).origin
 }
@@ -82,12 +88,7 @@ async fn the_station_flies_the_drones_own_target_far_from_the_origin() {
         "{}",
         before["guidance"]
     );
-    let drone = sim_drone(
-        station.running.link_local.expect("link"),
-        &far_rehearsal(),
-        4.0,
-    )
-    .await;
+    let drone = far_drone(&station).await;
     // The drone's plan is read back from it.
     let adopted = wait_for_drone_plan(addr).await;
     let target = ne_of(&adopted["guidance"]["target"])
@@ -148,12 +149,7 @@ async fn the_station_flies_the_drones_own_target_far_from_the_origin() {
 async fn a_plan_uploaded_through_the_api_is_flown_alike_by_drone_and_replica() {
     let station = start_station(config(|_| {})).await;
     let addr = station.http();
-    let drone = sim_drone(
-        station.running.link_local.expect("link"),
-        &far_rehearsal(),
-        4.0,
-    )
-    .await;
+    let drone = far_drone(&station).await;
     let adopted = wait_for_drone_plan(addr).await;
     assert!(adopted["guidance"]["target"].is_object(), "{adopted}");
     // Two descending waypoints west of a new target: a localizer line east with a glide
