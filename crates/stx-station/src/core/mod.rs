@@ -988,6 +988,39 @@ mod tests {
     }
 
     #[test]
+    fn failed_plan_reads_are_retried_later_and_later_and_said_once() {
+        let mut core = core();
+        core.on_link_event(
+            0.0,
+            GroundEvent::Link(LinkEvent::Connected {
+                system_id: 1,
+                component_id: 1,
+            }),
+        );
+        assert_eq!(core.take_link_actions(0.0), vec![LinkAction::PlanDownload]);
+        let fail = |core: &mut StationCore, t: f64| {
+            core.on_link_event(
+                t,
+                GroundEvent::Plan(stx_link::plan::PlanEvent::DownloadFailed {
+                    reason: "no answer".into(),
+                }),
+            );
+        };
+        fail(&mut core, 1.0);
+        assert!(core.take_link_actions(5.9).is_empty(), "not before 5 s");
+        assert_eq!(core.take_link_actions(6.0), vec![LinkAction::PlanDownload]);
+        fail(&mut core, 7.0);
+        assert!(core.take_link_actions(16.9).is_empty(), "then 10 s");
+        assert_eq!(core.take_link_actions(17.0), vec![LinkAction::PlanDownload]);
+        let said = core
+            .events
+            .iter()
+            .filter(|e| e.text.contains("plan could not be read"))
+            .count();
+        assert_eq!(said, 1);
+    }
+
+    #[test]
     fn derived_values_turn_stale_with_the_link() {
         let mut core = core();
         glide(&mut core, 0.0, 10.0);

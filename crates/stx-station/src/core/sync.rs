@@ -255,9 +255,11 @@ impl StationCore {
                     let off = (plan.target_ned_m.xy() - target.xy()).norm();
                     if !known || off > tolerance {
                         mismatch = true;
+                        // A read plan is exact: only failing downloads make the coarser
+                        // telemetry win over it.
                         let trust_telemetry = self.sync.target != Some(TargetSource::DronePlan)
                             || self.sync.failures >= TRUST_TELEMETRY_AFTER_FAILURES;
-                        if trust_telemetry && (!known || off > tolerance) {
+                        if trust_telemetry {
                             plan.target_ned_m = target;
                             self.sync.target = Some(TargetSource::DroneTelemetry);
                             self.set_replica_plan(now_s, plan);
