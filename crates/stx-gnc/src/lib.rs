@@ -19,6 +19,8 @@
 //! - [`performance`] summarises how the parafoil flies, [`pointmass`] flies that summary fast,
 //!   and [`predict`] uses it to say where the vehicle will land;
 //! - [`geo`] links the mission's local NED frame to latitude, longitude and altitude;
+//! - [`plan_upload`] turns an uploaded plan (waypoints, landing point) into guidance's plan,
+//!   the same way on the drone and in the station's replica;
 //! - [`params`] describes every onboard setting the station may read and write, once, for
 //!   the drone's parameter table and the station's editor alike.
 pub mod control;
@@ -30,5 +32,6 @@ pub mod measurement;
 pub mod mission;
 pub mod params;
 pub mod performance;
+pub mod plan_upload;
 pub mod pointmass;
 pub mod predict;

@@ -41,6 +41,32 @@ pub enum PlanItem {
     },
 }
 
+impl PlanItem {
+    /// The item in the mission's local frame, for [`stx_gnc::plan_upload::apply`] (the one
+    /// mapping the drone and the station's replica share).
+    pub fn to_local(&self, frame: &stx_gnc::geo::LocalFrame) -> stx_gnc::plan_upload::PlanPoint {
+        use stx_gnc::plan_upload::PlanPoint;
+        match *self {
+            Self::Waypoint {
+                lat_deg,
+                lon_deg,
+                alt_msl_m,
+            } => PlanPoint::Waypoint {
+                position_ned_m: frame.to_ned(lat_deg, lon_deg, alt_msl_m),
+            },
+            Self::Land {
+                lat_deg,
+                lon_deg,
+                alt_msl_m,
+                approach_heading_deg,
+            } => PlanPoint::Land {
+                position_ned_m: frame.to_ned(lat_deg, lon_deg, alt_msl_m),
+                approach_course_rad: approach_heading_deg.map(f64::to_radians),
+            },
+        }
+    }
+}
+
 /// Why a MISSION_ITEM_INT is not a [`PlanItem`], as the MISSION_ACK result to answer with.
 #[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
 pub enum PlanItemError {

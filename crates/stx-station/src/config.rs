@@ -73,6 +73,18 @@ fn default_stale_after_s() -> f64 {
     3.0
 }
 
+/// HTTPS for the dashboard and API (phones' browsers allow geolocation only on a secure
+/// page). Both files PEM; see `deploy/README.md` for making them.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TlsSettings {
+    /// The certificate chain, PEM, leaf first (e.g. `/etc/stx/station.crt`).
+    pub cert_path: PathBuf,
+    /// The certificate's private key, PEM (PKCS#8, PKCS#1 or SEC1), readable only by the
+    /// station (e.g. `/etc/stx/station.key`).
+    pub key_path: PathBuf,
+}
+
 /// A row of the forecast wind profile.
 #[derive(Debug, Clone, Copy, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -93,6 +105,9 @@ pub struct StationConfig {
     pub name: String,
     /// Address the dashboard and API listen on, e.g. `127.0.0.1:8080`.
     pub listen: SocketAddr,
+    /// Serve HTTPS instead of HTTP on `listen`; absent: plain HTTP.
+    #[serde(default)]
+    pub tls: Option<TlsSettings>,
     /// Built dashboard to serve (`npm run build` in `web/`), relative to the working directory.
     #[serde(default = "default_web_dir")]
     pub web_dir: PathBuf,
@@ -181,6 +196,14 @@ impl StationConfig {
         }
         if !(self.link.stale_after_s > 0.0 && self.link.stale_after_s.is_finite()) {
             return invalid("link.stale_after_s", "a finite number of seconds > 0");
+        }
+        if let Some(tls) = &self.tls {
+            if tls.cert_path.as_os_str().is_empty() {
+                return invalid("tls.cert_path", "a PEM certificate file");
+            }
+            if tls.key_path.as_os_str().is_empty() {
+                return invalid("tls.key_path", "a PEM private-key file");
+            }
         }
         if !(self.cutdown_window_s > 0.0 && self.cutdown_window_s <= 60.0) {
             return invalid("cutdown_window_s", "in (0, 60] s");

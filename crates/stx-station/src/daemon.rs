@@ -1,6 +1,7 @@
 //! The daemon's tokio wiring: the link task (stx-link's driver over the configured transport),
-//! the station loop (events in, state out at 4 Hz), the joystick watchdog, and the HTTP server,
-//! all stopped together by one shutdown signal.
+//! the station loop (events in, state out at 4 Hz), the joystick watchdog, and the HTTP server
+//! (HTTPS with `[tls]`: rustls through axum-server), all stopped together by one shutdown
+//! signal.
 
 use std::future::Future;
 use std::net::SocketAddr;
@@ -14,9 +15,10 @@ use stx_link::transport::{Action, DriveOptions, DriverEvent, Transport, drive};
 use thiserror::Error;
 use tokio::sync::{broadcast, mpsc, watch};
 
-use crate::config::StationConfig;
+use crate::config::{StationConfig, TlsSettings};
 use crate::core::{LinkAction, Outbound, StationCore};
-use crate::http::{LinkRequest, ManualState, Shared, router};
+use crate::http::{LinkRequest, ManualState, Shared, StateFrame, router};
+use axum_server::tls_rustls::RustlsConfig;
 
 /// Why the daemon could not start or stopped.
 #[derive(Debug, Error)]
@@ -41,6 +43,53 @@ pub enum DaemonError {
     /// The HTTP server failed.
     #[error("HTTP server: {0}")]
     Serve(#[source] std::io::Error),
+    /// The TLS certificate or key cannot be used.
+    #[error("TLS: `{field}` ({path}): {reason}")]
+    Tls {
+        /// The configuration field.
+        field: &'static str,
+        /// The file.
+        path: String,
+        /// What is wrong.
+        reason: String,
+    },
+}
+
+/// The rustls server configuration of `[tls]`, read and checked before anything starts.
+pub fn tls_config(tls: &TlsSettings) -> Result<RustlsConfig, DaemonError> {
+    use rustls_pki_types::pem::PemObject;
+    use rustls_pki_types::{CertificateDer, PrivateKeyDer};
+    let cert_err = |reason: String| DaemonError::Tls {
+        field: "tls.cert_path",
+        path: tls.cert_path.display().to_string(),
+        reason,
+    };
+    let certs = CertificateDer::pem_file_iter(&tls.cert_path)
+        .map_err(|e| cert_err(e.to_string()))?
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(|e| cert_err(e.to_string()))?;
+    if certs.is_empty() {
+        return Err(cert_err("no PEM certificate in the file".into()));
+    }
+    let key = PrivateKeyDer::from_pem_file(&tls.key_path).map_err(|e| DaemonError::Tls {
+        field: "tls.key_path",
+        path: tls.key_path.display().to_string(),
+        reason: e.to_string(),
+    })?;
+    let provider = Arc::new(rustls::crypto::ring::default_provider());
+    let mut server = rustls::ServerConfig::builder_with_provider(provider)
+        .with_safe_default_protocol_versions()
+        .map_err(|e| cert_err(e.to_string()))?
+        .with_no_client_auth()
+        .with_single_cert(certs, key)
+        .map_err(|e| DaemonError::Tls {
+            field: "tls.key_path",
+            path: tls.key_path.display().to_string(),
+            reason: format!("does not fit the certificate: {e}"),
+        })?;
+    // HTTP/1.1 only: the dashboard's WebSocket upgrades over it.
+    server.alpn_protocols = vec![b"http/1.1".to_vec()];
+    Ok(RustlsConfig::from_config(Arc::new(server)))
 }
 
 /// The state message period: 4 Hz, the drone's rate.
@@ -55,12 +104,93 @@ const COALESCE: Duration = Duration::from_millis(1);
 const PREDICTION_PERIOD: Duration = Duration::from_secs(1);
 /// Sticks silent this long stop the uplink of MANUAL_CONTROL.
 pub const MANUAL_SILENCE_S: f64 = 0.5;
+/// Events, command results and parameter tables kept for each page that has not read them
+/// yet; a page further behind is told how many it missed (`lagged`).
+pub const RELIABLE_BACKLOG: usize = 4096;
+
+/// An operator's plan upload that meets the station's own plan download on the link is tried
+/// again this often, s …
+const UPLOAD_RETRY: Duration = Duration::from_millis(250);
+/// … this many times (a download is over within a few round trips) before it is refused.
+const UPLOAD_TRIES: u32 = 40;
+
+/// A link request the endpoint could not start, for the core.
+#[derive(Debug)]
+enum Refusal {
+    /// An operator's request.
+    Request { request_id: String, reason: String },
+    /// An operator's plan upload found another plan transfer running: try it again.
+    UploadBusy {
+        request_id: String,
+        items: Vec<stx_link::plan::PlanItem>,
+        tries: u32,
+        reason: String,
+    },
+    /// The station's own plan download.
+    PlanDownload { reason: String },
+}
+
+/// The closure that applies a [`LinkAction`] on the endpoint; a refusal goes back to the
+/// core.
+fn apply_action(
+    request_id: Option<String>,
+    action: LinkAction,
+    refusals: mpsc::Sender<Refusal>,
+) -> Action<GroundEndpoint> {
+    apply_action_try(request_id, action, refusals, 1)
+}
+
+fn apply_action_try(
+    request_id: Option<String>,
+    action: LinkAction,
+    refusals: mpsc::Sender<Refusal>,
+    tries: u32,
+) -> Action<GroundEndpoint> {
+    Box::new(move |ep, now| {
+        if let (Some(id), LinkAction::PlanUpload(items)) = (&request_id, &action)
+            && let Err(e @ stx_link::plan::PlanRequestError::Busy) =
+                ep.plan_upload(now, items.clone())
+        {
+            let _ = refusals.try_send(Refusal::UploadBusy {
+                request_id: id.clone(),
+                items: items.clone(),
+                tries,
+                reason: e.to_string(),
+            });
+            return;
+        }
+        let outcome = match action {
+            LinkAction::Command {
+                request_id: link_id,
+                command,
+            } => ep
+                .send_command(now, link_id, command)
+                .map_err(|e| e.to_string()),
+            LinkAction::ParamSet { name, value } => {
+                ep.param_set(now, &name, value).map_err(|e| e.to_string())
+            }
+            // Sent above (or refused as busy).
+            LinkAction::PlanUpload(_) if request_id.is_some() => Ok(()),
+            LinkAction::PlanUpload(items) => ep.plan_upload(now, items).map_err(|e| e.to_string()),
+            LinkAction::PlanDownload => ep.plan_download(now).map_err(|e| e.to_string()),
+        };
+        if let Err(reason) = outcome {
+            let refusal = match request_id {
+                Some(request_id) => Refusal::Request { request_id, reason },
+                None => Refusal::PlanDownload { reason },
+            };
+            let _ = refusals.try_send(refusal);
+        }
+    })
+}
 
 /// What a running daemon exposes to its starter (tests and `stx serve --sim`).
 #[derive(Clone)]
 pub struct Running {
     /// Where the dashboard and API listen.
     pub http: SocketAddr,
+    /// `https` with `[tls]`, else `http`.
+    pub scheme: &'static str,
     /// The drone link's local socket address, for UDP and TCP servers (the port the drone
     /// must send to when the config asked for port 0).
     pub link_local: Option<SocketAddr>,
@@ -94,6 +224,7 @@ pub async fn run(
     shutdown: impl Future<Output = ()> + Send + 'static,
     started: impl FnOnce(Running) + Send,
 ) -> Result<(), DaemonError> {
+    let tls = config.tls.as_ref().map(tls_config).transpose()?;
     let listener = tokio::net::TcpListener::bind(config.listen)
         .await
         .map_err(|source| DaemonError::Listen {
@@ -130,19 +261,24 @@ pub async fn run(
         .map(|d| d.as_millis() as u64)
         .unwrap_or(0);
     let (requests_tx, mut requests_rx) = mpsc::channel::<LinkRequest>(1024);
-    let (broadcast_tx, _) = broadcast::channel::<Utf8Bytes>(256);
+    let (broadcast_tx, _) = broadcast::channel::<Utf8Bytes>(RELIABLE_BACKLOG);
     let shared = Arc::new(Shared {
         core: Mutex::new(StationCore::new(config.clone(), wall_origin_ms)),
         config: config.clone(),
         started: start,
         link: requests_tx,
         broadcast: broadcast_tx.clone(),
+        states: watch::channel(StateFrame::default()).0,
         manual: Mutex::new(ManualState::default()),
+        clients: Mutex::new(Default::default()),
+        next_client: Default::default(),
+        broadcast_total: Default::default(),
     });
 
     // Operators' requests → closures on the endpoint; refusals come back to the core.
-    let (refusals_tx, refusals_rx) = mpsc::channel::<(String, String)>(256);
+    let (refusals_tx, refusals_rx) = mpsc::channel::<Refusal>(256);
     let request_actions = actions_tx.clone();
+    let request_refusals = refusals_tx.clone();
     let mut stop = stop_rx.clone();
     let requests_task = tokio::spawn(async move {
         loop {
@@ -150,27 +286,11 @@ pub async fn run(
                 r = requests_rx.recv() => match r { Some(r) => r, None => break },
                 _ = stop.changed() => break,
             };
-            let refusals = refusals_tx.clone();
+            let refusals = request_refusals.clone();
             let action: Action<GroundEndpoint> = match request {
-                LinkRequest::Action { request_id, action } => Box::new(move |ep, now| {
-                    let outcome = match action {
-                        LinkAction::Command {
-                            request_id: link_id,
-                            command,
-                        } => ep
-                            .send_command(now, link_id, command)
-                            .map_err(|e| e.to_string()),
-                        LinkAction::ParamSet { name, value } => {
-                            ep.param_set(now, &name, value).map_err(|e| e.to_string())
-                        }
-                        LinkAction::PlanUpload(items) => {
-                            ep.plan_upload(now, items).map_err(|e| e.to_string())
-                        }
-                    };
-                    if let Err(reason) = outcome {
-                        let _ = refusals.try_send((request_id, reason));
-                    }
-                }),
+                LinkRequest::Action { request_id, action } => {
+                    apply_action(Some(request_id), action, refusals)
+                }
                 LinkRequest::Manual(sticks) => Box::new(move |ep, now| ep.manual_hold(now, sticks)),
                 LinkRequest::ManualRelease => Box::new(|ep, _| ep.manual_release()),
             };
@@ -187,6 +307,7 @@ pub async fn run(
         actions: actions_tx.clone(),
         events: events_rx,
         refusals: refusals_rx,
+        refusals_tx: refusals_tx.clone(),
         stats_tx,
         stats_rx,
         stop: stop_rx.clone(),
@@ -194,6 +315,7 @@ pub async fn run(
 
     started(Running {
         http: http_address,
+        scheme: if tls.is_some() { "https" } else { "http" },
         link_local,
         shared: shared.clone(),
     });
@@ -202,9 +324,33 @@ pub async fn run(
         shutdown.await;
         let _ = stop_tx.send(true);
     };
-    let served = axum::serve(listener, router(shared))
-        .with_graceful_shutdown(stop_http)
-        .await;
+    let served = match tls {
+        None => {
+            axum::serve(listener, router(shared))
+                .with_graceful_shutdown(stop_http)
+                .await
+        }
+        Some(tls) => {
+            let handle = axum_server::Handle::new();
+            let stopper = handle.clone();
+            tokio::spawn(async move {
+                stop_http.await;
+                stopper.graceful_shutdown(Some(Duration::from_secs(1)));
+            });
+            match listener
+                .into_std()
+                .and_then(|l| axum_server::from_tcp_rustls(l, tls))
+            {
+                Ok(server) => {
+                    server
+                        .handle(handle)
+                        .serve(router(shared).into_make_service())
+                        .await
+                }
+                Err(e) => Err(e),
+            }
+        }
+    };
     drop(actions_tx);
     station_task.abort();
     requests_task.abort();
@@ -217,7 +363,8 @@ struct StationLoop {
     shared: Arc<Shared>,
     actions: mpsc::Sender<Action<GroundEndpoint>>,
     events: mpsc::Receiver<DriverEvent<GroundEvent>>,
-    refusals: mpsc::Receiver<(String, String)>,
+    refusals: mpsc::Receiver<Refusal>,
+    refusals_tx: mpsc::Sender<Refusal>,
     stats_tx: mpsc::Sender<stx_link::endpoint::LinkStats>,
     stats_rx: mpsc::Receiver<stx_link::endpoint::LinkStats>,
     stop: watch::Receiver<bool>,
@@ -255,10 +402,36 @@ async fn station_loop(mut io: StationLoop) {
                 last_state = tokio::time::Instant::now();
                 publish(&shared, true);
             }
-            Some((request_id, reason)) = io.refusals.recv() => {
+            Some(refusal) = io.refusals.recv() => {
                 let now = shared.now_s();
-                lock(&shared).refuse(now, &request_id, reason);
-                publish(&shared, false);
+                match refusal {
+                    Refusal::Request { request_id, reason } => {
+                        lock(&shared).refuse(now, &request_id, reason);
+                        publish(&shared, false);
+                    }
+                    Refusal::UploadBusy { request_id, items, tries, reason } => {
+                        if tries >= UPLOAD_TRIES {
+                            lock(&shared).refuse(now, &request_id, reason);
+                            publish(&shared, false);
+                        } else {
+                            let actions = io.actions.clone();
+                            let refusals = io.refusals_tx.clone();
+                            tokio::spawn(async move {
+                                tokio::time::sleep(UPLOAD_RETRY).await;
+                                let retry = apply_action_try(
+                                    Some(request_id),
+                                    LinkAction::PlanUpload(items),
+                                    refusals,
+                                    tries + 1,
+                                );
+                                let _ = actions.send(retry).await;
+                            });
+                        }
+                    }
+                    Refusal::PlanDownload { reason } => {
+                        lock(&shared).plan_download_refused(now, &reason);
+                    }
+                }
             }
             Some(stats) = io.stats_rx.recv() => {
                 let now = shared.now_s();
@@ -300,6 +473,15 @@ async fn station_loop(mut io: StationLoop) {
                 }
             }
             _ = io.stop.changed() => break,
+        }
+        // What the core decided to do on the link on its own (read the drone's plan).
+        let now = shared.now_s();
+        let own = lock(&shared).take_link_actions(now);
+        for action in own {
+            let _ = io
+                .actions
+                .send(apply_action(None, action, io.refusals_tx.clone()))
+                .await;
         }
     }
 }
@@ -351,8 +533,11 @@ fn publish(shared: &Shared, with_state: bool) {
     if let Some(state) = state
         && let Ok(text) = serde_json::to_string(&state)
     {
-        // No page connected is not an error.
-        let _ = shared.broadcast.send(text.into());
+        // Latest wins: a page that is behind gets the newest state, never a queue of old ones.
+        shared.states.send_modify(|frame| {
+            frame.seq += 1;
+            frame.text = text.into();
+        });
     }
 }
 
@@ -364,6 +549,10 @@ fn send_outbound(shared: &Shared, outbound: Vec<Outbound>) {
             Outbound::Params(p) => serde_json::to_string(&p),
         };
         if let Ok(text) = text {
+            shared
+                .broadcast_total
+                .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+            // No page connected is not an error.
             let _ = shared.broadcast.send(text.into());
         }
     }

@@ -3,7 +3,16 @@
 //!
 //! Handlers only lock the core for a moment, build their answer, and hand link work to the
 //! daemon's link task through [`Shared::link`]; nothing here waits on the radio.
+//!
+//! Each WebSocket page is fed from two sources: `state` messages through a `watch` channel
+//! (latest wins: a page that falls behind skips to the newest state, counted as coalesced),
+//! and events, command results and parameter tables through a broadcast backlog of
+//! [`crate::daemon::RELIABLE_BACKLOG`] messages, never skipped silently: a page that falls
+//! further behind gets a `lagged` message with the number it missed, and re-reads the event
+//! log. Every page's counts are in `GET /api/clients`.
 
+use std::collections::BTreeMap;
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
@@ -15,13 +24,13 @@ use axum::extract::{FromRequestParts, Path, Query, State};
 use axum::http::request::Parts;
 use axum::http::{StatusCode, header};
 use axum::response::{IntoResponse, Response};
-use axum::routing::{get, post};
+use axum::routing::{any, get, post};
 use serde::Deserialize;
 use serde::de::DeserializeOwned;
 use stx_gnc::mission::FlightMode;
 use stx_link::manual::Sticks;
 use stx_link::plan::PlanItem;
-use tokio::sync::{broadcast, mpsc};
+use tokio::sync::{broadcast, mpsc, watch};
 use tower_http::services::{ServeDir, ServeFile};
 
 use crate::config::{Role, StationConfig};
@@ -59,10 +68,72 @@ pub struct Shared {
     pub started: Instant,
     /// To the link task.
     pub link: mpsc::Sender<LinkRequest>,
-    /// Pre-serialised messages for every WebSocket (shared bytes: one copy for all pages).
+    /// Events, command results and parameter tables for every WebSocket, pre-serialised
+    /// (shared bytes: one copy for all pages); kept until every page has read them, up to
+    /// the backlog.
     pub broadcast: broadcast::Sender<Utf8Bytes>,
+    /// The newest `state` message, pre-serialised, with its sequence number.
+    pub states: watch::Sender<StateFrame>,
     /// Joystick liveness.
     pub manual: Mutex<ManualState>,
+    /// Connected pages and what each was sent or missed.
+    pub clients: Mutex<BTreeMap<u64, Arc<ClientCounters>>>,
+    /// The next page's id.
+    pub next_client: AtomicU64,
+    /// Messages put on [`Shared::broadcast`] so far (to tell how far behind a page is).
+    pub broadcast_total: AtomicU64,
+}
+
+/// The newest `state`, numbered so a page can count the ones it skipped.
+#[derive(Debug, Clone, Default)]
+pub struct StateFrame {
+    /// 1 for the first state published, then +1 each.
+    pub seq: u64,
+    /// The message.
+    pub text: Utf8Bytes,
+}
+
+/// One page's WebSocket, as `GET /api/clients` shows it.
+#[derive(Debug, Default)]
+pub struct ClientCounters {
+    /// Token name.
+    pub name: String,
+    /// Role.
+    pub role: Option<Role>,
+    /// Mission time it connected, s.
+    pub connected_s: f64,
+    /// [`Shared::broadcast_total`] when it subscribed.
+    pub base: u64,
+    /// `state` messages sent.
+    pub states_sent: AtomicU64,
+    /// `state` messages skipped because the page was behind (a newer one was sent instead).
+    pub states_coalesced: AtomicU64,
+    /// Events, command results and parameter tables sent.
+    pub messages_sent: AtomicU64,
+    /// Events, command results and parameter tables it missed by falling more than the
+    /// backlog behind (each time announced to it with `lagged`).
+    pub messages_missed: AtomicU64,
+    /// Times it fell that far behind.
+    pub lag_episodes: AtomicU64,
+}
+
+impl ClientCounters {
+    fn view(&self, id: u64, total: u64) -> serde_json::Value {
+        let n = |c: &AtomicU64| c.load(Ordering::Relaxed);
+        let done = self.base + n(&self.messages_sent) + n(&self.messages_missed);
+        serde_json::json!({
+            "messages_behind": total.saturating_sub(done),
+            "id": id,
+            "name": self.name,
+            "role": self.role,
+            "connected_s": self.connected_s,
+            "states_sent": n(&self.states_sent),
+            "states_coalesced": n(&self.states_coalesced),
+            "messages_sent": n(&self.messages_sent),
+            "messages_missed": n(&self.messages_missed),
+            "lag_episodes": n(&self.lag_episodes),
+        })
+    }
 }
 
 impl Shared {
@@ -144,6 +215,18 @@ fn token_from(parts: &Parts) -> Option<String> {
             (k == "token").then(|| percent_decode(v))
         })
     })
+}
+
+fn percent_encode(s: &str) -> String {
+    let mut out = String::with_capacity(s.len());
+    for b in s.bytes() {
+        if b.is_ascii_alphanumeric() || b"-._~".contains(&b) {
+            out.push(char::from(b));
+        } else {
+            out.push_str(&format!("%{b:02X}"));
+        }
+    }
+    out
 }
 
 fn percent_decode(s: &str) -> String {
@@ -233,7 +316,12 @@ pub fn router(state: AppState) -> Router {
         .route("/api/commands/plan", post(command::<PlanBody>))
         .route("/api/cutdown/arm", post(arm_cutdown))
         .route("/api/cutdown/confirm", post(confirm_cutdown))
+        .route("/api/clients", get(clients))
         .route("/api/ws", get(websocket))
+        // An API path that does not exist is an API error, never the dashboard's page.
+        .route("/api", any(api_not_found))
+        .route("/api/", any(api_not_found))
+        .route("/api/{*rest}", any(api_not_found))
         .route("/kml", get(kml_link))
         .route("/kml/live", get(kml_live));
     if let Some(tiles) = &state.config.tiles_dir {
@@ -269,6 +357,25 @@ fn session_of(state: &Shared, caller: &Caller) -> Session {
                 .collect(),
         },
     }
+}
+
+async fn api_not_found(uri: axum::http::Uri) -> HttpError {
+    error(
+        StatusCode::NOT_FOUND,
+        "not_found",
+        format!("no API endpoint {} (see API.md)", uri.path()),
+    )
+}
+
+async fn clients(State(state): State<AppState>, _caller: Caller) -> Response {
+    let list: Vec<serde_json::Value> = state
+        .clients
+        .lock()
+        .unwrap_or_else(|e| e.into_inner())
+        .iter()
+        .map(|(id, c)| c.view(*id, state.broadcast_total.load(Ordering::Relaxed)))
+        .collect();
+    Json(serde_json::json!({ "clients": list })).into_response()
 }
 
 async fn session(State(state): State<AppState>, caller: Caller) -> Json<Session> {
@@ -573,10 +680,33 @@ async fn confirm_cutdown(
     queue(&state, request_id, action).await
 }
 
+/// The address Google Earth used to reach the station (the `Host` header): the listen
+/// address may be `0.0.0.0`, which names no machine. Without a usable header, the listen
+/// address with `0.0.0.0` read as loopback.
+fn public_host(headers: &axum::http::HeaderMap, listen: std::net::SocketAddr) -> String {
+    let valid = |h: &str| {
+        !h.is_empty()
+            && h.len() <= 255
+            && h.chars()
+                .all(|c| c.is_ascii_alphanumeric() || "-.:[]_".contains(c))
+    };
+    match headers.get(header::HOST).and_then(|v| v.to_str().ok()) {
+        Some(h) if valid(h) => h.to_string(),
+        _ => {
+            let ip = if listen.ip().is_unspecified() {
+                std::net::IpAddr::from([127, 0, 0, 1])
+            } else {
+                listen.ip()
+            };
+            std::net::SocketAddr::new(ip, listen.port()).to_string()
+        }
+    }
+}
+
 async fn kml_link(
     State(state): State<AppState>,
     caller: Caller,
-    parts: axum::http::Uri,
+    headers: axum::http::HeaderMap,
 ) -> Response {
     let token = state
         .config
@@ -585,10 +715,18 @@ async fn kml_link(
         .find(|t| t.name == caller.name)
         .map(|t| t.token.clone())
         .unwrap_or_default();
-    let _ = parts;
+    let scheme = if state.config.tls.is_some() {
+        "https"
+    } else {
+        "http"
+    };
+    let host = public_host(&headers, state.config.listen);
     let body = crate::kml::network_link(
         &state.config.name,
-        &format!("http://{}/kml/live?token={token}", state.config.listen),
+        &format!(
+            "{scheme}://{host}/kml/live?token={}",
+            percent_encode(&token)
+        ),
         2.0,
     );
     (
@@ -637,11 +775,29 @@ enum ClientMessage {
         #[serde(default)]
         buttons: u32,
     },
+    /// The dead-man was let go or the page lost focus: stop the sticks now.
+    ManualRelease,
     Ping,
 }
 
 async fn serve_socket(state: AppState, caller: Caller, mut socket: WebSocket) {
     let mut updates = state.broadcast.subscribe();
+    let base = state.broadcast_total.load(Ordering::Relaxed);
+    let mut states = state.states.subscribe();
+    let mut last_seq = states.borrow_and_update().seq;
+    let id = state.next_client.fetch_add(1, Ordering::Relaxed) + 1;
+    let counters = Arc::new(ClientCounters {
+        name: caller.name.clone(),
+        role: Some(caller.role),
+        connected_s: state.now_s(),
+        base,
+        ..ClientCounters::default()
+    });
+    state
+        .clients
+        .lock()
+        .unwrap_or_else(|e| e.into_inner())
+        .insert(id, counters.clone());
     let greeting = {
         let now = state.now_s();
         let core = state.core();
@@ -660,23 +816,51 @@ async fn serve_socket(state: AppState, caller: Caller, mut socket: WebSocket) {
             history.to_string(),
         ]
     };
+    let mut open = true;
     for text in greeting {
         if socket.send(Message::Text(text.into())).await.is_err() {
-            return;
+            open = false;
+            break;
         }
     }
-    loop {
+    while open {
         tokio::select! {
+            // Events and command results before states: they are what must not be lost.
+            biased;
             update = updates.recv() => match update {
                 Ok(text) => {
-                    if socket.send(Message::Text(text)).await.is_err() {
-                        break;
-                    }
+                    counters.messages_sent.fetch_add(1, Ordering::Relaxed);
+                    open = socket.send(Message::Text(text)).await.is_ok();
                 }
-                // A slow page misses some states; it gets the next ones.
-                Err(broadcast::error::RecvError::Lagged(_)) => continue,
+                Err(broadcast::error::RecvError::Lagged(missed)) => {
+                    counters.messages_missed.fetch_add(missed, Ordering::Relaxed);
+                    let episodes = counters.lag_episodes.fetch_add(1, Ordering::Relaxed) + 1;
+                    tracing::warn!(client = id, name = %caller.name, missed, episodes,
+                        "a page fell behind: it is told what it missed");
+                    let notice = serde_json::json!({
+                        "type": "lagged",
+                        "missed": missed,
+                        "missed_total": counters.messages_missed.load(Ordering::Relaxed),
+                        "time_s": state.now_s(),
+                        "refetch": "/api/events",
+                    });
+                    open = socket.send(Message::Text(notice.to_string().into())).await.is_ok();
+                }
                 Err(broadcast::error::RecvError::Closed) => break,
             },
+            changed = states.changed() => {
+                if changed.is_err() {
+                    break;
+                }
+                let frame = states.borrow_and_update().clone();
+                let skipped = frame.seq.saturating_sub(last_seq + 1);
+                if skipped > 0 {
+                    counters.states_coalesced.fetch_add(skipped, Ordering::Relaxed);
+                }
+                last_seq = frame.seq;
+                counters.states_sent.fetch_add(1, Ordering::Relaxed);
+                open = socket.send(Message::Text(frame.text)).await.is_ok();
+            }
             incoming = socket.recv() => match incoming {
                 Some(Ok(Message::Text(text))) => {
                     handle_client(&state, &caller, &mut socket, text.as_str()).await;
@@ -686,10 +870,43 @@ async fn serve_socket(state: AppState, caller: Caller, mut socket: WebSocket) {
             },
         }
     }
+    state
+        .clients
+        .lock()
+        .unwrap_or_else(|e| e.into_inner())
+        .remove(&id);
+}
+
+/// The `event` a page gets back when its message is refused.
+fn refusal(state: &Shared, text: &str) -> Message {
+    let reply = serde_json::json!({"type":"event","time_s":state.now_s(),"wall_ms":0,
+        "level":"error","source":"station","text":text});
+    Message::Text(reply.to_string().into())
 }
 
 async fn handle_client(state: &Shared, caller: &Caller, socket: &mut WebSocket, text: &str) {
-    match serde_json::from_str::<ClientMessage>(text) {
+    let message = serde_json::from_str::<ClientMessage>(text);
+    if matches!(
+        message,
+        Ok(ClientMessage::Manual { .. } | ClientMessage::ManualRelease)
+    ) && caller.role != Role::Operator
+    {
+        let reply = refusal(
+            state,
+            "viewers cannot fly the drone: operator role required",
+        );
+        let _ = socket.send(reply).await;
+        return;
+    }
+    match message {
+        Ok(ClientMessage::ManualRelease) => {
+            state
+                .manual
+                .lock()
+                .unwrap_or_else(|e| e.into_inner())
+                .last_s = None;
+            let _ = state.link.send(LinkRequest::ManualRelease).await;
+        }
         Ok(ClientMessage::Ping) => {
             let _ = socket
                 .send(Message::Text(r#"{"type":"pong"}"#.into()))
@@ -702,12 +919,6 @@ async fn handle_client(state: &Shared, caller: &Caller, socket: &mut WebSocket, 
             r,
             buttons,
         }) => {
-            if caller.role != Role::Operator {
-                let reply = serde_json::json!({"type":"event","time_s":state.now_s(),"wall_ms":0,
-                    "level":"error","source":"station","text":"viewers cannot fly the drone: operator role required"});
-                let _ = socket.send(Message::Text(reply.to_string().into())).await;
-                return;
-            }
             let clamp = |v: f64| {
                 if v.is_finite() {
                     v.clamp(-1.0, 1.0)
@@ -731,9 +942,8 @@ async fn handle_client(state: &Shared, caller: &Caller, socket: &mut WebSocket, 
                 .await;
         }
         Err(e) => {
-            let reply = serde_json::json!({"type":"event","time_s":state.now_s(),"wall_ms":0,
-                "level":"error","source":"station","text":format!("malformed message refused: {e}")});
-            let _ = socket.send(Message::Text(reply.to_string().into())).await;
+            let reply = refusal(state, &format!("malformed message refused: {e}"));
+            let _ = socket.send(reply).await;
         }
     }
 }

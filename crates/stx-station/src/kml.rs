@@ -1,5 +1,10 @@
 //! The KML feed for Google Earth: a network link that refreshes, and the live document with
 //! the track, the vehicle, the target, the planned pattern and the predicted touchdowns.
+//!
+//! Altitudes: the track, the vehicle and the target are where they are (`absolute`, MSL).
+//! Predicted touchdowns have no altitude of their own worth drawing (the station's predictor
+//! lands on the site's ground level, which is not the terrain under the point):
+//! they are `clampToGround`, on Google Earth's terrain wherever they fall.
 
 use std::fmt::Write;
 
@@ -33,10 +38,21 @@ pub fn network_link(name: &str, live_url: &str, refresh_s: f64) -> String {
     )
 }
 
-fn placemark(out: &mut String, name: &str, lat: f64, lon: f64, alt: f64) {
+/// A point in the air (MSL) or on the ground wherever it falls.
+#[derive(Debug, Clone, Copy)]
+enum Height {
+    Msl(f64),
+    Ground,
+}
+
+fn placemark(out: &mut String, name: &str, lat: f64, lon: f64, height: Height) {
+    let (mode, alt) = match height {
+        Height::Msl(alt) => ("absolute", alt),
+        Height::Ground => ("clampToGround", 0.0),
+    };
     let _ = writeln!(
         out,
-        "<Placemark><name>{}</name><Point><altitudeMode>absolute</altitudeMode>\
+        "<Placemark><name>{}</name><Point><altitudeMode>{mode}</altitudeMode>\
          <coordinates>{lon:.7},{lat:.7},{alt:.1}</coordinates></Point></Placemark>",
         escape(name)
     );
@@ -60,7 +76,13 @@ pub fn live(name: &str, track: &[TrackPoint], state: &StateMsg) -> String {
         out.push_str("</coordinates></LineString></Placemark>\n");
     }
     if let Some(e) = &state.estimate {
-        placemark(&mut out, "vehicle", e.lat_deg, e.lon_deg, e.alt_msl_m);
+        placemark(
+            &mut out,
+            "vehicle",
+            e.lat_deg,
+            e.lon_deg,
+            Height::Msl(e.alt_msl_m),
+        );
     }
     if let Some(g) = &state.guidance {
         if let Some(t) = &g.target {
@@ -69,7 +91,7 @@ pub fn live(name: &str, track: &[TrackPoint], state: &StateMsg) -> String {
                 "landing target",
                 t.lat_deg,
                 t.lon_deg,
-                t.alt_msl_m,
+                Height::Msl(t.alt_msl_m),
             );
         }
         if let Some(p) = &g.pattern {
@@ -83,19 +105,34 @@ pub fn live(name: &str, track: &[TrackPoint], state: &StateMsg) -> String {
         }
     }
     if let Some(p) = &state.prediction {
+        if let Some(planned) = &p.planned {
+            placemark(
+                &mut out,
+                "predicted landing (station, plan)",
+                planned.lat_deg,
+                planned.lon_deg,
+                Height::Ground,
+            );
+        }
         placemark(
             &mut out,
-            "predicted landing (plan)",
-            p.planned.lat_deg,
-            p.planned.lon_deg,
-            0.0,
-        );
-        placemark(
-            &mut out,
-            "predicted landing (uncontrolled)",
+            "predicted landing (station, uncontrolled)",
             p.uncontrolled.lat_deg,
             p.uncontrolled.lon_deg,
-            0.0,
+            Height::Ground,
+        );
+    }
+    if let Some(p) = state
+        .vehicle
+        .as_ref()
+        .and_then(|v| v.predicted_landing.as_ref())
+    {
+        placemark(
+            &mut out,
+            "predicted landing (drone's own)",
+            p.lat_deg,
+            p.lon_deg,
+            Height::Ground,
         );
     }
     out.push_str("</Document>\n</kml>\n");

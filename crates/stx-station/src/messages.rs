@@ -158,6 +158,28 @@ pub struct VehicleView {
     pub power: Option<PowerView>,
     /// The onboard estimate of the wind, NED, m/s.
     pub onboard_wind_ned_mps: Option<[f64; 3]>,
+    /// The drone's own prediction of its touchdown (POSITION_TARGET_GLOBAL_INT), beside the
+    /// station's in `prediction`.
+    pub predicted_landing: Option<OnboardLandingView>,
+    /// Seconds since the newest message from the drone arrived.
+    pub age_s: f64,
+    /// These data are old (see `API.md`): show them as stale.
+    pub stale: bool,
+}
+
+/// The drone's own predicted touchdown.
+#[derive(Debug, Clone, Serialize)]
+pub struct OnboardLandingView {
+    /// Latitude, degrees.
+    pub lat_deg: f64,
+    /// Longitude, degrees.
+    pub lon_deg: f64,
+    /// Altitude MSL of the touchdown point, m.
+    pub alt_msl_m: f64,
+    /// Seconds since it arrived.
+    pub age_s: f64,
+    /// Old: show it as stale.
+    pub stale: bool,
 }
 
 /// The station's own estimate.
@@ -201,6 +223,10 @@ pub struct EstimateView {
     pub position_sigma_m: f64,
     /// GPS in use.
     pub gps_ok: bool,
+    /// Seconds since the newest GPS, attitude or air data the estimate used arrived.
+    pub age_s: f64,
+    /// Old: show it as stale.
+    pub stale: bool,
 }
 
 /// The spiral's plan on the map.
@@ -220,6 +246,17 @@ pub struct PatternView {
     pub reach_ratio: f64,
 }
 
+/// The localizer line the replica follows.
+#[derive(Debug, Clone, Serialize)]
+pub struct LocalizerView {
+    /// The line's point `[lat, lon]`.
+    pub point: [f64; 2],
+    /// The line's course, degrees.
+    pub course_deg: f64,
+    /// Glide slope (sink over ground speed) down the line to its point, if any.
+    pub glide_slope: Option<f64>,
+}
+
 /// The guidance replica's view.
 #[derive(Debug, Clone, Serialize)]
 pub struct GuidanceView {
@@ -227,12 +264,23 @@ pub struct GuidanceView {
     pub mode: String,
     /// Phase.
     pub phase: String,
-    /// Landing target.
+    /// Landing target; `null` while the drone's target is not known.
     pub target: Option<LatLonAlt>,
+    /// Where the target comes from: `drone_plan` (read from the drone), `drone_telemetry`
+    /// (from its bearing and distance to the target, about 1 % of the distance), `operator`
+    /// (a command the drone acknowledged, until it is read back); `null`: unknown.
+    pub target_source: Option<&'static str>,
+    /// The localizer line, once known.
+    pub localizer: Option<LocalizerView>,
     /// Spiral plan, in spiral landing.
     pub pattern: Option<PatternView>,
     /// What the replica would command.
     pub commands: CommandsView,
+    /// Seconds since the navigation data the replica ran on arrived; `null` without an
+    /// estimate.
+    pub age_s: Option<f64>,
+    /// Old: show it as stale.
+    pub stale: bool,
 }
 
 /// Servo commands of the replica.
@@ -261,13 +309,17 @@ pub struct TouchdownView {
     pub major_axis_deg: f64,
 }
 
-/// Both predictions.
+/// Both predictions of the station.
 #[derive(Debug, Clone, Serialize)]
 pub struct PredictionView {
-    /// Flying the plan.
-    pub planned: TouchdownView,
+    /// Flying the plan; `null` while the plan of the drone's mode is not known.
+    pub planned: Option<TouchdownView>,
     /// Servos neutral.
     pub uncontrolled: TouchdownView,
+    /// Seconds since the navigation data the prediction started from arrived.
+    pub age_s: Option<f64>,
+    /// Old: show it as stale.
+    pub stale: bool,
 }
 
 /// Mission state.

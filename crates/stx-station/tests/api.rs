@@ -496,3 +496,177 @@ async fn kml_feeds_google_earth() {
     assert_eq!(status, 200);
     assert!(live.starts_with("<?xml") && live.contains("<kml"), "{live}");
 }
+
+#[tokio::test]
+async fn unknown_api_paths_are_404_with_a_reason_not_the_page() {
+    let station = start_station(config(|_| {})).await;
+    for path in ["/api/nope", "/api/commands/teleport/now", "/api", "/api/"] {
+        for method in ["GET", "POST"] {
+            let (status, body) = http(station.http(), method, path, Some(VIEWER), Some("{}")).await;
+            assert_eq!(status, 404, "{method} {path}: {body}");
+            assert_eq!(body["error"], "not_found", "{method} {path}: {body}");
+            assert!(reason(&body).contains(path), "{body}");
+        }
+    }
+    // Known endpoints still answer.
+    let (status, _) = http(station.http(), "GET", "/api/state", Some(VIEWER), None).await;
+    assert_eq!(status, 200);
+}
+
+#[tokio::test]
+async fn manual_release_stops_the_sticks_at_once() {
+    let station = start_station(config(|_| {})).await;
+    let drone = fake_drone(station.running.link_local.expect("link address")).await;
+    let mut ws = ws_connect(station.http(), OPERATOR).await;
+    for _ in 0..6 {
+        ws_send(
+            &mut ws,
+            json!({"type":"manual","x":0.0,"y":0.5,"z":0.0,"r":0.0,"buttons":1}),
+        )
+        .await;
+        tokio::time::sleep(Duration::from_millis(100)).await;
+    }
+    assert!(
+        eventually(3.0, || drone.seen(|s| !s.sticks.is_empty())).await,
+        "sticks reached the drone"
+    );
+    // Released right after the last stick message: the station's silence timeout (0.5 s)
+    // would keep streaming for half a second more; the release stops it now.
+    ws_send(&mut ws, json!({"type":"manual_release"})).await;
+    tokio::time::sleep(Duration::from_millis(120)).await;
+    let at_release = drone.seen(|s| s.sticks.len());
+    tokio::time::sleep(Duration::from_millis(600)).await;
+    assert_eq!(
+        drone.seen(|s| s.sticks.len()),
+        at_release,
+        "MANUAL_CONTROL went on after manual_release"
+    );
+    // No error came back for the message.
+    let refused = ws_until(&mut ws, 0.5, |m| {
+        m["type"] == "event" && m["level"] == "error"
+    })
+    .await;
+    assert!(refused.is_none(), "{refused:?}");
+}
+
+#[tokio::test]
+async fn the_kml_link_names_the_host_google_earth_used() {
+    let station = start_station(config(|c| c.listen = "0.0.0.0:0".parse().expect("address"))).await;
+    let port = station.http().port();
+    let mut stream = tokio::net::TcpStream::connect(("127.0.0.1", port))
+        .await
+        .expect("connect");
+    use tokio::io::{AsyncReadExt, AsyncWriteExt};
+    let request = format!(
+        "GET /kml?token=viewer-token HTTP/1.1\r\nHost: field-laptop.local:{port}\r\nConnection: close\r\n\r\n"
+    );
+    stream.write_all(request.as_bytes()).await.expect("write");
+    let mut response = String::new();
+    stream.read_to_string(&mut response).await.expect("read");
+    assert!(response.starts_with("HTTP/1.1 200"), "{response}");
+    assert!(
+        response.contains(&format!(
+            "<href>http://field-laptop.local:{port}/kml/live?token=viewer-token</href>"
+        )),
+        "{response}"
+    );
+    assert!(!response.contains("0.0.0.0"), "{response}");
+}
+
+/// A page that stops reading while far more events than the backlog are logged: it is told
+/// exactly how many it missed, gets the newest in order, and its states are coalesced; a
+/// page that reads along loses nothing without being told either. Both counted per page.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_slow_page_is_told_what_it_missed_and_states_are_coalesced() {
+    const EVENTS: usize = 12_000;
+    let station = start_station(config(|_| {})).await;
+    let mut slow = ws_connect(station.http(), OPERATOR).await;
+    let mut fast = ws_connect(station.http(), VIEWER).await;
+    // Both greeted before the flood.
+    for ws in [&mut slow, &mut fast] {
+        assert!(
+            ws_until(ws, 5.0, |m| m["type"] == "history")
+                .await
+                .is_some()
+        );
+    }
+    let padding = "x".repeat(4000);
+    {
+        let mut core = station.running.shared.core.lock().expect("core");
+        for i in 0..EVENTS {
+            core.log(
+                1.0,
+                stx_station::messages::Level::Info,
+                "station",
+                format!("flood {i} {padding}"),
+            );
+        }
+    }
+    /// Reads until the last flood event; the flood events' numbers and the `missed` counts.
+    async fn drain(ws: &mut Ws) -> (Vec<usize>, u64) {
+        let mut seen = Vec::new();
+        let mut missed = 0;
+        while seen.last() != Some(&(EVENTS - 1)) {
+            let m = ws_next(ws, 20.0).await.expect("the page is fed");
+            if m["type"] == "lagged" {
+                missed += m["missed"].as_u64().expect("missed");
+            } else if let Some(text) = m["text"].as_str()
+                && let Some(rest) = text.strip_prefix("flood ")
+            {
+                seen.push(
+                    rest.split(' ')
+                        .next()
+                        .and_then(|n| n.parse().ok())
+                        .expect("n"),
+                );
+            }
+        }
+        (seen, missed)
+    }
+    let (fast_seen, fast_missed) = drain(&mut fast).await;
+    assert_eq!(fast_seen.len() as u64 + fast_missed, EVENTS as u64);
+    // The slow page has read nothing for a while: states kept coming meanwhile.
+    tokio::time::sleep(Duration::from_millis(1500)).await;
+    let (_, clients) = http(station.http(), "GET", "/api/clients", Some(VIEWER), None).await;
+    let slow_counts = clients["clients"]
+        .as_array()
+        .and_then(|c| c.iter().find(|c| c["name"] == "operator"))
+        .cloned()
+        .unwrap_or_else(|| panic!("the slow page is listed: {clients}"));
+    // It is further behind than the backlog: it will be told so when it reads again.
+    assert!(
+        slow_counts["messages_behind"].as_u64()
+            > Some(stx_station::daemon::RELIABLE_BACKLOG as u64),
+        "{slow_counts}"
+    );
+    let (slow_seen, slow_missed) = drain(&mut slow).await;
+    assert!(slow_missed > 0, "the slow page must have lagged");
+    assert_eq!(
+        slow_seen.len() as u64 + slow_missed,
+        EVENTS as u64,
+        "every event is either delivered or announced as missed"
+    );
+    assert!(slow_seen.windows(2).all(|w| w[0] < w[1]), "in order");
+    // While it was blocked, states were replaced by newer ones, not queued.
+    let next_state = ws_until(&mut slow, 5.0, |m| m["type"] == "state").await;
+    assert!(next_state.is_some());
+    let (_, clients) = http(station.http(), "GET", "/api/clients", Some(VIEWER), None).await;
+    let slow_counts = clients["clients"]
+        .as_array()
+        .and_then(|c| c.iter().find(|c| c["name"] == "operator"))
+        .cloned()
+        .unwrap_or_default();
+    assert_eq!(
+        slow_counts["messages_missed"].as_u64(),
+        Some(slow_missed),
+        "the count per page is what the page was told: {slow_counts}"
+    );
+    assert!(
+        slow_counts["lag_episodes"].as_u64() >= Some(1),
+        "{slow_counts}"
+    );
+    assert!(
+        slow_counts["states_coalesced"].as_u64() > Some(0),
+        "{slow_counts}"
+    );
+}

@@ -37,7 +37,8 @@ enum BenchWhat {
         #[arg(long, default_value_t = 2.0)]
         eval_seconds: f64,
     },
-    /// The station daemon's memory after an accelerated three-hour mission (`stx serve --sim`).
+    /// The station daemon's memory after an accelerated three-hour mission (`stx serve`, the
+    /// simulated drone in its own process).
     Memory {
         /// Print one JSON object instead of a table.
         #[arg(long)]
@@ -60,11 +61,11 @@ enum BenchWhat {
         /// WebSocket pages connected while telemetry flows.
         #[arg(long, default_value_t = 50)]
         clients: usize,
-        /// Telemetry frames timed.
-        #[arg(long, default_value_t = 400)]
+        /// Telemetry bursts timed (each the drone's full set for one control period).
+        #[arg(long, default_value_t = 240)]
         frames: usize,
-        /// Telemetry frames per second.
-        #[arg(long, default_value_t = 20.0)]
+        /// Telemetry bursts per second (the drone's control rate).
+        #[arg(long, default_value_t = 4.0)]
         frame_rate_hz: f64,
         /// Commands timed.
         #[arg(long, default_value_t = 200)]
@@ -225,7 +226,7 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
                 println!("{}", serde_json::to_string_pretty(&report)?);
             } else {
                 println!(
-                    "station daemon after {:.0} s of mission ({}, {:.0} s wall at {}x, {} pages): RSS {:.1} MB, peak {:.1} MB (after 1 min: {:.1} MB); pages received {} messages, {:.1} MB",
+                    "station daemon alone after {:.0} s of mission ({}, {:.0} s wall at {}x, {} pages): RSS {:.1} MB, peak {:.1} MB (after 1 min: {:.1} MB; the drone's process peaked at {:.1} MB); pages received {} messages, {:.1} MB",
                     report.mission_time_s,
                     if report.landed {
                         "landed"
@@ -238,6 +239,7 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
                     report.rss_after_mb,
                     report.rss_peak_mb,
                     report.rss_early_mb,
+                    report.drone_rss_peak_mb,
                     report.page_messages,
                     report.page_bytes as f64 / 1e6
                 );
@@ -266,10 +268,11 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
                 let t = &report.telemetry_to_websocket;
                 let c = &report.command_to_mavlink;
                 println!(
-                    "telemetry → WebSocket, {} pages, {} frames at {} Hz: p50 {:.2} ms, p99 {:.2} ms, max {:.2} ms ({} samples, {} missed)",
+                    "telemetry → WebSocket, {} pages, {} bursts at {} Hz, state {} bytes: p50 {:.2} ms, p99 {:.2} ms, max {:.2} ms ({} samples, {} missed)",
                     t.clients,
                     t.frames_sent,
                     t.frame_rate_hz,
+                    t.state_bytes,
                     t.latency.p50_ms,
                     t.latency.p99_ms,
                     t.latency.max_ms,

@@ -1,12 +1,15 @@
 //! `stx bench memory`: the station daemon's memory after a whole mission of three hours, flown
 //! faster than real time.
 //!
-//! It runs the real thing as an operator would: `stx serve --sim` in a child process (this
-//! binary), the simulated drone flying the built-in `mission` held on the pad long enough that
-//! launch day lasts three hours of mission time (a station is up well before the balloon goes),
-//! and dashboard pages connected over WebSocket the whole time, reading everything. Once the
-//! drone reports it has landed, the child's resident set (`VmRSS`) and its peak (`VmHWM`) are
-//! read from `/proc`, sampled every second along the way too.
+//! It runs the real thing as an operator would: the daemon `stx serve` in one child process
+//! (this binary) and the simulated drone `stx drone` in another, on the daemon's UDP link —
+//! the same bytes as `stx serve --sim`, but with the drone's physics and memory outside the
+//! figure. The drone flies the built-in `mission` held on the pad long enough that launch day
+//! lasts three hours of mission time (a station is up well before the balloon goes), and
+//! dashboard pages are connected over WebSocket the whole time, reading everything. Once the
+//! station sees the drone landed, the daemon's resident set (`VmRSS`) and its peak (`VmHWM`)
+//! are read from `/proc` (sampled every second along the way too); the drone's peak is reported
+//! beside it.
 
 use std::io::IsTerminal;
 use std::path::PathBuf;
@@ -49,6 +52,9 @@ pub struct MemoryReport {
     pub rss_after_mb: f64,
     /// The highest resident memory of the daemon during the run (`VmHWM`), MB.
     pub rss_peak_mb: f64,
+    /// The simulated drone's own peak resident memory (its process, not in the figures
+    /// above), MB.
+    pub drone_rss_peak_mb: f64,
     /// Resident memory one minute of real time into the run, MB, to see growth against.
     pub rss_early_mb: f64,
     /// Messages the pages received over the run.
@@ -180,22 +186,38 @@ async fn measure(options: &MemoryBenchOptions) -> anyhow::Result<MemoryReport> {
             "127.0.0.1:0",
             "--link",
             "udpin:127.0.0.1:0",
-            "--sim",
         ])
-        .arg("--sim-scenario")
-        .arg(mission.path())
-        .args(["--sim-speed", &options.speed.to_string()])
         .env("RUST_LOG", "warn")
         .stdout(Stdio::piped())
         .stderr(Stdio::null())
         .kill_on_drop(true)
         .spawn()
-        .context("starting stx serve --sim")?;
+        .context("starting stx serve")?;
     let pid = child.id().context("the daemon's pid")?;
+    let mut out = BufReader::new(child.stdout.take().context("the daemon's stdout")?);
     let mut line = String::new();
-    BufReader::new(child.stdout.take().context("the daemon's stdout")?)
-        .read_line(&mut line)
-        .await?;
+    out.read_line(&mut line).await?;
+    let mut link_line = String::new();
+    out.read_line(&mut link_line).await?;
+    // "stx station: drone link listening on 127.0.0.1:PORT"
+    let Some(link) = link_line
+        .trim()
+        .strip_prefix("stx station: drone link listening on ")
+    else {
+        bail!("stx serve did not print its link: {link_line:?}");
+    };
+    let mut drone = Command::new(&exe)
+        .args(["drone", "--connect", &format!("udpout:{link}")])
+        .arg("--scenario")
+        .arg(mission.path())
+        .args(["--speed", &options.speed.to_string(), "--linger", "600"])
+        .env("RUST_LOG", "warn")
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .kill_on_drop(true)
+        .spawn()
+        .context("starting stx drone")?;
+    let drone_pid = drone.id().context("the drone's pid")?;
     // "stx station: open http://127.0.0.1:PORT/?token=TOKEN"
     let url = line.trim().rsplit(' ').next().unwrap_or_default();
     let Some((address, token)) = url
@@ -231,6 +253,9 @@ async fn measure(options: &MemoryBenchOptions) -> anyhow::Result<MemoryReport> {
         if let Some(status) = child.try_wait()? {
             bail!("stx serve exited during the mission: {status}");
         }
+        if let Some(status) = drone.try_wait()? {
+            bail!("stx drone exited during the mission: {status}");
+        }
         let (rss, _) = memory_mb(pid)?;
         if rss_early_mb.is_none() && start.elapsed() >= Duration::from_secs(60) {
             rss_early_mb = Some(rss);
@@ -257,6 +282,8 @@ async fn measure(options: &MemoryBenchOptions) -> anyhow::Result<MemoryReport> {
     progress.finish_and_clear();
     let wall_time_s = start.elapsed().as_secs_f64();
     let (rss_after_mb, rss_peak_mb) = memory_mb(pid)?;
+    let (_, drone_rss_peak_mb) = memory_mb(drone_pid)?;
+    drone.kill().await.ok();
     child.kill().await.ok();
     Ok(MemoryReport {
         mission_time_s: state["vehicle"]["attitude"]["time_boot_ms"]
@@ -268,6 +295,7 @@ async fn measure(options: &MemoryBenchOptions) -> anyhow::Result<MemoryReport> {
         landed,
         rss_after_mb,
         rss_peak_mb,
+        drone_rss_peak_mb,
         rss_early_mb: rss_early_mb.unwrap_or(rss_after_mb),
         page_messages: messages.load(Ordering::Relaxed),
         page_bytes: bytes.load(Ordering::Relaxed),

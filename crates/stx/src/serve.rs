@@ -100,9 +100,13 @@ pub fn run(args: ServeArgs) -> anyhow::Result<()> {
         let mut drone_task = None;
         let station = stx_station::daemon::run(config, stopped(stop_rx.clone()), |running| {
             println!(
-                "stx station: open http://{}/?token={operator}",
-                running.http
+                "stx station: open {}://{}/?token={operator}",
+                running.scheme, running.http
             );
+            if let Some(link) = running.link_local {
+                // For a drone started separately against a port the system chose.
+                println!("stx station: drone link listening on {link}");
+            }
             if let (Some(mut options), Some(link)) = (sim, running.link_local) {
                 options.connect = format!("udpout:{}", loopback_if_unspecified(link));
                 drone_task = Some(tokio::spawn(fly_beside(options, stopped(stop_rx))));

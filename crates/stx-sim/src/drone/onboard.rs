@@ -467,57 +467,31 @@ impl Onboard {
         }
     }
 
-    /// Takes an uploaded plan (see the module documentation).
+    /// Takes an uploaded plan (see the module documentation): the mapping of
+    /// [`stx_gnc::plan_upload`], shared with the station's guidance replica.
     pub fn handle_plan(&mut self, time_s: f64, items: &[PlanItem]) {
-        let mut plan = *self.guidance.plan();
-        let mut waypoints = Vec::new();
-        let mut land = None;
-        for item in items {
-            match *item {
-                PlanItem::Waypoint {
-                    lat_deg,
-                    lon_deg,
-                    alt_msl_m,
-                } => waypoints.push(self.frame.to_ned(lat_deg, lon_deg, alt_msl_m)),
-                PlanItem::Land {
-                    lat_deg,
-                    lon_deg,
-                    alt_msl_m,
-                    approach_heading_deg,
-                } => {
-                    land = Some((
-                        self.frame.to_ned(lat_deg, lon_deg, alt_msl_m),
-                        approach_heading_deg,
-                    ));
-                }
-            }
-        }
+        use stx_gnc::plan_upload::{LineChange, apply};
+        let points: Vec<_> = items.iter().map(|i| i.to_local(&self.frame)).collect();
+        let update = apply(self.guidance.plan(), &points);
+        let plan = update.plan;
         let mut said = Vec::new();
-        if let Some((target, approach)) = land {
-            plan.target_ned_m = target;
-            plan.approach_course_rad = approach.map(|d| wrap_pi(d.to_radians()));
+        if update.target_set {
             self.has_target = true;
+            let target = plan.target_ned_m;
             said.push(format!("target {:.0} m N {:.0} m E", target.x, target.y));
         }
-        let line = match (waypoints.as_slice(), land) {
-            ([a, b, ..], _) => Some((*a, *b)),
-            ([a], Some((t, _))) => Some((*a, t)),
-            _ => None,
-        };
-        if let Some((a, b)) = line {
-            let distance = (b.x - a.x).hypot(b.y - a.y);
-            if distance > 1.0 {
-                plan.localizer = Localizer::through([a.x, a.y], [b.x, b.y]);
-                let drop = b.z - a.z;
-                plan.localizer_glide_slope = (drop > 0.0).then_some(drop / distance);
+        match update.line {
+            LineChange::Set => {
                 self.has_localizer = true;
                 said.push(format!(
                     "localizer course {:.0}°",
                     plan.localizer.course_rad.to_degrees().rem_euclid(360.0)
                 ));
-            } else {
+            }
+            LineChange::PointsCoincide => {
                 said.push("localizer points coincide: line ignored".into());
             }
+            LineChange::None => {}
         }
         self.guidance.set_plan(plan, time_s);
         self.say(

@@ -8,6 +8,7 @@ use nalgebra::Vector3;
 use stx_gnc::control::Localizer;
 use stx_gnc::geo::LocalFrame;
 use stx_gnc::mission::FlightMode;
+use stx_gnc::plan_upload::PlanPoint;
 use stx_link::command::{Command, CommandEvent, CommandOutcome, CommandResult, RequestId};
 use stx_link::param::{ParamEvent, ParamValue};
 use stx_link::plan::{PlanEvent, PlanItem};
@@ -56,6 +57,8 @@ pub enum LinkAction {
     ParamSet { name: String, value: f32 },
     /// Upload a plan.
     PlanUpload(Vec<PlanItem>),
+    /// Read the plan the drone holds (the station's own initiative, no request id).
+    PlanDownload,
 }
 
 /// A refusal of a request, as the HTTP layer answers it.
@@ -90,7 +93,7 @@ pub struct CutdownArm {
 }
 
 /// A plan change the guidance replica adopts once the drone accepts it.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub(crate) enum PlanChange {
     Target {
         target_ned_m: Vector3<f64>,
@@ -102,6 +105,8 @@ pub(crate) enum PlanChange {
         line: Localizer,
         glide_slope: Option<f64>,
     },
+    /// An uploaded plan, applied with the drone's own mapping (`stx_gnc::plan_upload`).
+    Upload(Vec<PlanPoint>),
 }
 
 #[derive(Debug, Clone)]
@@ -250,30 +255,35 @@ impl Commands {
                 if items.is_empty() {
                     return Err(ApiError::bad_request("items must not be empty"));
                 }
-                let mut change = None;
+                if items.len() > usize::from(stx_link::plan::MAX_PLAN_ITEMS) {
+                    return Err(ApiError::bad_request(format!(
+                        "items: at most {} items",
+                        stx_link::plan::MAX_PLAN_ITEMS
+                    )));
+                }
                 for item in &items {
-                    let (lat, lon, alt) = match item {
+                    let (lat, lon, alt, approach) = match *item {
                         PlanItem::Waypoint {
                             lat_deg,
                             lon_deg,
                             alt_msl_m,
-                        } => (*lat_deg, *lon_deg, *alt_msl_m),
+                        } => (lat_deg, lon_deg, alt_msl_m, None),
                         PlanItem::Land {
                             lat_deg,
                             lon_deg,
                             alt_msl_m,
                             approach_heading_deg,
-                        } => {
-                            change = Some(PlanChange::Target {
-                                target_ned_m: frame.to_ned(*lat_deg, *lon_deg, *alt_msl_m),
-                                approach_course_rad: approach_heading_deg.map(f64::to_radians),
-                            });
-                            (*lat_deg, *lon_deg, *alt_msl_m)
-                        }
+                        } => (lat_deg, lon_deg, alt_msl_m, approach_heading_deg),
                     };
                     check_lat_lon(lat, lon)?;
                     check_finite("alt_msl_m", alt)?;
+                    if let Some(a) = approach {
+                        check_finite("approach_course_deg", a)?;
+                    }
                 }
+                let change = Some(PlanChange::Upload(
+                    items.iter().map(|i| i.to_local(frame)).collect(),
+                ));
                 let (id, _) = self.new_id();
                 self.record(&id, "set_plan", None);
                 let text = format!("upload a plan of {} items", items.len());

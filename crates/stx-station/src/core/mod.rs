@@ -3,12 +3,14 @@
 //!
 //! - telemetry updates the latest of each kind and feeds the station's own estimator (the same
 //!   code as onboard) with the GPS, AHRS and pitot measurements;
-//! - a guidance replica follows the drone's mode and the plan the operators sent, to draw the
-//!   pattern and predict the landing ([`stx_gnc::predict`]) the way the drone will fly it;
+//! - a guidance replica follows the drone's mode and the plan the drone holds (read back from
+//!   it, see [`sync`]), to draw the pattern and predict the landing ([`stx_gnc::predict`]) the
+//!   way the drone will fly it;
 //! - operators' requests become [`LinkAction`]s for the daemon to apply to the link, each with a
 //!   request id whose outcome comes back as a `command_result`.
 
 mod commands;
+mod sync;
 mod views;
 
 use std::collections::{HashMap, VecDeque};
@@ -30,6 +32,7 @@ use crate::config::StationConfig;
 use crate::messages::{EventMsg, Level, StateMsg, TrackPoint};
 
 pub use commands::{ApiError, CommandRequest, CutdownArm, LinkAction};
+pub use sync::TargetSource;
 
 /// Most events kept for the log.
 const MAX_EVENTS: usize = 10_000;
@@ -57,19 +60,30 @@ pub struct PredictionJob {
     performance: stx_gnc::performance::GlidePerformance,
     ground_altitude_msl_m: f64,
     config: PredictorConfig,
+    /// When the sensor data behind the estimate arrived (mission time, s).
+    data_s: Option<f64>,
+}
+
+/// A finished [`PredictionJob`].
+pub struct Predicted {
+    prediction: LandingPrediction,
+    data_s: Option<f64>,
 }
 
 impl PredictionJob {
     /// Flies the plan and the uncontrolled glide from the estimate (milliseconds).
-    pub fn run(&self) -> LandingPrediction {
-        predict(
-            &self.estimate,
-            &self.guidance,
-            &self.performance,
-            &StandardAtmosphere,
-            self.ground_altitude_msl_m,
-            &self.config,
-        )
+    pub fn run(&self) -> Predicted {
+        Predicted {
+            prediction: predict(
+                &self.estimate,
+                &self.guidance,
+                &self.performance,
+                &StandardAtmosphere,
+                self.ground_altitude_msl_m,
+                &self.config,
+            ),
+            data_s: self.data_s,
+        }
     }
 }
 
@@ -85,6 +99,11 @@ pub(crate) struct Latest {
     pub system: Option<(stx_link::telemetry::SystemStatus, f64)>,
     pub battery: Option<(stx_link::telemetry::BatteryStatus, f64)>,
     pub wind: Option<(stx_link::telemetry::Wind, f64)>,
+    pub guidance: Option<(stx_link::telemetry::GuidanceStatus, f64)>,
+    /// The drone's own prediction of its touchdown.
+    pub predicted_landing: Option<(stx_link::telemetry::PredictedLanding, f64)>,
+    /// The newest GPS, attitude or air data: what navigation last learnt from.
+    pub sensors_s: Option<f64>,
     pub any_s: Option<f64>,
 }
 
@@ -113,6 +132,12 @@ pub struct StationCore {
     pub(crate) estimate: Option<Estimate>,
     pub(crate) guidance: Guidance,
     pub(crate) prediction: Option<LandingPrediction>,
+    /// When the sensor data the prediction started from arrived (mission time, s).
+    pub(crate) prediction_data_s: Option<f64>,
+    /// The plan download and where the replica's plan comes from.
+    pub(crate) sync: sync::PlanSync,
+    /// The drone's clock of the estimate guidance last ran on, s.
+    guided_at_s: Option<f64>,
     pub(crate) track: Vec<TrackPoint>,
     next_track_s: f64,
     pub(crate) events: VecDeque<EventMsg>,
@@ -144,6 +169,9 @@ impl StationCore {
             estimate: None,
             guidance,
             prediction: None,
+            prediction_data_s: None,
+            sync: sync::PlanSync::default(),
+            guided_at_s: None,
             track: Vec::new(),
             next_track_s: 0.0,
             events: VecDeque::new(),
@@ -282,6 +310,12 @@ impl StationCore {
                     self.outbound.push(Outbound::Params(params));
                 }
             }
+            GroundEvent::Plan(stx_link::plan::PlanEvent::DownloadDone { items }) => {
+                self.on_plan_downloaded(now_s, &items);
+            }
+            GroundEvent::Plan(stx_link::plan::PlanEvent::DownloadFailed { reason }) => {
+                self.on_plan_download_failed(now_s, &reason);
+            }
             GroundEvent::Plan(e) => {
                 if let Some(msg) = self.commands.on_plan_event(&e) {
                     self.after_command_result(now_s, &msg);
@@ -292,6 +326,9 @@ impl StationCore {
             }
             GroundEvent::Link(LinkEvent::Connected { system_id, .. }) => {
                 tracing::info!(system_id, "drone heartbeat");
+                // A drone heard for the first time, or again, may fly a plan the station has
+                // not seen.
+                self.want_plan_download(now_s);
             }
             GroundEvent::Link(LinkEvent::Lost { .. }) => {}
             GroundEvent::Link(LinkEvent::PersistSigningTimestamp(_)) => {}
@@ -325,6 +362,7 @@ impl StationCore {
 
     fn apply_plan_change(&mut self, now_s: f64, change: commands::PlanChange) {
         let mut plan: Plan = *self.guidance.plan();
+        let mut read_back = true;
         match change {
             commands::PlanChange::Target {
                 target_ned_m,
@@ -332,16 +370,38 @@ impl StationCore {
             } => {
                 plan.target_ned_m = target_ned_m;
                 plan.approach_course_rad = approach_course_rad;
+                self.sync.target = Some(TargetSource::Operator);
             }
-            commands::PlanChange::Heading(h) => plan.heading_rad = h,
-            commands::PlanChange::Course(c) => plan.course_rad = c,
+            commands::PlanChange::Heading(h) => {
+                plan.heading_rad = h;
+                read_back = false;
+            }
+            commands::PlanChange::Course(c) => {
+                plan.course_rad = c;
+                read_back = false;
+            }
             commands::PlanChange::Localizer { line, glide_slope } => {
                 plan.localizer = line;
                 plan.localizer_glide_slope = glide_slope;
+                self.sync.line_known = true;
+            }
+            commands::PlanChange::Upload(points) => {
+                // The drone's own mapping of an upload.
+                let update = stx_gnc::plan_upload::apply(&plan, &points);
+                plan = update.plan;
+                if update.target_set {
+                    self.sync.target = Some(TargetSource::Operator);
+                }
+                if update.line == stx_gnc::plan_upload::LineChange::Set {
+                    self.sync.line_known = true;
+                }
             }
         }
-        self.guidance
-            .set_plan(plan, self.drone_time_s.unwrap_or(now_s));
+        self.set_replica_plan(now_s, plan);
+        if read_back {
+            // What the drone holds now is the truth: read it back.
+            self.want_plan_download(now_s);
+        }
     }
 
     /// Advances the drone's clock with a message's time stamp; a clock that steps far back
@@ -359,6 +419,8 @@ impl StationCore {
                     format!("the drone's clock went back from {last:.1} s to {t:.1} s: it restarted; navigation starts over"),
                 );
                 self.drone_time_s = Some(t);
+                self.guided_at_s = None;
+                self.want_plan_download(now_s);
             }
             Some(last) => self.drone_time_s = Some(last.max(t)),
             None => self.drone_time_s = Some(t),
@@ -389,6 +451,7 @@ impl StationCore {
             }
             Telemetry::GpsRaw(g) => {
                 self.latest.gps = Some((g, now_s));
+                self.latest.sensors_s = Some(now_s);
                 // GPS_RAW_INT's time may be the receiver's (Unix) clock: it is stamped with
                 // the drone's clock of the burst it came in.
                 if let Some(t) = self.drone_time_s
@@ -404,6 +467,7 @@ impl StationCore {
             Telemetry::Attitude(a) => {
                 let t = self.observe_drone_clock(now_s, a.time_boot_ms);
                 self.latest.attitude = Some((a, now_s));
+                self.latest.sensors_s = Some(now_s);
                 let m = Measurement::Attitude(AttitudeSample {
                     time_s: t,
                     roll_rad: a.roll_rad,
@@ -415,6 +479,7 @@ impl StationCore {
             Telemetry::AirData(a) => {
                 let t = self.observe_drone_clock(now_s, a.time_boot_ms);
                 self.latest.air = Some((a, now_s));
+                self.latest.sensors_s = Some(now_s);
                 let m = Measurement::AirData(AirDataSample {
                     time_s: t,
                     differential_pressure_pa: a.diff_pressure_pa,
@@ -427,10 +492,17 @@ impl StationCore {
             Telemetry::System(s) => self.latest.system = Some((s, now_s)),
             Telemetry::Battery(b) => self.latest.battery = Some((b, now_s)),
             Telemetry::Wind(w) => self.latest.wind = Some((w, now_s)),
-            Telemetry::Hud(_)
-            | Telemetry::StatusText(_)
-            | Telemetry::Guidance(_)
-            | Telemetry::PredictedLanding(_) => {}
+            Telemetry::Guidance(g) => {
+                self.latest.guidance = Some((g, now_s));
+                self.on_guidance_status(now_s, g);
+            }
+            Telemetry::PredictedLanding(p) => {
+                self.observe_drone_clock(now_s, p.time_boot_ms);
+                self.latest.predicted_landing = Some((p, now_s));
+            }
+            // VFR_HUD repeats GLOBAL_POSITION_INT and the air data; STATUSTEXT arrives as
+            // `GroundEvent::StatusText`.
+            Telemetry::Hud(_) | Telemetry::StatusText(_) => {}
         }
     }
 
@@ -474,10 +546,20 @@ impl StationCore {
         let est = self.drone_time_s.map(|t| self.estimator.estimate(t));
         let usable = est.filter(|e| e.position_sigma_m.iter().all(|s| s.is_finite()));
         if let Some(est) = usable {
-            let density = StandardAtmosphere
-                .air_at(self.frame.alt_msl_m - est.position_ned_m.z)
-                .density_kg_per_m3;
-            self.replica_command = self.guidance.update(&est, density).controls;
+            let mode = self.guidance.mode();
+            if !self.plan_known_for(mode) {
+                // Flying towards a target the drone may not have would draw and log a
+                // pattern that does not exist.
+                self.replica_command = stx_dynamics::state::Controls::default();
+            } else if self.guided_at_s.is_none_or(|t| est.time_s > t) {
+                // Only new navigation data move guidance on: a stale link does not make
+                // the replica fly on by itself.
+                self.guided_at_s = Some(est.time_s);
+                let density = StandardAtmosphere
+                    .air_at(self.frame.alt_msl_m - est.position_ned_m.z)
+                    .density_kg_per_m3;
+                self.replica_command = self.guidance.update(&est, density).controls;
+            }
             for e in self.guidance.drain_events() {
                 self.log(
                     now_s,
@@ -520,6 +602,7 @@ impl StationCore {
     pub fn prediction_job(&self) -> Option<PredictionJob> {
         let estimate = self.estimate?;
         Some(PredictionJob {
+            data_s: self.latest.sensors_s,
             estimate,
             guidance: self.guidance.clone(),
             performance: self.config.guidance.performance,
@@ -532,8 +615,14 @@ impl StationCore {
     }
 
     /// Takes the result of a [`PredictionJob`].
-    pub fn set_prediction(&mut self, prediction: LandingPrediction) {
-        self.prediction = Some(prediction);
+    pub fn set_prediction(&mut self, predicted: Predicted) {
+        self.prediction = Some(predicted.prediction);
+        self.prediction_data_s = predicted.data_s;
+    }
+
+    /// The plan the guidance replica flies.
+    pub fn replica_plan(&self) -> &Plan {
+        self.guidance.plan()
     }
 
     /// The mode the drone reports (uncontrolled before the first heartbeat).
@@ -830,6 +919,165 @@ mod tests {
             },
         );
         assert!(core.events.iter().any(|e| e.text.contains("Landed")));
+    }
+
+    #[test]
+    fn guidance_telemetry_gives_the_drones_target_until_its_plan_is_read() {
+        let mut core = core();
+        glide(&mut core, 0.0, 5.0);
+        assert!(
+            core.state_msg_now(5.0)
+                .guidance
+                .and_then(|g| g.target)
+                .is_none()
+        );
+        // The drone's NAV_CONTROLLER_OUTPUT towards its target 300 m N, 2,500 m E.
+        let (p, _) = core.latest.position.expect("a position");
+        let here = core.frame.to_ned(p.lat_deg, p.lon_deg, p.alt_msl_m);
+        let to = Vector3::new(300.0, 2500.0, 0.0) - here;
+        let status = stx_link::telemetry::GuidanceStatus {
+            desired_roll_deg: 0.0,
+            desired_heading_deg: 0.0,
+            bearing_to_target_deg: to.y.atan2(to.x).to_degrees().rem_euclid(360.0).round(),
+            distance_to_target_m: to.xy().norm().round(),
+            alt_error_m: 0.0,
+            xtrack_error_m: 0.0,
+        };
+        let guidance = |core: &mut StationCore, t: f64| {
+            core.on_link_event(
+                t,
+                GroundEvent::Telemetry {
+                    from: (1, 1),
+                    telemetry: Telemetry::Guidance(status),
+                },
+            );
+        };
+        guidance(&mut core, 5.0);
+        let g = core.state_msg_now(5.0).guidance.expect("guidance");
+        assert_eq!(g.target_source, Some("drone_telemetry"));
+        let t = g.target.expect("a target");
+        let ne = core.frame.to_ned(t.lat_deg, t.lon_deg, t.alt_msl_m);
+        // Whole degrees of bearing at 2.5 km: within about 22 m.
+        assert!(
+            (ne.xy() - nalgebra::Vector2::new(300.0, 2500.0)).norm() < 25.0,
+            "{ne:?}"
+        );
+        assert_eq!(core.take_link_actions(5.0), vec![LinkAction::PlanDownload]);
+        assert!(core.take_link_actions(5.1).is_empty(), "asked once");
+        // The plan read back is exact, and agreeing telemetry changes nothing.
+        let (lat, lon, alt) = core.frame.to_geodetic(&Vector3::new(300.0, 2500.0, 0.0));
+        core.on_link_event(
+            6.0,
+            GroundEvent::Plan(stx_link::plan::PlanEvent::DownloadDone {
+                items: vec![stx_link::plan::PlanItem::Land {
+                    lat_deg: lat,
+                    lon_deg: lon,
+                    alt_msl_m: alt,
+                    approach_heading_deg: None,
+                }],
+            }),
+        );
+        guidance(&mut core, 6.5);
+        let g = core.state_msg_now(6.5).guidance.expect("guidance");
+        assert_eq!(g.target_source, Some("drone_plan"));
+        assert!(
+            (core.replica_plan().target_ned_m.xy() - nalgebra::Vector2::new(300.0, 2500.0)).norm()
+                < 0.5
+        );
+        assert!(core.take_link_actions(20.0).is_empty(), "no new download");
+    }
+
+    #[test]
+    fn failed_plan_reads_are_retried_later_and_later_and_said_once() {
+        let mut core = core();
+        core.on_link_event(
+            0.0,
+            GroundEvent::Link(LinkEvent::Connected {
+                system_id: 1,
+                component_id: 1,
+            }),
+        );
+        assert_eq!(core.take_link_actions(0.0), vec![LinkAction::PlanDownload]);
+        let fail = |core: &mut StationCore, t: f64| {
+            core.on_link_event(
+                t,
+                GroundEvent::Plan(stx_link::plan::PlanEvent::DownloadFailed {
+                    reason: "no answer".into(),
+                }),
+            );
+        };
+        fail(&mut core, 1.0);
+        assert!(core.take_link_actions(5.9).is_empty(), "not before 5 s");
+        assert_eq!(core.take_link_actions(6.0), vec![LinkAction::PlanDownload]);
+        fail(&mut core, 7.0);
+        assert!(core.take_link_actions(16.9).is_empty(), "then 10 s");
+        assert_eq!(core.take_link_actions(17.0), vec![LinkAction::PlanDownload]);
+        let said = core
+            .events
+            .iter()
+            .filter(|e| e.text.contains("plan could not be read"))
+            .count();
+        assert_eq!(said, 1);
+    }
+
+    #[test]
+    fn derived_values_turn_stale_with_the_link() {
+        let mut core = core();
+        glide(&mut core, 0.0, 10.0);
+        let job = core.prediction_job().expect("a prediction");
+        core.set_prediction(job.run());
+        let fresh = core.state_msg_now(10.0);
+        assert!(!fresh.estimate.as_ref().expect("estimate").stale);
+        assert!(!fresh.vehicle.as_ref().expect("vehicle").stale);
+        assert!(!fresh.prediction.as_ref().expect("prediction").stale);
+        assert!(!fresh.guidance.as_ref().expect("guidance").stale);
+        let later = 10.0 + core.config.link.stale_after_s + 1.0;
+        let old = core.state_msg_now(later);
+        let estimate = old.estimate.expect("the last estimate is still shown");
+        assert!(estimate.stale && estimate.age_s > core.config.link.stale_after_s);
+        assert!(old.vehicle.expect("vehicle").stale);
+        assert!(old.prediction.expect("prediction").stale);
+        assert!(old.guidance.expect("guidance").stale);
+        assert!(old.link.stale);
+    }
+
+    #[test]
+    fn kml_predicted_landings_lie_on_the_ground_not_at_sea_level() {
+        let mut core = core();
+        glide(&mut core, 0.0, 10.0);
+        let job = core.prediction_job().expect("a prediction");
+        core.set_prediction(job.run());
+        core.on_link_event(
+            10.0,
+            GroundEvent::Telemetry {
+                from: (1, 1),
+                telemetry: Telemetry::PredictedLanding(stx_link::telemetry::PredictedLanding {
+                    time_boot_ms: 10_000,
+                    lat_deg: 38.54,
+                    lon_deg: -7.88,
+                    alt_msl_m: 245.0,
+                }),
+            },
+        );
+        let doc = crate::kml::live("test", &core.track(1.0), &core.state_msg_now(10.0));
+        let predicted: Vec<&str> = doc
+            .lines()
+            .filter(|l| l.contains("predicted landing"))
+            .collect();
+        assert_eq!(
+            predicted.len(),
+            3,
+            "station plan, uncontrolled, drone's own: {doc}"
+        );
+        for p in predicted {
+            // The site is 245 m above the sea: altitude 0 absolute would be underground.
+            assert!(
+                p.contains("<altitudeMode>clampToGround</altitudeMode>"),
+                "{p}"
+            );
+            assert!(!p.contains("absolute"), "{p}");
+        }
+        assert!(doc.contains("predicted landing (drone's own)"));
     }
 
     #[test]

@@ -8,8 +8,8 @@ use stx_gnc::predict::PredictedTouchdown;
 use super::StationCore;
 use crate::messages::{
     AirView, AttitudeView, CommandsView, EstimateView, GpsView, GuidanceView, LatLonAlt, LinkView,
-    MissionView, ParamView, ParamsMsg, PatternView, PowerView, PredictionView, ServosView,
-    StateMsg, TouchdownView, VehicleView,
+    LocalizerView, MissionView, OnboardLandingView, ParamView, ParamsMsg, PatternView, PowerView,
+    PredictionView, ServosView, StateMsg, TouchdownView, VehicleView,
 };
 
 fn snake<T: serde::Serialize + std::fmt::Debug>(v: T) -> String {
@@ -27,10 +27,14 @@ impl StationCore {
     /// The `state` message for `now_s` from what the station knows (no side effects).
     pub fn state_msg_now(&self, now_s: f64) -> StateMsg {
         let stale_after = self.config.link.stale_after_s;
-        let age_s = self.latest.any_s.map(|t| (now_s - t).max(0.0));
+        let age = |since: Option<f64>| since.map(|t| (now_s - t).max(0.0));
+        // One rule for every block derived from the drone's data.
+        let stale =
+            |age_s: Option<f64>| age_s.is_none_or(|a| a > stale_after) || !self.link.connected;
+        let age_s = age(self.latest.any_s);
         let link = LinkView {
             connected: self.link.connected,
-            stale: age_s.is_none_or(|a| a > stale_after) || !self.link.connected,
+            stale: stale(age_s),
             age_s,
             rate_hz: self.link.messages_per_s,
             loss_percent: self.link.packet_loss_pct,
@@ -40,7 +44,16 @@ impl StationCore {
             ages_s: self.link.last_message_age_s.clone(),
         };
         let l = &self.latest;
-        let vehicle = l.any_s.map(|_| VehicleView {
+        let vehicle = l.any_s.map(|any_s| VehicleView {
+            age_s: (now_s - any_s).max(0.0),
+            stale: stale(age(Some(any_s))),
+            predicted_landing: l.predicted_landing.map(|(p, at)| OnboardLandingView {
+                lat_deg: p.lat_deg,
+                lon_deg: p.lon_deg,
+                alt_msl_m: p.alt_msl_m,
+                age_s: (now_s - at).max(0.0),
+                stale: stale(age(Some(at))),
+            }),
             mode: l.status.map(|(s, _)| snake(s.mode)),
             stage: l.status.map(|(s, _)| snake(s.stage)),
             phase: l.status.map(|(s, _)| snake(s.phase)),
@@ -105,6 +118,7 @@ impl StationCore {
                 ])
             }),
         });
+        let estimate_age_s = self.estimate.and(age(self.latest.sensors_s));
         let estimate = self.estimate.map(|e| {
             let (lat, lon, alt) = self.frame.to_geodetic(&e.position_ned_m);
             let w = e.wind_ned_mps;
@@ -132,6 +146,8 @@ impl StationCore {
                 wind_sigma_mps: e.wind_sigma_mps.x.max(e.wind_sigma_mps.y),
                 position_sigma_m: e.position_sigma_m.x.hypot(e.position_sigma_m.y),
                 gps_ok: e.gps_ok,
+                age_s: estimate_age_s.unwrap_or(0.0),
+                stale: stale(estimate_age_s),
             }
         });
         let plan = self.guidance.plan();
@@ -141,21 +157,31 @@ impl StationCore {
                 .to_geodetic(&nalgebra::Vector3::new(ne[0], ne[1], 0.0));
             [lat, lon]
         };
-        let target = {
+        let target = self.sync.target.map(|_| {
             let (lat, lon, alt) = self.frame.to_geodetic(&plan.target_ned_m);
             LatLonAlt {
                 lat_deg: lat,
                 lon_deg: lon,
                 alt_msl_m: alt,
             }
-        };
+        });
+        let mode = self.guidance.mode();
+        let plan_known = self.plan_known_for(mode);
         let phase = self.guidance.phase();
         let spiral = self.guidance.spiral_status();
         let guidance = Some(GuidanceView {
-            mode: snake(self.guidance.mode()),
+            mode: snake(mode),
             phase: snake(phase),
-            target: Some(target),
-            pattern: (phase != GuidancePhase::Idle).then(|| PatternView {
+            target,
+            target_source: self.sync.target.map(|s| s.name()),
+            localizer: self.sync.line_known.then(|| LocalizerView {
+                point: to_pair(plan.localizer.point_ne_m),
+                course_deg: plan.localizer.course_rad.to_degrees().rem_euclid(360.0),
+                glide_slope: plan.localizer_glide_slope,
+            }),
+            age_s: estimate_age_s,
+            stale: stale(estimate_age_s),
+            pattern: (plan_known && phase != GuidancePhase::Idle).then(|| PatternView {
                 corners: spiral.corners_ne_m.iter().map(|c| to_pair(*c)).collect(),
                 final_entry: to_pair(spiral.final_entry_ne_m),
                 final_course_deg: wrap_pi(spiral.final_course_rad)
@@ -190,9 +216,12 @@ impl StationCore {
                 major_axis_deg: t.major_axis_rad.to_degrees().rem_euclid(180.0),
             }
         };
+        let prediction_age_s = age(self.prediction_data_s);
         let prediction = self.prediction.map(|p| PredictionView {
-            planned: touchdown(&p.planned),
+            planned: plan_known.then(|| touchdown(&p.planned)),
             uncontrolled: touchdown(&p.uncontrolled),
+            age_s: prediction_age_s,
+            stale: stale(prediction_age_s),
         });
         StateMsg {
             kind: "state",

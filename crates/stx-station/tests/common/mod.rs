@@ -296,3 +296,66 @@ pub async fn ws_send(ws: &mut Ws, value: Value) {
         .await
         .expect("send");
 }
+
+/// The real simulated drone (`stx_sim`'s onboard software, physics and link) flying `config`
+/// over loopback UDP to the station, stepped `speed` times faster than real time.
+pub struct SimDrone {
+    actions: mpsc::Sender<Action<stx_sim::drone::link::LinkedDrone>>,
+}
+
+pub async fn sim_drone(
+    station_link: SocketAddr,
+    config: &stx_sim::drone::config::MissionConfig,
+    speed: f64,
+) -> SimDrone {
+    use stx_sim::drone::Drone;
+    use stx_sim::drone::link::LinkedDrone;
+    let drone = Drone::new(config, stx_dynamics::vehicle::Vehicle::straplex()).expect("drone");
+    let linked =
+        LinkedDrone::new(drone, fast_link(LinkConfig::vehicle()), Duration::ZERO).expect("link");
+    let transport = Transport::open_str(&format!("udpout:{station_link}"))
+        .await
+        .expect("drone socket");
+    let (actions_tx, actions_rx) = mpsc::channel::<Action<LinkedDrone>>(64);
+    let (events_tx, mut events_rx) = mpsc::channel(1024);
+    tokio::spawn(drive(
+        transport,
+        linked,
+        actions_rx,
+        events_tx,
+        DriveOptions::default(),
+    ));
+    tokio::spawn(async move { while events_rx.recv().await.is_some() {} });
+    let steps = actions_tx.clone();
+    let period = Duration::from_secs_f64(stx_sim::guided::CONTROL_PERIOD_S / speed);
+    tokio::spawn(async move {
+        let mut ticker = tokio::time::interval(period);
+        loop {
+            ticker.tick().await;
+            let step: Action<LinkedDrone> = Box::new(|d, now| {
+                let _ = d.step(now);
+            });
+            if steps.send(step).await.is_err() {
+                break;
+            }
+        }
+    });
+    SimDrone {
+        actions: actions_tx,
+    }
+}
+
+impl SimDrone {
+    /// Reads something of the drone between two of its steps.
+    pub async fn query<T: Send + 'static>(
+        &self,
+        f: impl FnOnce(&stx_sim::drone::link::LinkedDrone) -> T + Send + 'static,
+    ) -> T {
+        let (tx, rx) = oneshot::channel();
+        let ask: Action<stx_sim::drone::link::LinkedDrone> = Box::new(move |d, _| {
+            let _ = tx.send(f(d));
+        });
+        let _ = self.actions.send(ask).await;
+        rx.await.expect("the drone answers")
+    }
+}
