@@ -6,7 +6,7 @@
 import { h, panel, s, setAttr, setText } from "./dom";
 import { firstPad, manualMessage, readSticks, type PadLike, type Sticks } from "../lib/joystick";
 import { ManualSender, MANUAL_RATE_HZ, type ManualGate } from "../lib/manualSender";
-import type { ManualMsg } from "../lib/types";
+import type { ManualMsg, ManualReleaseMsg } from "../lib/types";
 
 const POLL_MS = 20;
 
@@ -31,7 +31,7 @@ export class JoystickPanel {
   private padId = "";
   private lastPaint = 0;
 
-  constructor(send: (m: ManualMsg) => boolean) {
+  constructor(send: (m: ManualMsg | ManualReleaseMsg) => boolean) {
     this.sender = new ManualSender({ send, sample: () => this.sample() });
     this.status = h("span", { "data-testid": "joystick-status" });
     this.deadmanEl = h("span", { class: "deadman", "data-testid": "joystick-deadman" });
@@ -163,7 +163,7 @@ export class JoystickPanel {
     setText(this.sendingEl, sending ? `SENDING at ${MANUAL_RATE_HZ} Hz` : `not sending: ${this.sender.blocked ?? "—"}`);
     this.sendingEl.dataset.sending = String(sending);
     const last = this.sender.lastSentMs;
-    setText(this.rateEl, `limit ${MANUAL_RATE_HZ} Hz · measured ${this.sender.rateHz().toFixed(0)} Hz · last sent ${last === null ? "never" : `${((Date.now() - last) / 1000).toFixed(1)} s ago`} · ${this.sender.sent} sent`);
+    setText(this.rateEl, `limit ${MANUAL_RATE_HZ} Hz · measured ${this.sender.rateHz().toFixed(0)} Hz · last sent ${last === null ? "never" : `${((Date.now() - last) / 1000).toFixed(1)} s ago`} · ${this.sender.sent} sent · ${this.sender.releases} released`);
     this.hold.classList.toggle("on", this.screenHold);
   }
 }
