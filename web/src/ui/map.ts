@@ -31,8 +31,8 @@ export class MapView {
   private origin: LatLon;
   private readonly grid = L.layerGroup();
   private readonly track = L.polyline([], { color: "#0b2f8a", weight: 3 });
-  private readonly pattern = L.polygon([], { color: "#c000c0", weight: 2, dashArray: "6 5", fill: false });
-  private readonly final = L.polyline([], { color: "#c000c0", weight: 4 });
+  private readonly pattern = L.polygon([], { color: "#c000c0", weight: 2, dashArray: "6 5", fill: false, className: "map-pattern" });
+  private readonly final = L.polyline([], { color: "#c000c0", weight: 4, className: "map-final-line" });
   private readonly ellPlanned = L.polygon([], { color: "#006400", weight: 2, fillOpacity: 0.12 });
   private readonly ellUncontrolled = L.polygon([], { color: "#c05800", weight: 2, fillOpacity: 0.08, dashArray: "4 4" });
   private readonly planned: L.Marker;
@@ -48,6 +48,7 @@ export class MapView {
   private readonly finalText: HTMLElement;
   private readonly landedText: HTMLElement;
   private readonly followBtn: HTMLButtonElement;
+  private readonly overlay: HTMLElement;
   private picker: Picker = null;
   private follow = true;
   /** True while the page itself moves the view, so its events are not taken for the operator's. */
@@ -94,10 +95,11 @@ export class MapView {
     this.landedText = h("div", { class: "map-badge landed", "data-testid": "map-landed", hidden: true });
     this.followBtn = h("button", { type: "button", class: "small on", "data-testid": "map-follow", "aria-pressed": "true", title: "keep the vehicle, target, pattern and predicted landings in view (off when you drag or zoom)" }, "Follow");
     this.followBtn.addEventListener("click", () => this.setFollow(!this.follow));
-    const overlay = h("div", { class: "map-overlay" }, this.tilesStatus, h("div", { class: "map-badge wind" }, this.windArrow, this.windText), this.finalText, this.landedText, this.followBtn);
+    const overlay = h("div", { class: "map-overlay", "data-testid": "map-overlay" }, this.tilesStatus, h("div", { class: "map-badge wind" }, this.windArrow, this.windText), this.finalText, this.landedText, this.followBtn);
     L.DomEvent.disableClickPropagation(overlay);
     L.DomEvent.disableScrollPropagation(overlay);
     el.append(overlay);
+    this.overlay = overlay;
 
     this.map.on("moveend zoomend", () => this.drawGrid());
     this.map.on("click", (e: L.LeafletMouseEvent) => {
@@ -122,15 +124,20 @@ export class MapView {
     if (size.x === 0 || size.y === 0) return; // not laid out yet: Leaflet would zoom to the limit
     this.framing = true;
     try {
-      this.map.fitBounds([[want.south, want.west], [want.north, want.east]], { padding: [36, 36], maxZoom: 18, animate: false });
+      // The badges run along the top edge: keep the key geometry below them.
+      const top = this.overlay.offsetHeight + 24;
+      this.map.fitBounds([[want.south, want.west], [want.north, want.east]], { paddingTopLeft: [36, top], paddingBottomRight: [36, 36], maxZoom: 18, animate: false });
     } finally {
       this.framing = false;
     }
   }
 
+  /** The part of the view below the badge strip, where key geometry must stay. */
   private viewBox(): Box {
-    const b = this.map.getBounds();
-    return { south: b.getSouth(), west: b.getWest(), north: b.getNorth(), east: b.getEast() };
+    const size = this.map.getSize();
+    const nw = this.map.containerPointToLatLng([0, Math.min(size.y - 1, this.overlay.offsetHeight + 8)]);
+    const se = this.map.containerPointToLatLng([size.x, size.y]);
+    return { south: se.lat, west: nw.lng, north: nw.lat, east: se.lng };
   }
 
   /** Leaflet measures its container: call once the element is in the document and when it resizes. */

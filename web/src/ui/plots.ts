@@ -142,6 +142,9 @@ function drawStaleBands(u: uPlot, data: Series): void {
     ctx.stroke();
     if (x1 - x0 > 40 * devicePixelRatio) {
       ctx.fillStyle = "#000";
+      // uPlot leaves the context as its axes last set it (right-aligned labels).
+      ctx.textAlign = "left";
+      ctx.textBaseline = "alphabetic";
       ctx.font = `bold ${11 * devicePixelRatio}px sans-serif`;
       ctx.fillText("stale", x0 + 4 * devicePixelRatio, top + 14 * devicePixelRatio);
     }
