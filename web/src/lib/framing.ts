@@ -3,7 +3,7 @@
 // when something key is at the edge or out of view, or when everything has shrunk to a corner of
 // it — not at every 4 Hz state, which would make the map jitter and fight the eye.
 
-import { toLocal } from "./geo";
+import { fromLocal, toLocal } from "./geo";
 import { isLanded } from "./recovery";
 import type { LatLon, State } from "./types";
 
@@ -41,9 +41,7 @@ export function keyPoints(s: State): LatLon[] {
     if (!p) continue;
     // The ellipse's extent: its semi-major axis in every direction bounds it.
     const r = p.semi_major_m ?? 0;
-    const dLat = r / 111_320;
-    const dLon = r / (111_320 * Math.max(0.01, Math.cos((p.lat_deg * Math.PI) / 180)));
-    out.push({ lat_deg: p.lat_deg - dLat, lon_deg: p.lon_deg - dLon }, { lat_deg: p.lat_deg + dLat, lon_deg: p.lon_deg + dLon });
+    out.push(fromLocal(p, { east_m: -r, north_m: -r }), fromLocal(p, { east_m: r, north_m: r }));
   }
   return out.filter((p) => Number.isFinite(p.lat_deg) && Number.isFinite(p.lon_deg));
 }
@@ -56,15 +54,9 @@ export function boxAround(points: readonly LatLon[], minSpanM = MIN_SPAN_M): Box
     b = { south: Math.min(b.south, p.lat_deg), west: Math.min(b.west, p.lon_deg), north: Math.max(b.north, p.lat_deg), east: Math.max(b.east, p.lon_deg) };
   }
   const mid = { lat_deg: (b.south + b.north) / 2, lon_deg: (b.west + b.east) / 2 };
-  const half = minSpanM / 2;
-  const dLat = half / 111_320;
-  const dLon = half / (111_320 * Math.max(0.01, Math.cos((mid.lat_deg * Math.PI) / 180)));
-  return {
-    south: Math.min(b.south, mid.lat_deg - dLat),
-    north: Math.max(b.north, mid.lat_deg + dLat),
-    west: Math.min(b.west, mid.lon_deg - dLon),
-    east: Math.max(b.east, mid.lon_deg + dLon),
-  };
+  const sw = fromLocal(mid, { east_m: -minSpanM / 2, north_m: -minSpanM / 2 });
+  const ne = fromLocal(mid, { east_m: minSpanM / 2, north_m: minSpanM / 2 });
+  return { south: Math.min(b.south, sw.lat_deg), north: Math.max(b.north, ne.lat_deg), west: Math.min(b.west, sw.lon_deg), east: Math.max(b.east, ne.lon_deg) };
 }
 
 function sizeM(b: Box): { w: number; h: number } {
