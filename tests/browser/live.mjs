@@ -37,6 +37,7 @@ const OPERATOR = "operator-token";
 const VIEWER = "viewer-token";
 const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
 const started = Date.now();
+const FIELD_HOST = "stx-field.test";
 
 const results = [];
 let failed = false;
@@ -120,7 +121,9 @@ async function until(what, pred, timeoutMs, everyMs = 200) {
 
 const browser = await chromium.launch({
   executablePath: process.env.CHROMIUM ?? "/usr/bin/chromium",
-  args: ["--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking", "--disable-component-update", "--disable-sync", "--no-first-run", "--enable-unsafe-swiftshader"],
+  // FIELD_HOST is the station under a name that is not loopback, as a phone reaches the field
+  // laptop: plain HTTP there is not a secure context, so the browser gives no position.
+  args: ["--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking", "--disable-component-update", "--disable-sync", "--no-first-run", "--enable-unsafe-swiftshader", `--host-resolver-rules=MAP ${FIELD_HOST} 127.0.0.1`],
 });
 const text = (page, id) => page.locator(`[data-testid="${id}"]`).first().innerText();
 const attr = (page, id, name) => page.locator(`[data-testid="${id}"]`).first().getAttribute(name);
@@ -540,6 +543,18 @@ async function rehearsal() {
   const typedB = Number(/(\d{3})°/.exec(await text(npage, "rec-bearing"))?.[1]);
   check("no position: a typed position gives distance and bearing; nonsense is refused", /two coordinates|not understood/.test(bad) && Math.abs(typedD - wantD) <= 1.5 && angleDiff(typedB, wantB) <= 1, `"${bad}"; shown ${typedD} m / ${typedB}°, computed ${wantD.toFixed(1)} m / ${wantB.toFixed(1)}°`);
   await npage.screenshot({ path: join(out, "recovery-no-position.png"), fullPage: true });
+  // The same page over plain HTTP from another machine's point of view: no secure context. (The
+  // estimate of a landed drone still wanders by decimetres between polls.)
+  const pointNear = (t) => {
+    const [la, lo] = t.split(",").map(Number);
+    return Number.isFinite(la) && Number.isFinite(lo) && distanceM({ lat_deg: la, lon_deg: lo }, recPoint) < 5;
+  };
+  const field = base.replace("127.0.0.1", FIELD_HOST);
+  await npage.goto(`${field}/recovery.html?token=${VIEWER}`);
+  await npage.waitForFunction(() => document.querySelector('[data-testid="rec-kind"]')?.dataset.kind === "actual", null, { timeout: 10000 }).catch(() => {});
+  const insecure = { secure: await npage.evaluate(() => window.isSecureContext), why: await text(npage, "rec-phone-why").catch(() => ""), point: await text(npage, "rec-point-decimal") };
+  check("plain HTTP (not a secure context): the page says so and still gives the point", insecure.secure === false && /plain HTTP/.test(insecure.why) && pointNear(insecure.point), `secure ${insecure.secure}; "${insecure.why}"; point ${insecure.point}`);
+  await npage.screenshot({ path: join(out, "recovery-plain-http.png"), fullPage: true });
   await nctx.close();
 }
 

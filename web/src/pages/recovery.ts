@@ -217,7 +217,7 @@ function render(): void {
     setText(el.point, "");
     setText(el.decimal, "");
     setText(el.ttl, "");
-    el.arrow.style.visibility = "hidden";
+    el.arrow.hidden = true;
     el.copy.disabled = true;
   } else {
     el.copy.disabled = false;
@@ -236,13 +236,13 @@ function render(): void {
       const b = bearingDeg(from, pt);
       setText(el.distance, fmtDistance(d));
       setText(el.bearing, `bearing ${fmtDir(b)} (${cardinal(b)})`);
-      el.arrow.style.visibility = "visible";
+      el.arrow.hidden = false;
       el.arrow.style.transform = `rotate(${(deviceHeading === null ? b : wrap360(b - deviceHeading)).toFixed(0)}deg)`;
       setText(el.arrowNote, deviceHeading === null ? "arrow: north is up (no compass)" : "arrow: relative to where the phone points");
     } else {
       setText(el.distance, "— m");
       setText(el.bearing, "bearing —° (phone position unknown)");
-      el.arrow.style.visibility = "hidden";
+      el.arrow.hidden = true;
       setText(el.arrowNote, "");
     }
   }

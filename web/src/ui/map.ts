@@ -4,15 +4,14 @@
 // are always drawn, so positions stay readable when no tile loads (offline field, no cache).
 // While "follow" is on, the view frames the vehicle, target, pattern and predictions
 // (lib/framing.ts); a drag or zoom by the operator turns it off. Text about the geometry lives in
-// the corner badges, never on the map, so no label hides the target or the pattern.
+// the badge strip along the top, never on the map, so no label hides the target or the pattern.
 
 import L from "leaflet";
 import "leaflet/dist/leaflet.css";
 import { h, setText } from "./dom";
-import { ellipsePoints, fromLocal, gridValues, niceStep, toLocal } from "../lib/geo";
+import { distanceM, ellipsePoints, fromLocal, gridValues, niceStep, toLocal } from "../lib/geo";
 import { fmt, fmtDir, fmtDistance } from "../lib/format";
 import { boxAround, keyPoints, needsFraming, type Box } from "../lib/framing";
-import { distanceM } from "../lib/geo";
 import { isLanded } from "../lib/recovery";
 import { tilesBadge } from "../lib/tiles";
 import { withToken } from "../lib/token";
