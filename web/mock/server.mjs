@@ -627,7 +627,7 @@ const armed = new Map();
  * Test hooks, outside the API (the real daemon has none of these):
  *   POST /mock/link?down=1|0   force the drone link down (STALE) or let it follow the schedule
  *   POST /mock/garbage         broadcast malformed frames (the page must count them, not crash)
- *   GET  /mock/stats           manual messages received, per client role
+ *   GET  /mock/stats           manual and manual_release messages received
  */
 function mockControl(req, res, url) {
   if (req.method === "POST" && url.pathname === "/mock/link") {
@@ -644,10 +644,11 @@ function mockControl(req, res, url) {
     }
     return send(res, 200, { sent: 4 });
   }
-  if (req.method === "GET" && url.pathname === "/mock/stats") return send(res, 200, { manual_total: manualTotal });
+  if (req.method === "GET" && url.pathname === "/mock/stats") return send(res, 200, { manual_total: manualTotal, manual_releases: manualReleases });
   return err(res, 404, "not_found", "unknown mock hook");
 }
 let manualTotal = 0;
+let manualReleases = 0;
 
 const server = createServer((req, res) => {
   handle(req, res).catch((e) => {
@@ -693,6 +694,10 @@ server.on("upgrade", (req, socket, head) => {
         fl.manual = { y: clamp(m.y, -1, 1), z: clamp(m.z, 0, 1), at: fl.t };
         manualCount += 1;
         manualTotal += 1;
+      } else if (m.type === "manual_release") {
+        // As the daemon does: the sticks stop at once, not after the 0.5 s silence.
+        if (who.role === "operator") fl.manual = null;
+        manualReleases += 1;
       }
     });
     ws.on("close", () => clients.delete(client));

@@ -2,11 +2,13 @@
 // socket open, page focused and visible, a gamepad connected, and the dead-man held. The moment
 // one fails the stream stops — the station then stops uplinking within 0.5 s (API.md). While it
 // holds, messages go out at a steady 10 Hz from a timer, not from input events, so the rate is
-// what the station expects whatever the gamepad or the display does.
+// what the station expects whatever the gamepad or the display does. When a stream ends for any
+// reason but a dead socket, one `manual_release` follows, so the station stops at once rather
+// than after its 0.5 s silence timeout (a released dead-man must not fly on for half a second).
 //
 // Timers come from the global scope so tests drive them with fake timers; `now` is injectable.
 
-import type { ManualMsg } from "./types";
+import type { ManualMsg, ManualReleaseMsg } from "./types";
 
 export const MANUAL_RATE_HZ = 10;
 
@@ -32,7 +34,7 @@ export function blockedBy(g: ManualGate): string | null {
 
 export interface ManualSenderDeps {
   /** Sends one message; false if it could not be sent (socket gone), which stops the stream. */
-  send: (m: ManualMsg) => boolean;
+  send: (m: ManualMsg | ManualReleaseMsg) => boolean;
   /** The current stick message, or null if the gamepad vanished. */
   sample: () => ManualMsg | null;
   now?: () => number;
@@ -44,6 +46,8 @@ export class ManualSender {
   private readonly deps: Required<ManualSenderDeps>;
   /** Messages sent since the page loaded. */
   sent = 0;
+  /** `manual_release` messages sent since the page loaded (one per ended stream). */
+  releases = 0;
   lastSentMs: number | null = null;
   lastMsg: ManualMsg | null = null;
   /** Why we are not sending (null while sending). */
@@ -73,10 +77,13 @@ export class ManualSender {
 
   stop(why: string): void {
     this.blocked = why;
-    if (this.timer !== null) {
-      clearInterval(this.timer);
-      this.timer = null;
-    }
+    if (this.timer === null) return;
+    clearInterval(this.timer);
+    this.timer = null;
+    // Only a stream that ran is released, and only once: the gate is re-evaluated at 50 Hz and
+    // every later stop finds the timer already gone. A closed socket cannot carry it; the
+    // station's own timeout covers that case.
+    if (why !== "disconnected" && this.deps.send({ type: "manual_release" })) this.releases += 1;
   }
 
   /** Measured send rate over the last second, Hz. */

@@ -3,9 +3,9 @@
 import { describe, expect, it } from "vitest";
 import { backoffMs, BACKOFF_MAX_MS, BACKOFF_MIN_MS } from "./backoff";
 import { resolveToken, searchWithoutToken, TOKEN_KEY, withToken } from "./token";
-import { breakWraps, Series } from "./series";
-import { forecastAt } from "./wind";
-import { isLanded, recoveryPoint } from "./recovery";
+import { breakWraps, MAX_GAP_S, Series, staleSpans } from "./series";
+import { directionPieces, forecastAt, MeasuredProfile } from "./wind";
+import { isLanded, landingBadge, phaseLabel, recoveryPoint } from "./recovery";
 import { planBody } from "./plan";
 import { all, parseLat, parseNumber } from "./inputs";
 import { decodeMessage } from "./parse";
@@ -59,6 +59,32 @@ describe("Series", () => {
     expect(s.push(3, [2])).toBe(true);
     expect(s.t).toEqual([3]);
   });
+  // Regression: while the link was stale the plots drew the last values on as a flat live line.
+  it("stores stale samples as gaps and flags them", () => {
+    const s = new Series(["a", "b"], 600);
+    s.push(1, [1, 2]);
+    s.push(1.25, [1, 2], true);
+    s.push(1.5, [1, 2], true);
+    s.push(1.75, [3, 4]);
+    expect(s.cols[0]).toEqual([1, null, null, 3]);
+    expect(s.cols[1]).toEqual([2, null, null, 4]);
+    expect(s.kinds).toEqual(["live", "stale", "stale", "live"]);
+    expect(staleSpans(s.t, s.kinds)).toEqual([[1, 1.75]]);
+  });
+  it("breaks the line over a silence (socket stalled) instead of joining across it", () => {
+    const s = new Series(["a"], 600);
+    s.push(10, [1]);
+    s.push(10 + MAX_GAP_S, [1]); // a step of exactly the limit is still a line
+    s.push(30, [1]);
+    expect(s.cols[0]).toEqual([1, 1, null, 1]);
+    expect(s.t[2]).toBeCloseTo((13 + 30) / 2);
+    expect(staleSpans(s.t, s.kinds)).toEqual([[13, 30]]);
+  });
+  it("a stale run still going ends at the last sample", () => {
+    expect(staleSpans([1, 2, 3], ["live", "stale", "stale"])).toEqual([[1, 3]]);
+    expect(staleSpans([1, 2], ["stale", "live"])).toEqual([[1, 2]]);
+    expect(staleSpans([], [])).toEqual([]);
+  });
   it("breaks heading lines at the 360 → 0 wrap", () => {
     expect(breakWraps([350, 355, 2, 8, null, 10, -10])).toEqual([350, 355, null, 8, null, 10, null]);
   });
@@ -78,6 +104,31 @@ describe("forecastAt", () => {
     expect(forecastAt(p, 0)).toEqual({ speed_mps: 2, from_deg: 350 });
     expect(forecastAt(p, 5000)).toEqual({ speed_mps: 6, from_deg: 30 });
     expect(forecastAt([], 100)).toBeNull();
+  });
+});
+
+describe("wind profiles (speed and direction)", () => {
+  it("the measured profile averages per level, directions as vectors", () => {
+    const m = new MeasuredProfile(25);
+    m.add(1000, 3, 350);
+    m.add(1005, 5, 10);
+    m.add(500, 2, 270);
+    m.add(Number.NaN, 2, 270);
+    const pts = m.points();
+    expect(pts.map((p) => p.alt_msl_m)).toEqual([500, 1000]);
+    expect(pts[1]!.speed_mps).toBeCloseTo(4);
+    expect(Math.min(pts[1]!.from_deg, 360 - pts[1]!.from_deg)).toBeLessThan(1e-9);
+    expect(pts[0]!.from_deg).toBeCloseTo(270);
+  });
+  it("a direction profile is cut where it crosses north, and at missing directions", () => {
+    const pieces = directionPieces([
+      { alt_msl_m: 0, from_deg: 340 },
+      { alt_msl_m: 100, from_deg: 355 },
+      { alt_msl_m: 200, from_deg: 5 },
+      { alt_msl_m: 300, from_deg: null },
+      { alt_msl_m: 400, from_deg: -90 },
+    ]);
+    expect(pieces.map((p) => p.map((q) => q.from_deg))).toEqual([[340, 355], [5], [270]]);
   });
 });
 
@@ -109,6 +160,25 @@ describe("recoveryPoint", () => {
   it("falls back to what exists, or null", () => {
     expect(recoveryPoint(base({ prediction: { planned: null, uncontrolled: { lat_deg: 1, lon_deg: 2 } } }))?.kind).toBe("uncontrolled");
     expect(recoveryPoint(base({ prediction: null }))).toBeNull();
+  });
+
+  it("landing badge: a live countdown", () => {
+    expect(landingBadge(base({}), false, 0.2)).toEqual({ state: "live", text: "landing in 100 s" });
+    expect(landingBadge(base({ guidance: { mode: "uncontrolled" } }), false, 0.2).text).toBe("landing in 110 s (uncontrolled)");
+    expect(landingBadge(null, false, null).state).toBe("none");
+  });
+  // Regression: a stale link left "landing in N s" in the header as if it were current.
+  it("landing badge: stale data say so and how old they are", () => {
+    expect(landingBadge(base({}), true, 12)).toEqual({ state: "stale", text: "landing in 100 s as of 12 s ago — STALE" });
+  });
+  // Regression: after touchdown the header said "phase flare · landing in 0 s".
+  it("landed: the badge says where it landed, the phase says landed", () => {
+    const s = base({ mission: { stage: "landed" }, guidance: { mode: "spiral_landing", phase: "flare", target: { lat_deg: 38.6, lon_deg: -7.9001 } } });
+    const b = landingBadge(s, false, 0.1);
+    expect(b.state).toBe("landed");
+    expect(b.text).toBe("LANDED · 9 m from the target");
+    expect(phaseLabel(s)).toBe("landed");
+    expect(phaseLabel(base({ vehicle: { phase: "branch2" }, guidance: { phase: "flare" } }))).toBe("branch2");
   });
 });
 

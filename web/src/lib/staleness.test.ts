@@ -1,5 +1,5 @@
 import { describe, expect, it } from "vitest";
-import { judgeStaleness, messageAges } from "./staleness";
+import { judgeStaleness, linkStale, messageAges } from "./staleness";
 import type { Link } from "./types";
 
 const link = (over: Partial<Link> = {}): Link => ({
@@ -48,5 +48,15 @@ describe("messageAges", () => {
     // HEARTBEAT comes at 1 Hz: 3.1 s is within its 3.5 s; GPS at 2.1 s is past the 2 s limit.
     expect(ages.map((a) => [a.name, a.old])).toEqual([["HEARTBEAT", false], ["GPS_RAW_INT", true], ["ATTITUDE", false]]);
     expect(ages[0]!.age_s).toBeCloseTo(3.1);
+  });
+});
+
+describe("linkStale", () => {
+  it("a sample is stale when the station says so, the link is down, or its age is over the limit or unknown", () => {
+    expect(linkStale(link({}))).toBe(false);
+    expect(linkStale(link({ stale: true }))).toBe(true);
+    expect(linkStale(link({ connected: false }))).toBe(true);
+    expect(linkStale(link({ age_s: 2.5 }))).toBe(true);
+    expect(linkStale(link({ age_s: null }))).toBe(true);
   });
 });

@@ -51,6 +51,14 @@ export function judgeStaleness({ socketOpen, link, receivedAtMs, nowMs }: StaleI
   return { freshness, stale: reasons.length > 0, age_s, reasons };
 }
 
+/**
+ * Whether one state's vehicle data were already old when the station built it: what the plots
+ * use for each sample (the page's own clock does not matter for a sample's past).
+ */
+export function linkStale(link: Link): boolean {
+  return link.stale || !link.connected || link.age_s === null || link.age_s > LINK_AGE_STALE_S;
+}
+
 export interface MessageAge {
   name: string;
   age_s: number;

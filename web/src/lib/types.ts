@@ -215,3 +215,12 @@ export interface ManualMsg {
   r: number;
   buttons: number;
 }
+
+/**
+ * Sent once when a manual stream ends on the operator's side (dead-man released, focus or
+ * visibility lost, gamepad gone): the station stops uplinking MANUAL_CONTROL at once instead of
+ * waiting out its 0.5 s silence timeout.
+ */
+export interface ManualReleaseMsg {
+  type: "manual_release";
+}

@@ -33,3 +33,71 @@ export function forecastAt(profile: readonly ForecastWind[], alt_msl_m: number):
   }
   return null;
 }
+
+/** Height of one level of the measured profile, m. */
+export const PROFILE_BIN_M = 25;
+
+export interface ProfilePoint {
+  alt_msl_m: number;
+  speed_mps: number;
+  from_deg: number;
+}
+
+/**
+ * The wind the drone has measured on its way down, one averaged point per `PROFILE_BIN_M`: what
+ * the forecast profile is compared with. Directions are averaged as vectors (350° and 10° give
+ * 0°, not 180°). Fed only with current (not stale) estimates.
+ */
+export class MeasuredProfile {
+  private readonly bins = new Map<number, { n: number; speed: number; e: number; n_: number }>();
+
+  constructor(readonly binM = PROFILE_BIN_M) {}
+
+  add(alt_msl_m: number, speed_mps: number, from_deg: number): void {
+    if (![alt_msl_m, speed_mps, from_deg].every(Number.isFinite)) return;
+    const k = Math.round(alt_msl_m / this.binM);
+    const b = this.bins.get(k) ?? { n: 0, speed: 0, e: 0, n_: 0 };
+    const r = (from_deg * Math.PI) / 180;
+    b.n += 1;
+    b.speed += speed_mps;
+    b.e += Math.sin(r);
+    b.n_ += Math.cos(r);
+    this.bins.set(k, b);
+  }
+
+  clear(): void {
+    this.bins.clear();
+  }
+
+  /** The levels, lowest first. */
+  points(): ProfilePoint[] {
+    return [...this.bins.entries()]
+      .sort((a, b) => a[0] - b[0])
+      .map(([k, b]) => ({ alt_msl_m: k * this.binM, speed_mps: b.speed / b.n, from_deg: wrap360((Math.atan2(b.e, b.n_) * 180) / Math.PI) }));
+  }
+}
+
+/**
+ * A direction profile as polyline pieces on a 0…360 axis: a piece ends where the direction
+ * crosses north (350° → 10°), where a straight line would sweep across the whole chart.
+ */
+export function directionPieces(points: readonly { alt_msl_m: number; from_deg: number | null }[]): { alt_msl_m: number; from_deg: number }[][] {
+  const out: { alt_msl_m: number; from_deg: number }[][] = [];
+  let cur: { alt_msl_m: number; from_deg: number }[] = [];
+  for (const p of points) {
+    if (p.from_deg === null || !Number.isFinite(p.from_deg)) {
+      if (cur.length > 0) out.push(cur);
+      cur = [];
+      continue;
+    }
+    const d = wrap360(p.from_deg);
+    const prev = cur[cur.length - 1];
+    if (prev !== undefined && Math.abs(d - prev.from_deg) > 180) {
+      out.push(cur);
+      cur = [];
+    }
+    cur.push({ alt_msl_m: p.alt_msl_m, from_deg: d });
+  }
+  if (cur.length > 0) out.push(cur);
+  return out;
+}

@@ -9,6 +9,7 @@ import { CommandTracker, type CommandEntry } from "../lib/commands";
 import { fmt, fmtMissionTime, label } from "../lib/format";
 import { parseParams, parseSession, isObj } from "../lib/parse";
 import { LiveSocket, type SocketStatus } from "../lib/socket";
+import { landingBadge, phaseLabel } from "../lib/recovery";
 import { judgeStaleness, type StaleVerdict } from "../lib/staleness";
 import { resolveToken, searchWithoutToken, withToken } from "../lib/token";
 import type { EventMsg, Level, Session, State, TrackPoint } from "../lib/types";
@@ -175,13 +176,15 @@ function build(session: Session): void {
   const hdrMode = h("span", { class: "badge", "data-testid": "hdr-mode" });
   const hdrStage = h("span", { class: "badge", "data-testid": "hdr-stage" });
   const hdrPhase = h("span", { class: "badge", "data-testid": "hdr-phase" });
-  const hdrLink = h("span", { class: "badge", "data-testid": "hdr-link" });
+  const hdrLink = h("span", { class: "badge", "data-testid": "hdr-link", title: "drone link: message rate, share lost, age of the last message" });
   const hdrLanding = h("span", { class: "badge", "data-testid": "hdr-landing" });
-  const kml = h("a", { href: withToken("/kml", token), "data-testid": "kml-link", class: "linkbtn", title: "open in Google Earth: a network link that refreshes every 2 s" }, "KML (Google Earth)");
-  const recovery = h("a", { href: "recovery.html", target: "_blank", rel: "noopener", "data-testid": "recovery-link", class: "linkbtn" }, "Recovery view");
+  const kml = h("a", { href: withToken("/kml", token), "data-testid": "kml-link", class: "linkbtn", title: "open in Google Earth: a network link that refreshes every 2 s" }, "KML");
+  // The recovery page opens in a new tab, which does not share this tab's sessionStorage: the
+  // token goes in its address (the page takes it out of the address bar at once, as this one does).
+  const recovery = h("a", { href: withToken("recovery.html", token), target: "_blank", rel: "noopener", "data-testid": "recovery-link", class: "linkbtn", title: "the recovery team's page for phones (new tab)" }, "Recovery");
   const header = h("header", { class: "top" },
     h("strong", { class: "station" }, station.name), clock, conn, roleBadge,
-    h("span", { class: "hdr-group" }, "mode ", hdrMode, " stage ", hdrStage, " phase ", hdrPhase),
+    h("span", { class: "hdr-group" }, h("small", {}, "mode "), hdrMode, h("small", {}, " stage "), hdrStage, h("small", {}, " phase "), hdrPhase),
     hdrLink, hdrLanding, h("span", { class: "spacer" }), kml, recovery);
   const banner = h("div", { class: "banner", role: "alert", "data-testid": "banner", hidden: true });
   const viewerNote = h("div", { class: "viewer-note", "data-testid": "viewer-note" }, `Viewer: you can watch everything; commanding needs the operator role (${OPERATOR_REQUIRED}).`);
@@ -272,9 +275,7 @@ function build(session: Session): void {
     setText(clock, fmtMissionTime(s.time_s));
     setText(hdrMode, label(s.vehicle?.mode ?? s.guidance?.mode));
     setText(hdrStage, label(s.mission.stage ?? s.vehicle?.stage));
-    setText(hdrPhase, label(s.guidance?.phase ?? s.vehicle?.phase));
-    const p = s.prediction?.planned ?? s.prediction?.uncontrolled ?? null;
-    setText(hdrLanding, p ? `landing in ${fmt(p.time_to_land_s, "s", 0)}` : "landing —");
+    setText(hdrPhase, label(phaseLabel(s)));
   }
 
   /** Staleness and connection state: runs on every state and on a timer (ages grow in silence). */
@@ -288,8 +289,13 @@ function build(session: Session): void {
     const connText = st.kind === "open" ? "CONNECTED" : st.kind === "connecting" ? "CONNECTING…" : `DISCONNECTED — retry in ${Math.max(0, (st.retryAtMs - now) / 1000).toFixed(0)} s`;
     setText(conn, connText);
     conn.dataset.state = st.kind;
-    setText(hdrLink, latest ? `link ${fmt(latest.link.rate_hz, "Hz", 0)} · loss ${fmt(latest.link.loss_percent, "%")} · age ${fmt(verdict.age_s, "s")}` : "link —");
+    setText(hdrLink, latest ? `${fmt(latest.link.rate_hz, "Hz", 0)} · ${fmt(latest.link.loss_percent, "%")} lost · ${fmt(verdict.age_s, "s")} old` : "link —");
     hdrLink.dataset.state = verdict.freshness;
+    // Derived from the vehicle's data: shown stale with them (ages grow in silence, hence here).
+    const lb = landingBadge(latest, verdict.stale, verdict.age_s);
+    setText(hdrLanding, lb.text);
+    hdrLanding.dataset.state = lb.state;
+    for (const b of [hdrMode, hdrStage, hdrPhase]) b.classList.toggle("stale", verdict.stale);
     if (st.kind !== "open") {
       banner.hidden = false;
       banner.dataset.kind = "disconnected";

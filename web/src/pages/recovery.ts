@@ -2,6 +2,9 @@
 // landing point), how far and which way from the phone, and links to open the point in the
 // phone's map app. It polls /api/state (simpler than a socket over a flaky mobile link) and keeps
 // the last state in localStorage, so it still shows the last known point with no network.
+// Without the phone's position (permission refused, or plain HTTP, where browsers give none) the
+// page stays useful: the point to copy or open, why there is no position, and a field to type or
+// paste one.
 
 import "../styles/common.css";
 import "../styles/recovery.css";
@@ -9,6 +12,7 @@ import { Api } from "../lib/api";
 import { bearingDeg, distanceM } from "../lib/geo";
 import { cardinal, fmtDir, fmtDistance, fmtDuration, fmtLatLon, fmtWallUtc, wrap360 } from "../lib/format";
 import { isObj, parseState } from "../lib/parse";
+import { parsePosition, positionUnavailable } from "../lib/position";
 import { recoveryPoint } from "../lib/recovery";
 import { resolveToken, searchWithoutToken } from "../lib/token";
 import type { LatLon, State } from "../lib/types";
@@ -27,7 +31,9 @@ let state: State | null = null;
 let stateAtMs: number | null = null; // page clock when fetched
 let fromCache = false;
 let phone: (LatLon & { accuracy_m: number }) | null = null;
-let phoneError = "";
+/** A position typed or pasted by hand: used instead of the browser's while set. */
+let manual: LatLon | null = null;
+let geoErrorCode: number | null = null;
 let deviceHeading: number | null = null;
 let fetchError = "";
 
@@ -44,13 +50,49 @@ const el = {
   updated: h("div", { "data-testid": "rec-updated" }),
   stale: h("div", { class: "stale-flag", role: "alert", "data-testid": "rec-stale" }),
   phone: h("div", { class: "muted", "data-testid": "rec-phone" }),
+  why: h("div", { class: "why", role: "status", "data-testid": "rec-phone-why" }),
+  decimal: h("div", { class: "mid mono", "data-testid": "rec-point-decimal" }),
+  copy: h("button", { type: "button", class: "btn", "data-testid": "rec-copy" }, "Copy coordinates"),
+  copyStatus: h("div", { class: "small", "data-testid": "rec-copy-status", role: "status" }),
+  phoneInput: h("input", { type: "text", inputmode: "text", autocomplete: "off", placeholder: "e.g. 38.5333, -7.8889 or a geo:/map link", "data-testid": "rec-phone-input", "aria-label": "your position: latitude, longitude" }),
+  phoneSet: h("button", { type: "button", class: "btn", "data-testid": "rec-phone-set" }, "Use"),
+  phoneClear: h("button", { type: "button", class: "btn", "data-testid": "rec-phone-clear", hidden: true }, "Forget"),
+  phoneErr: h("div", { class: "form-error", role: "alert", "data-testid": "rec-phone-error" }),
+  manualBox: h("details", { class: "manual", "data-testid": "rec-manual" }),
 };
+el.manualBox.append(
+  h("summary", {}, "Enter your position by hand"),
+  h("div", { class: "manual-row" }, el.phoneInput, el.phoneSet, el.phoneClear),
+  el.phoneErr,
+);
 
 document.getElementById("app")!.replaceChildren(
   h("header", {}, h("strong", {}, "STRAPLEX recovery"), h("a", { href: "index.html", class: "muted small" }, "live page")),
   el.stale,
-  h("main", {}, el.kind, el.arrow, el.arrowNote, el.distance, el.bearing, el.point, el.ttl, h("div", { class: "links" }, el.geo, el.osm), el.updated, el.phone),
+  h("main", {}, el.kind, el.arrow, el.arrowNote, el.distance, el.bearing, el.point, el.decimal, el.ttl,
+    h("div", { class: "links" }, el.geo, el.osm, el.copy), el.copyStatus, el.updated, el.phone, el.why, el.manualBox),
 );
+
+el.copy.addEventListener("click", () => void copyPoint());
+const usePhoneInput = (): void => {
+  const r = parsePosition(el.phoneInput.value);
+  if (!r.ok) {
+    setText(el.phoneErr, r.error);
+    return;
+  }
+  manual = r.value;
+  setText(el.phoneErr, "");
+  render();
+};
+el.phoneSet.addEventListener("click", usePhoneInput);
+el.phoneInput.addEventListener("keydown", (e) => {
+  if (e.key === "Enter") usePhoneInput();
+});
+el.phoneClear.addEventListener("click", () => {
+  manual = null;
+  el.phoneInput.value = "";
+  render();
+});
 
 loadCache();
 render();
@@ -101,26 +143,51 @@ function loadCache(): void {
 }
 
 function watchPhone(): void {
-  if (!window.isSecureContext) {
-    phoneError = "phone position needs HTTPS (or localhost): open this page over https";
-    return;
-  }
-  if (!("geolocation" in navigator)) {
-    phoneError = "this browser has no geolocation";
-    return;
-  }
+  if (!window.isSecureContext || !("geolocation" in navigator)) return; // render() says why
   navigator.geolocation.watchPosition(
     (p) => {
       phone = { lat_deg: p.coords.latitude, lon_deg: p.coords.longitude, accuracy_m: p.coords.accuracy };
-      phoneError = "";
+      geoErrorCode = null;
       render();
     },
     (e) => {
-      phoneError = `phone position unavailable: ${e.message || "permission denied"}`;
+      // A watch keeps trying after a timeout or a lost fix; the last position stays shown until
+      // a refusal, which is final.
+      geoErrorCode = e.code;
+      if (e.code === 1) phone = null;
       render();
     },
     { enableHighAccuracy: true, maximumAge: 5000, timeout: 30000 },
   );
+}
+
+/** The point as "lat, lon" in decimal degrees: what map apps and messengers accept. */
+function decimal(p: LatLon): string {
+  return `${p.lat_deg.toFixed(6)}, ${p.lon_deg.toFixed(6)}`;
+}
+
+async function copyPoint(): Promise<void> {
+  const pt = state ? recoveryPoint(state) : null;
+  if (pt === null) return;
+  const text = decimal(pt);
+  try {
+    // The async clipboard needs a secure page; plain HTTP gets the old selection copy.
+    if (navigator.clipboard && window.isSecureContext) await navigator.clipboard.writeText(text);
+    else legacyCopy(text);
+    setText(el.copyStatus, `copied: ${text}`);
+  } catch {
+    setText(el.copyStatus, `could not copy — select it by hand: ${text}`);
+  }
+}
+
+function legacyCopy(text: string): void {
+  const ta = h("textarea", { readonly: true, style: "position:fixed;top:-100px;opacity:0" });
+  ta.value = text;
+  document.body.append(ta);
+  ta.select();
+  const ok = document.execCommand("copy");
+  ta.remove();
+  if (!ok) throw new Error("copy refused");
 }
 
 /** Compass heading of the phone, where the browser gives an absolute one; else the arrow is north-up. */
@@ -148,30 +215,54 @@ function render(): void {
     setText(el.distance, "— m");
     setText(el.bearing, "bearing —°");
     setText(el.point, "");
+    setText(el.decimal, "");
     setText(el.ttl, "");
-    el.arrow.style.visibility = "hidden";
+    el.arrow.hidden = true;
+    el.copy.disabled = true;
   } else {
+    el.copy.disabled = false;
     setText(el.kind, pt.kind === "actual" ? "LANDED — actual position" : pt.kind === "planned" ? "Predicted landing (guided)" : "Predicted landing (uncontrolled)");
     el.kind.dataset.kind = pt.kind;
     setText(el.point, fmtLatLon(pt.lat_deg, pt.lon_deg));
+    setText(el.decimal, decimal(pt));
+    el.point.dataset.lat = pt.lat_deg.toFixed(7);
+    el.point.dataset.lon = pt.lon_deg.toFixed(7);
     setText(el.ttl, pt.kind === "actual" ? "" : `lands in ${fmtDuration(pt.time_to_land_s)}${pt.semi_major_m !== null ? ` · ±${Math.round(pt.semi_major_m)} m (1σ)` : ""}`);
     el.geo.setAttribute("href", `geo:${pt.lat_deg.toFixed(6)},${pt.lon_deg.toFixed(6)}`);
     el.osm.setAttribute("href", `https://www.openstreetmap.org/?mlat=${pt.lat_deg.toFixed(6)}&mlon=${pt.lon_deg.toFixed(6)}#map=17/${pt.lat_deg.toFixed(6)}/${pt.lon_deg.toFixed(6)}`);
-    if (phone) {
-      const d = distanceM(phone, pt);
-      const b = bearingDeg(phone, pt);
+    const from = manual ?? phone;
+    if (from) {
+      const d = distanceM(from, pt);
+      const b = bearingDeg(from, pt);
       setText(el.distance, fmtDistance(d));
       setText(el.bearing, `bearing ${fmtDir(b)} (${cardinal(b)})`);
-      el.arrow.style.visibility = "visible";
+      el.arrow.hidden = false;
       el.arrow.style.transform = `rotate(${(deviceHeading === null ? b : wrap360(b - deviceHeading)).toFixed(0)}deg)`;
       setText(el.arrowNote, deviceHeading === null ? "arrow: north is up (no compass)" : "arrow: relative to where the phone points");
     } else {
       setText(el.distance, "— m");
       setText(el.bearing, "bearing —° (phone position unknown)");
-      el.arrow.style.visibility = "hidden";
+      el.arrow.hidden = true;
       setText(el.arrowNote, "");
     }
   }
   setText(el.updated, state ? `last update ${fmtWallUtc(state.wall_ms ?? stateAtMs)} · ${ageS === null ? "" : `${fmtDuration(ageS)} ago`}` : "");
-  setText(el.phone, phone ? `phone ${fmtLatLon(phone.lat_deg, phone.lon_deg)} ±${Math.round(phone.accuracy_m)} m` : phoneError || "locating the phone…");
+  const noPos = positionUnavailable({ secure: window.isSecureContext, hasGeolocation: "geolocation" in navigator, errorCode: geoErrorCode, origin: location.origin });
+  const phoneText = manual
+    ? `from your position entered by hand: ${fmtLatLon(manual.lat_deg, manual.lon_deg)}`
+    : phone
+      ? `phone ${fmtLatLon(phone.lat_deg, phone.lon_deg)} ±${Math.round(phone.accuracy_m)} m`
+      : noPos
+        ? "phone position unavailable"
+        : "locating the phone…";
+  setText(el.phone, phoneText);
+  setText(el.why, phone ? "" : (noPos ?? ""));
+  el.why.hidden = phone !== null || noPos === null;
+  el.phone.dataset.source = manual ? "manual" : phone ? "gps" : noPos ? "unavailable" : "locating";
+  el.phoneClear.hidden = manual === null;
+  // Without the phone's own position, typing one is the way to get distance and bearing.
+  if (!phone && noPos && !el.manualBox.dataset.opened) {
+    el.manualBox.open = true;
+    el.manualBox.dataset.opened = "1";
+  }
 }

@@ -15,7 +15,7 @@ const field = (lbl: string, testid: string, attrs: Record<string, string> = {}):
   const input = h("input", { type: "text", inputmode: "decimal", "data-testid": testid, "data-command": true, "aria-label": lbl, ...attrs });
   return { root: h("label", { class: "field" }, h("span", {}, lbl), input), input };
 };
-const button = (text: string, testid: string, cls = ""): HTMLButtonElement => h("button", { type: "button", "data-testid": testid, "data-command": true, class: cls }, text);
+const button = (text: string, testid: string, cls = "", aria?: string): HTMLButtonElement => h("button", { type: "button", "data-testid": testid, "data-command": true, class: cls, "aria-label": aria ?? null }, text);
 const errorLine = (testid: string): HTMLElement => h("div", { class: "form-error", role: "alert", "data-testid": testid });
 
 export class ModeButtons {
@@ -50,7 +50,7 @@ export class TargetEditor {
   readonly root: HTMLElement;
   private readonly lat = field("Latitude °", "target-lat");
   private readonly lon = field("Longitude °", "target-lon");
-  private readonly alt = field("Altitude MSL m", "target-alt");
+  private readonly alt = field("Alt. MSL m", "target-alt");
   private readonly course = field("Course °", "target-approach-course");
   private readonly intoWind: HTMLInputElement;
   private readonly fixed: HTMLInputElement;
@@ -80,9 +80,9 @@ export class TargetEditor {
     });
     this.root = panel("Landing target", "panel-target",
       h("div", { class: "form-row" }, this.lat.root, this.lon.root, pick),
-      h("div", { class: "form-row" }, this.alt.root),
-      h("div", { class: "form-row", role: "radiogroup", "aria-label": "approach course" },
-        h("label", {}, this.intoWind, " into the wind"), h("label", {}, this.fixed, " fixed"), this.course.root),
+      h("div", { class: "form-row" }, this.alt.root,
+        h("div", { class: "approach", role: "radiogroup", "aria-label": "approach course" },
+          h("span", {}, "Approach"), h("div", {}, h("label", {}, this.intoWind, " into the wind"), " ", h("label", {}, this.fixed, " fixed"))), this.course.root),
       h("div", { class: "form-row" }, sendBtn), this.err);
   }
 
@@ -113,7 +113,7 @@ export class GuidanceInputs {
   constructor(send: SendCommand, picks: PickGroup, map: MapView) {
     const hd = field("Heading °", "heading-input");
     const hdErr = errorLine("heading-error");
-    const hdBtn = button("Send heading", "heading-send");
+    const hdBtn = button("Send", "heading-send", "", "send heading");
     hdBtn.addEventListener("click", () => {
       const v = parseDeg(hd.input.value, "heading");
       hdErr.textContent = v.ok ? "" : v.error;
@@ -121,7 +121,7 @@ export class GuidanceInputs {
     });
     const cs = field("Course °", "course-input");
     const csErr = errorLine("course-error");
-    const csBtn = button("Send course", "course-send");
+    const csBtn = button("Send", "course-send", "", "send course");
     csBtn.addEventListener("click", () => {
       const v = parseDeg(cs.input.value, "course");
       csErr.textContent = v.ok ? "" : v.error;
@@ -146,7 +146,7 @@ export class GuidanceInputs {
       draw();
     });
     for (const f of [lat, lon, crs]) f.input.addEventListener("input", draw);
-    const lzBtn = button("Send localizer", "localizer-send");
+    const lzBtn = button("Send", "localizer-send", "", "send localizer");
     lzBtn.addEventListener("click", () => {
       const c = all(parseLat(lat.input.value), parseLon(lon.input.value), parseDeg(crs.input.value, "course"));
       if (!c.ok) {
@@ -167,8 +167,7 @@ export class GuidanceInputs {
     });
 
     this.root = panel("Heading · course · localizer", "panel-guidance-inputs",
-      h("div", { class: "form-row" }, hd.root, hdBtn), hdErr,
-      h("div", { class: "form-row" }, cs.root, csBtn), csErr,
+      h("div", { class: "form-row" }, hd.root, hdBtn, h("span", { class: "sep" }), cs.root, csBtn), hdErr, csErr,
       h("h3", {}, "Localizer"),
       h("div", { class: "form-row" }, lat.root, lon.root, pick),
       h("div", { class: "form-row" }, crs.root, gs.root, lzBtn), lzErr);

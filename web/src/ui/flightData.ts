@@ -11,22 +11,27 @@ export class FlightData {
   private readonly rows: Row[] = [];
 
   constructor() {
-    const grid = h("div", { class: "ro-grid" });
+    // Numbers in three columns, the longer texts (position, GPS, air, battery) as one line each
+    // below: the left column must hold every panel down to the link without scrolling.
+    const grid = h("div", { class: "ro-grid three" });
+    const list = h("div", { class: "ro-list" });
+    let into = grid;
     const add = (lbl: string, id: string, get: (s: State) => string, title?: string): void => {
       const r = readout(lbl, id, title);
-      grid.append(r.root);
+      into.append(r.root);
       this.rows.push({ value: r.value, get });
     };
     add("Airspeed", "ro-airspeed", (s) => fmt(s.estimate?.airspeed_mps ?? s.vehicle?.air?.airspeed_mps, "m/s"));
     add("Ground speed", "ro-groundspeed", (s) => fmt(s.estimate?.ground_speed_mps, "m/s"));
     add("Sink rate", "ro-sink", (s) => fmt(s.estimate?.sink_rate_mps, "m/s"), "positive down");
     add("Heading rate", "ro-heading-rate", (s) => fmt(s.estimate?.heading_rate_dps, "°/s"));
-    add("Glide (air)", "ro-glide-air", (s) => fmt(s.estimate?.glide_ratio_air, ": 1", 2), "horizontal air distance per metre of height");
-    add("Glide (ground)", "ro-glide-ground", (s) => fmt(s.estimate?.glide_ratio_ground, ": 1", 2), "horizontal ground distance per metre of height");
+    add("Glide air", "ro-glide-air", (s) => fmt(s.estimate?.glide_ratio_air, ": 1", 2), "horizontal air distance per metre of height");
+    add("Glide gnd", "ro-glide-ground", (s) => fmt(s.estimate?.glide_ratio_ground, ": 1", 2), "horizontal ground distance per metre of height");
     add("Altitude MSL", "ro-alt-msl", (s) => fmt(s.estimate?.alt_msl_m ?? s.vehicle?.gps?.alt_msl_m, "m", 0));
     add("Height AGL", "ro-height", (s) => fmt(s.estimate?.height_m, "m", 0), "height above the ground at the station origin");
-    add("Position", "ro-position", (s) => fmtLatLon(s.estimate?.lat_deg ?? s.vehicle?.gps?.lat_deg, s.estimate?.lon_deg ?? s.vehicle?.gps?.lon_deg));
     add("Position σ", "ro-pos-sigma", (s) => fmt(s.estimate?.position_sigma_m, "m"));
+    into = list;
+    add("Position", "ro-position", (s) => fmtLatLon(s.estimate?.lat_deg ?? s.vehicle?.gps?.lat_deg, s.estimate?.lon_deg ?? s.vehicle?.gps?.lon_deg));
     add("GPS", "ro-gps", (s) => {
       const g = s.vehicle?.gps;
       return g ? `${label(g.fix)} · ${fmt(g.satellites, "sats", 0)} · ±${fmt(g.h_acc_m, "m")}` : "—";
@@ -39,7 +44,7 @@ export class FlightData {
       const p = s.vehicle?.power;
       return p ? `${fmt(p.voltage_v, "V", 2)} · ${fmt(p.current_a, "A", 2)} · ${fmt(p.remaining_percent, "%", 0)}` : "—";
     });
-    this.root = panel("Flight data", "panel-flight", grid);
+    this.root = panel("Flight data", "panel-flight", grid, list);
   }
 
   update(s: State): void {
@@ -82,7 +87,8 @@ export class Actuators {
   private readonly right = new Bar("Brake R", "act-brake-right", false);
 
   constructor() {
-    this.root = panel("Actuators (−1…1, 0…1; tick: commanded)", "panel-actuators", this.main.root, this.left.root, this.right.root);
+    this.root = panel("Actuators", "panel-actuators", this.main.root, this.left.root, this.right.root);
+    this.root.title = "main line −1…1 (bar from the centre), brakes 0…1; the magenta tick is what guidance commands";
   }
 
   update(s: State): void {

@@ -6,7 +6,7 @@
 import { h, panel, s, setAttr, setText } from "./dom";
 import { firstPad, manualMessage, readSticks, type PadLike, type Sticks } from "../lib/joystick";
 import { ManualSender, MANUAL_RATE_HZ, type ManualGate } from "../lib/manualSender";
-import type { ManualMsg } from "../lib/types";
+import type { ManualMsg, ManualReleaseMsg } from "../lib/types";
 
 const POLL_MS = 20;
 
@@ -31,7 +31,7 @@ export class JoystickPanel {
   private padId = "";
   private lastPaint = 0;
 
-  constructor(send: (m: ManualMsg) => boolean) {
+  constructor(send: (m: ManualMsg | ManualReleaseMsg) => boolean) {
     this.sender = new ManualSender({ send, sample: () => this.sample() });
     this.status = h("span", { "data-testid": "joystick-status" });
     this.deadmanEl = h("span", { class: "deadman", "data-testid": "joystick-deadman" });
@@ -89,7 +89,7 @@ export class JoystickPanel {
     this.root = panel("Manual (joystick)", "panel-joystick",
       h("div", { class: "joy" }, stick as unknown as Node,
         h("div", { class: "joy-info" },
-          h("div", {}, "Gamepad: ", this.status),
+          h("div", { class: "pad-id" }, "Gamepad: ", this.status),
           h("div", {}, this.valuesEl),
           h("div", {}, "Dead-man: ", this.deadmanEl),
           h("div", {}, this.sendingEl),
@@ -152,7 +152,7 @@ export class JoystickPanel {
     if (!force && now - this.lastPaint < 100) return;
     this.lastPaint = now;
     const st = this.sticks;
-    setText(this.status, st ? this.padId || "connected" : "none — connect one and press a button");
+    setText(this.status, st ? this.padId || "connected" : "none (connect, press a button)");
     setAttr(this.dot, "cx", String(50 + 46 * (st?.mainLine ?? 0)));
     setAttr(this.dot, "cy", String(4 + 92 * (st?.brake ?? 0)));
     setText(this.valuesEl, st ? `main line ${st.mainLine >= 0 ? "+" : ""}${st.mainLine.toFixed(2)} · brake ${st.brake.toFixed(2)}` : "main line — · brake —");
@@ -163,7 +163,7 @@ export class JoystickPanel {
     setText(this.sendingEl, sending ? `SENDING at ${MANUAL_RATE_HZ} Hz` : `not sending: ${this.sender.blocked ?? "—"}`);
     this.sendingEl.dataset.sending = String(sending);
     const last = this.sender.lastSentMs;
-    setText(this.rateEl, `limit ${MANUAL_RATE_HZ} Hz · measured ${this.sender.rateHz().toFixed(0)} Hz · last sent ${last === null ? "never" : `${((Date.now() - last) / 1000).toFixed(1)} s ago`} · ${this.sender.sent} sent`);
+    setText(this.rateEl, `${this.sender.rateHz().toFixed(0)} of ${MANUAL_RATE_HZ} Hz · last ${last === null ? "never" : `${((Date.now() - last) / 1000).toFixed(1)} s ago`} · ${this.sender.sent} sent · ${this.sender.releases} released`);
     this.hold.classList.toggle("on", this.screenHold);
   }
 }

@@ -20,16 +20,16 @@ export class LinkPanel {
   constructor() {
     const r = readout("Rate", "link-rate");
     const l = readout("Loss", "link-loss");
-    const a = readout("Last message", "link-age");
-    const e = readout("CRC / parse / sig errors", "link-errors");
-    const b = readout("Bad station messages", "link-bad-messages", "messages from the station this page could not read");
+    const a = readout("Last msg", "link-age", "age of the last message from the drone");
+    const e = readout("CRC/parse/sig", "link-errors", "frames refused: CRC errors / parse errors / signature errors");
+    const b = readout("Bad msgs", "link-bad-messages", "messages from the station this page could not read");
     const st = readout("Link", "link-state");
     [this.rate, this.loss, this.age, this.errors, this.bad, this.state] = [r.value, l.value, a.value, e.value, b.value, st.value];
     this.agesBody = h("tbody");
     const details = h("details", { class: "ages", "data-testid": "link-details" },
       h("summary", { "data-testid": "link-details-toggle" }, "Per-message ages"),
       h("table", { "data-testid": "link-ages-table" }, h("thead", {}, h("tr", {}, h("th", {}, "message"), h("th", {}, "age"))), this.agesBody));
-    this.root = panel("Link", "panel-link", h("div", { class: "ro-grid" }, st.root, r.root, l.root, a.root, e.root, b.root), details);
+    this.root = panel("Link", "panel-link", h("div", { class: "ro-grid three" }, st.root, r.root, l.root, a.root, e.root, b.root), details);
   }
 
   update(link: Link | null, verdict: StaleVerdict, stats: MessageStats, receivedAtMs: number | null, nowMs: number): void {

@@ -2,12 +2,18 @@
 // predicted landing points with their 1-σ ellipses, wind arrow, and drafts being edited. Tiles
 // come from the station's `tile_url`; a metric grid around the session origin and a scale bar
 // are always drawn, so positions stay readable when no tile loads (offline field, no cache).
+// While "follow" is on, the view frames the vehicle, target, pattern and predictions
+// (lib/framing.ts); a drag or zoom by the operator turns it off. Text about the geometry lives in
+// the badge strip along the top, never on the map, so no label hides the target or the pattern.
 
 import L from "leaflet";
 import "leaflet/dist/leaflet.css";
 import { h, setText } from "./dom";
-import { ellipsePoints, fromLocal, gridValues, niceStep, toLocal } from "../lib/geo";
-import { fmt, fmtDir } from "../lib/format";
+import { distanceM, ellipsePoints, fromLocal, gridValues, niceStep, toLocal } from "../lib/geo";
+import { fmt, fmtDir, fmtDistance } from "../lib/format";
+import { boxAround, keyPoints, needsFraming, type Box } from "../lib/framing";
+import { isLanded } from "../lib/recovery";
+import { tilesBadge } from "../lib/tiles";
 import { withToken } from "../lib/token";
 import type { LandingPrediction, LatLon, State, Station, TrackPoint } from "../lib/types";
 
@@ -24,8 +30,8 @@ export class MapView {
   private origin: LatLon;
   private readonly grid = L.layerGroup();
   private readonly track = L.polyline([], { color: "#0b2f8a", weight: 3 });
-  private readonly pattern = L.polygon([], { color: "#c000c0", weight: 2, dashArray: "6 5", fill: false });
-  private readonly final = L.polyline([], { color: "#c000c0", weight: 4 });
+  private readonly pattern = L.polygon([], { color: "#c000c0", weight: 2, dashArray: "6 5", fill: false, className: "map-pattern" });
+  private readonly final = L.polyline([], { color: "#c000c0", weight: 4, className: "map-final-line" });
   private readonly ellPlanned = L.polygon([], { color: "#006400", weight: 2, fillOpacity: 0.12 });
   private readonly ellUncontrolled = L.polygon([], { color: "#c05800", weight: 2, fillOpacity: 0.08, dashArray: "4 4" });
   private readonly planned: L.Marker;
@@ -38,9 +44,16 @@ export class MapView {
   private readonly tilesStatus: HTMLElement;
   private readonly windText: HTMLElement;
   private readonly windArrow: HTMLElement;
-  private readonly finalLabel: L.Tooltip;
+  private readonly finalText: HTMLElement;
+  private readonly landedText: HTMLElement;
+  private readonly followBtn: HTMLButtonElement;
+  private readonly overlay: HTMLElement;
   private picker: Picker = null;
   private follow = true;
+  /** True while the page itself moves the view, so its events are not taken for the operator's. */
+  private framing = false;
+  /** The box of the key points at the last state (lib/framing.ts). */
+  private lastWant: Box | null = null;
   private tilesLoaded = 0;
   private tilesFailed = 0;
   private lastTrackKey = "";
@@ -71,37 +84,69 @@ export class MapView {
     this.vehicle = L.marker(ll(this.origin), { icon: icon("mk-vehicle", VEHICLE_SVG, 40, "map-vehicle"), zIndexOffset: 1000, interactive: false });
     this.draftTarget = L.marker(ll(this.origin), { icon: icon("mk-draft", TARGET_SVG, 34, "map-draft-target"), interactive: false, opacity: 0.6 });
     for (const layer of [this.pattern, this.final, this.ellUncontrolled, this.ellPlanned, this.track, this.draftPlan, this.draftLocalizer]) layer.addTo(this.map);
-    this.finalLabel = L.tooltip({ permanent: true, direction: "left", className: "final-label", interactive: false });
 
-    // Controls drawn on top of the map: tiles status, wind, follow toggle.
-    this.tilesStatus = h("div", { class: "map-badge", "data-testid": "map-tiles-status" }, "tiles: loading…");
+    // Badges drawn on top of the map: tiles status, wind, final approach, landing, follow toggle.
+    const tb = tilesBadge(this.tiles !== null, 0, 0);
+    this.tilesStatus = h("div", { class: "map-badge", "data-testid": "map-tiles-status", "data-state": tb.state }, tb.text);
     this.windArrow = h("div", { class: "wind-arrow", "aria-hidden": "true" }, "➜");
     this.windText = h("span", { "data-testid": "map-wind" }, "wind —");
-    const followBtn = h("button", { type: "button", class: "small on", "data-testid": "map-follow", "aria-pressed": "true", title: "keep the vehicle in view" }, "Follow vehicle");
-    followBtn.addEventListener("click", () => {
-      this.follow = !this.follow;
-      followBtn.classList.toggle("on", this.follow);
-      followBtn.setAttribute("aria-pressed", String(this.follow));
-    });
-    const overlay = h("div", { class: "map-overlay" }, this.tilesStatus, h("div", { class: "map-badge wind" }, this.windArrow, this.windText), followBtn);
+    this.finalText = h("div", { class: "map-badge final", "data-testid": "map-final", hidden: true });
+    this.landedText = h("div", { class: "map-badge landed", "data-testid": "map-landed", hidden: true });
+    this.followBtn = h("button", { type: "button", class: "small on", "data-testid": "map-follow", "aria-pressed": "true", title: "keep the vehicle, target, pattern and predicted landings in view (off when you drag or zoom)" }, "Follow");
+    this.followBtn.addEventListener("click", () => this.setFollow(!this.follow));
+    const overlay = h("div", { class: "map-overlay", "data-testid": "map-overlay" }, this.tilesStatus, h("div", { class: "map-badge wind" }, this.windArrow, this.windText), this.finalText, this.landedText, this.followBtn);
     L.DomEvent.disableClickPropagation(overlay);
+    L.DomEvent.disableScrollPropagation(overlay);
     el.append(overlay);
+    this.overlay = overlay;
 
     this.map.on("moveend zoomend", () => this.drawGrid());
     this.map.on("click", (e: L.LeafletMouseEvent) => {
       if (this.picker) this.picker({ lat_deg: e.latlng.lat, lon_deg: e.latlng.lng });
     });
-    // A drag means the operator wants to look elsewhere: stop following until asked again.
-    this.map.on("dragstart", () => {
-      this.follow = false;
-      followBtn.classList.remove("on");
-      followBtn.setAttribute("aria-pressed", "false");
+    // A drag or a zoom by the operator means they want to look elsewhere: stop following until
+    // asked again. The page's own framing raises the same events, hence the flag.
+    this.map.on("dragstart zoomstart", () => {
+      if (!this.framing) this.setFollow(false);
     });
+  }
+
+  private setFollow(on: boolean): void {
+    this.follow = on;
+    this.followBtn.classList.toggle("on", on);
+    this.followBtn.setAttribute("aria-pressed", String(on));
+    if (on && this.lastWant) this.frame(this.lastWant);
+  }
+
+  private frame(want: Box): void {
+    const size = this.map.getSize();
+    if (size.x === 0 || size.y === 0) return; // not laid out yet: Leaflet would zoom to the limit
+    this.framing = true;
+    try {
+      // The badges run along the top edge: keep the key geometry below them.
+      const top = this.overlay.offsetHeight + 24;
+      this.map.fitBounds([[want.south, want.west], [want.north, want.east]], { paddingTopLeft: [36, top], paddingBottomRight: [36, 36], maxZoom: 18, animate: false });
+    } finally {
+      this.framing = false;
+    }
+  }
+
+  /** The part of the view below the badge strip, where key geometry must stay. */
+  private viewBox(): Box {
+    const size = this.map.getSize();
+    const nw = this.map.containerPointToLatLng([0, Math.min(size.y - 1, this.overlay.offsetHeight + 8)]);
+    const se = this.map.containerPointToLatLng([size.x, size.y]);
+    return { south: se.lat, west: nw.lng, north: nw.lat, east: se.lng };
   }
 
   /** Leaflet measures its container: call once the element is in the document and when it resizes. */
   invalidate(): void {
-    this.map.invalidateSize();
+    this.framing = true;
+    try {
+      this.map.invalidateSize();
+    } finally {
+      this.framing = false;
+    }
     this.drawGrid();
   }
 
@@ -120,6 +165,7 @@ export class MapView {
 
   update(s: State, stale: boolean): void {
     const e = s.estimate;
+    const landed = isLanded(s);
     const lat = e?.lat_deg ?? s.vehicle?.gps?.lat_deg ?? null;
     const lon = e?.lon_deg ?? s.vehicle?.gps?.lon_deg ?? null;
     if (lat !== null && lon !== null) {
@@ -130,30 +176,43 @@ export class MapView {
       if (el) {
         el.style.transform = `rotate(${hd.toFixed(1)}deg)`;
         el.classList.toggle("stale", stale);
+        el.classList.toggle("landed", landed);
         el.dataset.heading = hd.toFixed(1);
       }
-      if (this.follow && !this.map.getBounds().pad(-0.2).contains([lat, lon])) this.map.panTo([lat, lon], { animate: false });
     }
     const g = s.guidance;
     this.show(this.target, g?.target ?? null);
-    const pat = g?.pattern ?? null;
+    const tEl = this.target.getElement()?.querySelector<HTMLElement>("[data-testid=map-target]");
+    if (tEl && g?.target) {
+      // Where the page drew the target, for tests and for people reading the DOM.
+      tEl.dataset.lat = g.target.lat_deg.toFixed(7);
+      tEl.dataset.lon = g.target.lon_deg.toFixed(7);
+    }
+    // After touchdown the pattern and the predictions are over: the map shows where it is.
+    const pat = landed ? null : (g?.pattern ?? null);
     this.pattern.setLatLngs(pat ? pat.corners.map(ll) : []);
     if (pat?.final_entry && g?.target) {
       this.final.setLatLngs([ll(pat.final_entry), ll(g.target)]);
-      // A standalone label at the final entry: a tooltip bound to the line would stay where the
-      // line was when it was bound.
-      this.finalLabel.setLatLng(ll(pat.final_entry)).setContent(`final ${fmtDir(pat.final_course_deg)} · from ${fmt(pat.final_approach_height_m, "m", 0)}`);
-      if (!this.map.hasLayer(this.finalLabel)) this.finalLabel.addTo(this.map);
+      setText(this.finalText, `final ${fmtDir(pat.final_course_deg)} from ${fmt(pat.final_approach_height_m, "m", 0)}${pat.target_reachable === false ? " · target NOT reachable" : ""}`);
+      this.finalText.hidden = false;
     } else {
       this.final.setLatLngs([]);
-      this.finalLabel.remove();
+      this.finalText.hidden = true;
     }
-    this.showPrediction(this.planned, this.ellPlanned, s.prediction?.planned ?? null, "planned");
-    this.showPrediction(this.uncontrolled, this.ellUncontrolled, s.prediction?.uncontrolled ?? null, "uncontrolled");
+    const pred = landed ? null : s.prediction;
+    this.showPrediction(this.planned, this.ellPlanned, pred?.planned ?? null, "planned", stale);
+    this.showPrediction(this.uncontrolled, this.ellUncontrolled, pred?.uncontrolled ?? null, "uncontrolled", stale);
+    for (const [layer, color] of [[this.pattern, "#c000c0"], [this.final, "#c000c0"]] as const) layer.setStyle({ color: stale ? "#888" : color });
+    this.landedText.hidden = !landed;
+    if (landed && lat !== null && lon !== null) {
+      setText(this.landedText, `LANDED${g?.target ? ` ${fmtDistance(distanceM({ lat_deg: lat, lon_deg: lon }, g.target))} from the target` : ""}`);
+    }
     if (e?.wind_from_deg != null) {
       this.windArrow.style.transform = `rotate(${(e.wind_from_deg + 90).toFixed(0)}deg)`;
       setText(this.windText, `wind ${fmt(e.wind_speed_mps, "m/s")} from ${fmtDir(e.wind_from_deg)}`);
     } else setText(this.windText, "wind —");
+    this.lastWant = boxAround(keyPoints(s));
+    if (this.follow && this.lastWant && needsFraming(this.viewBox(), this.lastWant)) this.frame(this.lastWant);
   }
 
   showDraftTarget(p: LatLon | null): void {
@@ -185,12 +244,14 @@ export class MapView {
     if (!this.map.hasLayer(m)) m.addTo(this.map);
   }
 
-  private showPrediction(m: L.Marker, ell: L.Polygon, p: LandingPrediction | null, name: string): void {
+  private showPrediction(m: L.Marker, ell: L.Polygon, p: LandingPrediction | null, name: string, stale: boolean): void {
     this.show(m, p);
+    m.getElement()?.classList.toggle("stale", stale);
     if (p === null || p.semi_major_m === null || p.semi_minor_m === null) {
       ell.setLatLngs([]);
       return;
     }
+    ell.setStyle({ color: stale ? "#888" : name === "planned" ? "#006400" : "#c05800" });
     ell.setLatLngs(ellipsePoints(p, p.semi_major_m, p.semi_minor_m, p.major_axis_deg ?? 0).map(ll));
     const tip = `predicted landing (${name}) · 1σ ${fmt(p.semi_major_m, "m", 0)} × ${fmt(p.semi_minor_m, "m", 0)} · in ${fmt(p.time_to_land_s, "s", 0)}`;
     if (!ell.getTooltip()) ell.bindTooltip(tip, { sticky: true });
@@ -200,16 +261,17 @@ export class MapView {
   private onTile(ok: boolean): void {
     if (ok) this.tilesLoaded += 1;
     else this.tilesFailed += 1;
-    const offline = this.tilesLoaded === 0 && this.tilesFailed > 0;
-    // No tile source at all (offline field, no cache): stop asking, so the browser does not log
-    // a failed request for every pan; the grid carries the map. A reload tries again.
+    const b = tilesBadge(true, this.tilesLoaded, this.tilesFailed);
+    const offline = b.state === "offline";
+    // A tile source that answers nothing (offline field, no cache): stop asking, so the browser
+    // does not log a failed request for every pan; the grid carries the map. A reload tries again.
     if (offline && this.tilesFailed >= GIVE_UP_AFTER_FAILED_TILES && this.tiles) {
       this.tiles.remove();
       this.tiles = null;
     }
     this.root.classList.toggle("tiles-offline", offline);
-    setText(this.tilesStatus, offline ? "tiles unavailable — metric grid" : this.tilesFailed > 0 ? `tiles: ${this.tilesFailed} failed` : "tiles OK");
-    this.tilesStatus.dataset.state = offline ? "offline" : "ok";
+    setText(this.tilesStatus, b.text);
+    this.tilesStatus.dataset.state = b.state;
   }
 
   /** Grid lines every 1/2/5×10^k m east and north of the origin, labelled in metres. */

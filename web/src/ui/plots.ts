@@ -1,11 +1,14 @@
 // Plots over time (uPlot): altitude; airspeed and sink rate; heading and course; main line and
 // brakes. Fed by `history.states`, then by live states; 10 minutes kept (series.ts). Redrawn at
 // most once a second: the data come at 4 Hz but the eye does not need it, and the cores are shared.
+// Time without current data (stale link, silent station) is a gap in the lines under a grey
+// hatched band labelled "stale", never a line drawn on as if live.
 
 import uPlot from "uplot";
 import "uplot/dist/uPlot.min.css";
 import { h } from "./dom";
-import { breakWraps, Series } from "../lib/series";
+import { breakWraps, Series, staleSpans } from "../lib/series";
+import { linkStale } from "../lib/staleness";
 import { wrap360 } from "../lib/format";
 import type { State } from "../lib/types";
 
@@ -60,7 +63,9 @@ export class Plots {
       const hgt = Math.max(120, c.box.clientHeight - 4);
       if (c.box.clientWidth === 0) continue; // hidden tab: try again when shown
       if (c.plot === null) {
-        c.plot = new uPlot(this.options(c.def, w, hgt), this.columns(c), c.box);
+        c.plot = new uPlot(this.options(c.def, w, hgt, c.data), this.columns(c), c.box);
+        // What the chart draws, for the end-to-end test (it reads the data, not the pixels).
+        (c.box as HTMLElement & { uplot?: uPlot }).uplot = c.plot;
       } else c.plot.setSize({ width: w, height: hgt });
     }
     if (this.timer === null) this.timer = setInterval(() => this.redraw(), 1000);
@@ -78,7 +83,8 @@ export class Plots {
   }
 
   push(s: State): void {
-    for (const c of this.charts) if (c.data.push(s.time_s, c.def.pick(s))) this.dirty = true;
+    const stale = linkStale(s.link);
+    for (const c of this.charts) if (c.data.push(s.time_s, c.def.pick(s), stale)) this.dirty = true;
   }
 
   private redraw(): void {
@@ -92,10 +98,11 @@ export class Plots {
     return [c.data.t.slice(), ...cols.map((x) => x.slice())] as uPlot.AlignedData;
   }
 
-  private options(def: ChartDef, width: number, height: number): uPlot.Options {
+  private options(def: ChartDef, width: number, height: number, data: Series): uPlot.Options {
     return {
       width,
       height,
+      hooks: { drawClear: [(u: uPlot) => drawStaleBands(u, data)] },
       title: `${def.title} (${def.unit})`,
       legend: { show: true, live: true },
       cursor: { drag: { x: false, y: false } },
@@ -106,5 +113,41 @@ export class Plots {
       ],
       series: [{ label: "T s" }, ...def.series.map((x) => ({ label: x.label, stroke: x.color, width: 2, spanGaps: false, ...(x.dash ? { dash: x.dash } : {}) }))],
     };
+  }
+}
+
+/** Grey hatched bands over the stretches without current data, under the lines. */
+function drawStaleBands(u: uPlot, data: Series): void {
+  const spans = staleSpans(data.t, data.kinds);
+  if (spans.length === 0) return;
+  const ctx = u.ctx;
+  const { top, height, left, width } = u.bbox;
+  for (const [a, b] of spans) {
+    const x0 = Math.max(left, u.valToPos(a, "x", true));
+    const x1 = Math.min(left + width, u.valToPos(b, "x", true));
+    if (!Number.isFinite(x0) || !Number.isFinite(x1) || x1 <= x0) continue;
+    ctx.save();
+    ctx.beginPath();
+    ctx.rect(x0, top, x1 - x0, height);
+    ctx.clip();
+    ctx.fillStyle = "rgba(120, 120, 120, 0.22)";
+    ctx.fillRect(x0, top, x1 - x0, height);
+    ctx.strokeStyle = "rgba(80, 80, 80, 0.35)";
+    ctx.lineWidth = 1;
+    ctx.beginPath();
+    for (let x = x0 - height; x < x1; x += 10 * devicePixelRatio) {
+      ctx.moveTo(x, top + height);
+      ctx.lineTo(x + height, top);
+    }
+    ctx.stroke();
+    if (x1 - x0 > 40 * devicePixelRatio) {
+      ctx.fillStyle = "#000";
+      // uPlot leaves the context as its axes last set it (right-aligned labels).
+      ctx.textAlign = "left";
+      ctx.textBaseline = "alphabetic";
+      ctx.font = `bold ${11 * devicePixelRatio}px sans-serif`;
+      ctx.fillText("stale", x0 + 4 * devicePixelRatio, top + 14 * devicePixelRatio);
+    }
+    ctx.restore();
   }
 }

@@ -1,29 +1,52 @@
-// Wind: the onboard estimate (speed, from-direction, σ) against the forecast profile, drawn as
-// speed versus altitude with the estimate marked at the current altitude.
+// Wind: the onboard estimate (speed, from-direction, σ) against the forecast profile, drawn as two
+// profiles against altitude side by side — speed on the left, direction (from, 0…360°) on the
+// right — with the forecast dashed, the wind measured so far on the way down solid, and the
+// current estimate as a dot (with its σ on the speed side).
 
 import { h, panel, readout, s, setText } from "./dom";
 import { fmt, fmtDir } from "../lib/format";
-import { forecastAt } from "../lib/wind";
+import { linkStale } from "../lib/staleness";
+import { directionPieces, forecastAt, MeasuredProfile } from "../lib/wind";
 import type { ForecastWind, State } from "../lib/types";
 
-const W = 240;
-const H = 130;
-const PAD = { l: 40, r: 8, t: 8, b: 24 };
+const W = 280;
+const H = 122;
+const T = 6;
+const B = 26;
+/** Speed chart x range and direction chart x range, in SVG units. */
+const SP = { l: 34, r: 146 };
+const DR = { l: 166, r: 274 };
+const FORECAST = { stroke: "#555", "stroke-width": 2, "stroke-dasharray": "5 3", fill: "none" };
+const MEASURED = { stroke: "#006b8f", "stroke-width": 2, fill: "none" };
+/** The smallest altitude band drawn, m. */
+const MIN_BAND_M = 300;
+
+/** The forecast between two altitudes: its levels inside, and interpolated values at both ends. */
+function forecastIn(p: readonly ForecastWind[], lo: number, hi: number): ForecastWind[] {
+  if (p.length === 0) return [];
+  const end = (a: number): ForecastWind[] => {
+    const f = forecastAt(p, a);
+    return f ? [{ alt_msl_m: a, speed_mps: f.speed_mps, from_deg: f.from_deg }] : [];
+  };
+  return [...end(lo), ...p.filter((x) => x.alt_msl_m > lo && x.alt_msl_m < hi), ...end(hi)];
+}
 
 export class WindPanel {
   readonly root: HTMLElement;
   private readonly est: HTMLElement;
   private readonly fc: HTMLElement;
   private readonly svg: SVGSVGElement;
-  private lastProfileKey = "";
+  private readonly measured = new MeasuredProfile();
+  private lastKey = "";
+  private lastTime = -Infinity;
 
   constructor() {
     const a = readout("Estimate", "ro-wind");
-    const b = readout("Forecast here", "ro-wind-forecast");
+    const b = readout("Forecast", "ro-wind-forecast", "the forecast profile at the current altitude");
     this.est = a.value;
     this.fc = b.value;
-    this.svg = s("svg", { viewBox: `0 0 ${W} ${H}`, class: "wind-chart", role: "img", "aria-label": "wind speed against altitude: forecast line, estimate dot", "data-testid": "wind-chart" });
-    this.root = panel("Wind", "panel-wind", h("div", { class: "ro-grid" }, a.root, b.root), this.svg as unknown as Node);
+    this.svg = s("svg", { viewBox: `0 0 ${W} ${H}`, class: "wind-chart", role: "img", "aria-label": "wind against altitude: speed (left) and direction it blows from (right); forecast dashed, measured solid, estimate dot", "data-testid": "wind-chart" });
+    this.root = panel("Wind", "panel-wind", h("div", { class: "ro-list" }, a.root, b.root), this.svg as unknown as Node);
   }
 
   update(st: State): void {
@@ -32,45 +55,82 @@ export class WindPanel {
     const alt = e?.alt_msl_m ?? null;
     const f = alt === null ? null : forecastAt(st.forecast_wind, alt);
     setText(this.fc, f ? `${fmt(f.speed_mps, "m/s")} from ${fmtDir(f.from_deg)}` : "—");
-    this.draw(st.forecast_wind, alt, e?.wind_speed_mps ?? null, e?.wind_sigma_mps ?? null);
+    // A new mission clock (station restart) is a new descent: the old profile does not belong.
+    if (st.time_s < this.lastTime) this.measured.clear();
+    this.lastTime = st.time_s;
+    if (!linkStale(st.link) && alt !== null && e?.wind_speed_mps != null && e.wind_from_deg != null) this.measured.add(alt, e.wind_speed_mps, e.wind_from_deg);
+    this.draw(st.forecast_wind, alt, e?.wind_speed_mps ?? null, e?.wind_sigma_mps ?? null, e?.wind_from_deg ?? null);
   }
 
-  private draw(p: readonly ForecastWind[], alt: number | null, speed: number | null, sigma: number | null): void {
-    const key = `${p.map((x) => `${x.alt_msl_m}:${x.speed_mps}`).join(",")}|${alt?.toFixed(0)}|${speed?.toFixed(2)}|${sigma?.toFixed(2)}`;
-    if (key === this.lastProfileKey) return;
-    this.lastProfileKey = key;
+  private draw(profile: readonly ForecastWind[], alt: number | null, speed: number | null, sigma: number | null, from: number | null): void {
+    let p = profile;
+    const m = this.measured.points();
+    const key = `${p.map((x) => `${x.alt_msl_m}:${x.speed_mps}:${x.from_deg}`).join(",")}|${m.length}|${alt?.toFixed(0)}|${speed?.toFixed(2)}|${sigma?.toFixed(2)}|${from?.toFixed(0)}`;
+    if (key === this.lastKey) return;
+    this.lastKey = key;
     this.svg.replaceChildren();
-    if (p.length === 0) {
-      this.svg.append(s("text", { x: W / 2, y: H / 2, "text-anchor": "middle", "font-size": 12 }, "no forecast"));
+    if (p.length === 0 && m.length === 0) {
+      this.svg.append(s("text", { x: W / 2, y: H / 2, "text-anchor": "middle", "font-size": 12 }, "no forecast, no measurement yet"));
       return;
     }
-    const alts = p.map((x) => x.alt_msl_m).concat(alt === null ? [] : [alt]);
-    const aMin = Math.min(...alts);
-    const aMax = Math.max(...alts, aMin + 1);
-    const vMax = Math.max(1, ...p.map((x) => x.speed_mps), (speed ?? 0) + (sigma ?? 0)) * 1.1;
-    const X = (v: number): number => PAD.l + (v / vMax) * (W - PAD.l - PAD.r);
-    const Y = (a: number): number => H - PAD.b - ((a - aMin) / (aMax - aMin)) * (H - PAD.t - PAD.b);
-    const axis = s("g", { stroke: "#000", "stroke-width": 1 },
-      s("line", { x1: PAD.l, y1: PAD.t, x2: PAD.l, y2: H - PAD.b }),
-      s("line", { x1: PAD.l, y1: H - PAD.b, x2: W - PAD.r, y2: H - PAD.b }));
-    const labels = s("g", { "font-size": 10, fill: "#000" },
-      s("text", { x: PAD.l - 3, y: Y(aMax) + 8, "text-anchor": "end" }, `${aMax.toFixed(0)}`),
-      s("text", { x: PAD.l - 3, y: Y(aMin), "text-anchor": "end" }, `${aMin.toFixed(0)}`),
-      s("text", { x: 2, y: H / 2 - 4 }, "alt"),
-      s("text", { x: 2, y: H / 2 + 8 }, "m MSL"),
-      s("text", { x: X(0), y: H - 8, "text-anchor": "start" }, "0"),
-      s("text", { x: X(vMax / 1.1), y: H - 8, "text-anchor": "middle" }, `${(vMax / 1.1).toFixed(1)}`),
-      s("text", { x: W - PAD.r, y: H - 1, "text-anchor": "end" }, "speed m/s"));
-    const line = s("polyline", { points: p.map((x) => `${X(x.speed_mps).toFixed(1)},${Y(x.alt_msl_m).toFixed(1)}`).join(" "), fill: "none", stroke: "#555", "stroke-width": 2, "stroke-dasharray": "5 3" });
-    this.svg.append(axis, labels, line);
+    // The altitude band flown so far (plus some room), not the whole forecast up to 12 km, where
+    // a descent from 1 km would be a smear at the bottom; the forecast is sampled inside it.
+    const flown = m.map((x) => x.alt_msl_m).concat(alt === null ? [] : [alt]);
+    let aMin: number;
+    let aMax: number;
+    if (flown.length > 0) {
+      const lo = Math.min(...flown);
+      const hi = Math.max(...flown);
+      const pad = Math.max(50, (hi - lo) * 0.1, (MIN_BAND_M - (hi - lo)) / 2);
+      aMin = lo - pad;
+      aMax = hi + pad;
+    } else {
+      aMin = Math.min(...p.map((x) => x.alt_msl_m));
+      aMax = Math.max(...p.map((x) => x.alt_msl_m), aMin + 1);
+    }
+    p = forecastIn(p, aMin, aMax);
+    const vTop = Math.max(1, ...p.map((x) => x.speed_mps), ...m.map((x) => x.speed_mps), (speed ?? 0) + (sigma ?? 0)) * 1.1;
+    const Y = (a: number): number => H - B - ((a - aMin) / (aMax - aMin)) * (H - T - B);
+    const XS = (v: number): number => SP.l + (v / vTop) * (SP.r - SP.l);
+    const XD = (d: number): number => DR.l + (d / 360) * (DR.r - DR.l);
+    const line = (pts: string[], style: Record<string, string | number>, testid: string): SVGElement => s("polyline", { points: pts.join(" "), ...style, "data-testid": testid });
+    const at = (x: number, y: number): string => `${x.toFixed(1)},${y.toFixed(1)}`;
+
+    const frame = s("g", { stroke: "#000", "stroke-width": 1, fill: "none" },
+      s("rect", { x: SP.l, y: T, width: SP.r - SP.l, height: H - T - B }),
+      s("rect", { x: DR.l, y: T, width: DR.r - DR.l, height: H - T - B }));
+    const grid = s("g", { stroke: "#ccc", "stroke-width": 1 }, ...[90, 180, 270].map((d) => s("line", { x1: XD(d), x2: XD(d), y1: T, y2: H - B })));
+    const labels = s("g", { "font-size": 9, fill: "#000" },
+      s("text", { x: SP.l - 2, y: T + 8, "text-anchor": "end" }, `${aMax.toFixed(0)}`),
+      s("text", { x: SP.l - 2, y: H - B, "text-anchor": "end" }, `${aMin.toFixed(0)}`),
+      s("text", { x: 1, y: (H - B) / 2 + 2 }, "m MSL"),
+      s("text", { x: SP.l, y: H - B + 10, "text-anchor": "start" }, "0"),
+      s("text", { x: SP.r, y: H - B + 10, "text-anchor": "end" }, `${(vTop / 1.1).toFixed(1)}`),
+      s("text", { x: (SP.l + SP.r) / 2, y: H - 3, "text-anchor": "middle", "font-weight": 700 }, "speed m/s"),
+      ...[0, 90, 180, 270, 360].map((d) => s("text", { x: XD(d), y: H - B + 10, "text-anchor": d === 0 ? "start" : d === 360 ? "end" : "middle" }, d === 0 ? "N" : d === 90 ? "E" : d === 180 ? "S" : d === 270 ? "W" : "N")),
+      s("text", { x: (DR.l + DR.r) / 2, y: H - 3, "text-anchor": "middle", "font-weight": 700 }, "from °"));
+    this.svg.append(grid, frame, labels);
+
+    // Speed profiles.
+    if (p.length > 0) this.svg.append(line(p.map((x) => at(XS(x.speed_mps), Y(x.alt_msl_m))), FORECAST, "wind-forecast-speed"));
+    if (m.length > 1) this.svg.append(line(m.map((x) => at(XS(x.speed_mps), Y(x.alt_msl_m))), MEASURED, "wind-measured-speed"));
+    // Direction profiles, cut where they cross north.
+    for (const piece of directionPieces(p)) this.svg.append(line(piece.map((x) => at(XD(x.from_deg), Y(x.alt_msl_m))), FORECAST, "wind-forecast-dir"));
+    for (const piece of directionPieces(m)) if (piece.length > 1) this.svg.append(line(piece.map((x) => at(XD(x.from_deg), Y(x.alt_msl_m))), MEASURED, "wind-measured-dir"));
+
     if (alt !== null) {
-      this.svg.append(s("line", { x1: PAD.l, x2: W - PAD.r, y1: Y(alt), y2: Y(alt), stroke: "#999", "stroke-width": 1 }));
+      this.svg.append(
+        s("line", { x1: SP.l, x2: SP.r, y1: Y(alt), y2: Y(alt), stroke: "#999", "stroke-width": 1 }),
+        s("line", { x1: DR.l, x2: DR.r, y1: Y(alt), y2: Y(alt), stroke: "#999", "stroke-width": 1 }));
       if (speed !== null) {
         const sg = sigma ?? 0;
         this.svg.append(
-          s("line", { x1: X(Math.max(0, speed - sg)), x2: X(speed + sg), y1: Y(alt), y2: Y(alt), stroke: "#006b8f", "stroke-width": 4 }),
-          s("circle", { cx: X(speed), cy: Y(alt), r: 5, fill: "#006b8f", stroke: "#000" }),
-        );
+          s("line", { x1: XS(Math.max(0, speed - sg)), x2: XS(speed + sg), y1: Y(alt), y2: Y(alt), stroke: "#006b8f", "stroke-width": 4 }),
+          s("circle", { cx: XS(speed), cy: Y(alt), r: 4.5, fill: "#006b8f", stroke: "#000", "data-testid": "wind-est-speed" }));
+      }
+      if (from !== null) {
+        const d = ((from % 360) + 360) % 360;
+        this.svg.append(s("circle", { cx: XD(d), cy: Y(alt), r: 4.5, fill: "#006b8f", stroke: "#000", "data-testid": "wind-est-dir" }));
       }
     }
   }

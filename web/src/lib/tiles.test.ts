@@ -1,0 +1,15 @@
+import { describe, expect, it } from "vitest";
+import { tilesBadge } from "./tiles";
+
+describe("tilesBadge", () => {
+  // Regression: with no tile_url (the shipped config) the badge said "tiles: loading…" forever.
+  it("says at once that no tile source is configured", () => {
+    expect(tilesBadge(false, 0, 0)).toEqual({ state: "none", text: "no tiles configured — metric grid" });
+  });
+  it("follows a configured source: loading, ok, partial, offline", () => {
+    expect(tilesBadge(true, 0, 0).state).toBe("loading");
+    expect(tilesBadge(true, 3, 0).state).toBe("ok");
+    expect(tilesBadge(true, 3, 2)).toEqual({ state: "partial", text: "tiles: 2 failed" });
+    expect(tilesBadge(true, 0, 6)).toEqual({ state: "offline", text: "tiles unavailable — metric grid" });
+  });
+});
