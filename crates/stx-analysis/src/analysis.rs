@@ -18,7 +18,7 @@ pub const NUMERICAL_ZERO_FLOOR: f64 = 1e-6;
 /// Rank tolerance relative to the norm of the balanced pair (`lti::balance`): a direction is
 /// lost when `[λI − A, B]` (or the staircase's step) has a singular value below
 /// `1e-5 · max(‖A‖₂, ‖B‖₂)` in the system's own units. From 100 m to 40 km the lost directions
-/// sit at least 5× below it and every kept one at least 6× above (the report lists them all,
+/// sit at least 4× below it and every kept one at least 5× above (the report lists them all,
 /// and warns when one comes within [`MARGIN_FACTOR`]).
 pub const RANK_RELATIVE_TOLERANCE: f64 = 1e-5;
 
