@@ -201,23 +201,7 @@ pub fn analyze(
 /// servos swapped.
 fn state_mirror() -> DMatrix<f64> {
     let mut m = DMatrix::identity(N_STATES, N_STATES);
-    for i in [
-        idx::POSITION + 1,
-        idx::CANOPY_EULER,
-        idx::CANOPY_EULER + 2,
-        idx::CANOPY_VELOCITY + 1,
-        idx::CANOPY_RATES,
-        idx::CANOPY_RATES + 2,
-        idx::DRONE_EULER,
-        idx::DRONE_EULER + 2,
-        idx::DRONE_RATES,
-        idx::DRONE_RATES + 2,
-        idx::CAPSULE_ANGLES,
-        idx::CAPSULE_RATES,
-        idx::TRANSPONDER_ANGLES,
-        idx::TRANSPONDER_RATES,
-        idx::MAIN_LINE,
-    ] {
+    for i in idx::LATERAL {
         m[(i, i)] = -1.0;
     }
     let (r, l) = (idx::BRAKE_RIGHT, idx::BRAKE_LEFT);

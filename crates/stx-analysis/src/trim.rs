@@ -432,7 +432,7 @@ mod tests {
         }
         assert!(t.tensions.min() > 0.0);
         // Symmetric: no lateral state.
-        for i in [3, 7, 9, 11, 14, 16, 17, 19, 20, 22, 24, 26] {
+        for i in idx::LATERAL {
             assert!(
                 t.state[i].abs() < 1e-8,
                 "{} = {}",

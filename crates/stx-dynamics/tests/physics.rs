@@ -68,6 +68,19 @@ fn fly(
     out
 }
 
+/// Indices of the flown states checked by central differences: every `stride`-th from
+/// `first`, each with both neighbours, skipping the schedule's switch times (the controls are
+/// changed at the start of a step, so neighbours bracketing a switch were flown differently).
+fn instants(flight: &[(f64, StateVector)], h: f64, first: usize, stride: usize) -> Vec<usize> {
+    (first..flight.len() - 1)
+        .step_by(stride)
+        .filter(|&k| {
+            let t = flight[k].0;
+            [2.0, 4.0, 6.0].iter().all(|s| (t - s).abs() >= 2.0 * h)
+        })
+        .collect()
+}
+
 /// Controls that excite every mode: a right turn, then asymmetric brakes, then a flare.
 fn exciting_schedule(t: f64) -> Controls {
     match t {
@@ -131,13 +144,8 @@ fn newton_euler_holds_for_every_body_with_the_solved_tensions() {
     let v = m.vehicle.clone();
     let weight = v.total_mass_kg() * v.gravity_mps2;
     let mut checked = 0;
-    for k in (500..flight.len() - 1).step_by(250) {
+    for k in instants(&flight, h, 500, 250) {
         let (t, x) = flight[k];
-        // The controls were changed at the start of step k, so the neighbours bracketing t
-        // were flown with the controls of step k−1 only if nothing changed: skip switch times.
-        if [2.0, 4.0, 6.0].iter().any(|s| (t - s).abs() < 2.0 * h) {
-            continue;
-        }
         m.set_controls(exciting_schedule(t));
         let (xm, xp) = (flight[k - 1].1, flight[k + 1].1);
         let u = m.controls().main_line_m;
@@ -328,11 +336,8 @@ fn the_canopys_momentum_with_its_apparent_mass_changes_by_the_forces_on_it() {
     let weight = v.total_mass_kg() * v.gravity_mps2;
     let mut checked = 0;
     let mut largest_apparent_share = 0.0_f64;
-    for k in (500..flight.len() - 1).step_by(250) {
+    for k in instants(&flight, h, 500, 250) {
         let (t, x) = flight[k];
-        if [2.0, 4.0, 6.0].iter().any(|s| (t - s).abs() < 2.0 * h) {
-            continue;
-        }
         m.set_controls(exciting_schedule(t));
         let tension = m.evaluate(t, &x).tensions;
         let (before, after) = (momenta(&flight[k - 1].1), momenta(&flight[k + 1].1));
@@ -393,11 +398,8 @@ fn the_chains_velocities_are_the_derivatives_of_its_positions() {
         exciting_schedule,
     );
     let v = m.vehicle.clone();
-    for k in (100..flight.len() - 1).step_by(300) {
+    for k in instants(&flight, h, 100, 300) {
         let (t, x) = flight[k];
-        if [2.0, 4.0, 6.0].iter().any(|s| (t - s).abs() < 2.0 * h) {
-            continue;
-        }
         let u = exciting_schedule(t)
             .saturated(v.main_line_travel_m)
             .main_line_m;
@@ -641,31 +643,9 @@ fn without_air_every_body_falls_at_g_and_the_lines_go_slack() {
     assert!((k.velocity_ned_mps(Body::Canopy).z - v0.z - g * 10.0).abs() < 1e-6);
 }
 
-/// The states that a mirror-symmetric flight (no wind, no main line, equal brakes) keeps at
-/// zero: lateral position, roll and yaw of every body, their rates, sideslip, the main line.
-const LATERAL_STATES: [usize; 15] = [
-    idx::POSITION + 1,
-    idx::CANOPY_EULER,
-    idx::CANOPY_EULER + 2,
-    idx::CANOPY_VELOCITY + 1,
-    idx::CANOPY_RATES,
-    idx::CANOPY_RATES + 2,
-    idx::DRONE_EULER,
-    idx::DRONE_EULER + 2,
-    idx::DRONE_RATES,
-    idx::DRONE_RATES + 2,
-    idx::CAPSULE_ANGLES,
-    idx::CAPSULE_RATES,
-    idx::TRANSPONDER_ANGLES,
-    idx::TRANSPONDER_RATES,
-    idx::MAIN_LINE,
-];
-
+/// The largest of the states a mirror-symmetric flight keeps at zero.
 fn largest_lateral(x: &StateVector) -> f64 {
-    LATERAL_STATES
-        .iter()
-        .map(|&i| x[i].abs())
-        .fold(0.0, f64::max)
+    idx::LATERAL.iter().map(|&i| x[i].abs()).fold(0.0, f64::max)
 }
 
 /// Flies `x0` with `stepper` to `end_s` (no control) and returns the largest lateral state seen
