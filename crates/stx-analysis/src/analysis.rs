@@ -6,26 +6,38 @@ use stx_dynamics::state::{Controls, N_STATES, idx};
 use stx_dynamics::vehicle::Vehicle;
 
 use crate::linearize::{INPUT_NAMES, LinearModel, OUTPUT_NAMES, linearize};
-use crate::lti::{HautusReport, RankReport};
+use crate::lti::{HautusReport, LinearSystem, RankReport, balance, hautus, scaled, staircase_rank};
 use crate::seed::{self, SeedReference};
 use crate::trim::{Trim, TrimError, trim};
 
-/// An eigenvalue counts as zero below this modulus, s⁻¹: a time constant over 1000 s, longer
-/// than a descent from 3 km. The altitude's mode (density gradient) sits near 10⁻⁴.
-pub const ZERO_EIGENVALUE_TOLERANCE: f64 = 1e-3;
+/// Floor of the zero threshold, s⁻¹: far above the 1e-11 at which the exact invariances (x,
+/// y, ψ) come out, far below any mode of the vehicle. It decides only where the air's density
+/// does not change along the glide.
+pub const NUMERICAL_ZERO_FLOOR: f64 = 1e-6;
 
-/// Rank tolerance relative to `max(‖A‖₂, ‖B‖₂)` (or `‖C‖₂`); `‖A‖₂` is about 4500 (the
-/// stiff line-pitch and drone modes), so the absolute tolerance is about 4.5·10⁻⁴. At the
-/// sea-level trim the Hautus singular values of the modes that are controllable are all
-/// above 0.03, and the two that are not sit at 10⁻⁶ (the x/z direction, reachable only
-/// through the density gradient) and 0 (the antisymmetric brake): the tolerance lies two
-/// decades from either side. The report lists every mode's values so the choice can be
-/// checked.
-pub const RANK_RELATIVE_TOLERANCE: f64 = 1e-7;
+/// Rank tolerance relative to the norm of the balanced pair (`lti::balance`): a direction is
+/// lost when `[λI − A, B]` (or the staircase's step) has a singular value below
+/// `1e-5 · max(‖A‖₂, ‖B‖₂)` in the system's own units. From 100 m to 40 km the lost directions
+/// sit at least 4× below it and every kept one at least 5× above (the report lists them all,
+/// and warns when one comes within [`MARGIN_FACTOR`]).
+pub const RANK_RELATIVE_TOLERANCE: f64 = 1e-5;
 
-/// Eigenvalues closer than this are tested together (the four invariances, the three servo
-/// lags), s⁻¹: the zero threshold.
-pub const RANK_CLUSTER_TOLERANCE: f64 = ZERO_EIGENVALUE_TOLERANCE;
+/// A decision whose nearest singular value or eigenvalue lies within this factor of its
+/// threshold is reported as marginal.
+pub const MARGIN_FACTOR: f64 = 3.0;
+
+/// Relative size (largest entry against `A`'s largest) of the mirror-antisymmetric part of
+/// `A` below which it is finite-difference noise: at a symmetric trim it is ≈ 1e-11.
+pub const MIRROR_NOISE: f64 = 1e-8;
+
+/// The zero threshold for a model trimmed at `trim`, s⁻¹: an eigenvalue slower than the rate
+/// at which the glide's air changes ([`Trim::density_change_rate_per_s`]) cannot be told from
+/// the drift of the trim itself, and counts as zero. The altitude's own mode, the glide
+/// sinking into denser air, is half that rate by the 1/√ρ law of the glide's speed, so it
+/// counts as zero at every altitude, as it is in the seed's constant-density model.
+pub fn zero_tolerance(trim: &Trim) -> f64 {
+    trim.density_change_rate_per_s().max(NUMERICAL_ZERO_FLOOR)
+}
 
 /// One state's trimmed value.
 #[derive(Debug, Clone, Serialize)]
@@ -98,8 +110,10 @@ pub struct AnalysisReport {
     pub eigenvalues: Vec<[f64; 2]>,
     /// How many have |λ| below `zero_tolerance`.
     pub zero_eigenvalues: usize,
-    /// The zero threshold, s⁻¹.
+    /// The zero threshold, s⁻¹ ([`zero_tolerance`]).
     pub zero_tolerance: f64,
+    /// What the zero threshold is, in words with its numbers.
+    pub zero_tolerance_basis: String,
     /// Largest real part among the others, s⁻¹ (negative: stable).
     pub max_real_part_nonzero: f64,
     /// Modes, one per real eigenvalue or conjugate pair.
@@ -112,12 +126,12 @@ pub struct AnalysisReport {
     pub controllability_rank: usize,
     /// Observability rank with the outputs (Hautus test).
     pub observability_rank: usize,
-    /// Rank tolerance relative to the matrices' norm.
+    /// Rank tolerance relative to the balanced matrices' norm.
     pub rank_relative_tolerance: f64,
-    /// Controllability with the main line alone (Hautus; a lower bound on what is lost where
-    /// an uncontrollable eigenvalue is defective, as the y–ψ chain is for the brake alone).
+    /// Controllability with the main line alone (orthogonal staircase, which counts a lost
+    /// Jordan chain in full where the Hautus test counts one direction).
     pub controllability_rank_main_line_only: usize,
-    /// Controllability with the brake alone (same caveat).
+    /// Controllability with the brake alone (orthogonal staircase).
     pub controllability_rank_brake_only: usize,
     /// Every mode's Hautus singular values for controllability.
     pub controllability: HautusReport,
@@ -127,10 +141,30 @@ pub struct AnalysisReport {
     pub controllability_staircase: RankReport,
     /// Cross-check for observability.
     pub observability_staircase: RankReport,
+    /// Base-2 logarithms of the state scaling the rank tests ran in (`lti::balance`), for
+    /// controllability (`[A B]`) and observability (`[Aᵀ Cᵀ]`), in state order.
+    pub state_scaling_log2: StateScaling,
+    /// Largest entry of `A`'s mirror-antisymmetric part against `A`'s largest: finite-difference
+    /// noise (≈ 1e-11) at a symmetric trim. Below [`MIRROR_NOISE`] the rank tests ran on the
+    /// mirror-symmetric part, which keeps the lateral and longitudinal motions exactly apart.
+    pub mirror_asymmetry: f64,
+    /// Decisions that are uncertain: the two rank methods disagree, a singular value or an
+    /// eigenvalue lies within [`MARGIN_FACTOR`] of its threshold, or the model is not
+    /// symmetric. Empty when every decision is clear.
+    pub warnings: Vec<String>,
     /// The matrices, row by row.
     pub matrices: Matrices,
     /// The seed's values.
     pub seed: SeedReference,
+}
+
+/// State scalings, as powers of two.
+#[derive(Debug, Clone, Serialize)]
+pub struct StateScaling {
+    /// Balancing `[A B]`.
+    pub controllability: Vec<i32>,
+    /// Balancing `[Aᵀ Cᵀ]`.
+    pub observability: Vec<i32>,
 }
 
 /// A, B, C, D row by row.
@@ -162,38 +196,161 @@ pub fn analyze(
     Ok((report(&lin), lin))
 }
 
+/// The left–right mirror: the sign of every lateral state (y, roll and yaw of each body,
+/// sideslip velocity, roll and yaw rates, the differential main line), with the two brake
+/// servos swapped.
+fn state_mirror() -> DMatrix<f64> {
+    let mut m = DMatrix::identity(N_STATES, N_STATES);
+    for i in idx::LATERAL {
+        m[(i, i)] = -1.0;
+    }
+    let (r, l) = (idx::BRAKE_RIGHT, idx::BRAKE_LEFT);
+    (m[(r, r)], m[(l, l)], m[(r, l)], m[(l, r)]) = (0.0, 0.0, 1.0, 1.0);
+    m
+}
+
+/// The mirror-symmetric part of a system linearised at a symmetric trim, and the relative
+/// size of what it drops from `A`. Finite differences leave lateral–longitudinal couplings of
+/// 1e-11 relative where symmetry makes them zero; the staircase multiplies by `A` thirty times
+/// and would grow them into directions a single input does not reach.
+pub fn mirror_symmetric(sys: &LinearSystem) -> (LinearSystem, f64) {
+    let s = state_mirror();
+    // Inputs: U_L flips, U_S does not. Outputs x y z u v w φ θ ψ: y, v, φ, ψ flip.
+    let s_u = DMatrix::from_diagonal(&DVector::from_vec(vec![-1.0, 1.0]));
+    let s_y = DMatrix::from_diagonal(&DVector::from_vec(vec![
+        1.0, -1.0, 1.0, 1.0, -1.0, 1.0, -1.0, 1.0, -1.0,
+    ]));
+    let mirrored_a = &s * &sys.a * &s;
+    let asymmetry = (&sys.a - &mirrored_a).amax() * 0.5 / sys.a.amax().max(f64::MIN_POSITIVE);
+    let symmetric = LinearSystem {
+        a: (&sys.a + mirrored_a) * 0.5,
+        b: (&sys.b + &s * &sys.b * &s_u) * 0.5,
+        c: (&sys.c + &s_y * &sys.c * &s) * 0.5,
+        d: (&sys.d + &s_y * &sys.d * &s_u) * 0.5,
+    };
+    (symmetric, asymmetry)
+}
+
+/// Warnings about one rank decision: the two methods disagree, or a singular value either
+/// method decided on lies within [`MARGIN_FACTOR`] of the tolerance.
+pub fn rank_warnings(what: &str, hautus: &HautusReport, staircase: &RankReport) -> Vec<String> {
+    let mut warnings = Vec::new();
+    if hautus.rank != staircase.rank {
+        warnings.push(format!(
+            "{what}: the Hautus test gives rank {} and the orthogonal staircase {}; the rank \
+             is uncertain",
+            hautus.rank, staircase.rank
+        ));
+    }
+    let tolerance = hautus.absolute_tolerance;
+    let kept = hautus
+        .modes
+        .iter()
+        .filter_map(|m| m.smallest_singular_values.get(m.deficiency).copied())
+        .fold(f64::INFINITY, f64::min);
+    let lost = hautus
+        .modes
+        .iter()
+        .filter(|m| m.deficiency > 0)
+        .map(|m| m.smallest_singular_values[m.deficiency - 1])
+        .fold(0.0, f64::max);
+    let close = |value: f64| value < MARGIN_FACTOR * tolerance && value > tolerance / MARGIN_FACTOR;
+    for (method, kept, lost) in [
+        ("Hautus", kept, lost),
+        (
+            "staircase",
+            staircase.smallest_kept,
+            staircase.largest_dropped,
+        ),
+    ] {
+        for (side, value) in [("kept", kept), ("lost", lost)] {
+            if close(value) {
+                warnings.push(format!(
+                    "{what}: a {side} direction's singular value {value:.2e} ({method}) is \
+                     within a factor {MARGIN_FACTOR} of the tolerance {tolerance:.2e}"
+                ));
+            }
+        }
+    }
+    warnings
+}
+
 /// The report of a linear model.
 pub fn report(lin: &LinearModel) -> AnalysisReport {
-    let sys = &lin.system;
-    let eigenvalues = sys.eigenvalues();
-    let zero = eigenvalues
-        .iter()
-        .filter(|(re, im)| re.hypot(*im) < ZERO_EIGENVALUE_TOLERANCE)
-        .count();
+    let raw = &lin.system;
+    let eigenvalues = raw.eigenvalues();
+    let zero_tol = zero_tolerance(&lin.trim);
+    let is_zero = |e: &(f64, f64)| e.0.hypot(e.1) < zero_tol;
+    let zero = eigenvalues.iter().filter(|e| is_zero(e)).count();
     let max_real = eigenvalues
         .iter()
-        .filter(|(re, im)| re.hypot(*im) >= ZERO_EIGENVALUE_TOLERANCE)
+        .filter(|e| !is_zero(e))
         .map(|e| e.0)
         .fold(f64::NEG_INFINITY, f64::max);
-    let controllability =
-        sys.controllability_hautus(RANK_RELATIVE_TOLERANCE, RANK_CLUSTER_TOLERANCE);
-    let observability = sys.observability_hautus(RANK_RELATIVE_TOLERANCE, RANK_CLUSTER_TOLERANCE);
+    let mut warnings = Vec::new();
+    let slowest_nonzero = eigenvalues
+        .iter()
+        .filter(|e| !is_zero(e))
+        .map(|e| e.0.hypot(e.1))
+        .fold(f64::INFINITY, f64::min);
+    if slowest_nonzero < MARGIN_FACTOR * zero_tol {
+        warnings.push(format!(
+            "an eigenvalue of modulus {slowest_nonzero:.2e} 1/s counts as non-zero but lies \
+             within a factor {MARGIN_FACTOR} of the zero threshold {zero_tol:.2e} 1/s"
+        ));
+    }
+
+    let (symmetric, asymmetry) = mirror_symmetric(raw);
+    let sys = if asymmetry <= MIRROR_NOISE {
+        &symmetric
+    } else {
+        warnings.push(format!(
+            "the linear model is not mirror-symmetric (antisymmetric part {asymmetry:.1e} of A); \
+             ranks are decided on it as it is"
+        ));
+        raw
+    };
+    let scaling_c = balance(&sys.a, &sys.b);
+    let (a_c, b_c) = scaled(&sys.a, &sys.b, &scaling_c);
+    let (a_t, c_t) = (sys.a.transpose(), sys.c.transpose());
+    let scaling_o = balance(&a_t, &c_t);
+    let (a_o, c_o) = scaled(&a_t, &c_t, &scaling_o);
+    let controllability = hautus(&a_c, &b_c, RANK_RELATIVE_TOLERANCE, zero_tol);
+    let observability = hautus(&a_o, &c_o, RANK_RELATIVE_TOLERANCE, zero_tol);
+    let controllability_staircase = staircase_rank(&a_c, &b_c, RANK_RELATIVE_TOLERANCE);
+    let observability_staircase = staircase_rank(&a_o, &c_o, RANK_RELATIVE_TOLERANCE);
+    warnings.extend(rank_warnings(
+        "controllability",
+        &controllability,
+        &controllability_staircase,
+    ));
+    warnings.extend(rank_warnings(
+        "observability",
+        &observability,
+        &observability_staircase,
+    ));
     let single = |col: usize| {
-        crate::lti::hautus(
-            &sys.a,
-            &sys.b.columns(col, 1).into_owned(),
+        staircase_rank(
+            &a_c,
+            &b_c.columns(col, 1).into_owned(),
             RANK_RELATIVE_TOLERANCE,
-            RANK_CLUSTER_TOLERANCE,
         )
         .rank
     };
+    let log2 = |d: &DVector<f64>| d.iter().map(|v| v.log2().round() as i32).collect();
     AnalysisReport {
         trim: trim_report(&lin.trim),
-        n_states: sys.n_states(),
-        modes: modes(&sys.a, &eigenvalues, lin.servo_rates_per_s),
+        n_states: raw.n_states(),
+        modes: modes(&raw.a, &eigenvalues, lin.servo_rates_per_s, zero_tol),
         eigenvalues: eigenvalues.iter().map(|&(re, im)| [re, im]).collect(),
         zero_eigenvalues: zero,
-        zero_tolerance: ZERO_EIGENVALUE_TOLERANCE,
+        zero_tolerance: zero_tol,
+        zero_tolerance_basis: format!(
+            "the rate at which the glide's air changes: sink {:.2} m/s × |d ln ρ/dh| {:.3e} 1/m \
+             (floor {NUMERICAL_ZERO_FLOOR:e} 1/s)",
+            lin.trim.sink_rate_mps,
+            lin.trim.density_change_rate_per_s() / lin.trim.sink_rate_mps.abs()
+        ),
         max_real_part_nonzero: max_real,
         inputs: INPUT_NAMES,
         outputs: OUTPUT_NAMES,
@@ -204,14 +361,20 @@ pub fn report(lin: &LinearModel) -> AnalysisReport {
         controllability_rank_brake_only: single(1),
         controllability,
         observability,
-        controllability_staircase: sys.controllability(RANK_RELATIVE_TOLERANCE),
-        observability_staircase: sys.observability(RANK_RELATIVE_TOLERANCE),
+        controllability_staircase,
+        observability_staircase,
+        state_scaling_log2: StateScaling {
+            controllability: log2(&scaling_c),
+            observability: log2(&scaling_o),
+        },
+        mirror_asymmetry: asymmetry,
+        warnings,
         matrices: Matrices {
             states: idx::NAMES.to_vec(),
-            a: rows(&sys.a),
-            b: rows(&sys.b),
-            c: rows(&sys.c),
-            d: rows(&sys.d),
+            a: rows(&raw.a),
+            b: rows(&raw.b),
+            c: rows(&raw.c),
+            d: rows(&raw.d),
         },
         seed: seed::reference(),
     }
@@ -286,7 +449,12 @@ fn eigenvector(a: &DMatrix<f64>, re: f64, im: f64) -> Option<DVector<Complex<f64
     Some(v)
 }
 
-fn modes(a: &DMatrix<f64>, eigenvalues: &[(f64, f64)], servo_rates: [f64; 3]) -> Vec<Mode> {
+fn modes(
+    a: &DMatrix<f64>,
+    eigenvalues: &[(f64, f64)],
+    servo_rates: [f64; 3],
+    zero_tolerance: f64,
+) -> Vec<Mode> {
     let ours: Vec<(f64, f64)> = eigenvalues.iter().copied().filter(|e| e.1 >= 0.0).collect();
     let seed_upper: Vec<(f64, f64)> = seed::EIGENVALUES
         .iter()
@@ -299,8 +467,11 @@ fn modes(a: &DMatrix<f64>, eigenvalues: &[(f64, f64)], servo_rates: [f64; 3]) ->
         .map(|(k, &(re, im))| {
             let modulus = re.hypot(im);
             let is_servo = im == 0.0 && servo_rates.iter().any(|k| (re + k).abs() < 1e-6);
-            let dominant = if modulus < ZERO_EIGENVALUE_TOLERANCE {
-                vec![("x, y, z, psi_c (invariance)".to_string(), 1.0)]
+            let dominant = if modulus < zero_tolerance {
+                vec![(
+                    "x, y, psi_c (invariances), z (drifts with the air)".to_string(),
+                    1.0,
+                )]
             } else if is_servo {
                 // A repeated eigenvalue: its eigenvectors are any mix of the servos'.
                 vec![("delta_l, servo_r, servo_l (servo lags)".to_string(), 1.0)]
@@ -328,7 +499,7 @@ fn modes(a: &DMatrix<f64>, eigenvalues: &[(f64, f64)], servo_rates: [f64; 3]) ->
                 eigenvalue: [re, im],
                 natural_frequency_rad_s: modulus,
                 // Undefined for the invariances: reported as 0.
-                damping_ratio: if modulus >= ZERO_EIGENVALUE_TOLERANCE {
+                damping_ratio: if modulus >= zero_tolerance {
                     -re / modulus
                 } else {
                     0.0
@@ -373,6 +544,55 @@ mod tests {
         let theirs = [(-0.36, 1.64), (-0.26, 1.53), (-5.0, 0.0), (-0.62, 0.0)];
         let p = pair_nearest(&ours, &theirs);
         assert_eq!(p, vec![Some(1), Some(0), Some(2)]);
+    }
+
+    #[test]
+    fn disagreeing_rank_methods_and_marginal_values_are_warned_about() {
+        // A chain of lags whose last, fast mode the input reaches only weakly: the Hautus
+        // singular value there falls below the tolerance while the staircase keeps it.
+        let a = DMatrix::from_row_slice(3, 3, &[-0.02, 0.0, 0.0, 0.3, -0.05, 0.0, 0.0, 0.3, -30.0]);
+        let b = DMatrix::from_row_slice(3, 1, &[1.0, 0.0, 0.0]);
+        let h = crate::lti::hautus(&a, &b, 1e-5, 1e-6);
+        let s = crate::lti::staircase_rank(&a, &b, 1e-5);
+        assert_ne!(h.rank, s.rank);
+        let warnings = rank_warnings("controllability", &h, &s);
+        assert!(
+            warnings
+                .iter()
+                .any(|w| w.contains("Hautus test gives rank 2")),
+            "{warnings:?}"
+        );
+        // Clear decisions raise nothing.
+        let a = DMatrix::from_row_slice(2, 2, &[-1.0, 0.0, 1.0, -2.0]);
+        let b = DMatrix::from_row_slice(2, 1, &[1.0, 0.0]);
+        let h = crate::lti::hautus(&a, &b, 1e-5, 1e-6);
+        let s = crate::lti::staircase_rank(&a, &b, 1e-5);
+        assert!(rank_warnings("controllability", &h, &s).is_empty());
+    }
+
+    #[test]
+    fn the_mirror_keeps_a_symmetric_system_and_measures_an_asymmetric_one() {
+        let mut a = DMatrix::<f64>::zeros(N_STATES, N_STATES);
+        // Longitudinal u ← θ and lateral v ← φ couplings are symmetric; v ← θ is not.
+        a[(idx::CANOPY_VELOCITY, idx::CANOPY_EULER + 1)] = -9.8;
+        a[(idx::CANOPY_VELOCITY + 1, idx::CANOPY_EULER)] = 9.8;
+        let sys = LinearSystem {
+            a: a.clone(),
+            b: DMatrix::zeros(N_STATES, 2),
+            c: DMatrix::zeros(9, N_STATES),
+            d: DMatrix::zeros(9, 2),
+        };
+        let (sym, asymmetry) = mirror_symmetric(&sys);
+        assert_eq!(asymmetry, 0.0);
+        assert_eq!(sym.a, a);
+        let mut skew = sys.clone();
+        skew.a[(idx::CANOPY_VELOCITY + 1, idx::CANOPY_EULER + 1)] = 0.98;
+        let (sym, asymmetry) = mirror_symmetric(&skew);
+        assert!((asymmetry - 0.1).abs() < 1e-12, "{asymmetry}");
+        assert_eq!(
+            sym.a[(idx::CANOPY_VELOCITY + 1, idx::CANOPY_EULER + 1)],
+            0.0
+        );
     }
 
     #[test]

@@ -21,6 +21,15 @@
 //! their geometric multiplicity, exact when they are not defective (so for the flight model,
 //! whose only repeated eigenvalues are the servo lags and the invariances). `stx analyze`
 //! reports the Hautus ranks and the staircase as a cross-check.
+//!
+//! Scale. Both tests compare singular values with a tolerance, and singular values depend on
+//! the units the states are written in: in SI units the flight model's `A` mixes metres with
+//! radians and 80 m/s of glide at 35 km, its norm (≈ 5000) says more about units than about
+//! dynamics, and a slow mode's eigenvector can be all `y` metres. [`balance`] first rescales
+//! the states by powers of two (exact, a similarity: eigenvalues and ranks are unchanged) so
+//! that every state's couplings in and out of `[A B]` are of one size — the system's own
+//! units (Osborne's iteration, as SLICOT's TB01ID does before its staircase). Tolerances are
+//! then relative to the balanced norms.
 
 use nalgebra::{DMatrix, DVector};
 use serde::Serialize;
@@ -97,6 +106,57 @@ pub fn eigenvalues(a: &DMatrix<f64>) -> Vec<(f64, f64)> {
     };
     ev.sort_by(|p, q| q.0.total_cmp(&p.0).then(q.1.total_cmp(&p.1)));
     ev
+}
+
+/// Diagonal state scaling `d` (powers of two) that balances the pair `(A, B)`: with
+/// `A' = D⁻¹ A D` and `B' = D⁻¹ B`, each state's off-diagonal row of `[A' B']` and column of
+/// `A'` have nearly equal 1-norms (Osborne's iteration; a state with no coupling in or out is
+/// left alone). For observability pass `(Aᵀ, Cᵀ)`.
+pub fn balance(a: &DMatrix<f64>, b: &DMatrix<f64>) -> DVector<f64> {
+    const MAX_SWEEPS: usize = 100;
+    let n = a.nrows();
+    let mut d = DVector::from_element(n, 1.0);
+    for _ in 0..MAX_SWEEPS {
+        let mut changed = false;
+        for i in 0..n {
+            let mut column = 0.0;
+            let mut row = 0.0;
+            for j in (0..n).filter(|&j| j != i) {
+                column += (a[(j, i)] * d[i] / d[j]).abs();
+                row += (a[(i, j)] * d[j] / d[i]).abs();
+            }
+            row += b.row(i).iter().map(|v| (v / d[i]).abs()).sum::<f64>();
+            if !(column > 0.0 && row > 0.0 && column.is_finite() && row.is_finite()) {
+                continue;
+            }
+            let (mut c, mut r, mut f) = (column, row, 1.0);
+            while c < r / 2.0 {
+                (c, r, f) = (c * 2.0, r / 2.0, f * 2.0);
+            }
+            while c >= r * 2.0 {
+                (c, r, f) = (c / 2.0, r * 2.0, f / 2.0);
+            }
+            if c + r < 0.95 * (column + row) {
+                d[i] *= f;
+                changed = true;
+            }
+        }
+        if !changed {
+            break;
+        }
+    }
+    d
+}
+
+/// `(D⁻¹ A D, D⁻¹ B)` for the diagonal `d`.
+pub fn scaled(
+    a: &DMatrix<f64>,
+    b: &DMatrix<f64>,
+    d: &DVector<f64>,
+) -> (DMatrix<f64>, DMatrix<f64>) {
+    let a = DMatrix::from_fn(a.nrows(), a.ncols(), |i, j| a[(i, j)] * d[j] / d[i]);
+    let b = DMatrix::from_fn(b.nrows(), b.ncols(), |i, j| b[(i, j)] / d[i]);
+    (a, b)
 }
 
 /// A rank decided by singular values against a tolerance.
@@ -476,6 +536,65 @@ mod tests {
         let sv = kalman.singular_values();
         let kalman_rank = sv.iter().filter(|&&s| s > 1e-10 * sv.max()).count();
         assert!(kalman_rank < n, "Kalman rank {kalman_rank}: {sv}");
+    }
+
+    /// A controllable chain of three lags written in badly mixed units: the first state in
+    /// km, the second in mm, the third in m, with a fast and a slow pole.
+    fn badly_scaled_chain() -> (DMatrix<f64>, DMatrix<f64>) {
+        let a = DMatrix::from_row_slice(
+            3,
+            3,
+            &[
+                -0.02,
+                0.0,
+                0.0,
+                1e6 * 0.3,
+                -0.05,
+                0.0,
+                0.0,
+                1e-3 * 0.3,
+                -3.0,
+            ],
+        );
+        let b = DMatrix::from_row_slice(3, 1, &[1e-3, 0.0, 0.0]);
+        (a, b)
+    }
+
+    #[test]
+    fn balancing_keeps_the_eigenvalues_and_evens_out_the_units() {
+        let (a, b) = badly_scaled_chain();
+        let d = balance(&a, &b);
+        let (ab, bb) = scaled(&a, &b, &d);
+        // A similarity by powers of two: the eigenvalues are those of A to rounding.
+        for (x, y) in eigenvalues(&a).iter().zip(eigenvalues(&ab)) {
+            assert!((x.0 - y.0).abs() < 1e-9 * (1.0 + x.0.abs()), "{x:?} {y:?}");
+            assert!((x.1 - y.1).abs() < 1e-9);
+        }
+        assert!(d.iter().all(|v| v.log2().fract() == 0.0), "{d}");
+        // The couplings now sit within a factor of a few of each other.
+        let couplings = [ab[(1, 0)].abs(), ab[(2, 1)].abs(), bb[(0, 0)].abs()];
+        let (lo, hi) = couplings
+            .iter()
+            .fold((f64::INFINITY, 0.0_f64), |(lo, hi), v| {
+                (lo.min(*v), hi.max(*v))
+            });
+        assert!(hi / lo < 16.0, "{couplings:?}");
+    }
+
+    #[test]
+    fn both_rank_tests_agree_on_a_balanced_system_in_mixed_units() {
+        // Controllable, and uncontrollable once the input's path is cut.
+        let (a, b) = badly_scaled_chain();
+        let (ab, bb) = scaled(&a, &b, &balance(&a, &b));
+        let h = hautus(&ab, &bb, 1e-5, 1e-6);
+        let s = staircase_rank(&ab, &bb, 1e-5);
+        assert_eq!((h.rank, s.rank), (3, 3), "{h:?} {s:?}");
+        let mut cut = a.clone();
+        cut[(2, 1)] = 0.0;
+        let (ab, bb) = scaled(&cut, &b, &balance(&cut, &b));
+        let h = hautus(&ab, &bb, 1e-5, 1e-6);
+        let s = staircase_rank(&ab, &bb, 1e-5);
+        assert_eq!((h.rank, s.rank), (2, 2), "{h:?} {s:?}");
     }
 
     #[test]

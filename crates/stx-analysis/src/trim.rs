@@ -11,13 +11,18 @@
 //! one equation more than unknowns, consistent because the vehicle is left–right symmetric;
 //! Levenberg–Marquardt solves it in the least-squares sense and the residual shows that it
 //! was solved exactly.
+//!
+//! A solution is a glide only inside the model's domain: lift and drag are polynomials in α,
+//! so the equations also balance flying backwards or falling flat. The canopy must fly
+//! forwards, sink, and hold an angle of attack inside the range its coefficients are stated
+//! for (`canopy.aero.alpha_range_deg`); anything else is refused as [`TrimError::NotAGlide`].
 
 use std::sync::Arc;
 
 use nalgebra::{DMatrix, DVector};
 use stx_dynamics::atmosphere::{Atmosphere, StandardAtmosphere, US76_MAX_ALTITUDE_M, UniformAir};
 use stx_dynamics::integrate::{Hooks, Rk4, integrate};
-use stx_dynamics::model::{Body, Environment, Kinematics, ParafoilModel, Tensions};
+use stx_dynamics::model::{Body, CanopyAir, Environment, Kinematics, ParafoilModel, Tensions};
 use stx_dynamics::state::{Controls, N_STATES, Pose, StateVector, idx};
 use stx_dynamics::vehicle::Vehicle;
 use stx_dynamics::wind::Calm;
@@ -58,6 +63,19 @@ pub enum TrimError {
     /// It converged to a state in which a line pushes: not a glide this model can fly.
     #[error("trim has a slack line (tension {tension_n:.3} N): not a glide")]
     SlackLine { tension_n: f64 },
+    /// It converged to a steady state outside the model's domain: flying backwards, rising,
+    /// or at an angle of attack the canopy's coefficients do not describe.
+    #[error("trim is not a glide the model describes: {quantity} = {value:.3} {unit} {rule}")]
+    NotAGlide {
+        /// What is out of range.
+        quantity: &'static str,
+        /// Its value.
+        value: f64,
+        /// Its unit.
+        unit: &'static str,
+        /// The rule it breaks.
+        rule: String,
+    },
 }
 
 /// A steady glide.
@@ -95,6 +113,21 @@ impl Trim {
     /// Glide ratio, horizontal over vertical distance.
     pub fn glide_ratio(&self) -> f64 {
         self.horizontal_speed_mps / self.sink_rate_mps
+    }
+
+    /// How fast the air around the glide changes, 1/s: the sink rate times the relative
+    /// density gradient of the standard atmosphere there, `w·|d ln ρ/dh|` — the inverse of the
+    /// time it takes to sink through one density scale height. A linearisation about this
+    /// trim describes the motion for times short against it.
+    pub fn density_change_rate_per_s(&self) -> f64 {
+        const HALF_SPAN_M: f64 = 50.0;
+        let rho = |h: f64| StandardAtmosphere.air_at(h).density_kg_per_m3;
+        let (above, below) = (
+            rho(self.altitude_m + HALF_SPAN_M),
+            rho(self.altitude_m - HALF_SPAN_M),
+        );
+        let per_m = ((below.ln() - above.ln()) / (2.0 * HALF_SPAN_M)).abs();
+        self.sink_rate_mps.abs() * per_m
     }
 }
 
@@ -227,6 +260,7 @@ pub fn trim(vehicle: &Vehicle, altitude_m: f64, controls: Controls) -> Result<Tr
     let kin = Kinematics::new(vehicle, &state, controls.main_line_m);
     let v_canopy = kin.velocity_ned_mps(Body::Canopy);
     let v_drone = kin.velocity_ned_mps(Body::Drone);
+    check_domain(vehicle, &state, &evaluation.canopy_air, v_canopy.z)?;
     Ok(Trim {
         state,
         controls,
@@ -242,6 +276,50 @@ pub fn trim(vehicle: &Vehicle, altitude_m: f64, controls: Controls) -> Result<Tr
         sink_rate_mps: v_canopy.z,
         drone_velocity_ned_mps: [v_drone.x, v_drone.y, v_drone.z],
     })
+}
+
+/// Refuses a steady state the model does not describe as a glide: the canopy must fly forwards
+/// through the air (calm air: its body-frame u), sink (nothing pushes it), and hold an angle of
+/// attack inside the range its coefficients are meant for (`canopy.aero.alpha_range_deg`). Lift
+/// and drag are polynomials in α, so Newton can balance them anywhere, backwards included.
+fn check_domain(
+    vehicle: &Vehicle,
+    state: &StateVector,
+    air: &CanopyAir,
+    sink_rate_mps: f64,
+) -> Result<(), TrimError> {
+    let forward_mps = state[idx::CANOPY_VELOCITY];
+    // NaN is refused with the rest: only a positive value passes.
+    if forward_mps.is_nan() || forward_mps <= 0.0 {
+        return Err(TrimError::NotAGlide {
+            quantity: "canopy forward speed u",
+            value: forward_mps,
+            unit: "m/s",
+            rule: "must be > 0: the canopy would fly backwards".into(),
+        });
+    }
+    if sink_rate_mps.is_nan() || sink_rate_mps <= 0.0 {
+        return Err(TrimError::NotAGlide {
+            quantity: "sink rate",
+            value: sink_rate_mps,
+            unit: "m/s",
+            rule: "must be > 0: an unpowered glide descends".into(),
+        });
+    }
+    let [low, high] = vehicle.config.canopy.aero.alpha_range_deg;
+    let alpha_deg = air.alpha_rad.to_degrees();
+    if !(low..=high).contains(&alpha_deg) {
+        return Err(TrimError::NotAGlide {
+            quantity: "angle of attack",
+            value: alpha_deg,
+            unit: "deg",
+            rule: format!(
+                "is outside [{low}, {high}] deg, the range the canopy's coefficients describe \
+                 (canopy.aero.alpha_range_deg)"
+            ),
+        });
+    }
+    Ok(())
 }
 
 /// Largest |derivative| over the residual rows.
@@ -354,7 +432,7 @@ mod tests {
         }
         assert!(t.tensions.min() > 0.0);
         // Symmetric: no lateral state.
-        for i in [3, 7, 9, 11, 14, 16, 17, 19, 20, 22, 24, 26] {
+        for i in idx::LATERAL {
             assert!(
                 t.state[i].abs() < 1e-8,
                 "{} = {}",
@@ -390,6 +468,77 @@ mod tests {
         let free = trim(&v, 100.0, Controls::default()).expect("trim");
         let braked = trim(&v, 100.0, Controls::symmetric_brake(0.4)).expect("braked trim");
         assert!(braked.glide_ratio() < free.glide_ratio());
+    }
+
+    fn vehicle_with(edits: &[(&str, &str)]) -> Vehicle {
+        let mut text = stx_dynamics::vehicle::STRAPLEX_TOML.to_string();
+        for (from, to) in edits {
+            assert!(text.contains(from), "{from}");
+            text = text.replace(from, to);
+        }
+        Vehicle::from_toml_str(&text).expect("a valid vehicle file")
+    }
+
+    #[test]
+    fn a_canopy_with_negative_lift_does_not_trim_flying_backwards() {
+        // Regression: cl0 = −3 with no lift slope "trimmed" at u = −1.68 m/s, α = 126°, and
+        // was reported as a steady glide.
+        let v = vehicle_with(&[
+            ("cl0 = 0.250", "cl0 = -3.0"),
+            ("cl_alpha = 2.300", "cl_alpha = 0.0"),
+        ]);
+        match trim(&v, 100.0, Controls::default()) {
+            Err(TrimError::NotAGlide {
+                quantity, value, ..
+            }) => {
+                assert_eq!(quantity, "canopy forward speed u");
+                assert!(value < 0.0, "{value}");
+            }
+            other => panic!("expected a refusal, got {other:?}"),
+        }
+    }
+
+    #[test]
+    fn a_trim_outside_the_coefficients_angle_of_attack_range_is_refused() {
+        // Without a lift slope the canopy "trims" falling nearly flat at α ≈ 89°.
+        let v = vehicle_with(&[("cl_alpha = 2.300", "cl_alpha = 0.0")]);
+        let err = trim(&v, 100.0, Controls::default()).expect_err("not a glide");
+        match &err {
+            TrimError::NotAGlide {
+                quantity, value, ..
+            } => {
+                assert_eq!(*quantity, "angle of attack");
+                assert!(*value > 80.0, "{value}");
+            }
+            other => panic!("expected the angle of attack to be refused, got {other:?}"),
+        }
+        assert!(err.to_string().contains("alpha_range_deg"), "{err}");
+        // The same vehicle is accepted when its file says its coefficients hold there.
+        let wide = vehicle_with(&[
+            ("cl_alpha = 2.300", "cl_alpha = 0.0"),
+            (
+                "alpha_range_deg = [0.0, 45.0]",
+                "alpha_range_deg = [0.0, 90.0]",
+            ),
+        ]);
+        let t = trim(&wide, 100.0, Controls::default()).expect("inside the stated range");
+        assert!(t.alpha_rad.to_degrees() > 80.0);
+    }
+
+    #[test]
+    fn a_canopy_too_small_to_carry_the_stack_does_not_converge() {
+        // 10 cm² of canopy: no glide near the guess, none after flying a minute either.
+        let v = vehicle_with(&[("area_m2 = 3.000 ", "area_m2 = 0.001 ")]);
+        match trim(&v, 100.0, Controls::default()) {
+            Err(TrimError::NotConverged {
+                iterations,
+                residual,
+            }) => {
+                assert!(residual > RESIDUAL_TOLERANCE, "{residual}");
+                assert!(iterations > 0);
+            }
+            other => panic!("expected no convergence, got {other:?}"),
+        }
     }
 
     #[test]

@@ -869,7 +869,7 @@ pub fn tune(
         let cl = small.closed_loop_eigenvalues(&g);
         let max_real = cl
             .iter()
-            .filter(|e| e.0.hypot(e.1) >= crate::analysis::ZERO_EIGENVALUE_TOLERANCE)
+            .filter(|e| e.0.hypot(e.1) >= crate::analysis::zero_tolerance(small.trim()))
             .map(|e| e.0)
             .fold(f64::NEG_INFINITY, f64::max);
         Candidate {

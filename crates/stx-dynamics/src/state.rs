@@ -85,6 +85,28 @@ pub mod idx {
         "servo_r",
         "servo_l",
     ];
+
+    /// The states whose sign the left–right mirror flips: lateral position, roll and yaw of
+    /// every body, sideslip velocity, roll and yaw rates, and the differential main line. A
+    /// flight without wind, main line or differential brake keeps them at zero; the mirror
+    /// also swaps the two brake servos.
+    pub const LATERAL: [usize; 15] = [
+        POSITION + 1,
+        CANOPY_EULER,
+        CANOPY_EULER + 2,
+        CANOPY_VELOCITY + 1,
+        CANOPY_RATES,
+        CANOPY_RATES + 2,
+        DRONE_EULER,
+        DRONE_EULER + 2,
+        DRONE_RATES,
+        DRONE_RATES + 2,
+        CAPSULE_ANGLES,
+        CAPSULE_RATES,
+        TRANSPONDER_ANGLES,
+        TRANSPONDER_RATES,
+        MAIN_LINE,
+    ];
 }
 
 /// Control inputs, the commands to the three servos (seed eqs. 4.15–4.17).

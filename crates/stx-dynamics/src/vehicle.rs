@@ -15,8 +15,10 @@ pub const STRAPLEX_TOML: &str = include_str!("../../../config/vehicle/straplex.t
 /// Why a vehicle description was refused.
 #[derive(Debug, Error)]
 pub enum VehicleError {
-    /// The text is not valid TOML for this schema (unknown or missing field, wrong type).
-    #[error("vehicle file is not valid: {0}")]
+    /// The text is not valid TOML for this schema (unknown or missing field, wrong type). The
+    /// parser's message is the error's source, not part of its text, so that an error chain
+    /// prints it once.
+    #[error("vehicle file is not valid TOML for the vehicle schema")]
     Parse(#[from] toml::de::Error),
     /// A field has a value the model cannot fly with.
     #[error("vehicle field `{field}` = {value} breaks the rule: {rule}")]
@@ -75,6 +77,17 @@ pub struct CanopyAeroConfig {
     pub cnr: f64,
     /// Yaw moment with sideslip, 1/rad, in the seed's sign (negative weathervanes).
     pub cn_beta: f64,
+    /// Angles of attack `[lowest, highest]` over which these coefficients describe a gliding
+    /// canopy, degrees. A trim outside them is refused as a glide the model does not describe
+    /// (flights pass through other angles in transients and are flown regardless).
+    #[serde(default = "default_alpha_range_deg")]
+    pub alpha_range_deg: [f64; 2],
+}
+
+/// The angle-of-attack range of a vehicle file that gives none, degrees (see
+/// `config/vehicle/straplex.toml` for the reasoning).
+pub fn default_alpha_range_deg() -> [f64; 2] {
+    [0.0, 45.0]
 }
 
 /// Brake coefficients per unit of normalised deflection (0 released … 1 fully pulled).
@@ -408,6 +421,19 @@ impl VehicleConfig {
         rules.non_negative("canopy.aero.cmq", a.cmq);
         rules.non_negative("canopy.aero.cnr", a.cnr);
         rules.finite("canopy.aero.cn_beta", a.cn_beta);
+        let [alpha_low, alpha_high] = a.alpha_range_deg;
+        rules.check(
+            "canopy.aero.alpha_range_deg",
+            alpha_low,
+            "the lower end must lie in [-90, 90) degrees",
+            (-90.0..90.0).contains(&alpha_low),
+        );
+        rules.check(
+            "canopy.aero.alpha_range_deg",
+            alpha_high,
+            "the upper end must lie in (lower end, 90] degrees",
+            alpha_high > alpha_low && alpha_high <= 90.0,
+        );
         let b = &c.brakes;
         rules.finite("canopy.brakes.cl_ds", b.cl_ds);
         rules.non_negative("canopy.brakes.cd_ds", b.cd_ds);
@@ -615,14 +641,62 @@ mod tests {
         );
     }
 
+    /// The error and its causes, as an error chain prints them.
+    fn chain(err: &VehicleError) -> String {
+        let mut text = err.to_string();
+        let mut source = std::error::Error::source(err);
+        while let Some(cause) = source {
+            text.push_str(&format!(": {cause}"));
+            source = cause.source();
+        }
+        text
+    }
+
     #[test]
     fn unknown_and_missing_fields_are_refused_with_their_name() {
         let text = STRAPLEX_TOML.replace("cd0 = 0.150", "cd_zero = 0.150");
-        let err = Vehicle::from_toml_str(&text).unwrap_err().to_string();
+        let err = chain(&Vehicle::from_toml_str(&text).unwrap_err());
         assert!(err.contains("cd_zero"), "{err}");
         let text = STRAPLEX_TOML.replace("cnr = 0.090", "");
-        let err = Vehicle::from_toml_str(&text).unwrap_err().to_string();
+        let err = chain(&Vehicle::from_toml_str(&text).unwrap_err());
         assert!(err.contains("cnr"), "{err}");
+    }
+
+    #[test]
+    fn a_parse_error_keeps_the_parsers_message_out_of_its_own_text() {
+        // Regression: the message was in both the error's text and its source, so a printed
+        // error chain showed the TOML parser's report twice.
+        let err = Vehicle::from_toml_str("gravity_mps2 = \"down\"\n").unwrap_err();
+        let source = std::error::Error::source(&err)
+            .expect("the parser's error")
+            .to_string();
+        assert!(
+            source.contains("gravity_mps2") || source.contains("down"),
+            "{source}"
+        );
+        assert!(!err.to_string().contains("TOML parse error"), "{err}");
+    }
+
+    #[test]
+    fn the_angle_of_attack_range_is_checked_and_defaults_when_absent() {
+        assert_eq!(
+            Vehicle::straplex().config.canopy.aero.alpha_range_deg,
+            default_alpha_range_deg()
+        );
+        let text = STRAPLEX_TOML.replace("alpha_range_deg = [0.0, 45.0]", "");
+        assert_ne!(text, STRAPLEX_TOML);
+        let v = Vehicle::from_toml_str(&text).expect("valid without the range");
+        assert_eq!(v.config.canopy.aero.alpha_range_deg, [0.0, 45.0]);
+        for bad in [
+            "[30.0, 10.0]",
+            "[-95.0, 10.0]",
+            "[0.0, 120.0]",
+            "[nan, 10.0]",
+        ] {
+            let text = STRAPLEX_TOML.replace("[0.0, 45.0]", bad);
+            let err = Vehicle::from_toml_str(&text).unwrap_err().to_string();
+            assert!(err.contains("canopy.aero.alpha_range_deg"), "{bad}: {err}");
+        }
     }
 
     #[test]

@@ -119,7 +119,11 @@ pub struct Summary {
     pub steady: Option<Steady>,
     /// Smallest line tension seen, N.
     pub min_line_tension_n: f64,
-    /// Largest deviation of a line from its length, m.
+    /// Largest deviation of a constrained line (mean main line, capsule line, transponder
+    /// line) from its length, m, measured between the model's own line ends. The model's
+    /// coordinates make these lengths hold by construction, so this is the floating-point
+    /// consistency of its kinematic chain (~1e-11 m), not a check of the physics; the chain
+    /// itself is checked against the tabled geometry in `stx-dynamics/tests/physics.rs`.
     pub max_line_length_error_m: f64,
     /// Largest total speed of the canopy, km/h.
     pub max_total_speed_kmh: f64,

@@ -44,6 +44,9 @@ pub fn run(args: AnalyzeArgs) -> anyhow::Result<()> {
     write_plots(&args.out_dir, &vehicle, &report, &lin)?;
     if args.json {
         println!("{}", serde_json::to_string(&report)?);
+        for warning in &report.warnings {
+            eprintln!("warning: {warning}");
+        }
     } else {
         print_tables(&report);
         println!(
@@ -123,9 +126,10 @@ fn print_tables(r: &AnalysisReport) {
         );
     }
     println!(
-        "zero eigenvalues (|λ| < {:.0e} 1/s): {} (seed: {}); largest other real part {:.3} 1/s \
-         (seed: {:.2})",
+        "zero eigenvalues (|λ| < {:.2e} 1/s, {}): {} (seed: {}); largest other real part \
+         {:.3} 1/s (seed: {:.2})",
         r.zero_tolerance,
+        r.zero_tolerance_basis,
         r.zero_eigenvalues,
         r.seed.zero_eigenvalues,
         r.max_real_part_nonzero,
@@ -141,11 +145,11 @@ fn print_tables(r: &AnalysisReport) {
     );
     println!(
         "{:<44} {:>6} {:>6}",
-        "controllability, U_L alone", r.controllability_rank_main_line_only, "-"
+        "controllability, U_L alone (staircase)", r.controllability_rank_main_line_only, "-"
     );
     println!(
         "{:<44} {:>6} {:>6}",
-        "controllability, U_S alone", r.controllability_rank_brake_only, "-"
+        "controllability, U_S alone (staircase)", r.controllability_rank_brake_only, "-"
     );
     println!(
         "{:<44} {:>6} {:>6}",
@@ -160,9 +164,11 @@ fn print_tables(r: &AnalysisReport) {
         "cross-check: staircase observability", r.observability_staircase.rank, ""
     );
     println!(
-        "tolerance {:.0e} × max(‖A‖, ‖B‖) = {:.2e}; smallest singular value of [λI − A, B] per \
-         mode:",
-        r.rank_relative_tolerance, r.controllability.absolute_tolerance
+        "states balanced to the system's own scales; tolerance {:.0e} × max(‖A‖, ‖B‖) = {:.2e} \
+         (observability {:.2e}); smallest singular value of [λI − A, B] per mode:",
+        r.rank_relative_tolerance,
+        r.controllability.absolute_tolerance,
+        r.observability.absolute_tolerance
     );
     for (c, o) in r.controllability.modes.iter().zip(&r.observability.modes) {
         println!(
@@ -182,6 +188,12 @@ fn print_tables(r: &AnalysisReport) {
                 String::new()
             },
         );
+    }
+    if r.warnings.is_empty() {
+        println!("every zero and rank decision is clear of its threshold by a factor 3 or more");
+    }
+    for warning in &r.warnings {
+        println!("warning: {warning}");
     }
 }
 
@@ -244,8 +256,21 @@ fn write_plots(
     // Open-loop steps: linear against nonlinear, small and large.
     let deg = 180.0 / std::f64::consts::PI;
     let step_panel = |du: [f64; 2], state: usize, scale: f64, label: &str, title: String| {
-        let responses = forced_responses(vehicle, lin, &[], du, 20.0, 0.1)
-            .map_err(|e| anyhow!("open-loop step: {e}"))?;
+        // High up, a large step can take the nonlinear stack where its model ends (a dive
+        // through the Euler angles' singularity): the panel says so instead of the whole
+        // analysis failing.
+        let responses = match forced_responses(vehicle, lin, &[], du, 20.0, 0.1) {
+            Ok(responses) => responses,
+            Err(e) => {
+                eprintln!("warning: {title}: the nonlinear flight failed ({e}); panel left empty");
+                return Ok(Panel {
+                    title: format!("{title}: nonlinear flight failed"),
+                    x_label: "time, s".into(),
+                    y_label: label.into(),
+                    ..Default::default()
+                });
+            }
+        };
         Ok::<Panel, anyhow::Error>(Panel {
             title,
             x_label: "time, s".into(),

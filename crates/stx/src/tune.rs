@@ -28,11 +28,13 @@ pub struct TuneArgs {
     #[arg(long, default_value_t = 600.0)]
     altitude: f64,
     /// Gains to start from and keep for the other controllers (default: the --out file if it
-    /// exists, else the built-in defaults).
+    /// exists, else the built-in defaults, which `config/gains.toml` holds).
     #[arg(long)]
     gains: Option<PathBuf>,
-    /// The gains file written.
-    #[arg(long, default_value = "config/gains.toml")]
+    /// The gains file written. The default is a build directory, not `config/`: tuned gains
+    /// are flown with `--gains FILE` and become the defaults only after the Monte Carlo gate
+    /// of crates/stx-analysis/ANALYSIS_NOTES.md.
+    #[arg(long, default_value = DEFAULT_OUT)]
     out: PathBuf,
     /// Where tune-CONTROLLER.json and step-CONTROLLER.svg are written.
     #[arg(long, default_value = "target/analysis")]
@@ -41,6 +43,10 @@ pub struct TuneArgs {
     #[arg(long)]
     json: bool,
 }
+
+/// Where `stx tune` writes its gains unless told: untracked, so that tuning never rewrites the
+/// shipped defaults (`config/gains.toml`, which guidance's tests pin).
+pub const DEFAULT_OUT: &str = "target/tune/gains.toml";
 
 /// Reads and validates a gains file (`stx tune` writes them).
 pub fn load_gains(path: &Path) -> anyhow::Result<ControlGains> {
@@ -108,24 +114,68 @@ pub fn run(args: TuneArgs) -> anyhow::Result<()> {
     fs::write(&svg_path, plot(&report))
         .with_context(|| format!("writing {}", svg_path.display()))?;
 
+    let wrote = format!(
+        "wrote {} (from {source}), {}, {}\nfly them with --gains {0} (stx sim, stx montecarlo)",
+        args.out.display(),
+        json_path.display(),
+        svg_path.display()
+    );
     if args.json {
         println!("{}", serde_json::to_string(&report)?);
+        eprintln!("{wrote}");
     } else {
         print_report(&report);
-        println!(
-            "\nwrote {} (from {source}), {}, {}",
-            args.out.display(),
-            json_path.display(),
-            svg_path.display()
-        );
+        println!("\n{wrote}");
     }
     Ok(())
+}
+
+/// A gain with three significant figures, however small: the tuner rounds to three, and
+/// 0.000226 must not read like 0.00022.
+fn gain_text(value: f64) -> String {
+    if value == 0.0 || !value.is_finite() {
+        return format!("{value}");
+    }
+    let decimals = (2 - value.abs().log10().floor() as i32).max(0) as usize;
+    format!("{value:.decimals$}")
+}
+
+/// A gain: the short name people use, its field name (`Controller::gain_names`), its value.
+type Gain = (&'static str, &'static str, fn(&ControlGains) -> f64);
+
+/// Every gain a candidate can change.
+const GAINS: [Gain; 5] = [
+    ("HK1", "hk1_m_per_rad", |g| g.hk1_m_per_rad),
+    ("HK2", "hk2_m_s_per_rad", |g| g.hk2_m_s_per_rad),
+    ("HK3", "hk3_m_per_m", |g| g.hk3_m_per_m),
+    ("VK1", "vk1", |g| g.vk1),
+    ("VK2", "vk2_per_m", |g| g.vk2_per_m),
+];
+
+/// The tuned gains' values in `gains`, then any other gain that differs from `current`'s
+/// (the seed's localizer vector sets HK1 and HK2 as well as HK3).
+fn gains_column(controller: Controller, current: &ControlGains, gains: &ControlGains) -> String {
+    let tuned: Vec<String> = controller.get(gains).into_iter().map(gain_text).collect();
+    let others: Vec<String> = GAINS
+        .iter()
+        .filter(|(_, field, get)| {
+            !controller.gain_names().contains(field) && get(gains) != get(current)
+        })
+        .map(|(name, _, get)| format!("{name} {}", gain_text(get(gains))))
+        .collect();
+    if others.is_empty() {
+        tuned.join(", ")
+    } else {
+        format!("{} ({})", tuned.join(", "), others.join(", "))
+    }
 }
 
 fn gains_file(r: &TuneReport, source: &str) -> String {
     let cost = |c: &Candidate| c.nonlinear_cost.unwrap_or(f64::NAN);
     format!(
         "# Control gains read by guidance (`stx sim --gains`, `stx montecarlo --gains`).\n\
+         # They become the built-in defaults (config/gains.toml) only after the Monte Carlo \
+         gate of crates/stx-analysis/ANALYSIS_NOTES.md.\n\
          # Written by `stx tune --controller {}` at a {:.0} m trim ({}).\n\
          # {}: nonlinear step cost {:.3} before, {:.3} tuned, {:.3} with the seed's A.13 gains.\n\
          # Gains of the other controllers carried over from {source}.\n{}",
@@ -175,7 +225,7 @@ fn print_report(r: &TuneReport) {
         }
     );
     println!(
-        "\n{:<10} {:<24} {:<6} {:<7} {:>7} {:>8} {:>7} {:>7} {:>6} {:>7}",
+        "\n{:<10} {:<32} {:<6} {:<7} {:>7} {:>8} {:>7} {:>7} {:>6} {:>7}",
         "gains", "values", "step", "model", "rise s", "over %", "settle", "use", "sat %", "cost"
     );
     let (scale, unit) = match r.controller {
@@ -183,12 +233,7 @@ fn print_report(r: &TuneReport) {
         _ => (1.0, " m"),
     };
     for c in [&r.current, &r.tuned, &r.seed] {
-        let values = c
-            .values
-            .iter()
-            .map(|v| format!("{v:.4}"))
-            .collect::<Vec<_>>()
-            .join(", ");
+        let values = gains_column(r.controller, &r.current.gains, &c.gains);
         let mut first = true;
         for trial in [&c.small, &c.large] {
             let step = format!("{:.0}{unit}", trial.step * scale);
@@ -199,20 +244,20 @@ fn print_report(r: &TuneReport) {
             };
             first = false;
             println!(
-                "{label:<10} {vals:<24} {step:<6} {:<7} {}",
+                "{label:<10} {vals:<32} {step:<6} {:<7} {}",
                 "linear",
                 metrics_row(&trial.linear)
             );
             match (&trial.nonlinear, &trial.nonlinear_error) {
                 (Some(m), _) => println!(
-                    "{:<10} {:<24} {:<6} {:<7} {}",
+                    "{:<10} {:<32} {:<6} {:<7} {}",
                     "",
                     "",
                     "",
                     "14-DOF",
                     metrics_row(m)
                 ),
-                (None, Some(e)) => println!("{:<10} {:<24} {:<6} 14-DOF  failed: {e}", "", "", ""),
+                (None, Some(e)) => println!("{:<10} {:<32} {:<6} 14-DOF  failed: {e}", "", "", ""),
                 _ => {}
             }
         }
@@ -312,4 +357,40 @@ fn plot(r: &TuneReport) -> String {
         900.0,
         340.0,
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn gains_are_printed_to_three_significant_figures_however_small() {
+        // Regression: `{:.4}` printed both of these as 0.0002.
+        assert_eq!(gain_text(0.000226), "0.000226");
+        assert_eq!(gain_text(0.00022), "0.000220");
+        assert_eq!(gain_text(0.0168), "0.0168");
+        assert_eq!(gain_text(1.67), "1.67");
+        assert_eq!(gain_text(970.0), "970");
+        assert_eq!(gain_text(-0.0063), "-0.00630");
+    }
+
+    #[test]
+    fn the_seed_localizer_row_shows_the_heading_gains_it_changes() {
+        // Regression: the row showed HK3 alone though the seed's vector also sets HK1, HK2.
+        let current = ControlGains::default();
+        let seed = Controller::Localizer.seed_gains(&current);
+        assert_eq!(
+            gains_column(Controller::Localizer, &current, &seed),
+            "0.220 (HK1 0.560, HK2 0.360)"
+        );
+        // The current gains' own row lists only the tuned gain.
+        let own = gains_column(Controller::Localizer, &current, &current);
+        assert_eq!(own, gain_text(current.hk3_m_per_m));
+        // Heading's row does not repeat HK1, HK2 as "others".
+        let heading_seed = Controller::Heading.seed_gains(&current);
+        assert_eq!(
+            gains_column(Controller::Heading, &current, &heading_seed),
+            "0.0160, 0.0210"
+        );
+    }
 }

@@ -10,6 +10,15 @@ fn stx(args: &[&str]) -> std::process::Output {
         .expect("stx runs")
 }
 
+/// `stx` run with `dir` as its working directory.
+fn stx_in(dir: &std::path::Path, args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_stx"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .expect("stx runs")
+}
+
 fn temp_dir(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("stx-cli-analysis-{name}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
@@ -84,6 +93,59 @@ fn analyze_json_has_the_promised_fields_and_writes_report_and_plots() {
 }
 
 #[test]
+fn analyze_decides_ranks_alike_at_altitude_and_warns_when_a_decision_is_marginal() {
+    let dir = temp_dir("altitude");
+    let out_dir = dir.to_str().unwrap_or("");
+    // Regression: at 35 km the Hautus rank read 27 against the staircase's 29 and the
+    // altitude's mode counted as non-zero, with no warning.
+    let out = stx(&[
+        "analyze",
+        "--altitude",
+        "35000",
+        "--json",
+        "--out-dir",
+        out_dir,
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value =
+        serde_json::from_str(String::from_utf8_lossy(&out.stdout).trim()).expect("JSON");
+    assert_eq!(v["zero_eigenvalues"], 4);
+    assert_eq!(v["controllability_rank"], 29);
+    assert_eq!(v["controllability_staircase"]["rank"], 29);
+    assert_eq!(v["observability_rank"], 31);
+    assert_eq!(v["observability_staircase"]["rank"], 31);
+    assert_eq!(v["warnings"], serde_json::json!([]));
+    // At 50 km, above any STRAPLEX flight, the slowest lateral mode comes within a factor 3
+    // of the zero threshold: said in the JSON, on stderr, and in the tables.
+    let out = stx(&[
+        "analyze",
+        "--altitude",
+        "50000",
+        "--json",
+        "--out-dir",
+        out_dir,
+    ]);
+    assert!(out.status.success());
+    let v: serde_json::Value =
+        serde_json::from_str(String::from_utf8_lossy(&out.stdout).trim()).expect("JSON");
+    let warnings = v["warnings"].as_array().cloned().unwrap_or_default();
+    assert!(
+        warnings
+            .iter()
+            .any(|w| w.as_str().is_some_and(|w| w.contains("zero threshold"))),
+        "{warnings:?}"
+    );
+    assert!(String::from_utf8_lossy(&out.stderr).contains("warning: an eigenvalue"));
+    let out = stx(&["analyze", "--altitude", "50000", "--out-dir", out_dir]);
+    assert!(out.status.success());
+    assert!(String::from_utf8_lossy(&out.stdout).contains("warning: an eigenvalue"));
+}
+
+#[test]
 fn analyze_refuses_bad_input_with_exit_code_2() {
     let dir = temp_dir("bad");
     let out_dir = dir.to_str().unwrap_or("");
@@ -107,6 +169,28 @@ fn analyze_refuses_bad_input_with_exit_code_2() {
         out_dir,
     ]);
     assert_eq!(out.status.code(), Some(2));
+    // Regression: the TOML parser's report was printed twice (in the error and its cause).
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(stderr.matches("TOML parse error").count(), 1, "{stderr}");
+    // A vehicle whose only steady state flies backwards has no glide to analyse.
+    let backwards = dir.join("backwards.toml");
+    let text = stx_dynamics::vehicle::STRAPLEX_TOML
+        .replace("cl0 = 0.250", "cl0 = -3.0")
+        .replace("cl_alpha = 2.300", "cl_alpha = 0.0");
+    std::fs::write(&backwards, text).expect("write");
+    let out = stx(&[
+        "analyze",
+        "--vehicle",
+        backwards.to_str().unwrap_or(""),
+        "--out-dir",
+        out_dir,
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("not a glide") && stderr.contains("backwards"),
+        "{stderr}"
+    );
     // A missing one.
     let out = stx(&[
         "analyze",
@@ -120,23 +204,28 @@ fn analyze_refuses_bad_input_with_exit_code_2() {
 
 #[test]
 fn tune_writes_a_gains_file_that_sim_and_montecarlo_read() {
+    // Run where a checkout's config/ would be: the default output must not land there.
     let dir = temp_dir("tune");
-    let gains = dir.join("gains.toml");
-    let out = stx(&[
-        "tune",
-        "--controller",
-        "localizer",
-        "--out",
-        gains.to_str().unwrap_or(""),
-        "--out-dir",
-        dir.to_str().unwrap_or(""),
-        "--json",
-    ]);
+    std::fs::create_dir_all(dir.join("config")).expect("config dir");
+    let out = stx_in(&dir, &["tune", "--controller", "localizer", "--json"]);
     assert!(
         out.status.success(),
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
+    let gains = dir.join("target/tune/gains.toml");
+    assert!(
+        String::from_utf8_lossy(&out.stderr).contains("target/tune/gains.toml"),
+        "the path written is printed"
+    );
+    let in_config: Vec<_> = std::fs::read_dir(dir.join("config"))
+        .expect("config dir")
+        .collect();
+    assert!(
+        in_config.is_empty(),
+        "stx tune wrote into config/: {in_config:?}"
+    );
+    let dir = dir.join("target/analysis");
     let v: serde_json::Value =
         serde_json::from_str(String::from_utf8_lossy(&out.stdout).trim()).expect("JSON");
     assert_eq!(v["controller"], "localizer");

@@ -118,9 +118,16 @@ mod row {
 }
 
 /// Unknowns after the 14 generalized-speed derivatives: the tension magnitudes.
+///
+/// The main lines enter as their mean tension and half their difference (`T_R = mean + half`,
+/// `T_L = mean − half`), not as `T_R` and `T_L`. Their columns are then sums and differences of
+/// the two lines' mirrored coefficients, whose lateral (or longitudinal) parts cancel exactly in
+/// floating point, so a mirror-symmetric state yields exactly zero lateral derivatives. Solved
+/// for `T_R`, `T_L` directly, rounding made the two differ by an ulp; that seed grew into
+/// lateral motion of a stack flying without wind or control (MODEL_NOTES.md, "Symmetry").
 mod unknown {
-    pub const RIGHT_MAIN: usize = 14;
-    pub const LEFT_MAIN: usize = 15;
+    pub const MAIN_MEAN: usize = 14;
+    pub const MAIN_HALF_DIFFERENCE: usize = 15;
     pub const CAPSULE_LINE: usize = 16;
     pub const TRANSPONDER_LINE: usize = 17;
 }
@@ -179,6 +186,14 @@ impl Equations {
         for k in 0..3 {
             self.a[ROW_POSITION[first + k]][UNKNOWN_POSITION[column]] = values[k];
         }
+    }
+
+    /// The main lines' coefficients in rows `first..first + 3`, given per unit of the right
+    /// and of the left line's tension: the mean tension's column is their sum, the half
+    /// difference's their difference (see [`unknown`]).
+    fn set_main_line_columns(&mut self, first: usize, right: &Vector3<f64>, left: &Vector3<f64>) {
+        self.set_column(first, unknown::MAIN_MEAN, &(right + left));
+        self.set_column(first, unknown::MAIN_HALF_DIFFERENCE, &(right - left));
     }
 
     /// Right-hand side of rows `first..first + 3`.
@@ -287,8 +302,7 @@ impl ParafoilModel {
         let a_c = &acc.linear[0];
         eq.set_rows(row::CANOPY_FORCE, &(a_c.jac * v.canopy_mass_kg));
         eq.add_block(row::CANOPY_FORCE, kinematics::nu::CANOPY_VELOCITY, &m_app);
-        eq.set_column(row::CANOPY_FORCE, unknown::RIGHT_MAIN, &(-e_main_c[0]));
-        eq.set_column(row::CANOPY_FORCE, unknown::LEFT_MAIN, &(-e_main_c[1]));
+        eq.set_main_line_columns(row::CANOPY_FORCE, &(-e_main_c[0]), &(-e_main_c[1]));
         eq.set_rhs(
             row::CANOPY_FORCE,
             &(external[0] - a_c.bias * v.canopy_mass_kg),
@@ -297,16 +311,11 @@ impl ParafoilModel {
         // Canopy rotation about its CM, canopy frame.
         let alpha_c = &acc.angular[0];
         eq.set_rows(row::CANOPY_MOMENT, &(canopy_inertia * alpha_c.jac));
-        for (side, column) in [unknown::RIGHT_MAIN, unknown::LEFT_MAIN]
-            .into_iter()
-            .enumerate()
-        {
-            eq.set_column(
-                row::CANOPY_MOMENT,
-                column,
-                &(-v.r_lines_on_canopy_m[side].cross(&e_main_c[side])),
-            );
-        }
+        eq.set_main_line_columns(
+            row::CANOPY_MOMENT,
+            &(-v.r_lines_on_canopy_m[0].cross(&e_main_c[0])),
+            &(-v.r_lines_on_canopy_m[1].cross(&e_main_c[1])),
+        );
         eq.set_rhs(
             row::CANOPY_MOMENT,
             &(canopy_wrench.moment_nm
@@ -318,8 +327,7 @@ impl ParafoilModel {
         external[1] = weight(1, v.drone_mass_kg) + drone_wrench.force_n;
         let a_d = &acc.linear[1];
         eq.set_rows(row::DRONE_FORCE, &(a_d.jac * v.drone_mass_kg));
-        eq.set_column(row::DRONE_FORCE, unknown::RIGHT_MAIN, &e_main_d[0]);
-        eq.set_column(row::DRONE_FORCE, unknown::LEFT_MAIN, &e_main_d[1]);
+        eq.set_main_line_columns(row::DRONE_FORCE, &e_main_d[0], &e_main_d[1]);
         eq.set_column(row::DRONE_FORCE, unknown::CAPSULE_LINE, &(-e_cap_d));
         eq.set_rhs(
             row::DRONE_FORCE,
@@ -327,16 +335,11 @@ impl ParafoilModel {
         );
         let alpha_d = &acc.angular[1];
         eq.set_rows(row::DRONE_MOMENT, &(v.drone_inertia * alpha_d.jac));
-        for (side, column) in [unknown::RIGHT_MAIN, unknown::LEFT_MAIN]
-            .into_iter()
-            .enumerate()
-        {
-            eq.set_column(
-                row::DRONE_MOMENT,
-                column,
-                &v.r_lines_on_drone_m[side].cross(&e_main_d[side]),
-            );
-        }
+        eq.set_main_line_columns(
+            row::DRONE_MOMENT,
+            &v.r_lines_on_drone_m[0].cross(&e_main_d[0]),
+            &v.r_lines_on_drone_m[1].cross(&e_main_d[1]),
+        );
         eq.set_column(
             row::DRONE_MOMENT,
             unknown::CAPSULE_LINE,
@@ -411,10 +414,11 @@ impl ParafoilModel {
         Evaluation {
             derivative: dx,
             tensions: Tensions {
-                right_main_n: solution[14],
-                left_main_n: solution[15],
-                capsule_n: solution[16],
-                transponder_n: solution[17],
+                right_main_n: solution[unknown::MAIN_MEAN]
+                    + solution[unknown::MAIN_HALF_DIFFERENCE],
+                left_main_n: solution[unknown::MAIN_MEAN] - solution[unknown::MAIN_HALF_DIFFERENCE],
+                capsule_n: solution[unknown::CAPSULE_LINE],
+                transponder_n: solution[unknown::TRANSPONDER_LINE],
             },
             canopy_air,
             external_force_n: external,
