@@ -715,8 +715,9 @@ impl Drone {
             StageEvent::Launched => (
                 Severity::Notice,
                 format!(
-                    "launched: ascending at {:.1} m/s to burst at {:.0} m",
-                    self.config.balloon.ascent_rate_mps,
+                    "launched: ascending at {:.1} m/s on average ({:.1} m/s now) to burst at {:.0} m",
+                    self.config.balloon.mean_ascent_rate_mps,
+                    self.physics.balloon().launch_rate_mps(),
                     self.physics.burst_altitude_msl_m()
                 ),
             ),
