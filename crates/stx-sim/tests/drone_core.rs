@@ -401,6 +401,50 @@ fn a_gps_loss_turns_the_drone_into_the_wind_and_it_resumes_when_fixes_return() {
     assert!(miss < 0.6 * away_m, "missed by {miss} m");
 }
 
+/// Regression: a GPS lost in heading mode was flown through and marked as acted on, so a
+/// spiral landing selected afterwards steered on the lost position with no failsafe.
+#[test]
+fn a_gps_loss_flown_through_in_heading_mode_engages_when_a_position_mode_is_selected() {
+    let mut config = mission("rehearsal");
+    config.failures.gps_loss_s = vec![[40.0, 200.0]];
+    let mut d = drone(&config);
+    let mut log = Log::default();
+    fly(&mut d, &mut log, |d| d.time_s() >= 30.0);
+    assert_eq!(d.stage(), FlightStage::Parafoil);
+    assert_eq!(
+        d.handle_command(&Command::HoldHeading { heading_deg: 90.0 }),
+        CommandResult::Accepted
+    );
+    fly(&mut d, &mut log, |d| d.time_s() >= 60.0);
+    assert!(
+        log.text_time("continuing heading").is_some(),
+        "{:?}",
+        log.texts
+    );
+    assert!(log.text_time("into the wind").is_none());
+    assert!(!d.onboard().gps_failsafe_active());
+    for mode in [FlightMode::SpiralLanding, FlightMode::Course] {
+        assert_eq!(
+            d.handle_command(&Command::SetMode(mode)),
+            CommandResult::Accepted
+        );
+        let selected_s = d.time_s();
+        fly(&mut d, &mut log, |d| d.time_s() >= selected_s + 1.0);
+        assert!(
+            d.onboard().gps_failsafe_active(),
+            "{mode:?} selected without GPS: {:?}",
+            d.onboard().gps_state()
+        );
+        assert_eq!(d.status().state, SystemState::Critical);
+        // Back to heading mode: the failsafe steps aside (heading needs no GPS).
+        d.handle_command(&Command::HoldHeading { heading_deg: 90.0 });
+        fly(&mut d, &mut log, |d| d.time_s() >= selected_s + 2.0);
+        assert!(!d.onboard().gps_failsafe_active());
+    }
+    let acted = log.text_time("into the wind").expect("the action, once");
+    assert!((60.0..61.0).contains(&acted), "acted at {acted} s");
+}
+
 #[test]
 fn with_the_continue_policy_a_gps_loss_keeps_the_plan_on_dead_reckoning() {
     let mut config = mission("rehearsal");

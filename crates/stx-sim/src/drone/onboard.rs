@@ -41,6 +41,11 @@
 //! - `0`: it keeps flying the plan on the dead-reckoned estimate.
 //! - `2`: servos neutral: the parafoil glides straight and lands unflared.
 //!
+//! A loss in a mode that does not steer on position (heading, manual) is announced and flown
+//! through; if the operator then selects a mode that does (course, localizer, spiral landing)
+//! while the GPS is still out, the action is taken at once — the drone never steers on a
+//! position it has lost for longer than `FS_GPS_LOSS_S` unless `FS_GPS_ACTION` says so (`0`).
+//!
 //! When fixes return it says so, and a spiral landing replans from its approximation (the
 //! dead-reckoned position may have jumped).
 //!
@@ -600,7 +605,7 @@ impl Onboard {
                         Severity::Notice,
                         format!("GPS back after {:.0} s", time_s - since_s),
                     );
-                } else if !acted
+                } else if (!acted || self.gps_action_pending())
                     && stage == FlightStage::Parafoil
                     && time_s - since_s >= self.settings.failsafe.gps_loss_s
                     && let Some(est) = est
@@ -626,6 +631,13 @@ impl Onboard {
                 }
             }
         }
+    }
+
+    /// After the loss was flown through in a mode that does not need the GPS: whether the
+    /// mode now steers on position and the policy has an action for that.
+    fn gps_action_pending(&self) -> bool {
+        steers_on_position(self.mode())
+            && self.settings.failsafe.gps_loss_action != GpsLossAction::Continue
     }
 
     fn act_on_gps_loss(&mut self, time_s: f64, since_s: f64, est: &Estimate) {
