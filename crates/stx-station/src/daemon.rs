@@ -9,7 +9,7 @@ use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
 
 use axum::extract::ws::Utf8Bytes;
 use stx_link::endpoint::{GroundConfig, GroundEndpoint, GroundEvent, LinkEvent};
-use stx_link::signing::{SigningConfig, SigningKey};
+use stx_link::signing::SigningConfig;
 use stx_link::transport::{Action, DriveOptions, DriverEvent, Transport, drive};
 use thiserror::Error;
 use tokio::sync::{broadcast, mpsc, watch};
@@ -69,12 +69,13 @@ pub struct Running {
 }
 
 fn signing(config: &StationConfig) -> Result<Option<SigningConfig>, DaemonError> {
-    let Some(hex) = &config.link.signing_key_hex else {
+    let Some(key) = config
+        .link
+        .signing_key()
+        .map_err(|e| DaemonError::Signing(e.to_string()))?
+    else {
         return Ok(None);
     };
-    let key = SigningKey::from_bytes(parse_key_hex(hex).ok_or_else(|| {
-        DaemonError::Signing("link.signing_key_hex must be 64 hexadecimal characters".into())
-    })?);
     let unix_s = SystemTime::now()
         .duration_since(UNIX_EPOCH)
         .map_err(|e| DaemonError::Signing(e.to_string()))?;
@@ -117,6 +118,13 @@ pub async fn run(
     let mut ground = GroundConfig::default();
     ground.link = ground.link.with_signing(signing(&config)?);
     let endpoint = GroundEndpoint::new(ground, Duration::ZERO);
+    // The first high-water mark is on disk before anything is signed, or the station does not
+    // start.
+    stx_link::transport::persist_signing_mark(
+        &endpoint,
+        config.link.signing_timestamp_file.as_deref(),
+    )
+    .map_err(|e| DaemonError::Signing(e.to_string()))?;
     let (actions_tx, actions_rx) = mpsc::channel::<Action<GroundEndpoint>>(1024);
     let (events_tx, events_rx) = mpsc::channel(4096);
     let options = DriveOptions {
@@ -367,20 +375,6 @@ fn send_outbound(shared: &Shared, outbound: Vec<Outbound>) {
             let _ = shared.broadcast.send(text.into());
         }
     }
-}
-
-/// The 32 bytes of a 64-character hexadecimal key.
-pub fn parse_key_hex(hex: &str) -> Option<[u8; 32]> {
-    let bytes = hex.as_bytes();
-    if bytes.len() != 64 {
-        return None;
-    }
-    let mut key = [0_u8; 32];
-    for (i, out) in key.iter_mut().enumerate() {
-        let pair = std::str::from_utf8(bytes.get(2 * i..2 * i + 2)?).ok()?;
-        *out = u8::from_str_radix(pair, 16).ok()?;
-    }
-    Some(key)
 }
 
 fn lock(shared: &Shared) -> std::sync::MutexGuard<'_, StationCore> {

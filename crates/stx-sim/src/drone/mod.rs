@@ -500,6 +500,13 @@ impl Drone {
         }
     }
 
+    /// Whether `name` may take `value` now (range, kind, the rules between parameters, the
+    /// servo travel), without changing anything: the link's table asks this before it takes a
+    /// set from the station or echoes it.
+    pub fn check_param(&self, name: &str, value: f32) -> Result<(), ParamError> {
+        self.onboard.check_param(name, value).map(drop)
+    }
+
     /// Sets a parameter from the station (checked against the shared catalog); effective at
     /// the next period. On refusal nothing changes and the reason goes to the operator's log.
     pub fn set_param(&mut self, name: &str, value: f32) -> Result<(), ParamError> {

@@ -272,10 +272,9 @@ impl Onboard {
         self.texts.push_back((severity, text));
     }
 
-    /// Sets a parameter: its catalog range and kind, the servo travel for `GN_LINE_MAX`, and
-    /// the rules between parameters are checked; on refusal nothing changes. It takes effect
-    /// at the next control period.
-    pub fn set_param(&mut self, name: &str, value: f32) -> Result<(), ParamError> {
+    /// The settings `name = value` would give, or why it is refused (the checks of
+    /// [`set_param`](Self::set_param)); nothing changes.
+    pub fn check_param(&self, name: &str, value: f32) -> Result<OnboardSettings, ParamError> {
         let value = f64::from(value);
         if name == MAIN_LINE_LIMIT && value > self.main_line_travel_m {
             return Err(ParamError::OutOfRange {
@@ -285,7 +284,16 @@ impl Onboard {
                 max: self.main_line_travel_m,
             });
         }
-        self.settings.apply(name, value)?;
+        let mut settings = self.settings;
+        settings.apply(name, value)?;
+        Ok(settings)
+    }
+
+    /// Sets a parameter: its catalog range and kind, the servo travel for `GN_LINE_MAX`, and
+    /// the rules between parameters are checked; on refusal nothing changes. It takes effect
+    /// at the next control period.
+    pub fn set_param(&mut self, name: &str, value: f32) -> Result<(), ParamError> {
+        self.settings = self.check_param(name, value)?;
         self.guidance.set_gains(self.settings.guidance.gains);
         self.guidance
             .set_spiral_config(self.settings.guidance.spiral);
