@@ -452,15 +452,7 @@ fn link_lost_and_regained() {
 fn packet_loss_is_computed_from_sequence_gaps() {
     let mut pair = Pair::default_pair(13);
     pair.to_ground.loss = 0.10;
-    let att = Telemetry::Attitude(Attitude {
-        time_boot_ms: 0,
-        roll_rad: 0.1,
-        pitch_rad: 0.0,
-        yaw_rad: 1.0,
-        roll_rate_radps: 0.0,
-        pitch_rate_radps: 0.0,
-        yaw_rate_radps: 0.0,
-    });
+    let att = attitude();
     for i in 0..2000 {
         let t = secs(100.0 + f64::from(i) * 0.02);
         pair.run_until(t);
@@ -502,9 +494,8 @@ fn packet_loss_is_computed_from_sequence_gaps() {
     assert!(json.contains("packet_loss_pct"));
 }
 
-/// Frames from system 1 with the given sequence numbers, each its own datagram.
-fn frames_with_sequences(sequences: &[u8]) -> Vec<Vec<u8>> {
-    let msg = Telemetry::Attitude(Attitude {
+fn attitude() -> Telemetry {
+    Telemetry::Attitude(Attitude {
         time_boot_ms: 0,
         roll_rad: 0.1,
         pitch_rad: 0.0,
@@ -513,7 +504,11 @@ fn frames_with_sequences(sequences: &[u8]) -> Vec<Vec<u8>> {
         pitch_rate_radps: 0.0,
         yaw_rate_radps: 0.0,
     })
-    .to_mavlink();
+}
+
+/// Frames from system 1 with the given sequence numbers, each its own datagram.
+fn frames_with_sequences(sequences: &[u8]) -> Vec<Vec<u8>> {
+    let msg = attitude().to_mavlink();
     sequences
         .iter()
         .map(|&sequence| {

@@ -31,7 +31,7 @@ pub struct ServeArgs {
     /// then be a `udpin:` link).
     #[arg(long)]
     sim: bool,
-    /// The simulated drone's mission with --sim: `mission` (the whole 3-hour flight),
+    /// The simulated drone's mission with --sim: `mission` (the whole 2 h 41 min flight),
     /// `mission-short`, `rehearsal` (under the parafoil from 900 m), or a mission TOML file.
     #[arg(long, default_value = "mission-short", requires = "sim")]
     sim_scenario: String,
@@ -219,4 +219,37 @@ async fn shutdown_signal() {
     #[cfg(not(unix))]
     let _ = interrupt.await;
     tracing::info!("shutting down");
+}
+
+#[cfg(test)]
+mod sim_gains_tests {
+    use super::*;
+    use clap::Parser;
+
+    #[derive(Parser)]
+    struct Cli {
+        #[command(flatten)]
+        serve: ServeArgs,
+    }
+
+    #[test]
+    fn sim_gains_reach_the_simulated_drone_and_a_bad_file_is_bad_input() {
+        let gains = stx_gnc::control::ControlGains {
+            hk1_m_per_rad: 0.0123,
+            ..Default::default()
+        };
+        let path = std::env::temp_dir().join(format!("stx-sim-gains-{}.toml", std::process::id()));
+        std::fs::write(&path, gains.to_toml_string()).expect("write");
+        let config = load_config(None).expect("shipped config");
+        let args = |file: &str| {
+            Cli::try_parse_from(["stx-serve", "--sim", "--sim-gains", file])
+                .expect("flags parse")
+                .serve
+        };
+        let options = sim_options(&config, &args(path.to_str().expect("utf-8"))).expect("valid");
+        assert_eq!(options.gains, Some(gains));
+        let err = sim_options(&config, &args("/nonexistent/gains.toml")).expect_err("refused");
+        assert!(err.downcast_ref::<BadInput>().is_some(), "{err}");
+        let _ = std::fs::remove_file(&path);
+    }
 }

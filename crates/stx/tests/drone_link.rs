@@ -122,6 +122,21 @@ impl Station {
 }
 
 impl Station {
+    /// The drone's whole parameter table, within `timeout`.
+    async fn param_list(
+        &mut self,
+        timeout: Duration,
+        seen: &mut Vec<(FlightMode, FlightStage)>,
+    ) -> Vec<stx_link::param::ParamValue> {
+        self.act(|g, now| g.param_list(now).expect("list starts"))
+            .await;
+        self.until("parameter list", timeout, seen, |e| match e {
+            GroundEvent::Param(ParamEvent::ListComplete { params }) => Some(params.clone()),
+            _ => None,
+        })
+        .await
+    }
+
     /// The first STATUSTEXT containing `needle`, already seen or within `timeout`.
     async fn text(
         &mut self,
@@ -169,15 +184,7 @@ async fn a_station_reads_sets_commands_and_watches_the_rehearsal_land() {
         .await;
 
     // Parameters: the whole list, then a gain set and echoed.
-    station
-        .act(|g, now| g.param_list(now).expect("list starts"))
-        .await;
-    let params = station
-        .until("parameter list", long, &mut seen, |e| match e {
-            GroundEvent::Param(ParamEvent::ListComplete { params }) => Some(params.clone()),
-            _ => None,
-        })
-        .await;
+    let params = station.param_list(long, &mut seen).await;
     assert!(params.len() >= 10, "{params:?}");
     let gain = params
         .iter()
@@ -390,15 +397,7 @@ async fn the_gains_file_is_what_the_drone_reports_over_param() {
             _ => None,
         })
         .await;
-    station
-        .act(|g, now| g.param_list(now).expect("list starts"))
-        .await;
-    let params = station
-        .until("parameter list", long, &mut seen, |e| match e {
-            GroundEvent::Param(ParamEvent::ListComplete { params }) => Some(params.clone()),
-            _ => None,
-        })
-        .await;
+    let params = station.param_list(long, &mut seen).await;
     let _ = drone.kill();
     let _ = drone.wait();
     let value = |name: &str| {
