@@ -313,6 +313,25 @@ fn the_whole_mission_flies_from_launch_to_landing_at_max_speed_with_no_operator(
             "landed"
         ]
     );
+    // The timeline: the balloon climbs at 5 m/s on average from the pad (245 m) to its burst.
+    let start = |stage: &str| {
+        s["stages"]
+            .as_array()
+            .and_then(|a| a.iter().find(|st| st["stage"] == stage))
+            .and_then(|st| st["start_s"].as_f64())
+            .unwrap_or(f64::NAN)
+    };
+    let burst_msl_m = s["balloon_end"][2].as_f64().unwrap_or(f64::NAN);
+    let mean_ascent_mps = (burst_msl_m - 245.0) / (start("round_chute") - start("ascent"));
+    println!(
+        "timeline: launch {:.0} s, burst {:.0} s at {burst_msl_m:.0} m ({mean_ascent_mps:.3} m/s \
+         on average), deploy {:.0} s, landed {:.0} s",
+        start("ascent"),
+        start("round_chute"),
+        start("parafoil_deploy"),
+        start("landed")
+    );
+    assert!((mean_ascent_mps - 5.0).abs() < 0.05, "{s}");
     let miss = s["landing"]["miss_m"].as_f64().expect("a target");
     assert!(miss < 50.0, "missed by {miss} m");
     // Hours of mission in (much) less time.
