@@ -114,6 +114,10 @@ pub async fn run(
             source,
         })?;
     let link_local = transport.local_addr();
+    // For `udpin:…:0` / `tcpin:…:0`: the port the drone must be pointed at.
+    let link_shown = transport
+        .listening_address()
+        .map_or_else(|| config.link.address.clone(), |a| a.to_string());
     let start = Instant::now();
     let mut ground = GroundConfig::default();
     ground.link = ground.link.with_signing(signing(&config)?);
@@ -205,7 +209,7 @@ pub async fn run(
         link_local,
         shared: shared.clone(),
     });
-    tracing::info!(address = %http_address, link = %config.link.address, "station listening");
+    tracing::info!(address = %http_address, link = %link_shown, "station listening");
     let stop_http = async move {
         shutdown.await;
         let _ = stop_tx.send(true);
