@@ -7,8 +7,9 @@ time, and, as a ground station would:
   1. reads HEARTBEAT (a parafoil, custom mode = mode | stage << 8 | phase << 16), GPS_RAW_INT,
      ATTITUDE and the rest of the telemetry, and measures each message's rate over a window;
   2. lists the parameters (PARAM_REQUEST_LIST → every PARAM_VALUE, by index), sets one and reads
-     it back (the PARAM_SET echo and a PARAM_REQUEST_READ), and checks an out-of-range set is
-     refused with the old value;
+     it back (the PARAM_SET echo and a PARAM_REQUEST_READ), and checks an out-of-range set, and
+     one within its range that breaks a rule between parameters, are answered only with the
+     value in force;
   3. sends COMMAND_LONG DO_SET_MODE (heading mode) and gets COMMAND_ACK ACCEPTED, timing it,
      and sees the mode in the next HEARTBEAT;
   4. sends an unsupported command and a cutdown under the parafoil and gets non-ACCEPTED ACKs.
@@ -160,6 +161,26 @@ def exercise(conn):
     refused = recv(conn, "PARAM_VALUE", cond=lambda m: m.param_id == name)
     assert abs(refused.param_value - new) < 1e-6, f"out-of-range set changed {name}: {refused}"
     report["param_set"] = {"name": name, "old": old, "new": new}
+    # Within its range but against a rule between parameters (the shortest final approach
+    # longer than the longest): the only answer is the value in force — never the value asked
+    # for first and the old one after it.
+    rule_name = "SP_MIN_FINAL"
+    in_force = names[rule_name]
+    assert in_force < 1500.0 and names["SP_MAX_FINAL"] < 1500.0, names  # 1500 breaks the rule
+    conn.mav.param_set_send(1, 1, rule_name.encode(), 1500.0, mavutil.mavlink.MAV_PARAM_TYPE_REAL32)
+    answers = []
+    deadline = time.monotonic() + 2.0
+    while time.monotonic() < deadline:
+        m = conn.recv_match(type=["PARAM_VALUE", "STATUSTEXT"], blocking=True, timeout=0.2)
+        if m is None or m.get_srcSystem() != 1:
+            continue
+        if m.get_type() == "PARAM_VALUE" and m.param_id == rule_name:
+            answers.append(m.param_value)
+        elif m.get_type() == "STATUSTEXT" and rule_name in m.text:
+            report["rule_refusal_text"] = m.text
+    assert answers and all(abs(a - in_force) < 1e-6 for a in answers), (
+        f"{rule_name} = 1500 answered {answers}, in force {in_force}")
+    report["rule_refusal"] = {"name": rule_name, "asked": 1500.0, "answered": answers}
 
     # 3. A mode change, acknowledged; the heartbeat follows.
     t0 = time.monotonic()

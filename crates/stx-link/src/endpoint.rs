@@ -13,6 +13,16 @@
 //! traffic, errors, signing refusals, per-sender packet loss from sequence-number gaps, the
 //! message rate over a sliding window and the age of the last message of each kind.
 //!
+//! Loss from sequence numbers: a frame up to [`MAX_LOSS_GAP`] ahead of the last one counts the
+//! numbers skipped as lost; one at most [`MAX_REORDER_DEPTH`] behind is a late (reordered)
+//! frame — it un-counts one loss, since it did arrive — and one further behind means the sender
+//! restarted its sequence (a reboot, a second instance): counted as a restart, not as the
+//! ~255 frames a naive modulo-256 difference would say were lost.
+//!
+//! Stream transports (TCP, serial) call [`handle_stream_end`](GroundEndpoint::handle_stream_end)
+//! when a connection drops, so a frame cut off by it is counted as truncated rather than
+//! waiting for bytes that will never come.
+//!
 //! The calling convention follows quinn-proto: after [`handle_bytes`](GroundEndpoint::handle_bytes)
 //! or [`handle_timeout`](GroundEndpoint::handle_timeout), drain
 //! [`poll_event`](GroundEndpoint::poll_event) and [`poll_transmit`](GroundEndpoint::poll_transmit),
@@ -36,8 +46,8 @@ use crate::frame::{
 };
 use crate::manual::{ManualEvent, ManualReceiver, ManualSender, Sticks};
 use crate::param::{
-    ParamChange, ParamClient, ParamConfig, ParamEvent, ParamRequestError, ParamSpec, ParamTable,
-    ParamTableError,
+    ParamChange, ParamClient, ParamConfig, ParamEvent, ParamRefusal, ParamRequestError, ParamSpec,
+    ParamTable, ParamTableError, ParamValidator, RangeOnly,
 };
 use crate::plan::{PlanClient, PlanConfig, PlanEvent, PlanItem, PlanRequestError, PlanServer};
 use crate::signing::SigningConfig;
@@ -117,12 +127,48 @@ pub struct SenderStats {
     pub component_id: u8,
     /// Frames received.
     pub received: u64,
-    /// Frames missing, from sequence-number gaps.
+    /// Frames missing, from sequence-number gaps (less those that arrived late).
     pub lost: u64,
     /// Frames repeating the previous sequence number.
     pub duplicates: u64,
+    /// Frames that arrived after a later one (at most [`MAX_REORDER_DEPTH`] behind).
+    pub reordered: u64,
+    /// Times the sender's sequence jumped back further: it restarted (not counted as loss).
+    pub restarts: u64,
     /// `lost / (lost + received)`, %.
     pub loss_pct: f64,
+}
+
+/// Largest forward jump of a sender's sequence number counted as loss (half the 8-bit range:
+/// beyond it the frame is more likely behind than that far ahead).
+pub const MAX_LOSS_GAP: u8 = 128;
+
+/// Deepest a frame may be behind the sender's latest and count as reordered; further behind is
+/// a restart of the sender's sequence.
+pub const MAX_REORDER_DEPTH: u8 = 16;
+
+impl SenderStats {
+    /// Accounts a frame with `sequence` after the last one `last` (see the module
+    /// documentation); returns the sequence to remember as the latest.
+    fn account(&mut self, last: u8, sequence: u8) -> u8 {
+        self.received += 1;
+        let ahead = sequence.wrapping_sub(last);
+        let behind = last.wrapping_sub(sequence);
+        if ahead == 0 {
+            self.duplicates += 1;
+            last
+        } else if ahead <= MAX_LOSS_GAP {
+            self.lost += u64::from(ahead - 1);
+            sequence
+        } else if behind <= MAX_REORDER_DEPTH {
+            self.reordered += 1;
+            self.lost = self.lost.saturating_sub(1);
+            last
+        } else {
+            self.restarts += 1;
+            sequence
+        }
+    }
 }
 
 /// Link quality, for the dashboard and recordings.
@@ -233,6 +279,11 @@ impl LinkCore {
         self.check_persist();
     }
 
+    /// The signing timestamp high-water mark in force (`None`: signing off).
+    fn signing_mark(&self) -> Option<u64> {
+        self.encoder.signer().map(|s| s.value_to_persist())
+    }
+
     fn check_persist(&mut self) {
         if let Some(v) = self
             .encoder
@@ -254,6 +305,17 @@ impl LinkCore {
     /// Decodes `bytes`, returning the frames for the endpoint to dispatch.
     fn ingest(&mut self, now: Duration, bytes: &[u8]) -> Vec<Frame> {
         self.decoder.push(bytes);
+        self.drain_decoder(now)
+    }
+
+    /// The connection carrying the byte stream ended: what is buffered can no longer
+    /// complete. Returns the frames still found behind a cut-off candidate.
+    fn stream_end(&mut self, now: Duration) -> Vec<Frame> {
+        self.decoder.finish();
+        self.drain_decoder(now)
+    }
+
+    fn drain_decoder(&mut self, now: Duration) -> Vec<Frame> {
         let mut frames = Vec::new();
         while let Some(r) = self.decoder.poll(now) {
             match r {
@@ -280,16 +342,7 @@ impl LinkCore {
             .insert(h.message_id, (msg.message_name(), now));
         let key = (h.system_id, h.component_id);
         match self.senders.get_mut(&key) {
-            Some((last_seq, s)) => {
-                let gap = h.sequence.wrapping_sub(*last_seq);
-                if gap == 0 {
-                    s.duplicates += 1;
-                } else {
-                    s.lost += u64::from(gap - 1);
-                }
-                s.received += 1;
-                *last_seq = h.sequence;
-            }
+            Some((last_seq, s)) => *last_seq = s.account(*last_seq, h.sequence),
             None => {
                 self.senders.insert(
                     key,
@@ -517,6 +570,20 @@ impl GroundEndpoint {
         for frame in self.core.ingest(now, bytes) {
             self.dispatch(now, frame);
         }
+    }
+
+    /// The stream connection (TCP, serial) ended: a frame cut off by it is counted as
+    /// truncated and any frame behind it still delivered.
+    pub fn handle_stream_end(&mut self, now: Duration) {
+        for frame in self.core.stream_end(now) {
+            self.dispatch(now, frame);
+        }
+    }
+
+    /// The signing timestamp high-water mark in force, to be persisted before frames signed
+    /// under it leave (`None`: signing off).
+    pub fn signing_timestamp_mark(&self) -> Option<u64> {
+        self.core.signing_mark()
     }
 
     fn dispatch(&mut self, now: Duration, frame: Frame) {
@@ -757,6 +824,9 @@ pub enum VehicleEvent {
     Command(IncomingCommand),
     /// A parameter changed (by the station).
     ParamChanged(ParamChange),
+    /// A parameter set from the station was refused (range or the application's validator);
+    /// the station was answered with the value in force.
+    ParamRefused(ParamRefusal),
     /// A new plan was uploaded.
     PlanReceived(Vec<PlanItem>),
     /// Stick values, or their going stale.
@@ -796,9 +866,44 @@ impl VehicleEndpoint {
         })
     }
 
-    /// Feeds bytes received from the transport.
+    /// Feeds bytes received from the transport; parameter sets are checked against the
+    /// table's ranges only.
     pub fn handle_bytes(&mut self, now: Duration, bytes: &[u8]) {
-        for frame in self.core.ingest(now, bytes) {
+        self.handle_bytes_with(now, bytes, &mut RangeOnly);
+    }
+
+    /// Feeds bytes received from the transport; a parameter set within its range is put to
+    /// `validator` (the application's rules) before it is taken or echoed.
+    pub fn handle_bytes_with(
+        &mut self,
+        now: Duration,
+        bytes: &[u8],
+        validator: &mut impl ParamValidator,
+    ) {
+        let frames = self.core.ingest(now, bytes);
+        self.dispatch(now, frames, validator);
+    }
+
+    /// The stream connection (TCP, serial) ended: a frame cut off by it is counted as
+    /// truncated and any frame behind it still delivered.
+    pub fn handle_stream_end(&mut self, now: Duration) {
+        self.handle_stream_end_with(now, &mut RangeOnly);
+    }
+
+    /// [`handle_stream_end`](Self::handle_stream_end) with the application's parameter rules.
+    pub fn handle_stream_end_with(&mut self, now: Duration, validator: &mut impl ParamValidator) {
+        let frames = self.core.stream_end(now);
+        self.dispatch(now, frames, validator);
+    }
+
+    /// The signing timestamp high-water mark in force, to be persisted before frames signed
+    /// under it leave (`None`: signing off).
+    pub fn signing_timestamp_mark(&self) -> Option<u64> {
+        self.core.signing_mark()
+    }
+
+    fn dispatch(&mut self, now: Duration, frames: Vec<Frame>, validator: &mut impl ParamValidator) {
+        for frame in frames {
             let from = (frame.header.system_id, frame.header.component_id);
             let msg = &frame.message;
             let handled = match msg {
@@ -810,7 +915,7 @@ impl VehicleEndpoint {
                 }
                 _ => {
                     self.commands.handle_message(now, from, msg)
-                        || self.params.handle_message(msg)
+                        || self.params.handle_message_with(msg, validator)
                         || self.plan.handle_message(now, from, msg)
                         || self.manual.handle_message(now, msg)
                 }
@@ -913,6 +1018,9 @@ impl VehicleEndpoint {
         while let Some(m) = self.params.poll_transmit() {
             self.core.send(now, &m);
         }
+        while let Some((severity, text)) = self.params.poll_text() {
+            self.send_status_text(now, severity, &text);
+        }
         while let Some(m) = self.plan.poll_transmit() {
             self.core.send(now, &m);
         }
@@ -929,6 +1037,9 @@ impl VehicleEndpoint {
         }
         while let Some(c) = self.params.poll_change() {
             self.events.push_back(VehicleEvent::ParamChanged(c));
+        }
+        while let Some(r) = self.params.poll_refusal() {
+            self.events.push_back(VehicleEvent::ParamRefused(r));
         }
         while let Some(p) = self.plan.poll_plan() {
             self.events.push_back(VehicleEvent::PlanReceived(p));

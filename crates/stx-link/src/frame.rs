@@ -352,16 +352,18 @@ impl FrameDecoder {
             self.stats.bad_headers += 1;
             return Step::Error(FrameError::UnsupportedFlags { flags }, 1);
         }
+        // Decided on the header alone: a false start in noise must not hold back the frames
+        // behind it until up to 280 bytes have arrived.
+        let Some(extra) = known_extra_crc(message_id) else {
+            self.stats.unknown_message_ids += 1;
+            return Step::Error(FrameError::UnknownMessage { message_id }, 1);
+        };
         let signed = flags & IFLAG_SIGNED != 0;
         let crc_end = V2_HEADER_LEN + usize::from(payload_len) + 2;
         let total = crc_end + if signed { SIGNATURE_BLOCK_LEN } else { 0 };
         debug_assert!(total <= MAX_FRAME_LEN);
         let Some(raw) = rest.get(..total) else {
             return Step::NeedMore;
-        };
-        let Some(extra) = known_extra_crc(message_id) else {
-            self.stats.unknown_message_ids += 1;
-            return Step::Error(FrameError::UnknownMessage { message_id }, 1);
         };
         let (Some(crc_input), Some(crc_bytes)) =
             (raw.get(1..crc_end - 2), raw.get(crc_end - 2..crc_end))
@@ -457,13 +459,13 @@ impl FrameDecoder {
             return Step::NeedMore;
         };
         let message_id = u32::from(id);
-        let crc_end = V1_HEADER_LEN + usize::from(len) + 2;
-        let Some(raw) = rest.get(..crc_end) else {
-            return Step::NeedMore;
-        };
         let Some(extra) = known_extra_crc(message_id) else {
             self.stats.unknown_message_ids += 1;
             return Step::Error(FrameError::UnknownMessage { message_id }, 1);
+        };
+        let crc_end = V1_HEADER_LEN + usize::from(len) + 2;
+        let Some(raw) = rest.get(..crc_end) else {
+            return Step::NeedMore;
         };
         let computed = crc_mavlink(raw.get(1..crc_end - 2).unwrap_or(&[]), extra);
         let received = u16::from_le_bytes([
@@ -526,7 +528,8 @@ pub fn known_extra_crc(message_id: u32) -> Option<u8> {
 }
 
 fn is_known_id(message_id: u32) -> bool {
-    // Only reached for ids whose CRC_EXTRA is 0: rare, so building a default message is fine.
+    // Only reached for ids whose CRC_EXTRA is 0: the few such messages, and ids in noise
+    // (which the dialect's match rejects without building anything).
     MavMessage::default_message_from_id(message_id).is_some()
 }
 
@@ -574,7 +577,12 @@ impl FrameEncoder {
         self.signer = signer;
     }
 
-    /// The signer, when signing is on (to read the value to persist).
+    /// The signer, when signing is on.
+    pub fn signer(&self) -> Option<&Signer> {
+        self.signer.as_ref()
+    }
+
+    /// The signer, when signing is on (to take the value to persist).
     pub fn signer_mut(&mut self) -> Option<&mut Signer> {
         self.signer.as_mut()
     }
@@ -809,6 +817,34 @@ mod tests {
             }
         );
         assert_eq!(dec.stats().unknown_message_ids, 1);
+    }
+
+    /// Regression: the unknown-id check used to wait for the whole candidate (up to 280
+    /// bytes), so a false start in noise held back the valid frames behind it.
+    #[test]
+    fn a_false_start_with_an_unknown_id_does_not_hold_back_the_next_frame() {
+        let mut enc = FrameEncoder::new(1, 1);
+        let a = enc.encode(Duration::ZERO, &attitude(0.1));
+        let unknown_v1 = (0..=255_u8)
+            .find(|&id| known_extra_crc(u32::from(id)).is_none())
+            .expect("an id MAVLink 1 does not know");
+        for false_start in [
+            vec![MAGIC_V2, 255, 0, 0, 0, 1, 1, 0xEF, 0xCD, 0xAB],
+            vec![MAGIC_V1, 255, 0, 1, 1, unknown_v1],
+        ] {
+            let mut stream = false_start.clone();
+            stream.extend(&a);
+            let mut dec = FrameDecoder::default();
+            dec.push(&stream);
+            // No finish(): the frame must come out of what has arrived.
+            let (ok, err) = decode_all(&mut dec);
+            assert_eq!(ok.len(), 1, "{false_start:?}: {err:?}");
+            assert_eq!(ok[0].message, attitude(0.1));
+            assert!(matches!(err[..], [FrameError::UnknownMessage { .. }]));
+            assert_eq!(dec.stats().unknown_message_ids, 1);
+            assert_eq!(dec.stats().bytes_discarded as usize, false_start.len());
+            assert_eq!(dec.buffered(), 0);
+        }
     }
 
     #[test]

@@ -6,9 +6,12 @@
 //!   timeout), read one, set one (PARAM_SET, the echoed PARAM_VALUE is the value actually
 //!   set). Outcomes are [`ParamEvent`]s.
 //! - [`ParamTable`] (vehicle): named `f32` parameters with min / max / default and a
-//!   description; answers list / read / set, refuses out-of-range or non-finite sets (replies
-//!   with the unchanged value and a STATUSTEXT saying why) and reports changes to the
-//!   application as [`ParamChange`]s.
+//!   description; answers list / read / set, refuses out-of-range or non-finite sets and
+//!   those the application's [`ParamValidator`] refuses (the rules between parameters only
+//!   the application knows), replying with the unchanged value and a text saying why, and
+//!   reports changes to the application as [`ParamChange`]s. The validator runs inside the
+//!   set, before the echo, so the only PARAM_VALUE a set produces is the value in force: a
+//!   station never sees a value that is put back a moment later.
 //!
 //! Every value travels as `MAV_PARAM_TYPE_REAL32`.
 
@@ -19,7 +22,7 @@ use mavlink::dialects::common as mc;
 use mavlink::dialects::common::MavMessage;
 use serde::{Deserialize, Serialize};
 
-use crate::telemetry::{Severity, StatusText, Telemetry};
+use crate::telemetry::Severity;
 
 /// Longest parameter name, bytes.
 pub const PARAM_NAME_LEN: usize = 16;
@@ -473,6 +476,51 @@ pub enum ParamTableError {
         min: f32,
         max: f32,
     },
+    /// Set refused by the application's validator.
+    #[error("{name} = {value} refused: {reason}")]
+    Refused {
+        name: String,
+        value: f32,
+        reason: String,
+    },
+}
+
+/// The application's check of a parameter set from the station, run by [`ParamTable`] after
+/// its own range check and before anything changes or is echoed. `Err(reason)` refuses the
+/// value; the reason goes to the station in a STATUSTEXT and to the application as a
+/// [`ParamRefusal`].
+pub trait ParamValidator {
+    /// Whether `name` may take `value` now.
+    fn validate(&mut self, name: &str, value: f32) -> Result<(), String>;
+}
+
+impl<F: FnMut(&str, f32) -> Result<(), String>> ParamValidator for F {
+    fn validate(&mut self, name: &str, value: f32) -> Result<(), String> {
+        self(name, value)
+    }
+}
+
+/// A validator that accepts every value within the table's ranges.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct RangeOnly;
+
+impl ParamValidator for RangeOnly {
+    fn validate(&mut self, _name: &str, _value: f32) -> Result<(), String> {
+        Ok(())
+    }
+}
+
+/// A set from the station that was refused (the table still holds the old value).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ParamRefusal {
+    /// Name.
+    pub name: String,
+    /// The value asked for.
+    pub value: f32,
+    /// The value still in force.
+    pub in_force: f32,
+    /// Why.
+    pub reason: String,
 }
 
 /// A change of a vehicle parameter, for the application to apply.
@@ -489,7 +537,7 @@ pub struct ParamChange {
 /// Counters of the vehicle side.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub struct ParamTableStats {
-    /// Sets refused (out of range, not finite).
+    /// Sets refused (out of range, not finite, or by the application's validator).
     pub sets_refused: u64,
     /// Requests naming a parameter or index we do not have.
     pub unknown_requests: u64,
@@ -506,6 +554,8 @@ pub struct ParamTable {
     values: Vec<f32>,
     transmit: VecDeque<MavMessage>,
     changes: VecDeque<ParamChange>,
+    refusals: VecDeque<ParamRefusal>,
+    texts: VecDeque<(Severity, String)>,
     stats: ParamTableStats,
 }
 
@@ -544,6 +594,8 @@ impl ParamTable {
             values,
             transmit: VecDeque::new(),
             changes: VecDeque::new(),
+            refusals: VecDeque::new(),
+            texts: VecDeque::new(),
             stats: ParamTableStats::default(),
         })
     }
@@ -573,18 +625,23 @@ impl ParamTable {
         })
     }
 
-    /// Sets a value locally (from the application), announcing it to the station.
+    /// Sets a value locally (from the application, which has checked it), announcing it to
+    /// the station. Only the table's range is checked.
     pub fn set(&mut self, name: &str, value: f32) -> Result<(), ParamTableError> {
+        self.set_validated(name, value, &mut RangeOnly)
+    }
+
+    /// The index of `name` if `value` is within its range.
+    fn check_range(&self, name: &str, value: f32) -> Result<usize, ParamTableError> {
+        let unknown = || ParamTableError::Unknown {
+            name: name.to_string(),
+        };
         let i = self
             .specs
             .iter()
             .position(|s| s.name == name)
-            .ok_or_else(|| ParamTableError::Unknown {
-                name: name.to_string(),
-            })?;
-        let spec = self.specs.get(i).ok_or_else(|| ParamTableError::Unknown {
-            name: name.to_string(),
-        })?;
+            .ok_or_else(unknown)?;
+        let spec = self.specs.get(i).ok_or_else(unknown)?;
         if !(value.is_finite() && spec.min <= value && value <= spec.max) {
             return Err(ParamTableError::OutOfRange {
                 name: name.to_string(),
@@ -593,6 +650,24 @@ impl ParamTable {
                 max: spec.max,
             });
         }
+        Ok(i)
+    }
+
+    /// Range check, then `validator`, then the change and its announcement.
+    fn set_validated(
+        &mut self,
+        name: &str,
+        value: f32,
+        validator: &mut impl ParamValidator,
+    ) -> Result<(), ParamTableError> {
+        let i = self.check_range(name, value)?;
+        validator
+            .validate(name, value)
+            .map_err(|reason| ParamTableError::Refused {
+                name: name.to_string(),
+                value,
+                reason,
+            })?;
         if let Some(slot) = self.values.get_mut(i) {
             let old = *slot;
             *slot = value;
@@ -610,8 +685,20 @@ impl ParamTable {
         Ok(())
     }
 
-    /// Feeds a received message. Returns whether it was a parameter request for us.
+    /// Feeds a received message, sets checked against the range only. Returns whether it was
+    /// a parameter request for us.
     pub fn handle_message(&mut self, msg: &MavMessage) -> bool {
+        self.handle_message_with(msg, &mut RangeOnly)
+    }
+
+    /// Feeds a received message; a PARAM_SET within its range is then put to `validator`
+    /// before anything changes or is echoed. Returns whether it was a parameter request for
+    /// us.
+    pub fn handle_message_with(
+        &mut self,
+        msg: &MavMessage,
+        validator: &mut impl ParamValidator,
+    ) -> bool {
         let for_us = |ts: u8, tc: u8| {
             (ts == 0 || ts == self.system_id) && (tc == 0 || tc == self.component_id)
         };
@@ -644,21 +731,34 @@ impl ParamTable {
             }
             MavMessage::PARAM_SET(s) if for_us(s.target_system, s.target_component) => {
                 let name = name_from_wire(&s.param_id);
-                match self.set(&name, s.param_value) {
+                match self.set_validated(&name, s.param_value, validator) {
                     Ok(()) => {}
                     Err(ParamTableError::Unknown { .. }) => {
                         self.stats.unknown_requests += 1;
-                        self.status_text(Severity::Warning, &format!("PARAM {name}: unknown"));
+                        self.texts
+                            .push_back((Severity::Warning, format!("PARAM {name}: unknown")));
                     }
                     Err(e) => {
                         self.stats.sets_refused += 1;
                         tracing::warn!(error = %e, "parameter set refused");
+                        // The value in force answers the set: the station's client reads it
+                        // as the outcome.
                         if let Some(i) = self.specs.iter().position(|sp| sp.name == name)
                             && let Some(v) = self.value_at(i)
                         {
                             self.transmit.push_back(param_value_msg(&v));
+                            self.refusals.push_back(ParamRefusal {
+                                name: name.clone(),
+                                value: s.param_value,
+                                in_force: v.value,
+                                reason: match &e {
+                                    ParamTableError::Refused { reason, .. } => reason.clone(),
+                                    other => other.to_string(),
+                                },
+                            });
                         }
-                        self.status_text(Severity::Warning, &format!("PARAM {e}"));
+                        self.texts
+                            .push_back((Severity::Warning, format!("PARAM {e}")));
                     }
                 }
                 true
@@ -667,14 +767,20 @@ impl ParamTable {
         }
     }
 
-    fn status_text(&mut self, severity: Severity, text: &str) {
-        self.transmit
-            .push_back(Telemetry::StatusText(StatusText::single(severity, text)).to_mavlink());
-    }
-
     /// Next change for the application.
     pub fn poll_change(&mut self) -> Option<ParamChange> {
         self.changes.pop_front()
+    }
+
+    /// Next refused set, for the application.
+    pub fn poll_refusal(&mut self) -> Option<ParamRefusal> {
+        self.refusals.pop_front()
+    }
+
+    /// Next text for the station (why a set was refused), to send as STATUSTEXT (split when
+    /// longer than one chunk).
+    pub fn poll_text(&mut self) -> Option<(Severity, String)> {
+        self.texts.pop_front()
     }
 
     /// Next message to send.
@@ -784,19 +890,14 @@ mod tests {
             .expect("started");
         let m = cl.poll_transmit().expect("PARAM_SET");
         tb.handle_message(&m);
-        let mut saw_text = false;
         while let Some(m) = tb.poll_transmit() {
-            if let MavMessage::STATUSTEXT(t) = &m {
-                let text = String::from_utf8_lossy(&t.text[..]).to_string();
-                assert!(
-                    text.contains("HDG_KP") && text.contains("outside"),
-                    "{text}"
-                );
-                saw_text = true;
-            }
             cl.handle_message(Duration::ZERO, 1, &m);
         }
-        assert!(saw_text);
+        let (_, text) = tb.poll_text().expect("a text saying why");
+        assert!(
+            text.contains("HDG_KP") && text.contains("outside"),
+            "{text}"
+        );
         assert_eq!(
             cl.poll_event(),
             Some(ParamEvent::SetDone {
@@ -815,6 +916,70 @@ mod tests {
         assert!(
             matches!(cl.poll_event(), Some(ParamEvent::ReadDone { param }) if param.value == 8.0 && param.index == 2)
         );
+    }
+
+    /// Regression: a value within its range but refused by the application used to be
+    /// echoed first (the client reported it accepted) and put back afterwards.
+    #[test]
+    fn a_set_the_validator_refuses_is_answered_only_with_the_value_in_force() {
+        let mut tb = table();
+        let mut cl = ParamClient::default();
+        // The application's rule: the D gain at most a quarter of the P gain.
+        let kp = tb.get("HDG_KP").expect("KP");
+        let mut validator = |name: &str, value: f32| {
+            if name == "HDG_KD" && value > kp / 4.0 {
+                Err(format!("HDG_KD must not exceed HDG_KP/4 = {}", kp / 4.0))
+            } else {
+                Ok(())
+            }
+        };
+        cl.set(Duration::ZERO, (1, 1), "HDG_KD", 1.0)
+            .expect("started");
+        let m = cl.poll_transmit().expect("PARAM_SET");
+        assert!(tb.handle_message_with(&m, &mut validator));
+        let mut values = Vec::new();
+        while let Some(m) = tb.poll_transmit() {
+            if let MavMessage::PARAM_VALUE(v) = &m {
+                values.push(v.param_value);
+            }
+            cl.handle_message(Duration::ZERO, 1, &m);
+        }
+        assert_eq!(values, [0.1], "only the value in force goes out");
+        assert_eq!(
+            cl.poll_event(),
+            Some(ParamEvent::SetDone {
+                name: "HDG_KD".into(),
+                requested: 1.0,
+                actual: 0.1,
+                accepted: false
+            })
+        );
+        assert_eq!(cl.poll_event(), None);
+        assert_eq!(tb.get("HDG_KD"), Some(0.1));
+        assert_eq!(tb.poll_change(), None);
+        let refusal = tb.poll_refusal().expect("the application hears of it");
+        assert_eq!((refusal.value, refusal.in_force), (1.0, 0.1));
+        assert!(refusal.reason.contains("HDG_KP/4"), "{refusal:?}");
+        let (_, text) = tb.poll_text().expect("the station hears why");
+        assert!(
+            text.contains("HDG_KD") && text.contains("HDG_KP/4"),
+            "{text}"
+        );
+        assert_eq!(tb.stats().sets_refused, 1);
+
+        // Within the rule: taken and echoed once.
+        cl.set(Duration::ZERO, (1, 1), "HDG_KD", 0.15)
+            .expect("started");
+        let m = cl.poll_transmit().expect("PARAM_SET");
+        tb.handle_message_with(&m, &mut validator);
+        while let Some(m) = tb.poll_transmit() {
+            cl.handle_message(Duration::ZERO, 1, &m);
+        }
+        assert!(matches!(
+            cl.poll_event(),
+            Some(ParamEvent::SetDone { accepted: true, .. })
+        ));
+        assert_eq!(tb.get("HDG_KD"), Some(0.15));
     }
 
     #[test]

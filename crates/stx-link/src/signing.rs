@@ -3,6 +3,11 @@
 //!
 //! - [`SigningKey`] holds the 32-byte secret. It never prints its bytes (`Debug` shows
 //!   `SigningKey(<redacted>)`, there is no `Display` and no `Serialize`) and is wiped on drop.
+//!   It is read from 64 hexadecimal characters ([`SigningKey::from_hex`]), a key file
+//!   ([`SigningKey::from_file`]) or an environment variable ([`SIGNING_KEY_ENV`]) — never from
+//!   a command-line argument, which other users see in `ps` and shells keep in their history.
+//! - [`KeyText`] holds a key as written in a configuration file until it is parsed: it too
+//!   never shows (`Debug` and `Serialize` give `<redacted>`) and is wiped on drop.
 //! - [`SigningClock`] turns the monotonic `now` every sans-io call receives into MAVLink's
 //!   signing time: 10 µs units since 2015-01-01 00:00:00 UTC, anchored on one wall-clock
 //!   reading that the caller takes when it starts.
@@ -43,6 +48,33 @@ pub const PERSIST_RESERVE_10US: u64 = 1_000_000;
 /// stream is forgotten (it then has to pass the new-stream window again).
 pub const MAX_STREAMS: usize = 1024;
 
+/// Environment variable holding the signing key as 64 hexadecimal characters (what
+/// `stx drone` and `stx serve` read when no key file is given).
+pub const SIGNING_KEY_ENV: &str = "STX_SIGNING_KEY";
+
+/// Why a signing key could not be read. Never contains the key's text.
+#[derive(Debug, thiserror::Error)]
+pub enum KeyError {
+    /// Not 64 hexadecimal characters.
+    #[error("a signing key is 64 hexadecimal characters (32 bytes); this is not one")]
+    NotHex,
+    /// The key file could not be read.
+    #[error("cannot read the signing key file {path}: {source}")]
+    File {
+        /// The file.
+        path: std::path::PathBuf,
+        /// Why.
+        #[source]
+        source: std::io::Error,
+    },
+    /// The key file does not hold a key.
+    #[error("signing key file {path}: expected 64 hexadecimal characters (32 bytes)")]
+    FileNotHex {
+        /// The file.
+        path: std::path::PathBuf,
+    },
+}
+
 /// The 32-byte shared secret of MAVLink 2 signing.
 #[derive(Clone, PartialEq, Eq)]
 pub struct SigningKey([u8; 32]);
@@ -51,6 +83,36 @@ impl SigningKey {
     /// Wraps raw key bytes.
     pub fn from_bytes(bytes: [u8; 32]) -> Self {
         Self(bytes)
+    }
+
+    /// Parses 64 hexadecimal characters (surrounding whitespace ignored). The error never
+    /// repeats the text.
+    pub fn from_hex(text: &str) -> Result<Self, KeyError> {
+        let text = text.trim().as_bytes();
+        if text.len() != 64 {
+            return Err(KeyError::NotHex);
+        }
+        let mut bytes = [0_u8; 32];
+        for (out, pair) in bytes.iter_mut().zip(text.chunks_exact(2)) {
+            let digit = |c: u8| char::from(c).to_digit(16).ok_or(KeyError::NotHex);
+            // Both digits are < 16, so the byte cannot overflow.
+            *out = (digit(pair[0])? * 16 + digit(pair[1])?) as u8;
+        }
+        Ok(Self(bytes))
+    }
+
+    /// Reads a key file: 64 hexadecimal characters (a trailing newline is fine), e.g. made
+    /// with `openssl rand -hex 32 > key && chmod 600 key`.
+    pub fn from_file(path: &std::path::Path) -> Result<Self, KeyError> {
+        let text = std::fs::read_to_string(path).map_err(|source| KeyError::File {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        let key = Self::from_hex(&text).map_err(|_| KeyError::FileNotHex {
+            path: path.to_path_buf(),
+        });
+        wipe_string(text);
+        key
     }
 
     /// Derives a key from a passphrase the way MAVProxy and QGroundControl do: SHA-256 of the
@@ -75,11 +137,58 @@ impl fmt::Debug for SigningKey {
 
 impl Drop for SigningKey {
     fn drop(&mut self) {
-        for byte in self.0.iter_mut() {
-            // SAFETY: `byte` is a valid, aligned, exclusive reference into our own array.
-            unsafe { std::ptr::write_volatile(byte, 0) };
-        }
-        std::sync::atomic::compiler_fence(std::sync::atomic::Ordering::SeqCst);
+        wipe(&mut self.0);
+    }
+}
+
+/// Overwrites `bytes` with zeros in a way the optimiser keeps.
+fn wipe(bytes: &mut [u8]) {
+    for byte in bytes.iter_mut() {
+        // SAFETY: `byte` is a valid, aligned, exclusive reference into the slice.
+        unsafe { std::ptr::write_volatile(byte, 0) };
+    }
+    std::sync::atomic::compiler_fence(std::sync::atomic::Ordering::SeqCst);
+}
+
+fn wipe_string(text: String) {
+    let mut bytes = text.into_bytes();
+    wipe(&mut bytes);
+}
+
+/// A signing key as written in a configuration file (64 hexadecimal characters), held until
+/// it is parsed with [`KeyText::key`]. It never shows: `Debug` and `Serialize` give
+/// `<redacted>`, there is no `Display`; it is wiped on drop.
+#[derive(Clone, PartialEq, Eq, serde::Deserialize)]
+#[serde(transparent)]
+pub struct KeyText(String);
+
+impl KeyText {
+    /// Holds `text`.
+    pub fn new(text: String) -> Self {
+        Self(text)
+    }
+
+    /// The key it spells.
+    pub fn key(&self) -> Result<SigningKey, KeyError> {
+        SigningKey::from_hex(&self.0)
+    }
+}
+
+impl fmt::Debug for KeyText {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str("<redacted>")
+    }
+}
+
+impl serde::Serialize for KeyText {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str("<redacted>")
+    }
+}
+
+impl Drop for KeyText {
+    fn drop(&mut self) {
+        wipe_string(std::mem::take(&mut self.0));
     }
 }
 
@@ -448,6 +557,54 @@ mod tests {
         assert!(shown.contains("SigningKey(<redacted>)"));
         assert!(!shown.to_lowercase().contains("ab, ab"));
         assert!(!shown.contains("171"));
+    }
+
+    #[test]
+    fn keys_parse_from_hex_and_files_and_errors_never_repeat_the_text() {
+        let hex = "00112233445566778899aabbccddeeff00112233445566778899AABBCCDDEEFF";
+        let key = SigningKey::from_hex(&format!(" {hex}\n")).expect("valid");
+        let mut expected = [0_u8; 32];
+        for (i, b) in expected.iter_mut().enumerate() {
+            *b = [
+                0x00, 0x11, 0x22, 0x33, 0x44, 0x55, 0x66, 0x77, 0x88, 0x99, 0xAA, 0xBB, 0xCC, 0xDD,
+                0xEE, 0xFF,
+            ][i % 16];
+        }
+        assert!(key == SigningKey::from_bytes(expected));
+        for bad in [
+            &hex[..62],
+            "zz".repeat(32).as_str(),
+            "é".repeat(32).as_str(),
+        ] {
+            let e = SigningKey::from_hex(bad).map(drop).expect_err("refused");
+            assert!(!e.to_string().contains(bad), "{e}");
+        }
+        let dir = std::env::temp_dir().join(format!("stx-key-test-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).expect("dir");
+        let path = dir.join("key");
+        std::fs::write(&path, format!("{hex}\n")).expect("write");
+        assert!(SigningKey::from_file(&path).expect("read") == key);
+        std::fs::write(&path, "secret-but-not-hex\n").expect("write");
+        let e = SigningKey::from_file(&path).map(drop).expect_err("refused");
+        assert!(!e.to_string().contains("secret"), "{e}");
+        let e = SigningKey::from_file(&dir.join("absent"))
+            .map(drop)
+            .expect_err("refused");
+        assert!(e.to_string().contains("absent"), "{e}");
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
+    fn key_text_never_shows_in_debug_or_serialised_form() {
+        let hex = "ab".repeat(32);
+        let text: KeyText = serde_json::from_str(&format!("\"{hex}\"")).expect("deserialises");
+        assert!(text.key().is_ok());
+        let shown = format!(
+            "{text:?} {}",
+            serde_json::to_string(&text).expect("serialises")
+        );
+        assert!(!shown.contains("abab"), "{shown}");
+        assert!(shown.contains("<redacted>"));
     }
 
     #[test]

@@ -12,8 +12,14 @@
 //! - [`drive`] runs an endpoint over a transport: it reads, feeds bytes and timeouts to the
 //!   endpoint, writes what it transmits, runs the application's closures on it (the only way
 //!   to touch the endpoint while it is driven) and forwards its events. No I/O error is
-//!   swallowed: each is counted in [`IoStats`], logged with `tracing` and surfaced as an
-//!   [`IoEvent`].
+//!   swallowed: each is counted in [`IoStats`]; they are reported (a `tracing` warning and an
+//!   [`IoEvent`]) rate-limited, because a link without a peer fails every frame — the first
+//!   failure at once, then one report with the count per [`IO_ERROR_REPORT_INTERVAL`] while
+//!   failures go on.
+//! - With signing on, [`drive`] writes the signing timestamp's high-water mark to the
+//!   [`DriveOptions::signing_timestamp_file`] whenever it moves, before the frames signed under
+//!   it are sent, so a restart (even with the wall clock set back) continues above every
+//!   timestamp that ever left. [`default_state_dir`] is where stx keeps such files by default.
 //!
 //! Time: `now` given to the endpoint is `tokio::time::Instant` elapsed since the driver
 //! started, so `tokio::time::pause` makes tests deterministic.
@@ -31,13 +37,16 @@ use tokio::net::{TcpListener, TcpStream, UdpSocket};
 use tokio::sync::mpsc;
 use tokio::time::Instant;
 
-use crate::endpoint::{GroundEndpoint, GroundEvent, LinkEvent, VehicleEndpoint, VehicleEvent};
+use crate::endpoint::{GroundEndpoint, GroundEvent, VehicleEndpoint, VehicleEvent};
 
 /// Frames kept for a UDP-in peer not yet heard from.
 pub const MAX_QUEUED_WITHOUT_PEER: usize = 256;
 
 /// Wait before re-opening a TCP client connection or a serial port.
 pub const REOPEN_DELAY: Duration = Duration::from_secs(1);
+
+/// Shortest time between two reports of failing reads (or writes) of one transport.
+pub const IO_ERROR_REPORT_INTERVAL: Duration = Duration::from_secs(5);
 
 /// Where to connect.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -168,9 +177,11 @@ pub enum TransportError {
 /// Something that happened on the socket; none of it is hidden from the application.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum IoEvent {
-    /// A read failed (counted in `recv_errors`).
+    /// Reads failed: the first failure, then at most one report per
+    /// [`IO_ERROR_REPORT_INTERVAL`] while they go on. `error` is the latest failure, `count`
+    /// the total so far (`recv_errors`).
     RecvError { error: String, count: u64 },
-    /// A write failed (counted in `send_errors`).
+    /// Writes failed, reported like [`IoEvent::RecvError`]; `count` is `send_errors`.
     SendError { error: String, count: u64 },
     /// UDP-in: a frame was queued because no peer has been heard yet.
     QueuedWithoutPeer { queued: usize },
@@ -226,12 +237,59 @@ enum Kind {
     },
 }
 
+/// Rate limit of the reports of one kind of I/O failure (every failure is counted
+/// elsewhere): the first at once, then at most one per [`IO_ERROR_REPORT_INTERVAL`] carrying
+/// how many failed since the previous report.
+#[derive(Debug, Default)]
+struct ErrorReports {
+    last_report: Option<Instant>,
+    unreported: u64,
+    last_error: String,
+}
+
+/// Which way an I/O operation went.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Dir {
+    Recv,
+    Send,
+}
+
+impl ErrorReports {
+    /// A failure at `now`: `Some(failures since the last report)` when it is to be reported.
+    fn failed(&mut self, now: Instant) -> Option<u64> {
+        self.unreported += 1;
+        self.due(now)
+    }
+
+    /// A success at `now`: reports the failures not yet reported, once the interval allows.
+    fn succeeded(&mut self, now: Instant) -> Option<u64> {
+        if self.unreported == 0 {
+            return None;
+        }
+        self.due(now)
+    }
+
+    fn due(&mut self, now: Instant) -> Option<u64> {
+        let due = self
+            .last_report
+            .is_none_or(|t| now.duration_since(t) >= IO_ERROR_REPORT_INTERVAL);
+        due.then(|| {
+            self.last_report = Some(now);
+            std::mem::take(&mut self.unreported)
+        })
+    }
+}
+
 /// An open transport.
 pub struct Transport {
     address: Address,
     kind: Kind,
     stats: IoStats,
     events: VecDeque<IoEvent>,
+    recv_reports: ErrorReports,
+    send_reports: ErrorReports,
+    /// A stream connection ended since the driver last asked.
+    stream_ended: bool,
 }
 
 impl fmt::Debug for Transport {
@@ -323,12 +381,7 @@ impl Transport {
                 }
             }
         };
-        let mut t = Self {
-            address,
-            kind,
-            stats: IoStats::default(),
-            events: VecDeque::new(),
-        };
+        let mut t = Self::new(address, kind);
         if matches!(t.kind, Kind::Reopening { .. }) {
             t.stats.connects += 1;
             t.events.push_back(IoEvent::Connected {
@@ -343,22 +396,43 @@ impl Transport {
         label: &str,
         stream: S,
     ) -> Self {
+        let address = Address::Serial {
+            path: label.to_string(),
+            baud: 1,
+        };
+        let kind = Kind::Reopening {
+            address: address.clone(),
+            conn: Some(Box::new(stream)),
+            retry_at: None,
+        };
+        Self::new(address, kind)
+    }
+
+    fn new(address: Address, kind: Kind) -> Self {
         Self {
-            address: Address::Serial {
-                path: label.to_string(),
-                baud: 1,
-            },
-            kind: Kind::Reopening {
-                address: Address::Serial {
-                    path: label.to_string(),
-                    baud: 1,
-                },
-                conn: Some(Box::new(stream)),
-                retry_at: None,
-            },
+            address,
+            kind,
             stats: IoStats::default(),
             events: VecDeque::new(),
+            recv_reports: ErrorReports::default(),
+            send_reports: ErrorReports::default(),
+            stream_ended: false,
         }
+    }
+
+    /// The address a server transport actually listens on — `udpin:` and `tcpin:` with the
+    /// port the system chose for port 0 — for the operator to connect to; `None` for clients.
+    pub fn listening_address(&self) -> Option<Address> {
+        match (&self.address, self.local_addr()?) {
+            (Address::UdpIn(_), local) => Some(Address::UdpIn(local)),
+            (Address::TcpServer(_), local) => Some(Address::TcpServer(local)),
+            _ => None,
+        }
+    }
+
+    /// Whether a stream connection (TCP, serial) ended since the last call.
+    pub fn take_stream_ended(&mut self) -> bool {
+        std::mem::take(&mut self.stream_ended)
     }
 
     /// Local socket address (UDP and TCP server).
@@ -387,25 +461,73 @@ impl Transport {
 
     fn recv_error(&mut self, e: &io::Error) {
         self.stats.recv_errors += 1;
-        tracing::warn!(address = %self.address, error = %e, "receive error");
-        self.events.push_back(IoEvent::RecvError {
-            error: e.to_string(),
-            count: self.stats.recv_errors,
-        });
+        self.failed(Dir::Recv, e);
     }
 
     fn send_error(&mut self, e: &io::Error) {
         self.stats.send_errors += 1;
-        tracing::warn!(address = %self.address, error = %e, "send error");
-        self.events.push_back(IoEvent::SendError {
-            error: e.to_string(),
-            count: self.stats.send_errors,
+        self.failed(Dir::Send, e);
+    }
+
+    fn reports(&mut self, dir: Dir) -> &mut ErrorReports {
+        match dir {
+            Dir::Recv => &mut self.recv_reports,
+            Dir::Send => &mut self.send_reports,
+        }
+    }
+
+    fn failed(&mut self, dir: Dir, e: &io::Error) {
+        let reports = self.reports(dir);
+        reports.last_error = e.to_string();
+        if let Some(n) = reports.failed(Instant::now()) {
+            self.report(dir, n);
+        }
+    }
+
+    fn succeeded(&mut self, dir: Dir) {
+        if let Some(n) = self.reports(dir).succeeded(Instant::now()) {
+            self.report(dir, n);
+        }
+    }
+
+    /// One report of `since_last` failures of `dir` (log line and event).
+    fn report(&mut self, dir: Dir, since_last: u64) {
+        let error = self.reports(dir).last_error.clone();
+        let (what, total) = match dir {
+            Dir::Recv => ("receive", self.stats.recv_errors),
+            Dir::Send => ("send", self.stats.send_errors),
+        };
+        tracing::warn!(
+            address = %self.address,
+            %error,
+            since_last_report = since_last,
+            total,
+            "{what} failed (reported at most every {} s)",
+            IO_ERROR_REPORT_INTERVAL.as_secs()
+        );
+        self.events.push_back(match dir {
+            Dir::Recv => IoEvent::RecvError {
+                error,
+                count: total,
+            },
+            Dir::Send => IoEvent::SendError {
+                error,
+                count: total,
+            },
         });
     }
 
     /// Waits for bytes; returns how many were put in `buf` (0 when an event, such as an error
     /// or a connection change, happened instead). Cancel-safe.
     pub async fn recv(&mut self, buf: &mut [u8]) -> usize {
+        let n = self.recv_inner(buf).await;
+        if n > 0 {
+            self.succeeded(Dir::Recv);
+        }
+        n
+    }
+
+    async fn recv_inner(&mut self, buf: &mut [u8]) -> usize {
         match &mut self.kind {
             Kind::Udp {
                 socket,
@@ -431,6 +553,7 @@ impl Transport {
                 Some(stream) => match stream.read(buf).await {
                     Ok(0) => {
                         *conn = None;
+                        self.stream_ended = true;
                         self.events.push_back(IoEvent::Disconnected {
                             reason: "peer closed".into(),
                         });
@@ -442,6 +565,7 @@ impl Transport {
                     }
                     Err(e) => {
                         *conn = None;
+                        self.stream_ended = true;
                         self.recv_error(&e);
                         self.events.push_back(IoEvent::Disconnected {
                             reason: e.to_string(),
@@ -476,6 +600,7 @@ impl Transport {
                     Ok(0) => {
                         *conn = None;
                         *retry_at = Some(Instant::now() + REOPEN_DELAY);
+                        self.stream_ended = true;
                         self.events.push_back(IoEvent::Disconnected {
                             reason: "closed".into(),
                         });
@@ -488,6 +613,7 @@ impl Transport {
                     Err(e) => {
                         *conn = None;
                         *retry_at = Some(Instant::now() + REOPEN_DELAY);
+                        self.stream_ended = true;
                         self.recv_error(&e);
                         self.events.push_back(IoEvent::Disconnected {
                             reason: e.to_string(),
@@ -580,8 +706,9 @@ impl Transport {
                 Err(io::Error::new(io::ErrorKind::NotConnected, "no connection"))
             }
         };
-        if let Err(e) = result {
-            self.send_error(&e);
+        match result {
+            Ok(()) => self.succeeded(Dir::Send),
+            Err(e) => self.send_error(&e),
         }
     }
 }
@@ -600,12 +727,15 @@ pub trait SansIo: Send + 'static {
     fn poll_transmit(&mut self, now: Duration) -> Option<Vec<u8>>;
     /// Next event.
     fn poll_event(&mut self) -> Option<Self::Event>;
-    /// The signing timestamp to persist, if `event` asks for it.
-    fn persist_request(event: &Self::Event) -> Option<u64>;
+    /// The stream connection ended (TCP, serial): flush what can no longer complete.
+    fn handle_stream_end(&mut self, now: Duration);
+    /// The signing timestamp high-water mark in force (`None`: signing off); [`drive`]
+    /// persists it whenever it moves, before sending frames signed under it.
+    fn signing_timestamp_mark(&self) -> Option<u64>;
 }
 
 macro_rules! impl_sans_io {
-    ($ty:ty, $ev:ty, $link:path) => {
+    ($ty:ty, $ev:ty) => {
         impl SansIo for $ty {
             type Event = $ev;
             fn handle_bytes(&mut self, now: Duration, bytes: &[u8]) {
@@ -623,18 +753,18 @@ macro_rules! impl_sans_io {
             fn poll_event(&mut self) -> Option<$ev> {
                 <$ty>::poll_event(self)
             }
-            fn persist_request(event: &$ev) -> Option<u64> {
-                match event {
-                    $link(LinkEvent::PersistSigningTimestamp(v)) => Some(*v),
-                    _ => None,
-                }
+            fn handle_stream_end(&mut self, now: Duration) {
+                <$ty>::handle_stream_end(self, now)
+            }
+            fn signing_timestamp_mark(&self) -> Option<u64> {
+                <$ty>::signing_timestamp_mark(self)
             }
         }
     };
 }
 
-impl_sans_io!(GroundEndpoint, GroundEvent, GroundEvent::Link);
-impl_sans_io!(VehicleEndpoint, VehicleEvent, VehicleEvent::Link);
+impl_sans_io!(GroundEndpoint, GroundEvent);
+impl_sans_io!(VehicleEndpoint, VehicleEvent);
 
 /// What the driver forwards to the application.
 #[derive(Debug)]
@@ -651,8 +781,41 @@ pub type Action<E> = Box<dyn FnOnce(&mut E, Duration) + Send>;
 /// Options of [`drive`].
 #[derive(Debug, Clone, Default)]
 pub struct DriveOptions {
-    /// File where the signing timestamp high-water mark is written when it moves.
+    /// File where the signing timestamp high-water mark is written when it moves, before the
+    /// frames signed under it are sent. With signing on, set it: without it the timestamps
+    /// are monotonic across restarts only while the wall clock is.
     pub signing_timestamp_file: Option<PathBuf>,
+}
+
+/// Where stx keeps state that must survive a restart (signing timestamps), looked up in the
+/// environment `env` (e.g. `|k| std::env::var_os(k)`): `$STATE_DIRECTORY` (systemd's
+/// `StateDirectory=`), else `$XDG_STATE_HOME/stx`, else `$HOME/.local/state/stx`; `None` when
+/// none is set.
+pub fn default_state_dir(env: impl Fn(&str) -> Option<std::ffi::OsString>) -> Option<PathBuf> {
+    let set = |k: &str| env(k).filter(|v| !v.is_empty()).map(PathBuf::from);
+    set("STATE_DIRECTORY")
+        // systemd may list several directories, separated by ':'.
+        .map(|p| {
+            let text = p.to_string_lossy().into_owned();
+            PathBuf::from(text.split(':').next().unwrap_or_default())
+        })
+        .or_else(|| set("XDG_STATE_HOME").map(|p| p.join("stx")))
+        .or_else(|| set("HOME").map(|p| p.join(".local/state/stx")))
+}
+
+/// Writes `endpoint`'s signing timestamp high-water mark to `path` (when both signing and a
+/// file are set): what an adapter does once before [`drive`], so that a file that cannot be
+/// written stops the start instead of weakening the guarantee later.
+pub fn persist_signing_mark<E: SansIo>(endpoint: &E, path: Option<&Path>) -> io::Result<()> {
+    match (path, endpoint.signing_timestamp_mark()) {
+        (Some(path), Some(mark)) => store_signing_timestamp(path, mark).map_err(|e| {
+            io::Error::new(
+                e.kind(),
+                format!("signing timestamp file {}: {e}", path.display()),
+            )
+        }),
+        _ => Ok(()),
+    }
 }
 
 /// Reads a persisted signing timestamp; `Ok(None)` if the file does not exist.
@@ -668,9 +831,13 @@ pub fn load_signing_timestamp(path: &Path) -> io::Result<Option<u64>> {
     }
 }
 
-/// Writes a signing timestamp atomically (temporary file, fsync, rename).
+/// Writes a signing timestamp atomically (temporary file, fsync, rename), creating the
+/// directory if needed.
 pub fn store_signing_timestamp(path: &Path, value: u64) -> io::Result<()> {
     use std::io::Write;
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir)?;
+    }
     let tmp = path.with_extension("tmp");
     let mut f = std::fs::File::create(&tmp)?;
     writeln!(f, "{value}")?;
@@ -691,24 +858,38 @@ pub async fn drive<E: SansIo>(
     let start = Instant::now();
     let mut buf = vec![0_u8; 65_536];
     let mut open = true;
+    // The last mark written, or the last one that failed (not retried: it is reported once,
+    // and the mark moves on within seconds).
+    let mut persisted = None;
+    let mut frames = Vec::new();
     loop {
         let now = start.elapsed();
         endpoint.handle_timeout(now);
         while let Some(frame) = endpoint.poll_transmit(now) {
+            frames.push(frame);
+        }
+        // The mark covering these frames' timestamps is on disk before they leave.
+        let mark = endpoint.signing_timestamp_mark();
+        if let (Some(path), Some(v)) = (options.signing_timestamp_file.as_deref(), mark)
+            && persisted != Some(v)
+        {
+            persisted = Some(v);
+            match store_signing_timestamp(path, v) {
+                Ok(()) => {}
+                // The link matters more than the guarantee: send anyway, and say so.
+                Err(err) => {
+                    tracing::error!(path = %path.display(), error = %err, "cannot persist signing timestamp");
+                    transport.events.push_back(IoEvent::PersistFailed {
+                        path: path.to_path_buf(),
+                        error: err.to_string(),
+                    });
+                }
+            }
+        }
+        for frame in frames.drain(..) {
             transport.send(&frame).await;
         }
         while let Some(e) = endpoint.poll_event() {
-            if let (Some(v), Some(path)) = (
-                E::persist_request(&e),
-                options.signing_timestamp_file.as_deref(),
-            ) && let Err(err) = store_signing_timestamp(path, v)
-            {
-                tracing::error!(path = %path.display(), error = %err, "cannot persist signing timestamp");
-                transport.events.push_back(IoEvent::PersistFailed {
-                    path: path.to_path_buf(),
-                    error: err.to_string(),
-                });
-            }
             if events.send(DriverEvent::Endpoint(e)).await.is_err() {
                 open = false;
             }
@@ -729,6 +910,9 @@ pub async fn drive<E: SansIo>(
             n = transport.recv(&mut buf) => {
                 if n > 0 {
                     endpoint.handle_bytes(start.elapsed(), buf.get(..n).unwrap_or(&[]));
+                }
+                if transport.take_stream_ended() {
+                    endpoint.handle_stream_end(start.elapsed());
                 }
             }
             action = actions.recv() => match action {

@@ -8,8 +8,10 @@ use common::{Pair, msg_id};
 use stx_gnc::mission::FlightMode;
 use stx_link::command::{Command, CommandOutcome, CommandResult, RequestId};
 use stx_link::endpoint::{
-    GroundConfig, GroundEvent, LinkConfig, LinkEvent, VehicleConfig, VehicleEvent,
+    GroundConfig, GroundEndpoint, GroundEvent, LinkConfig, LinkEvent, SenderStats, VehicleConfig,
+    VehicleEvent,
 };
+use stx_link::frame::{FrameError, FrameIds, encode_frame_into};
 use stx_link::manual::{ManualEvent, Sticks};
 use stx_link::param::{ParamEvent, ParamSpec};
 use stx_link::plan::{PlanEvent, PlanItem};
@@ -450,15 +452,7 @@ fn link_lost_and_regained() {
 fn packet_loss_is_computed_from_sequence_gaps() {
     let mut pair = Pair::default_pair(13);
     pair.to_ground.loss = 0.10;
-    let att = Telemetry::Attitude(Attitude {
-        time_boot_ms: 0,
-        roll_rad: 0.1,
-        pitch_rad: 0.0,
-        yaw_rad: 1.0,
-        roll_rate_radps: 0.0,
-        pitch_rate_radps: 0.0,
-        yaw_rate_radps: 0.0,
-    });
+    let att = attitude();
     for i in 0..2000 {
         let t = secs(100.0 + f64::from(i) * 0.02);
         pair.run_until(t);
@@ -498,6 +492,107 @@ fn packet_loss_is_computed_from_sequence_gaps() {
     // Serialisable for the station.
     let json = serde_json::to_string(&stats).expect("serialises");
     assert!(json.contains("packet_loss_pct"));
+}
+
+fn attitude() -> Telemetry {
+    Telemetry::Attitude(Attitude {
+        time_boot_ms: 0,
+        roll_rad: 0.1,
+        pitch_rad: 0.0,
+        yaw_rad: 1.0,
+        roll_rate_radps: 0.0,
+        pitch_rate_radps: 0.0,
+        yaw_rate_radps: 0.0,
+    })
+}
+
+/// Frames from system 1 with the given sequence numbers, each its own datagram.
+fn frames_with_sequences(sequences: &[u8]) -> Vec<Vec<u8>> {
+    let msg = attitude().to_mavlink();
+    sequences
+        .iter()
+        .map(|&sequence| {
+            let mut out = Vec::new();
+            encode_frame_into(
+                Duration::ZERO,
+                &msg,
+                FrameIds {
+                    system_id: 1,
+                    component_id: 1,
+                    sequence,
+                },
+                None,
+                &mut out,
+            );
+            out
+        })
+        .collect()
+}
+
+fn sender_after(sequences: &[u8]) -> SenderStats {
+    let mut ground = GroundEndpoint::new(GroundConfig::default(), Duration::ZERO);
+    for f in frames_with_sequences(sequences) {
+        ground.handle_bytes(Duration::ZERO, &f);
+    }
+    let stats = ground.link_stats(Duration::ZERO);
+    assert_eq!(stats.frames_in, sequences.len() as u64);
+    stats.senders[0]
+}
+
+/// Regression: a reordered frame or a sender restarting its sequence counted as ~255 lost
+/// packets (the modulo-256 gap).
+#[test]
+fn reordered_frames_and_restarts_are_counted_apart_from_loss() {
+    // A real loss of three frames, across the wrap.
+    let s = sender_after(&[253, 254, 255, 3, 4]);
+    assert_eq!((s.lost, s.reordered, s.restarts), (3, 0, 0));
+    // Two frames swapped: nothing lost.
+    let s = sender_after(&[10, 11, 13, 12, 14, 15]);
+    assert_eq!((s.lost, s.reordered, s.restarts), (0, 1, 0), "{s:?}");
+    assert_eq!(s.loss_pct, 0.0);
+    // A late frame across the wrap, and one of two lost frames arriving late.
+    let s = sender_after(&[254, 0, 255, 1, 4, 2, 5]);
+    assert_eq!((s.lost, s.reordered, s.restarts), (1, 2, 0), "{s:?}");
+    // The sender restarts at 0 after 100: one restart, no loss.
+    let s = sender_after(&[98, 99, 100, 0, 1, 2]);
+    assert_eq!((s.lost, s.reordered, s.restarts), (0, 0, 1), "{s:?}");
+    // A duplicate is neither.
+    let s = sender_after(&[7, 7, 8]);
+    assert_eq!((s.lost, s.duplicates, s.reordered), (0, 1, 0));
+}
+
+/// Regression: when a TCP or serial connection dropped mid-frame, the partial frame was never
+/// counted (the decoder waited for bytes that could not come).
+#[test]
+fn a_frame_cut_off_by_the_end_of_the_stream_is_counted_as_truncated() {
+    let frames = frames_with_sequences(&[0, 1]);
+    let mut ground = GroundEndpoint::new(GroundConfig::default(), Duration::ZERO);
+    ground.handle_bytes(Duration::ZERO, &frames[0]);
+    ground.handle_bytes(Duration::ZERO, &frames[1][..frames[1].len() / 2]);
+    assert_eq!(ground.link_stats(Duration::ZERO).decoder.truncated, 0);
+    ground.handle_stream_end(Duration::ZERO);
+    let stats = ground.link_stats(Duration::ZERO);
+    assert_eq!(stats.frames_in, 1);
+    assert_eq!(stats.decoder.truncated, 1);
+    assert_eq!(
+        stats.decoder.bytes_discarded as usize,
+        frames[1].len() / 2,
+        "every byte of the cut-off frame is accounted for"
+    );
+    let mut events = Vec::new();
+    while let Some(e) = ground.poll_event() {
+        events.push(e);
+    }
+    assert!(
+        events.iter().any(|e| matches!(
+            e,
+            GroundEvent::Link(LinkEvent::FrameError(FrameError::Truncated { .. }))
+        )),
+        "{events:?}"
+    );
+    // A new connection starts clean.
+    ground.handle_bytes(Duration::ZERO, &frames[1]);
+    assert_eq!(ground.link_stats(Duration::ZERO).frames_in, 2);
 }
 
 fn signing(key: u8, link_id: u8, unix_s: u64) -> SigningConfig {

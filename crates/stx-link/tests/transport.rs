@@ -10,7 +10,8 @@ use stx_link::endpoint::{
 };
 use stx_link::param::{ParamEvent, ParamSpec};
 use stx_link::transport::{
-    Action, DriveOptions, DriverEvent, IoEvent, Transport, TransportError, drive,
+    Action, DriveOptions, DriverEvent, IO_ERROR_REPORT_INTERVAL, IoEvent, Transport,
+    TransportError, drive,
 };
 use tokio::sync::mpsc;
 use tokio::task::JoinHandle;
@@ -371,5 +372,247 @@ async fn signing_timestamp_file_is_written_and_read_back() {
     // 2026-01-01 is 347 155 200 s = 34 715 520 000 000 units of 10 µs after 2015-01-01; the
     // mark reserves 10 s (1 000 000 units) ahead of the first timestamp.
     assert_eq!(stored, 34_715_520_000_000 - 1 + 1_000_000);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Regression: every frame sent with no TCP peer (a `tcpin:` link before the station connects)
+/// logged a warning and raised an event — 66,761 lines in 1.2 s from `stx drone`. Every failure
+/// is still counted; reports come first at once, then one per interval with the total.
+#[tokio::test(start_paused = true)]
+async fn send_errors_without_a_peer_are_all_counted_but_reported_rate_limited() {
+    let mut t = Transport::open_str("tcpin:127.0.0.1:0")
+        .await
+        .expect("bind");
+    let frame = [0xFD_u8; 20];
+    let reports = |t: &mut Transport| {
+        let mut counts = Vec::new();
+        while let Some(e) = t.poll_event() {
+            if let IoEvent::SendError { count, .. } = e {
+                counts.push(count);
+            }
+        }
+        counts
+    };
+    for _ in 0..10_000 {
+        t.send(&frame).await;
+    }
+    assert_eq!(t.stats().send_errors, 10_000);
+    assert_eq!(reports(&mut t), [1], "the first failure, reported at once");
+    tokio::time::advance(IO_ERROR_REPORT_INTERVAL / 2).await;
+    t.send(&frame).await;
+    assert!(reports(&mut t).is_empty(), "not before the interval");
+    tokio::time::advance(IO_ERROR_REPORT_INTERVAL / 2).await;
+    t.send(&frame).await;
+    assert_eq!(reports(&mut t), [10_002], "one report with the total");
+    assert_eq!(t.stats().send_errors, 10_002);
+}
+
+#[tokio::test]
+async fn the_bound_port_of_a_server_address_with_port_0_is_known() {
+    for address in ["udpin:127.0.0.1:0", "tcpin:127.0.0.1:0"] {
+        let t = Transport::open_str(address).await.expect("bind");
+        let bound = t.listening_address().expect("a server");
+        let text = bound.to_string();
+        assert!(text.starts_with(&address[..address.len() - 1]), "{text}");
+        assert!(!text.ends_with(":0"), "{text}");
+        assert_eq!(
+            t.local_addr().map(|a| a.port()),
+            text.rsplit(':').next().and_then(|p| p.parse().ok())
+        );
+    }
+    let t = Transport::open_str("udpout:127.0.0.1:9")
+        .await
+        .expect("bind");
+    assert_eq!(t.listening_address(), None);
+}
+
+/// Regression: a TCP connection that dropped mid-frame left the partial frame uncounted.
+#[tokio::test]
+async fn a_frame_cut_off_by_a_dropped_tcp_connection_is_counted_as_truncated() {
+    use tokio::io::AsyncWriteExt;
+    let t = Transport::open_str("tcpin:127.0.0.1:0")
+        .await
+        .expect("bind");
+    let port = t.local_addr().expect("bound").port();
+    let mut v = spawn(t, vehicle());
+    let mut client = tokio::net::TcpStream::connect(("127.0.0.1", port))
+        .await
+        .expect("connect");
+    wait_for(&mut v.events, |e| {
+        matches!(e, DriverEvent::Io(IoEvent::Connected { .. }))
+    })
+    .await;
+    // A whole frame and half of a second one, then the connection drops.
+    let mut ground = ground();
+    let heartbeat = stx_link::MavMessage::HEARTBEAT(Default::default());
+    ground.send_message(Duration::ZERO, &heartbeat);
+    ground.send_message(Duration::ZERO, &heartbeat);
+    let mut bytes = ground.poll_transmit(Duration::ZERO).expect("a frame");
+    let whole = bytes.len();
+    let second = ground.poll_transmit(Duration::ZERO).expect("a frame");
+    bytes.extend(&second[..second.len() / 2]);
+    client.write_all(&bytes).await.expect("write");
+    drop(client);
+    wait_for(&mut v.events, |e| {
+        matches!(e, DriverEvent::Io(IoEvent::Disconnected { .. }))
+    })
+    .await;
+    drop(v.actions);
+    let (endpoint, _) = v.task.await.expect("driver");
+    let mut endpoint = endpoint;
+    let stats = endpoint.link_stats(Duration::from_secs(1));
+    assert!(whole > 0 && stats.frames_in >= 1, "{stats:?}");
+    assert_eq!(stats.decoder.truncated, 1, "{:?}", stats.decoder);
+    assert_eq!(
+        stats.decoder.bytes_in,
+        stats.decoder.bytes_discarded + (whole as u64),
+        "every byte accounted for"
+    );
+}
+
+/// Each write to a [`WatchingStream`]: the signing mark on disk at that moment, the bytes.
+type Writes = std::sync::Arc<std::sync::Mutex<Vec<(Option<u64>, Vec<u8>)>>>;
+
+/// A byte stream standing for a radio: it never delivers anything, and for each write it
+/// notes the bytes and the signing mark on disk at that moment.
+struct WatchingStream {
+    file: Option<std::path::PathBuf>,
+    writes: Writes,
+}
+
+impl tokio::io::AsyncRead for WatchingStream {
+    fn poll_read(
+        self: std::pin::Pin<&mut Self>,
+        _: &mut std::task::Context<'_>,
+        _: &mut tokio::io::ReadBuf<'_>,
+    ) -> std::task::Poll<std::io::Result<()>> {
+        std::task::Poll::Pending
+    }
+}
+
+impl tokio::io::AsyncWrite for WatchingStream {
+    fn poll_write(
+        self: std::pin::Pin<&mut Self>,
+        _: &mut std::task::Context<'_>,
+        buf: &[u8],
+    ) -> std::task::Poll<std::io::Result<usize>> {
+        let mark = self
+            .file
+            .as_deref()
+            .and_then(|f| stx_link::transport::load_signing_timestamp(f).expect("readable"));
+        self.writes.lock().expect("lock").push((mark, buf.to_vec()));
+        std::task::Poll::Ready(Ok(buf.len()))
+    }
+
+    fn poll_flush(
+        self: std::pin::Pin<&mut Self>,
+        _: &mut std::task::Context<'_>,
+    ) -> std::task::Poll<std::io::Result<()>> {
+        std::task::Poll::Ready(Ok(()))
+    }
+
+    fn poll_shutdown(
+        self: std::pin::Pin<&mut Self>,
+        _: &mut std::task::Context<'_>,
+    ) -> std::task::Poll<std::io::Result<()>> {
+        std::task::Poll::Ready(Ok(()))
+    }
+}
+
+/// The signing timestamp across a restart with the wall clock set back an hour, through the
+/// real driver and file. Regression: the driver sent frames before writing the high-water mark
+/// that covered them, so a crash could leave timestamps on the air above the mark on disk.
+/// Now every frame leaves with a mark above its timestamp already on disk, and the restarted
+/// endpoint signs above every timestamp the first run used. Without the file (the control
+/// case) the restart's timestamps fall back with the clock.
+#[tokio::test(start_paused = true)]
+async fn signed_timestamps_stay_monotonic_across_a_restart_with_the_clock_set_back() {
+    use stx_link::frame::FrameDecoder;
+    use stx_link::signing::{SigningConfig, SigningKey};
+    let dir = std::env::temp_dir().join(format!("stx-link-restart-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("tmp dir");
+    let jan_2026 = Duration::from_secs(1_767_225_600);
+
+    // Runs a signed vehicle for 30 s; returns each frame's timestamp with the mark on disk
+    // when it was written to the stream.
+    let run = |unix: Duration, file: Option<std::path::PathBuf>| async move {
+        let persisted = file
+            .as_deref()
+            .and_then(|f| stx_link::transport::load_signing_timestamp(f).expect("readable"));
+        let signing = SigningConfig::new(SigningKey::from_bytes([5; 32]), 0, unix)
+            .with_persisted_timestamp(persisted);
+        let ep = VehicleEndpoint::new(
+            VehicleConfig {
+                link: fast(LinkConfig::vehicle()).with_signing(Some(signing)),
+                ..Default::default()
+            },
+            Duration::ZERO,
+        )
+        .expect("vehicle");
+        let writes = Writes::default();
+        let stream = WatchingStream {
+            file: file.clone(),
+            writes: std::sync::Arc::clone(&writes),
+        };
+        let (atx, arx) = mpsc::channel::<Action<VehicleEndpoint>>(1);
+        let (etx, mut erx) = mpsc::channel(1024);
+        let task = tokio::spawn(drive(
+            Transport::from_stream("radio", stream),
+            ep,
+            arx,
+            etx,
+            DriveOptions {
+                signing_timestamp_file: file,
+            },
+        ));
+        let drain = tokio::spawn(async move { while erx.recv().await.is_some() {} });
+        tokio::time::sleep(Duration::from_secs(30)).await;
+        drop(atx);
+        let _ = task.await;
+        let _ = drain.await;
+        let writes = std::mem::take(&mut *writes.lock().expect("lock"));
+        writes
+            .into_iter()
+            .flat_map(|(mark, bytes)| {
+                let mut dec = FrameDecoder::default();
+                dec.push(&bytes);
+                let mut stamps = Vec::new();
+                while let Some(Ok(f)) = dec.poll(Duration::ZERO) {
+                    stamps.push((f.header.signature.expect("signed").timestamp_10us, mark));
+                }
+                stamps
+            })
+            .collect::<Vec<_>>()
+    };
+
+    for with_file in [true, false] {
+        let file = with_file.then(|| dir.join(format!("ts-{with_file}")));
+        let first = run(jan_2026, file.clone()).await;
+        assert!(first.len() > 200, "{} frames", first.len());
+        assert!(first.windows(2).all(|w| w[0].0 < w[1].0));
+        if with_file {
+            for (ts, mark) in &first {
+                assert!(
+                    mark.is_some_and(|m| m > *ts),
+                    "frame {ts} left with mark {mark:?} on disk"
+                );
+            }
+        }
+        let last = first.last().expect("frames").0;
+        let second = run(jan_2026 - Duration::from_secs(3600), file).await;
+        let restart = second.first().expect("frames after the restart").0;
+        if with_file {
+            assert!(
+                restart > last,
+                "after the restart {restart} <= before {last}"
+            );
+        } else {
+            assert!(
+                restart < last,
+                "control: the clock set back takes the timestamps back"
+            );
+        }
+    }
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -408,18 +408,11 @@ fn a_parameter_set_over_the_link_changes_what_guidance_flies_and_reads_back() {
         "main line {after} after the limit"
     );
 
-    // A value within its range that breaks a rule between parameters (the shortest final
-    // longer than the longest) is refused and put back: a read-back tells the truth.
+    // Regression: a value within its range that breaks a rule between parameters (the
+    // shortest final longer than the longest) was echoed first (the station was told it was
+    // accepted) and put back afterwards. Now the drone's rules run before the echo: the only
+    // PARAM_VALUE is the value in force, and the set is reported refused, with the reason.
     bench.ground_events.clear();
-    let now = bench.now();
-    bench
-        .ground
-        .param_set(now, "SP_MIN_FINAL", 1500.0)
-        .expect("set");
-    bench.exchange();
-    let now = bench.now();
-    bench.ground.param_read(now, "SP_MIN_FINAL").expect("read");
-    bench.exchange();
     let in_force = bench
         .drone
         .drone()
@@ -427,22 +420,57 @@ fn a_parameter_set_over_the_link_changes_what_guidance_flies_and_reads_back() {
         .settings()
         .guidance
         .spiral
-        .min_final_m;
-    assert!(in_force < 1500.0);
-    let events = bench.param_events();
+        .min_final_m as f32;
+    let refused_before = bench.drone.counters().params_refused;
+    let now = bench.now();
+    bench
+        .ground
+        .param_set(now, "SP_MIN_FINAL", 1500.0)
+        .expect("set");
+    bench.exchange();
+    bench.run_for(2.0);
+    assert_eq!(
+        bench.param_events(),
+        [ParamEvent::SetDone {
+            name: "SP_MIN_FINAL".into(),
+            requested: 1500.0,
+            actual: in_force,
+            accepted: false
+        }],
+        "one answer, the value in force, and nothing after it"
+    );
+    assert_eq!(
+        bench.drone.drone().param("SP_MIN_FINAL"),
+        Some(in_force),
+        "still flown"
+    );
+    assert_eq!(bench.drone.counters().params_refused, refused_before + 1);
     assert!(
-        events
-            .iter()
-            .any(|e| matches!(e, ParamEvent::ReadDone { param } if param.value == in_force as f32)),
-        "{events:?}"
+        bench.drone_events.iter().any(|e| matches!(
+            e,
+            DroneEvent::Param { name, accepted: false, .. } if name == "SP_MIN_FINAL"
+        )),
+        "{:?}",
+        bench.drone_events
     );
     assert!(
         bench
             .texts()
             .iter()
-            .any(|t| t.contains("parameter refused")),
+            .any(|t| t.contains("SP_MIN_FINAL") && t.contains("refused")),
         "{:?}",
         bench.texts()
+    );
+    // A read-back tells the same.
+    let now = bench.now();
+    bench.ground.param_read(now, "SP_MIN_FINAL").expect("read");
+    bench.exchange();
+    let events = bench.param_events();
+    assert!(
+        events
+            .iter()
+            .any(|e| matches!(e, ParamEvent::ReadDone { param } if param.value == in_force)),
+        "{events:?}"
     );
 }
 

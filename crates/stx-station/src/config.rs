@@ -5,12 +5,14 @@
 //! [`StationConfig::validate`] with errors that name the field, before any task starts.
 
 use std::collections::HashMap;
+use std::ffi::OsString;
 use std::net::SocketAddr;
 use std::path::PathBuf;
 
 use serde::{Deserialize, Serialize};
 use stx_gnc::geo::LocalFrame;
 use stx_gnc::guidance::GuidanceConfig;
+use stx_link::signing::{KeyText, SIGNING_KEY_ENV, SigningKey};
 use thiserror::Error;
 
 /// Why a station configuration was refused.
@@ -58,10 +60,20 @@ pub struct LinkSettings {
     /// stx-link address: `udpin:IP:PORT`, `udpout:…`, `tcp:HOST:PORT`, `tcpin:…`,
     /// `serial:PATH:BAUD`.
     pub address: String,
-    /// MAVLink 2 signing key, 64 hex characters (32 bytes); absent: signing off.
+    /// MAVLink 2 signing key written here, 64 hexadecimal characters (32 bytes). It is then
+    /// as secret as this file (mode 0600); prefer `signing_key_file` or the environment
+    /// variable `STX_SIGNING_KEY`. At most one of the three; none: signing off. Never shown:
+    /// its debug and serialised forms are `<redacted>`.
     #[serde(default)]
-    pub signing_key_hex: Option<String>,
-    /// File keeping the signing timestamp's high-water mark across restarts.
+    pub signing_key_hex: Option<KeyText>,
+    /// File holding the signing key, 64 hexadecimal characters (e.g. `openssl rand -hex 32`),
+    /// readable only by the station's user.
+    #[serde(default)]
+    pub signing_key_file: Option<PathBuf>,
+    /// File keeping the signing timestamp's high-water mark across restarts, so timestamps
+    /// stay monotonic even when the clock is set back. Required with signing on; when absent,
+    /// `stx serve` uses `signing.timestamp` in the state directory (`$STATE_DIRECTORY`, set by
+    /// systemd's `StateDirectory=`, else `$XDG_STATE_HOME/stx`, else `~/.local/state/stx`).
     #[serde(default)]
     pub signing_timestamp_file: Option<PathBuf>,
     /// Seconds without a message after which the vehicle's data are shown stale, s.
@@ -83,6 +95,35 @@ pub struct TlsSettings {
     /// The certificate's private key, PEM (PKCS#8, PKCS#1 or SEC1), readable only by the
     /// station (e.g. `/etc/stx/station.key`).
     pub key_path: PathBuf,
+}
+
+/// Name of the signing timestamp file in the state directory.
+pub const SIGNING_TIMESTAMP_FILE_NAME: &str = "signing.timestamp";
+
+impl LinkSettings {
+    /// Whether MAVLink 2 signing is on (a key is configured).
+    pub fn signing_on(&self) -> bool {
+        self.signing_key_hex.is_some() || self.signing_key_file.is_some()
+    }
+
+    /// The signing key (read from its file if it is in one); `None`: signing off.
+    pub fn signing_key(&self) -> Result<Option<SigningKey>, ConfigError> {
+        let invalid = |field: &str, e: stx_link::signing::KeyError| ConfigError::Invalid {
+            field: field.into(),
+            rule: e.to_string(),
+        };
+        if let Some(text) = &self.signing_key_hex {
+            return text
+                .key()
+                .map(Some)
+                .map_err(|e| invalid("link.signing_key_hex", e));
+        }
+        self.signing_key_file
+            .as_deref()
+            .map(SigningKey::from_file)
+            .transpose()
+            .map_err(|e| invalid("link.signing_key_file", e))
+    }
 }
 
 /// A row of the forecast wind profile.
@@ -150,11 +191,48 @@ fn default_cutdown_window_s() -> f64 {
 pub const DEFAULT_STATION_TOML: &str = include_str!("../../../config/station.toml");
 
 impl StationConfig {
-    /// Parses and validates a configuration.
+    /// Parses and validates a configuration as written (nothing from the environment).
     pub fn from_toml_str(text: &str) -> Result<Self, ConfigError> {
-        let config: StationConfig = toml::from_str(text)?;
+        Self::from_toml_str_with_env(text, |_| None)
+    }
+
+    /// Parses a configuration, completes it from the environment `env` (e.g.
+    /// `|k| std::env::var_os(k)`, see [`StationConfig::apply_environment`]) and validates it.
+    pub fn from_toml_str_with_env(
+        text: &str,
+        env: impl Fn(&str) -> Option<OsString>,
+    ) -> Result<Self, ConfigError> {
+        let mut config: StationConfig = toml::from_str(text)?;
+        config.apply_environment(env)?;
         config.validate()?;
         Ok(config)
+    }
+
+    /// Takes the signing key from `STX_SIGNING_KEY` in `env` when it is set (a key in the file
+    /// as well is refused: one source only), and, with signing on and no
+    /// `link.signing_timestamp_file`, the default one in the state directory.
+    pub fn apply_environment(
+        &mut self,
+        env: impl Fn(&str) -> Option<OsString>,
+    ) -> Result<(), ConfigError> {
+        if let Some(text) = env(SIGNING_KEY_ENV) {
+            if self.link.signing_on() {
+                return Err(ConfigError::Invalid {
+                    field: "link.signing_key_hex".into(),
+                    rule: format!("the key is also in {SIGNING_KEY_ENV}: give it one way only"),
+                });
+            }
+            let text = text.into_string().map_err(|_| ConfigError::Invalid {
+                field: SIGNING_KEY_ENV.into(),
+                rule: "64 hexadecimal characters (32 bytes)".into(),
+            })?;
+            self.link.signing_key_hex = Some(KeyText::new(text));
+        }
+        if self.link.signing_on() && self.link.signing_timestamp_file.is_none() {
+            self.link.signing_timestamp_file = stx_link::transport::default_state_dir(&env)
+                .map(|dir| dir.join(SIGNING_TIMESTAMP_FILE_NAME));
+        }
+        Ok(())
     }
 
     /// Checks every rule.
@@ -186,12 +264,23 @@ impl StationConfig {
         if let Err(e) = self.link.address.parse::<stx_link::transport::Address>() {
             return invalid("link.address", &e.to_string());
         }
-        if let Some(key) = &self.link.signing_key_hex
-            && (key.len() != 64 || !key.chars().all(|c| c.is_ascii_hexdigit()))
-        {
+        if self.link.signing_key_hex.is_some() && self.link.signing_key_file.is_some() {
             return invalid(
-                "link.signing_key_hex",
-                "64 hexadecimal characters (32 bytes)",
+                "link.signing_key_file",
+                "give the key one way only (signing_key_hex or signing_key_file)",
+            );
+        }
+        if let Some(text) = &self.link.signing_key_hex
+            && let Err(e) = text.key()
+        {
+            return invalid("link.signing_key_hex", &e.to_string());
+        }
+        if self.link.signing_on() && self.link.signing_timestamp_file.is_none() {
+            return invalid(
+                "link.signing_timestamp_file",
+                "required with signing on, so the timestamps stay monotonic across restarts \
+                 (stx serve defaults it to signing.timestamp in $STATE_DIRECTORY, \
+                 $XDG_STATE_HOME/stx or ~/.local/state/stx; none of them is set)",
             );
         }
         if !(self.link.stale_after_s > 0.0 && self.link.stale_after_s.is_finite()) {
@@ -269,5 +358,132 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(err.contains("token"), "{err}");
+    }
+
+    const KEY: &str = "5ec2e75ec2e75ec2e75ec2e75ec2e75ec2e75ec2e75ec2e75ec2e75ec2e75ec2";
+
+    fn with_link(extra: &str) -> String {
+        DEFAULT_STATION_TOML.replace(
+            "stale_after_s = 3.0",
+            &format!("stale_after_s = 3.0\n{extra}"),
+        )
+    }
+
+    fn env<'a>(vars: &'a [(&'a str, &'a str)]) -> impl Fn(&str) -> Option<OsString> + 'a {
+        move |k| {
+            vars.iter()
+                .find(|(name, _)| *name == k)
+                .map(|(_, v)| OsString::from(v))
+        }
+    }
+
+    /// Regression: a key without a timestamp file passed, and the timestamps then went back
+    /// with the clock after a restart.
+    #[test]
+    fn signing_needs_a_timestamp_file_which_defaults_to_the_state_directory() {
+        let text = with_link(&format!("signing_key_hex = \"{KEY}\""));
+        let err = StationConfig::from_toml_str(&text).unwrap_err().to_string();
+        assert!(err.contains("link.signing_timestamp_file"), "{err}");
+        let c = StationConfig::from_toml_str_with_env(
+            &text,
+            env(&[("STATE_DIRECTORY", "/var/lib/stx"), ("HOME", "/home/op")]),
+        )
+        .expect("valid with a state directory");
+        assert_eq!(
+            c.link.signing_timestamp_file,
+            Some(PathBuf::from("/var/lib/stx/signing.timestamp"))
+        );
+        let c = StationConfig::from_toml_str_with_env(&text, env(&[("HOME", "/home/op")]))
+            .expect("valid with a home");
+        assert_eq!(
+            c.link.signing_timestamp_file,
+            Some(PathBuf::from("/home/op/.local/state/stx/signing.timestamp"))
+        );
+        // Given explicitly, it is kept.
+        let text = with_link(&format!(
+            "signing_key_hex = \"{KEY}\"\nsigning_timestamp_file = \"/srv/ts\""
+        ));
+        let c = StationConfig::from_toml_str_with_env(&text, env(&[("HOME", "/home/op")]))
+            .expect("valid");
+        assert_eq!(
+            c.link.signing_timestamp_file,
+            Some(PathBuf::from("/srv/ts"))
+        );
+        // Without signing nothing is filled in.
+        let c = StationConfig::from_toml_str_with_env(DEFAULT_STATION_TOML, env(&[("HOME", "/h")]))
+            .expect("valid");
+        assert_eq!(c.link.signing_timestamp_file, None);
+        assert!(c.link.signing_key().expect("no key").is_none());
+    }
+
+    #[test]
+    fn the_key_comes_from_one_place_the_file_or_the_environment() {
+        let dir = std::env::temp_dir().join(format!("stx-station-key-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).expect("dir");
+        let key_file = dir.join("key");
+        std::fs::write(&key_file, format!("{KEY}\n")).expect("write");
+        let ts = "signing_timestamp_file = \"/srv/ts\"";
+        let text = with_link(&format!("signing_key_file = {key_file:?}\n{ts}"));
+        let c = StationConfig::from_toml_str(&text).expect("valid");
+        let from_file = c.link.signing_key().expect("readable").expect("a key");
+        assert!(from_file == SigningKey::from_hex(KEY).expect("hex"));
+
+        let c =
+            StationConfig::from_toml_str_with_env(&with_link(ts), env(&[(SIGNING_KEY_ENV, KEY)]))
+                .expect("valid");
+        assert!(c.link.signing_key().expect("valid").expect("a key") == from_file);
+
+        for (text, vars, field) in [
+            (
+                with_link(&format!("signing_key_file = {key_file:?}\n{ts}")),
+                vec![(SIGNING_KEY_ENV, KEY)],
+                "link.signing_key_hex",
+            ),
+            (
+                with_link(&format!(
+                    "signing_key_file = {key_file:?}\nsigning_key_hex = \"{KEY}\"\n{ts}"
+                )),
+                vec![],
+                "link.signing_key_file",
+            ),
+            (
+                with_link(&format!("signing_key_hex = \"{}\"\n{ts}", &KEY[..60])),
+                vec![],
+                "link.signing_key_hex",
+            ),
+        ] {
+            let err = StationConfig::from_toml_str_with_env(&text, env(&vars))
+                .unwrap_err()
+                .to_string();
+            assert!(err.contains(field), "{field}: {err}");
+            assert!(
+                !err.contains(&KEY[..60]),
+                "the key is never repeated: {err}"
+            );
+        }
+        let missing = with_link(&format!("signing_key_file = \"/nonexistent/key\"\n{ts}"));
+        let c = StationConfig::from_toml_str(&missing).expect("valid until read");
+        let err = c.link.signing_key().map(drop).unwrap_err().to_string();
+        assert!(err.contains("/nonexistent/key"), "{err}");
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    /// Regression: `signing_key_hex` was a plain `String` that `Debug` and `Serialize` printed.
+    #[test]
+    fn debug_and_serialised_config_never_contain_the_key() {
+        let text = with_link(&format!(
+            "signing_key_hex = \"{KEY}\"\nsigning_timestamp_file = \"/srv/ts\""
+        ));
+        let c = StationConfig::from_toml_str(&text).expect("valid");
+        assert!(c.link.signing_key().expect("valid").is_some());
+        for shown in [
+            format!("{c:?}"),
+            format!("{:#?}", c.link),
+            serde_json::to_string(&c).expect("json"),
+            toml::to_string(&c).expect("toml"),
+        ] {
+            assert!(!shown.contains("5ec2e7"), "{shown}");
+            assert!(shown.contains("<redacted>"), "{shown}");
+        }
     }
 }

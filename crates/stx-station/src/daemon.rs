@@ -10,7 +10,7 @@ use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
 
 use axum::extract::ws::Utf8Bytes;
 use stx_link::endpoint::{GroundConfig, GroundEndpoint, GroundEvent, LinkEvent};
-use stx_link::signing::{SigningConfig, SigningKey};
+use stx_link::signing::SigningConfig;
 use stx_link::transport::{Action, DriveOptions, DriverEvent, Transport, drive};
 use thiserror::Error;
 use tokio::sync::{broadcast, mpsc, watch};
@@ -199,12 +199,13 @@ pub struct Running {
 }
 
 fn signing(config: &StationConfig) -> Result<Option<SigningConfig>, DaemonError> {
-    let Some(hex) = &config.link.signing_key_hex else {
+    let Some(key) = config
+        .link
+        .signing_key()
+        .map_err(|e| DaemonError::Signing(e.to_string()))?
+    else {
         return Ok(None);
     };
-    let key = SigningKey::from_bytes(parse_key_hex(hex).ok_or_else(|| {
-        DaemonError::Signing("link.signing_key_hex must be 64 hexadecimal characters".into())
-    })?);
     let unix_s = SystemTime::now()
         .duration_since(UNIX_EPOCH)
         .map_err(|e| DaemonError::Signing(e.to_string()))?;
@@ -244,10 +245,21 @@ pub async fn run(
             source,
         })?;
     let link_local = transport.local_addr();
+    // For `udpin:…:0` / `tcpin:…:0`: the port the drone must be pointed at.
+    let link_shown = transport
+        .listening_address()
+        .map_or_else(|| config.link.address.clone(), |a| a.to_string());
     let start = Instant::now();
     let mut ground = GroundConfig::default();
     ground.link = ground.link.with_signing(signing(&config)?);
     let endpoint = GroundEndpoint::new(ground, Duration::ZERO);
+    // The first high-water mark is on disk before anything is signed, or the station does not
+    // start.
+    stx_link::transport::persist_signing_mark(
+        &endpoint,
+        config.link.signing_timestamp_file.as_deref(),
+    )
+    .map_err(|e| DaemonError::Signing(e.to_string()))?;
     let (actions_tx, actions_rx) = mpsc::channel::<Action<GroundEndpoint>>(1024);
     let (events_tx, events_rx) = mpsc::channel(4096);
     let options = DriveOptions {
@@ -319,7 +331,7 @@ pub async fn run(
         link_local,
         shared: shared.clone(),
     });
-    tracing::info!(address = %http_address, link = %config.link.address, "station listening");
+    tracing::info!(address = %http_address, link = %link_shown, "station listening");
     let stop_http = async move {
         shutdown.await;
         let _ = stop_tx.send(true);
@@ -556,20 +568,6 @@ fn send_outbound(shared: &Shared, outbound: Vec<Outbound>) {
             let _ = shared.broadcast.send(text.into());
         }
     }
-}
-
-/// The 32 bytes of a 64-character hexadecimal key.
-pub fn parse_key_hex(hex: &str) -> Option<[u8; 32]> {
-    let bytes = hex.as_bytes();
-    if bytes.len() != 64 {
-        return None;
-    }
-    let mut key = [0_u8; 32];
-    for (i, out) in key.iter_mut().enumerate() {
-        let pair = std::str::from_utf8(bytes.get(2 * i..2 * i + 2)?).ok()?;
-        *out = u8::from_str_radix(pair, 16).ok()?;
-    }
-    Some(key)
 }
 
 fn lock(shared: &Shared) -> std::sync::MutexGuard<'_, StationCore> {

@@ -22,12 +22,29 @@
 //! ([`stx_sim::drone::MissionSummary`]) with the run's wall time and link counters as one JSON
 //! line on stdout.
 //!
+//! Signing: the key comes from `--sign-key-file FILE` or the environment variable
+//! `STX_SIGNING_KEY` (64 hexadecimal characters), never from the command line, where `ps` and
+//! shell histories would show it. The timestamp's high-water mark lives in
+//! `--signing-timestamp-file` (default `drone-sys<ID>.signing.timestamp` in the state
+//! directory: `$STATE_DIRECTORY`, `$XDG_STATE_HOME/stx` or `~/.local/state/stx`); it is written
+//! before the first signed frame and ahead of every later one, so a restart with the clock set
+//! back still signs above every timestamp already used.
+//!
+//! `--gains FILE` (a gains file as `stx tune` writes it) sets the onboard guidance's control
+//! gains, which are also its parameters: the station reads and sets them over PARAM_*.
+//!
+//! A server address with port 0 (`udpin:…:0`, `tcpin:…:0`) is logged with the port actually
+//! bound. Socket errors are counted in the report's `io` and logged by the transport at most
+//! every few seconds with their count (a `tcpin:` link with no station yet fails every frame).
+//!
 //! The same flight is a library call for the station's `stx serve --sim`: [`fly`] with
 //! [`DroneOptions`] and a shutdown future, returning a [`DroneReport`].
 
+use std::ffi::OsString;
 use std::fmt;
 use std::future::Future;
 use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
 use std::str::FromStr;
 use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
 
@@ -36,10 +53,14 @@ use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
 use stx_dynamics::vehicle::Vehicle;
+use stx_gnc::control::ControlGains;
 use stx_gnc::mission::{FlightMode, FlightStage, GuidancePhase};
 use stx_link::endpoint::LinkConfig;
-use stx_link::signing::{SigningConfig, SigningKey};
-use stx_link::transport::{Action, DriveOptions, DriverEvent, IoEvent, IoStats, Transport, drive};
+use stx_link::signing::{SIGNING_KEY_ENV, SigningConfig, SigningKey};
+use stx_link::transport::{
+    Action, DriveOptions, DriverEvent, IoEvent, IoStats, Transport, default_state_dir, drive,
+    load_signing_timestamp, persist_signing_mark,
+};
 use stx_sim::drone::failures::{StuckServo, parse_window};
 use stx_sim::drone::link::{DroneEvent, LinkCounters, LinkedDrone};
 use stx_sim::drone::{Drone, MissionConfig, MissionSummary, stage_name};
@@ -96,9 +117,19 @@ pub struct DroneArgs {
     /// Seed of everything random (replaces the scenario's).
     #[arg(long)]
     seed: Option<u64>,
-    /// MAVLink 2 signing key, 64 hex digits (32 bytes); unsigned traffic is then refused.
-    #[arg(long, value_name = "HEX")]
-    sign_key: Option<String>,
+    /// File holding the MAVLink 2 signing key, 64 hex digits (32 bytes); unsigned traffic is
+    /// then refused. Or the key in the environment variable STX_SIGNING_KEY.
+    #[arg(long, value_name = "FILE")]
+    sign_key_file: Option<PathBuf>,
+    /// Where the signing timestamp's high-water mark is kept across restarts (default:
+    /// drone-sys<ID>.signing.timestamp in $STATE_DIRECTORY, $XDG_STATE_HOME/stx or
+    /// ~/.local/state/stx).
+    #[arg(long, value_name = "FILE")]
+    signing_timestamp_file: Option<PathBuf>,
+    /// Control gains of the onboard guidance (a gains file as `stx tune` writes it); they are
+    /// its parameters' starting values.
+    #[arg(long, value_name = "FILE")]
+    gains: Option<PathBuf>,
     /// Share of datagrams lost at random each way, % (replaces the scenario's).
     #[arg(long, value_name = "PCT")]
     packet_loss: Option<f64>,
@@ -151,6 +182,13 @@ pub struct DroneOptions {
     pub failures: FailureFlags,
     /// MAVLink 2 signing key; with one, unsigned traffic is refused.
     pub signing_key: Option<SigningKey>,
+    /// File keeping the signing timestamp's high-water mark; required with a key.
+    pub signing_timestamp_file: Option<PathBuf>,
+    /// The wall-clock reading the signing clock starts from (time since the Unix epoch);
+    /// `None` reads the system clock. Tests set it to rehearse a clock set back.
+    pub signing_clock_unix: Option<Duration>,
+    /// Control gains replacing the mission's (the onboard guidance's parameters).
+    pub gains: Option<ControlGains>,
     /// The drone's MAVLink system id.
     pub system_id: u8,
     /// How long to keep answering on the ground after landing, real time; `None`: until the
@@ -171,6 +209,9 @@ impl DroneOptions {
             seed: None,
             failures: FailureFlags::default(),
             signing_key: None,
+            signing_timestamp_file: None,
+            signing_clock_unix: None,
+            gains: None,
             system_id: 1,
             linger: Some(Duration::ZERO),
             progress: false,
@@ -207,6 +248,9 @@ fn load_mission(options: &DroneOptions) -> anyhow::Result<MissionConfig> {
     if let Some(stuck) = f.stuck_servo {
         config.failures.stuck_servo = Some(stuck);
     }
+    if let Some(gains) = options.gains {
+        config.onboard.guidance.gains = gains;
+    }
     config.validate().map_err(|e| {
         BadInput(anyhow::Error::from(e).context("with the command line's failures"))
     })?;
@@ -214,8 +258,9 @@ fn load_mission(options: &DroneOptions) -> anyhow::Result<MissionConfig> {
 }
 
 impl DroneArgs {
-    /// The options these flags ask for; a malformed flag is [`BadInput`].
-    fn options(&self) -> anyhow::Result<DroneOptions> {
+    /// The options these flags (and the environment `env`, e.g. `|k| std::env::var_os(k)`)
+    /// ask for; a malformed flag is [`BadInput`].
+    fn options(&self, env: impl Fn(&str) -> Option<OsString>) -> anyhow::Result<DroneOptions> {
         let bad = |e: anyhow::Error| anyhow::Error::from(BadInput(e));
         // Windows are FROM:TO on the command line (FROM..TO, the scenario file's form, too).
         let window = |flag: &str, w: &str| {
@@ -261,31 +306,53 @@ impl DroneArgs {
                 .collect::<anyhow::Result<_>>()?,
             stuck_servo,
         };
-        options.signing_key = self.sign_key.as_deref().map(parse_key).transpose()?;
+        options.signing_key = signing_key(self.sign_key_file.as_deref(), &env)?;
         options.system_id = self.system_id;
+        if options.signing_key.is_some() {
+            let file = self.signing_timestamp_file.clone().or_else(|| {
+                default_state_dir(&env)
+                    .map(|d| d.join(format!("drone-sys{}.signing.timestamp", self.system_id)))
+            });
+            options.signing_timestamp_file = Some(file.ok_or_else(|| {
+                bad(anyhow!(
+                    "--signing-timestamp-file: needed with signing (no $STATE_DIRECTORY, \
+                     $XDG_STATE_HOME or $HOME to put it in)"
+                ))
+            })?);
+        }
+        options.gains = self
+            .gains
+            .as_deref()
+            .map(crate::tune::load_gains)
+            .transpose()?;
         options.linger = Some(Duration::from_secs_f64(self.linger));
         options.progress = true;
         Ok(options)
     }
 }
 
-fn parse_key(hex: &str) -> anyhow::Result<SigningKey> {
-    let hex = hex.trim();
-    let bad = || {
-        // The text is a secret: never echo it.
-        anyhow::Error::from(BadInput(anyhow!(
-            "--sign-key: expected 64 hexadecimal digits (32 bytes)"
-        )))
-    };
-    if hex.len() != 64 || !hex.is_ascii() {
-        return Err(bad());
+/// The signing key from `file`, or from `STX_SIGNING_KEY` in `env`; both is ambiguous.
+/// Errors never repeat the key.
+fn signing_key(
+    file: Option<&Path>,
+    env: impl Fn(&str) -> Option<OsString>,
+) -> anyhow::Result<Option<SigningKey>> {
+    let bad = |e: anyhow::Error| anyhow::Error::from(BadInput(e));
+    match (file, env(SIGNING_KEY_ENV)) {
+        (Some(_), Some(_)) => Err(bad(anyhow!(
+            "--sign-key-file and {SIGNING_KEY_ENV} both give a signing key: use one"
+        ))),
+        (Some(path), None) => SigningKey::from_file(path)
+            .map(Some)
+            .map_err(|e| bad(anyhow!("--sign-key-file: {e}"))),
+        (None, Some(text)) => text
+            .to_str()
+            .ok_or(stx_link::signing::KeyError::NotHex)
+            .and_then(SigningKey::from_hex)
+            .map(Some)
+            .map_err(|e| bad(anyhow!("{SIGNING_KEY_ENV}: {e}"))),
+        (None, None) => Ok(None),
     }
-    let mut bytes = [0_u8; 32];
-    for (i, b) in bytes.iter_mut().enumerate() {
-        *b = u8::from_str_radix(hex.get(2 * i..2 * i + 2).ok_or_else(bad)?, 16)
-            .map_err(|_| bad())?;
-    }
-    Ok(SigningKey::from_bytes(bytes))
 }
 
 /// How a flight went: the mission's figures and the run's; what `--summary-json` prints.
@@ -309,7 +376,7 @@ pub struct DroneReport {
 }
 
 pub fn run(args: DroneArgs) -> anyhow::Result<()> {
-    let options = args.options()?;
+    let options = args.options(|k| std::env::var_os(k))?;
     // Bad missions and flags are refused before anything starts.
     load_mission(&options)?;
     let runtime = tokio::runtime::Builder::new_multi_thread()
@@ -380,13 +447,27 @@ pub async fn fly(
         .await
         .with_context(|| format!("opening {}", options.connect))
         .map_err(BadInput)?;
+    if let Some(address) = transport.listening_address() {
+        tracing::info!(%address, "drone link listening");
+    }
     let mut link = LinkConfig::vehicle();
     link.system_id = options.system_id;
     if let Some(key) = options.signing_key.clone() {
-        let unix = SystemTime::now()
-            .duration_since(UNIX_EPOCH)
-            .context("the system clock is before 1970")?;
-        link.signing = Some(SigningConfig::new(key, 0, unix));
+        let path = options.signing_timestamp_file.as_deref().ok_or_else(|| {
+            BadInput(anyhow!(
+                "signing needs a timestamp file, so the timestamps stay monotonic across restarts"
+            ))
+        })?;
+        let persisted = load_signing_timestamp(path)
+            .with_context(|| format!("signing timestamp file {}", path.display()))
+            .map_err(BadInput)?;
+        let unix = match options.signing_clock_unix {
+            Some(t) => t,
+            None => SystemTime::now()
+                .duration_since(UNIX_EPOCH)
+                .context("the system clock is before 1970")?,
+        };
+        link.signing = Some(SigningConfig::new(key, 0, unix).with_persisted_timestamp(persisted));
     }
     tracing::info!(
         mission = %drone.config().name,
@@ -397,6 +478,13 @@ pub async fn fly(
     );
     let linked =
         LinkedDrone::new(drone, link, Duration::ZERO).context("putting the drone on the link")?;
+    let timestamp_file = options
+        .signing_timestamp_file
+        .clone()
+        .filter(|_| options.signing_key.is_some());
+    persist_signing_mark(&linked, timestamp_file.as_deref())
+        .context("--signing-timestamp-file")
+        .map_err(BadInput)?;
 
     let (action_tx, action_rx) = mpsc::channel::<Action<LinkedDrone>>(STEPS_IN_FLIGHT);
     let (event_tx, mut event_rx) = mpsc::channel(4096);
@@ -405,7 +493,9 @@ pub async fn fly(
         linked,
         action_rx,
         event_tx,
-        DriveOptions::default(),
+        DriveOptions {
+            signing_timestamp_file: timestamp_file,
+        },
     ));
     // The driver's events are the drone's log: texts, commands, parameters, link state.
     let logger = tokio::spawn(async move {
@@ -569,10 +659,13 @@ fn log_event(event: DriverEvent<DroneEvent>) {
             tracing::info!(t = format!("{time_s:.1}"), connected, "station link");
         }
         DriverEvent::Endpoint(DroneEvent::PersistSigningTimestamp(_)) => {}
-        DriverEvent::Io(e @ (IoEvent::RecvError { .. } | IoEvent::SendError { .. })) => {
-            tracing::warn!(event = ?e, "link I/O error");
-        }
-        DriverEvent::Io(IoEvent::QueuedWithoutPeer { .. }) => {}
+        // The transport logs these itself, rate-limited, and counts every one (the report's
+        // `io`): logging each again flooded stderr while no station listened.
+        DriverEvent::Io(
+            IoEvent::RecvError { .. }
+            | IoEvent::SendError { .. }
+            | IoEvent::QueuedWithoutPeer { .. },
+        ) => {}
         DriverEvent::Io(e) => tracing::info!(event = ?e, "link"),
     }
 }
@@ -590,9 +683,72 @@ mod tests {
     }
 
     fn options(flags: &[&str]) -> anyhow::Result<DroneOptions> {
+        options_env(flags, &[("HOME", "/home/op")])
+    }
+
+    fn options_env(flags: &[&str], vars: &[(&str, &str)]) -> anyhow::Result<DroneOptions> {
         let cli = Cli::try_parse_from(std::iter::once("stx-drone").chain(flags.iter().copied()))
             .map_err(|e| anyhow!("{e}"))?;
-        cli.drone.options()
+        cli.drone.options(|k| {
+            vars.iter()
+                .find(|(name, _)| *name == k)
+                .map(|(_, v)| OsString::from(v))
+        })
+    }
+
+    const KEY: &str = "c0ffee00c0ffee00c0ffee00c0ffee00c0ffee00c0ffee00c0ffee00c0ffee00";
+
+    fn temp_dir(name: &str) -> PathBuf {
+        let dir = std::env::temp_dir().join(format!("stx-drone-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).expect("temp dir");
+        dir
+    }
+
+    #[test]
+    fn the_key_comes_from_a_file_or_the_environment_never_the_command_line() {
+        let dir = temp_dir("key");
+        let key_file = dir.join("key");
+        std::fs::write(&key_file, format!("{KEY}\n")).expect("write");
+        let file_flag = key_file.to_str().expect("utf-8");
+        let o = options(&["--sign-key-file", file_flag]).expect("valid");
+        assert!(o.signing_key == Some(SigningKey::from_hex(KEY).expect("hex")));
+        // The default timestamp file: the state directory, per system id.
+        assert_eq!(
+            o.signing_timestamp_file,
+            Some(PathBuf::from(
+                "/home/op/.local/state/stx/drone-sys1.signing.timestamp"
+            ))
+        );
+        let o = options_env(
+            &["--system-id", "7"],
+            &[(SIGNING_KEY_ENV, KEY), ("STATE_DIRECTORY", "/var/lib/stx")],
+        )
+        .expect("valid");
+        assert!(o.signing_key == Some(SigningKey::from_hex(KEY).expect("hex")));
+        assert_eq!(
+            o.signing_timestamp_file,
+            Some(PathBuf::from("/var/lib/stx/drone-sys7.signing.timestamp"))
+        );
+        // Nothing printable holds the key.
+        assert!(!format!("{o:?}").contains("c0ffee"));
+        // No key on the command line at all.
+        assert!(options(&["--sign-key", KEY]).is_err());
+        for (flags, vars) in [
+            (
+                vec!["--sign-key-file", file_flag],
+                vec![(SIGNING_KEY_ENV, KEY)],
+            ),
+            (vec![], vec![(SIGNING_KEY_ENV, "c0ffee")]),
+            (vec!["--sign-key-file", "/nonexistent/key"], vec![]),
+            // Signing without anywhere to keep the timestamp.
+            (vec!["--sign-key-file", file_flag], vec![("UNRELATED", "x")]),
+        ] {
+            let err = options_env(&flags, &vars).expect_err("refused");
+            assert!(err.downcast_ref::<BadInput>().is_some(), "{flags:?}: {err}");
+            assert!(!format!("{err:#}").contains("c0ffee"), "{err:#}");
+        }
+        let _ = std::fs::remove_dir_all(&dir);
     }
 
     #[test]
@@ -625,7 +781,7 @@ mod tests {
             &["--link-drop", "160:100"][..],
             &["--stuck-servo", "up@3"],
             &["--linger=-1"],
-            &["--sign-key", "00"],
+            &["--gains", "/nonexistent/gains.toml"],
         ] {
             let err = options(flags).expect_err("refused");
             assert!(err.downcast_ref::<BadInput>().is_some(), "{flags:?}: {err}");
@@ -647,6 +803,81 @@ mod tests {
         .expect_err("refused");
         assert!(err.downcast_ref::<BadInput>().is_some());
         assert!(format!("{err:#}").contains("mission-short"), "{err:#}");
+    }
+
+    /// Every signing timestamp `stx drone` sends until it has sent `frames`, then all it sends
+    /// while stopping (the flight of `options`, pointed at a fresh socket).
+    async fn signed_timestamps(mut options: DroneOptions, frames: usize) -> Vec<u64> {
+        let station = tokio::net::UdpSocket::bind("127.0.0.1:0")
+            .await
+            .expect("station socket");
+        let port = station.local_addr().expect("bound").port();
+        options.connect = format!("udpout:127.0.0.1:{port}");
+        let (stop, stopped) = tokio::sync::oneshot::channel::<()>();
+        let flight = tokio::spawn(fly(options, async {
+            let _ = stopped.await;
+        }));
+        let mut stamps = Vec::new();
+        let mut buf = [0_u8; 512];
+        let decode = |bytes: &[u8], stamps: &mut Vec<u64>| {
+            let mut dec = stx_link::frame::FrameDecoder::default();
+            dec.push(bytes);
+            while let Some(Ok(f)) = dec.poll(Duration::ZERO) {
+                stamps.push(f.header.signature.expect("signed").timestamp_10us);
+            }
+        };
+        while stamps.len() < frames {
+            let n = timeout(Duration::from_secs(20), station.recv(&mut buf))
+                .await
+                .expect("the drone sends")
+                .expect("recv");
+            decode(&buf[..n], &mut stamps);
+        }
+        stop.send(()).expect("flight running");
+        timeout(Duration::from_secs(20), flight)
+            .await
+            .expect("fly returns after the shutdown")
+            .expect("task")
+            .expect("flight");
+        while let Ok(n) = station.try_recv(&mut buf) {
+            decode(&buf[..n], &mut stamps);
+        }
+        stamps
+    }
+
+    /// Regression: `stx drone` signed with `SigningConfig::new(key, 0, now)` and no timestamp
+    /// file, so a restart with the clock set back signed below its last run (replays to the
+    /// station). Now the high-water mark is kept in a file, written before the first frame.
+    #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+    async fn a_restarted_drone_signs_above_its_last_run_with_the_clock_set_back() {
+        let dir = temp_dir("restart");
+        let file = dir.join("drone.signing.timestamp");
+        let options = |unix: Duration| {
+            let mut o = DroneOptions::new("udpout:127.0.0.1:9", "rehearsal");
+            o.speed = Speed::Times(10.0);
+            o.linger = None;
+            o.signing_key = Some(SigningKey::from_hex(KEY).expect("hex"));
+            o.signing_timestamp_file = Some(file.clone());
+            o.signing_clock_unix = Some(unix);
+            o
+        };
+        let jan_2026 = Duration::from_secs(1_767_225_600);
+        let first = signed_timestamps(options(jan_2026), 20).await;
+        let mark = stx_link::transport::load_signing_timestamp(&file)
+            .expect("readable")
+            .expect("written");
+        let last = *first.iter().max().expect("frames");
+        assert!(
+            mark > last,
+            "mark {mark} on disk above every timestamp sent ({last})"
+        );
+        let second = signed_timestamps(options(jan_2026 - Duration::from_secs(3600)), 5).await;
+        assert!(
+            second[0] > last,
+            "after the restart {} <= before {last}",
+            second[0]
+        );
+        let _ = std::fs::remove_dir_all(&dir);
     }
 
     #[tokio::test(flavor = "multi_thread", worker_threads = 2)]

@@ -31,7 +31,7 @@ pub struct ServeArgs {
     /// then be a `udpin:` link).
     #[arg(long)]
     sim: bool,
-    /// The simulated drone's mission with --sim: `mission` (the whole 3-hour flight),
+    /// The simulated drone's mission with --sim: `mission` (the whole 2 h 41 min flight),
     /// `mission-short`, `rehearsal` (under the parafoil from 900 m), or a mission TOML file.
     #[arg(long, default_value = "mission-short", requires = "sim")]
     sim_scenario: String,
@@ -41,6 +41,10 @@ pub struct ServeArgs {
     /// Seed of the simulated drone's randomness (default: the mission's).
     #[arg(long, requires = "sim")]
     sim_seed: Option<u64>,
+    /// Control gains of the simulated drone's onboard guidance (a gains file as `stx tune`
+    /// writes it).
+    #[arg(long, value_name = "FILE", requires = "sim")]
+    sim_gains: Option<PathBuf>,
 }
 
 /// Reads and validates the station configuration.
@@ -51,7 +55,7 @@ pub fn load_config(path: Option<&std::path::Path>) -> anyhow::Result<StationConf
             .with_context(|| format!("cannot read station config {}", p.display()))
             .map_err(BadInput)?,
     };
-    StationConfig::from_toml_str(&text)
+    StationConfig::from_toml_str_with_env(&text, |k| std::env::var_os(k))
         .with_context(|| {
             format!(
                 "station config {}",
@@ -142,12 +146,18 @@ fn sim_options(config: &StationConfig, args: &ServeArgs) -> anyhow::Result<Drone
     options.seed = args.sim_seed;
     // On the ground it keeps answering (parameters, replay of the landing) until the station stops.
     options.linger = None;
-    if let Some(hex) = &config.link.signing_key_hex {
-        let bytes = stx_station::daemon::parse_key_hex(hex)
-            .context("link.signing_key_hex must be 64 hexadecimal characters")
-            .map_err(BadInput)?;
-        options.signing_key = Some(stx_link::signing::SigningKey::from_bytes(bytes));
-    }
+    options.signing_key = config.link.signing_key().map_err(|e| BadInput(e.into()))?;
+    // The drone's own high-water mark, beside the station's.
+    options.signing_timestamp_file = config
+        .link
+        .signing_timestamp_file
+        .as_ref()
+        .map(|p| p.with_file_name("sim-drone.signing.timestamp"));
+    options.gains = args
+        .sim_gains
+        .as_deref()
+        .map(crate::tune::load_gains)
+        .transpose()?;
     // Fail on an unknown mission now, with exit code 2, not after the dashboard is up.
     crate::drone::check_mission(&options)?;
     Ok(options)
@@ -213,4 +223,37 @@ async fn shutdown_signal() {
     #[cfg(not(unix))]
     let _ = interrupt.await;
     tracing::info!("shutting down");
+}
+
+#[cfg(test)]
+mod sim_gains_tests {
+    use super::*;
+    use clap::Parser;
+
+    #[derive(Parser)]
+    struct Cli {
+        #[command(flatten)]
+        serve: ServeArgs,
+    }
+
+    #[test]
+    fn sim_gains_reach_the_simulated_drone_and_a_bad_file_is_bad_input() {
+        let gains = stx_gnc::control::ControlGains {
+            hk1_m_per_rad: 0.0123,
+            ..Default::default()
+        };
+        let path = std::env::temp_dir().join(format!("stx-sim-gains-{}.toml", std::process::id()));
+        std::fs::write(&path, gains.to_toml_string()).expect("write");
+        let config = load_config(None).expect("shipped config");
+        let args = |file: &str| {
+            Cli::try_parse_from(["stx-serve", "--sim", "--sim-gains", file])
+                .expect("flags parse")
+                .serve
+        };
+        let options = sim_options(&config, &args(path.to_str().expect("utf-8"))).expect("valid");
+        assert_eq!(options.gains, Some(gains));
+        let err = sim_options(&config, &args("/nonexistent/gains.toml")).expect_err("refused");
+        assert!(err.downcast_ref::<BadInput>().is_some(), "{err}");
+        let _ = std::fs::remove_file(&path);
+    }
 }

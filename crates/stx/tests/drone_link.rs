@@ -122,6 +122,21 @@ impl Station {
 }
 
 impl Station {
+    /// The drone's whole parameter table, within `timeout`.
+    async fn param_list(
+        &mut self,
+        timeout: Duration,
+        seen: &mut Vec<(FlightMode, FlightStage)>,
+    ) -> Vec<stx_link::param::ParamValue> {
+        self.act(|g, now| g.param_list(now).expect("list starts"))
+            .await;
+        self.until("parameter list", timeout, seen, |e| match e {
+            GroundEvent::Param(ParamEvent::ListComplete { params }) => Some(params.clone()),
+            _ => None,
+        })
+        .await
+    }
+
     /// The first STATUSTEXT containing `needle`, already seen or within `timeout`.
     async fn text(
         &mut self,
@@ -169,15 +184,7 @@ async fn a_station_reads_sets_commands_and_watches_the_rehearsal_land() {
         .await;
 
     // Parameters: the whole list, then a gain set and echoed.
-    station
-        .act(|g, now| g.param_list(now).expect("list starts"))
-        .await;
-    let params = station
-        .until("parameter list", long, &mut seen, |e| match e {
-            GroundEvent::Param(ParamEvent::ListComplete { params }) => Some(params.clone()),
-            _ => None,
-        })
-        .await;
+    let params = station.param_list(long, &mut seen).await;
     assert!(params.len() >= 10, "{params:?}");
     let gain = params
         .iter()
@@ -306,6 +313,25 @@ fn the_whole_mission_flies_from_launch_to_landing_at_max_speed_with_no_operator(
             "landed"
         ]
     );
+    // The timeline: the balloon climbs at 5 m/s on average from the pad (245 m) to its burst.
+    let start = |stage: &str| {
+        s["stages"]
+            .as_array()
+            .and_then(|a| a.iter().find(|st| st["stage"] == stage))
+            .and_then(|st| st["start_s"].as_f64())
+            .unwrap_or(f64::NAN)
+    };
+    let burst_msl_m = s["balloon_end"][2].as_f64().unwrap_or(f64::NAN);
+    let mean_ascent_mps = (burst_msl_m - 245.0) / (start("round_chute") - start("ascent"));
+    println!(
+        "timeline: launch {:.0} s, burst {:.0} s at {burst_msl_m:.0} m ({mean_ascent_mps:.3} m/s \
+         on average), deploy {:.0} s, landed {:.0} s",
+        start("ascent"),
+        start("round_chute"),
+        start("parafoil_deploy"),
+        start("landed")
+    );
+    assert!((mean_ascent_mps - 5.0).abs() < 0.05, "{s}");
     let miss = s["landing"]["miss_m"].as_f64().expect("a target");
     assert!(miss < 50.0, "missed by {miss} m");
     // Hours of mission in (much) less time.
@@ -347,8 +373,159 @@ fn the_failure_flags_are_flown_and_counted() {
     assert!(link["dropped_random"].as_u64().unwrap_or(0) > 100, "{link}");
 }
 
+/// `stx drone --gains FILE`: the onboard guidance starts with the file's gains, and they are
+/// its parameters — what a station lists over PARAM_* is what the file says.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn the_gains_file_is_what_the_drone_reports_over_param() {
+    let gains = stx_gnc::control::ControlGains {
+        hk1_m_per_rad: 0.0123,
+        hk2_m_s_per_rad: 0.0211,
+        hk3_m_per_m: 0.000345,
+        convergence_distance_m: 55.0,
+        vk1: 2.25,
+        vk2_per_m: 0.375,
+        brake_trim: 0.35,
+        main_line_limit_m: 0.0175,
+    };
+    let dir = std::env::temp_dir().join(format!("stx-drone-gains-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("dir");
+    let path = dir.join("gains.toml");
+    std::fs::write(&path, gains.to_toml_string()).expect("write");
+    assert_eq!(
+        stx_gnc::control::ControlGains::from_toml_str(&gains.to_toml_string()).expect("valid"),
+        gains
+    );
+    let mut station = Station::listen().await;
+    let mut drone = spawn_drone(
+        station.port,
+        &[
+            "--scenario",
+            "rehearsal",
+            "--gains",
+            path.to_str().expect("utf-8"),
+        ],
+    );
+    let mut seen = Vec::new();
+    let long = Duration::from_secs(30);
+    station
+        .until("a heartbeat", long, &mut seen, |e| match e {
+            GroundEvent::Telemetry {
+                telemetry: Telemetry::Status(_),
+                ..
+            } => Some(()),
+            _ => None,
+        })
+        .await;
+    let params = station.param_list(long, &mut seen).await;
+    let _ = drone.kill();
+    let _ = drone.wait();
+    let value = |name: &str| {
+        params
+            .iter()
+            .find(|p| p.name == name)
+            .map(|p| p.value)
+            .unwrap_or_else(|| panic!("no {name} in {params:?}"))
+    };
+    for (name, expected) in [
+        ("GN_HK1", gains.hk1_m_per_rad),
+        ("GN_HK2", gains.hk2_m_s_per_rad),
+        ("GN_HK3", gains.hk3_m_per_m),
+        ("GN_CONV_DIST", gains.convergence_distance_m),
+        ("GN_VK1", gains.vk1),
+        ("GN_VK2", gains.vk2_per_m),
+        ("GN_BRAKE_TRIM", gains.brake_trim),
+        ("GN_LINE_MAX", gains.main_line_limit_m),
+    ] {
+        assert_eq!(value(name), expected as f32, "{name}");
+    }
+    // Not the built-in gains.
+    assert_ne!(
+        value("GN_HK1"),
+        stx_gnc::control::ControlGains::default().hk1_m_per_rad as f32
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Regression: with `tcpin:` and no station connected, every frame failed and was logged
+/// twice — 66,761 stderr lines in 1.2 s. Now every failure is counted (the summary's
+/// `io.send_errors`) and reported a few times; and the port chosen for `:0` is logged, so a
+/// station can connect to it.
+#[test]
+fn a_drone_waiting_for_a_station_logs_its_port_and_not_every_failed_frame() {
+    use std::io::{BufRead, BufReader, Read};
+    let mut child = stx()
+        .args([
+            "drone",
+            "--connect",
+            "tcpin:127.0.0.1:0",
+            "--scenario",
+            "rehearsal",
+        ])
+        .args(["--speed", "max", "--summary-json"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("stx runs");
+    let stderr = child.stderr.take().expect("stderr");
+    let (lines_tx, lines_rx) = std::sync::mpsc::channel();
+    let reader = std::thread::spawn(move || {
+        for line in BufReader::new(stderr).lines().map_while(Result::ok) {
+            let _ = lines_tx.send(line);
+        }
+    });
+    let mut lines = Vec::new();
+    let mut got_frames = false;
+    for line in lines_rx.iter() {
+        let port = line
+            .split("tcpin:127.0.0.1:")
+            .nth(1)
+            .map(|rest| {
+                rest.chars()
+                    .take_while(char::is_ascii_digit)
+                    .collect::<String>()
+            })
+            .and_then(|p| p.parse::<u16>().ok())
+            .filter(|&p| p != 0 && line.contains("listening"));
+        lines.push(line);
+        if let Some(port) = port {
+            // The logged address is the real one: a station connecting there gets frames.
+            let mut client =
+                std::net::TcpStream::connect(("127.0.0.1", port)).expect("the logged port");
+            client
+                .set_read_timeout(Some(Duration::from_secs(10)))
+                .expect("timeout");
+            let mut buf = [0_u8; 64];
+            got_frames = client
+                .read(&mut buf)
+                .is_ok_and(|n| n > 0 && buf.contains(&0xFD));
+            break;
+        }
+    }
+    lines.extend(lines_rx.iter());
+    reader.join().expect("reader");
+    let s = summary(child);
+    assert!(got_frames, "no frames on the logged port: {lines:#?}");
+    let send_errors = s["io"]["send_errors"].as_u64().unwrap_or(0);
+    let error_lines = lines.iter().filter(|l| l.contains("send failed")).count();
+    println!(
+        "{} stderr lines, {error_lines} about failed sends, {send_errors} sends failed",
+        lines.len()
+    );
+    assert!(send_errors > 1000, "every failure counted: {s}");
+    assert!(
+        (1..=10).contains(&error_lines),
+        "{error_lines} lines about failed sends"
+    );
+    assert!(lines.len() < 300, "{} stderr lines", lines.len());
+}
+
 #[test]
 fn bad_names_files_and_flags_exit_with_code_2() {
+    let dir = std::env::temp_dir().join(format!("stx-drone-badkey-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("dir");
+    let bad_key = dir.join("key");
+    std::fs::write(&bad_key, "not-hex-secret\n").expect("write");
+    let bad_key = bad_key.to_str().expect("utf-8").to_string();
     for args in [
         vec!["--scenario", "no-such-mission"],
         vec!["--scenario", "/no/such/file.toml"],
@@ -357,7 +534,9 @@ fn bad_names_files_and_flags_exit_with_code_2() {
         vec!["--stuck-servo", "rudder@10"],
         vec!["--packet-loss", "150"],
         vec!["--speed", "0"],
-        vec!["--sign-key", "not-hex"],
+        vec!["--sign-key-file", bad_key.as_str()],
+        vec!["--sign-key-file", "/nonexistent/key"],
+        vec!["--gains", "/nonexistent/gains.toml"],
         vec!["--connect", "carrier-pigeon:1"],
     ] {
         let out = stx().arg("drone").args(&args).output().expect("stx runs");
@@ -369,4 +548,5 @@ fn bad_names_files_and_flags_exit_with_code_2() {
         );
         assert!(!stderr.contains("not-hex"), "the key is never echoed");
     }
+    let _ = std::fs::remove_dir_all(&dir);
 }

@@ -69,6 +69,15 @@ fn pymavlink_reads_telemetry_lists_and_sets_parameters_and_gets_its_commands_ack
         report["param_count"].as_u64().unwrap_or(0) >= 10,
         "{report}"
     );
+    // A set against the drone's rules is answered only with the value in force.
+    let refusal = &report["rule_refusal"];
+    assert_eq!(refusal["name"], "SP_MIN_FINAL", "{report}");
+    assert!(
+        refusal["answered"]
+            .as_array()
+            .is_some_and(|a| !a.is_empty() && a.iter().all(|v| v.as_f64() != Some(1500.0))),
+        "{report}"
+    );
     assert_eq!(report["mode_after"], 2, "{report}");
     // Acknowledged within a control period even on a loaded machine.
     assert!(

@@ -1,6 +1,6 @@
 //! Fuzz target for the ingest path: arbitrary bytes, cut into arbitrary chunks, through the
-//! frame decoder (signing off and on) and the vehicle and ground endpoints. Nothing may panic,
-//! and every byte must be accounted for.
+//! frame decoder (signing off and on) and the vehicle and ground endpoints, ending with the end
+//! of the stream. Nothing may panic, and every byte must be accounted for.
 #![no_main]
 
 use std::time::Duration;
@@ -63,5 +63,12 @@ fuzz_target!(|data: &[u8]| {
         while g.poll_transmit(t).is_some() {}
         while v.poll_event().is_some() {}
         while g.poll_event().is_some() {}
+    }
+    // The connection drops: whatever is buffered is flushed as truncated.
+    v.handle_stream_end(t);
+    g.handle_stream_end(t);
+    let (vs, gs) = (v.link_stats(t).decoder, g.link_stats(t).decoder);
+    for s in [vs, gs] {
+        assert_eq!(s.bytes_in, rest.len() as u64);
     }
 });

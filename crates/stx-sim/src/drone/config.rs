@@ -103,13 +103,15 @@ impl Default for StartConfig {
     }
 }
 
-/// The balloon (see `mission.rs`, "Balloon"): a constant free lift on an envelope that grows
-/// as the air thins gives an ascent rate `v = v₀·(ρ₀/ρ)^k`.
+/// The balloon (see `mission.rs`, "Ascent"): a constant free lift on an envelope that grows
+/// as the air thins gives an ascent rate `v = v₀·(ρ₀/ρ)^k`, with `v₀` such that the climb
+/// from the launch site to the burst altitude takes `(burst − site) / mean_ascent_rate_mps`.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct BalloonConfig {
-    /// Ascent rate at the launch site, m/s (> 0; ≈ 5 for STRAPLEX).
-    pub ascent_rate_mps: f64,
+    /// Mean ascent rate from launch to burst (climb over time), m/s (> 0; ≈ 5 for STRAPLEX).
+    /// The rate at launch is lower and the rate near burst higher (by `ascent_density_exponent`).
+    pub mean_ascent_rate_mps: f64,
     /// Exponent `k` of the density ratio, 0…0.5: 1/6 for drag balance with the volume growing
     /// as 1/ρ and a constant drag coefficient; 0 for a constant ascent rate.
     pub ascent_density_exponent: f64,
@@ -120,7 +122,7 @@ pub struct BalloonConfig {
 impl Default for BalloonConfig {
     fn default() -> Self {
         Self {
-            ascent_rate_mps: 5.0,
+            mean_ascent_rate_mps: 5.0,
             ascent_density_exponent: 1.0 / 6.0,
             burst_altitude_msl_m: 35_000.0,
         }
@@ -415,7 +417,7 @@ impl MissionConfig {
             _ => {}
         }
         let b = &self.balloon;
-        finite_positive("balloon.ascent_rate_mps", b.ascent_rate_mps)?;
+        finite_positive("balloon.mean_ascent_rate_mps", b.mean_ascent_rate_mps)?;
         if !(0.0..=0.5).contains(&b.ascent_density_exponent) {
             return Err(invalid(
                 "balloon.ascent_density_exponent",
@@ -577,8 +579,8 @@ mod tests {
         for (tables, field) in [
             ("[plan]\nmode = \"manual\"\n", "plan.mode"),
             (
-                "[balloon]\nascent_rate_mps = -1\n[plan]\ntarget_ne_m = [0, 0]\n",
-                "balloon.ascent_rate_mps",
+                "[balloon]\nmean_ascent_rate_mps = -1\n[plan]\ntarget_ne_m = [0, 0]\n",
+                "balloon.mean_ascent_rate_mps",
             ),
             (
                 "[balloon]\nburst_altitude_msl_m = 100\n[plan]\ntarget_ne_m = [0, 0]\n",

@@ -13,8 +13,10 @@
 //! Every frame out and every `handle_bytes` call in (one datagram) passes through
 //! [`LinkFaults`]: the link-drop windows (mission time) and the random packet loss. What the
 //! endpoint reports is applied to the drone at once: commands are executed and acknowledged,
-//! parameter sets applied (a refused one is put back, so a read-back tells the truth), uploaded
-//! plans flown, link loss and return noted (the drone keeps flying its plan either way).
+//! parameter sets checked by the drone's own rules inside the link's table before they are
+//! taken or echoed ([`Drone::check_param`] as the table's validator: a refused set is answered
+//! only with the value in force), uploaded plans flown, link loss and return noted (the drone
+//! keeps flying its plan either way).
 
 use std::collections::VecDeque;
 use std::time::Duration;
@@ -62,7 +64,7 @@ pub enum DroneEvent {
         /// The answer sent in COMMAND_ACK.
         result: CommandResult,
     },
-    /// A parameter set from the station, applied or refused (and put back).
+    /// A parameter set from the station, applied or refused.
     Param {
         /// Mission time, s.
         time_s: f64,
@@ -80,8 +82,8 @@ pub enum DroneEvent {
         /// Number of items.
         items: usize,
     },
-    /// Signing's timestamp high-water mark moved: persist it (stx-link's
-    /// `transport::drive` does, given a file).
+    /// Signing's timestamp high-water mark moved (stx-link's `transport::drive` persists the
+    /// mark itself, before the frames signed under it leave).
     PersistSigningTimestamp(u64),
 }
 
@@ -92,7 +94,7 @@ pub struct LinkCounters {
     pub commands: u64,
     /// Parameter sets taken.
     pub params_set: u64,
-    /// Parameter sets refused by the onboard rules (put back).
+    /// Parameter sets refused (range or the onboard rules); the value in force was kept.
     pub params_refused: u64,
     /// Plans uploaded.
     pub plans: u64,
@@ -189,7 +191,21 @@ impl LinkedDrone {
         if self.faults.drops_datagram(self.drone.time_s()) {
             return;
         }
-        self.endpoint.handle_bytes(link_now, bytes);
+        let drone = &self.drone;
+        self.endpoint
+            .handle_bytes_with(link_now, bytes, &mut |name: &str, value: f32| {
+                drone.check_param(name, value).map_err(|e| e.to_string())
+            });
+        self.process(link_now);
+    }
+
+    /// The stream connection carrying the link ended (TCP, serial).
+    pub fn handle_stream_end(&mut self, link_now: Duration) {
+        let drone = &self.drone;
+        self.endpoint
+            .handle_stream_end_with(link_now, &mut |name: &str, value: f32| {
+                drone.check_param(name, value).map_err(|e| e.to_string())
+            });
         self.process(link_now);
     }
 
@@ -292,7 +308,9 @@ impl LinkedDrone {
                     });
                 }
                 VehicleEvent::ParamChanged(change) => {
-                    // The echo of a value put back below: already in force.
+                    // The table asked the drone before taking the value, so this holds; were
+                    // the two ever to disagree, the table is brought back to what the drone
+                    // flies (that echo's own change is the value in force: skipped).
                     if self.drone.param(&change.name) == Some(change.new) {
                         continue;
                     }
@@ -304,8 +322,7 @@ impl LinkedDrone {
                         ));
                     } else {
                         self.counters.params_refused += 1;
-                        // Put the value in force back in the table (and on the wire), so
-                        // the station reads what the drone flies.
+                        tracing::error!(name = %change.name, "parameter passed the table's check but not the drone's");
                         if let Some(v) = self.drone.param(&change.name)
                             && let Err(e) = self.endpoint.params_mut().set(&change.name, v)
                         {
@@ -317,6 +334,15 @@ impl LinkedDrone {
                         name: change.name,
                         value: change.new,
                         accepted,
+                    });
+                }
+                VehicleEvent::ParamRefused(refusal) => {
+                    self.counters.params_refused += 1;
+                    self.event(DroneEvent::Param {
+                        time_s,
+                        name: refusal.name,
+                        value: refusal.value,
+                        accepted: false,
                     });
                 }
                 VehicleEvent::PlanReceived(items) => {
@@ -361,10 +387,11 @@ impl SansIo for LinkedDrone {
         LinkedDrone::poll_event(self)
     }
 
-    fn persist_request(event: &DroneEvent) -> Option<u64> {
-        match event {
-            DroneEvent::PersistSigningTimestamp(v) => Some(*v),
-            _ => None,
-        }
+    fn handle_stream_end(&mut self, now: Duration) {
+        LinkedDrone::handle_stream_end(self, now);
+    }
+
+    fn signing_timestamp_mark(&self) -> Option<u64> {
+        self.endpoint.signing_timestamp_mark()
     }
 }

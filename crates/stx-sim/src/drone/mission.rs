@@ -10,11 +10,16 @@
 //!   balances its drag, `L = ½ρv²·C_D·A`. The free lift of a latex balloon stays about
 //!   constant on the way up (the helium expands with the air, so the lift of the displaced air
 //!   does not change), while its envelope grows as `V ∝ 1/ρ`, so `A ∝ ρ^(−2/3)` and
-//!   `v = v₀·(ρ₀/ρ)^(1/6)`: 5 m/s at the launch site becomes about 11 m/s at 35 km in the
-//!   US Standard Atmosphere 1976. The exponent is a setting (0 gives a constant rate; cold gas
-//!   and a falling drag coefficient make real balloons rise somewhat more evenly). The balloon
-//!   is light and large, so horizontally it moves with the wind at its altitude. It bursts at
-//!   the burst altitude (MSL), or is cut away by a cutdown command.
+//!   `v = v₀·(ρ₀/ρ)^k` with `k = 1/6`. The exponent is a setting (0 gives a constant rate;
+//!   cold gas and a falling drag coefficient make real balloons rise more evenly). What a
+//!   flight is planned with, and what the mission file gives, is the *mean* ascent rate `v̄`
+//!   from launch to burst (≈ 5 m/s for STRAPLEX: the filling is chosen for it); the launch
+//!   rate follows from the time to burst `T = ∫dz/v = (1/v₀)∫(ρ/ρ₀)^k dz = H/v̄`, i.e.
+//!   `v₀ = v̄·(1/H)∫(ρ/ρ₀)^k dz` over the climb `H` in the US Standard Atmosphere 1976
+//!   ([`Balloon::with_mean_rate`]). For the 35-km mission (`v̄` = 5 m/s, `k` = 1/6) that is
+//!   3.5 m/s at the launch site, 8.0 m/s at burst, and 1 h 56 min to burst. The balloon is
+//!   light and large, so horizontally it moves with the wind at its altitude. It bursts at the
+//!   burst altitude (MSL), or is cut away by a cutdown command.
 //! - **RoundChute**, the whole stack under a round parachute (a point mass of the four bodies
 //!   plus the chute): `m·dv/dt = m·g − ½ρ|v−w|(v−w)·C_D·A` with the density of the US
 //!   Standard Atmosphere 1976 at its altitude and `w` the wind, integrated with RK4 in 0.05 s
@@ -79,11 +84,52 @@ pub struct Balloon {
     pub launch_density_kg_per_m3: f64,
 }
 
+/// Intervals of the Simpson rule over the climb in [`Balloon::with_mean_rate`] (even).
+const CLIMB_INTERVALS: usize = 2000;
+
 impl Balloon {
     /// Ascent rate in air of density `density_kg_per_m3`, m/s.
     pub fn ascent_rate_mps(&self, density_kg_per_m3: f64) -> f64 {
         let ratio = self.launch_density_kg_per_m3 / density_kg_per_m3.max(1e-9);
         self.ascent_rate_mps * ratio.powf(self.density_exponent)
+    }
+
+    /// The balloon that climbs from `launch_msl_m` to `burst_msl_m` (above it) in `atmosphere`
+    /// at `mean_rate_mps` on average (climb over time), with density exponent `exponent`: its
+    /// launch rate is `v̄·(1/H)∫(ρ/ρ₀)^k dz` (see the module documentation).
+    pub fn with_mean_rate(
+        mean_rate_mps: f64,
+        exponent: f64,
+        atmosphere: &dyn Atmosphere,
+        launch_msl_m: f64,
+        burst_msl_m: f64,
+    ) -> Self {
+        let rho0 = atmosphere.air_at(launch_msl_m).density_kg_per_m3;
+        let climb_m = (burst_msl_m - launch_msl_m).max(0.0);
+        let slowness = |z: f64| {
+            let rho = atmosphere.air_at(launch_msl_m + z).density_kg_per_m3;
+            (rho / rho0).powf(exponent)
+        };
+        let h = climb_m / CLIMB_INTERVALS as f64;
+        let inner: f64 = (1..CLIMB_INTERVALS)
+            .map(|i| slowness(i as f64 * h) * if i % 2 == 1 { 4.0 } else { 2.0 })
+            .sum();
+        let integral = h / 3.0 * (slowness(0.0) + inner + slowness(climb_m));
+        let mean_slowness = if climb_m > 0.0 {
+            integral / climb_m
+        } else {
+            1.0
+        };
+        Self {
+            ascent_rate_mps: mean_rate_mps * mean_slowness,
+            density_exponent: exponent,
+            launch_density_kg_per_m3: rho0,
+        }
+    }
+
+    /// The rate at the launch site, m/s.
+    pub fn launch_rate_mps(&self) -> f64 {
+        self.ascent_rate_mps
     }
 }
 
@@ -277,7 +323,6 @@ impl MissionPhysics {
             crate::montecarlo::steady_glide_state(&vehicle).map_err(PhysicsError::Template)?;
         let atmosphere: Arc<dyn Atmosphere> = Arc::new(StandardAtmosphere);
         let ground = config.site.alt_msl_m;
-        let launch_density = atmosphere.air_at(ground).density_kg_per_m3;
         let mut rng = ChaCha8Rng::seed_from_u64(config.seed);
         rng.set_stream(41);
         let ascent_swing = Swing::new(15.0, 2.0, 3.0, &mut rng);
@@ -302,11 +347,13 @@ impl MissionPhysics {
             velocity_ned_mps: Vector3::zeros(),
             parafoil: None,
             touchdown: None,
-            balloon: Balloon {
-                ascent_rate_mps: config.balloon.ascent_rate_mps,
-                density_exponent: config.balloon.ascent_density_exponent,
-                launch_density_kg_per_m3: launch_density,
-            },
+            balloon: Balloon::with_mean_rate(
+                config.balloon.mean_ascent_rate_mps,
+                config.balloon.ascent_density_exponent,
+                &StandardAtmosphere,
+                ground,
+                config.balloon.burst_altitude_msl_m,
+            ),
             ascent_swing,
             chute_swing,
             launch_at_s: start.launch_delay_s,
@@ -347,6 +394,11 @@ impl MissionPhysics {
     /// Altitude at which the balloon bursts, m above mean sea level.
     pub fn burst_altitude_msl_m(&self) -> f64 {
         self.burst_altitude_msl_m
+    }
+
+    /// The balloon's ascent model.
+    pub fn balloon(&self) -> &Balloon {
+        &self.balloon
     }
 
     /// The vehicle flown.
@@ -694,6 +746,40 @@ mod tests {
         };
         assert!((b.ascent_rate_mps(1.2) - 5.0).abs() < 1e-12);
         assert!((b.ascent_rate_mps(1.2 / 64.0) - 10.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn the_launch_rate_gives_the_mean_ascent_rate_to_burst() {
+        let atmosphere = StandardAtmosphere;
+        for (burst, exponent) in [(35_000.0, 1.0 / 6.0), (3_000.0, 1.0 / 6.0), (35_000.0, 0.0)] {
+            let b = Balloon::with_mean_rate(5.0, exponent, &atmosphere, 245.0, burst);
+            // Time to burst by stepping through the climb (independent of the Simpson rule).
+            let (mut z, mut t) = (245.0, 0.0);
+            let dz = 1.0;
+            while z < burst {
+                let v = b.ascent_rate_mps(atmosphere.air_at(z + dz / 2.0).density_kg_per_m3);
+                t += dz / v;
+                z += dz;
+            }
+            let mean = (burst - 245.0) / t;
+            assert!(
+                (mean - 5.0).abs() < 2e-3,
+                "{burst} m, k {exponent}: mean {mean}"
+            );
+            if exponent == 0.0 {
+                assert!((b.launch_rate_mps() - 5.0).abs() < 1e-12);
+            } else {
+                assert!(b.launch_rate_mps() < 5.0);
+            }
+        }
+        let b = Balloon::with_mean_rate(5.0, 1.0 / 6.0, &atmosphere, 245.0, 35_000.0);
+        let top = b.ascent_rate_mps(atmosphere.air_at(35_000.0).density_kg_per_m3);
+        assert!(
+            (b.launch_rate_mps() - 3.5).abs() < 0.05,
+            "{}",
+            b.launch_rate_mps()
+        );
+        assert!((top - 8.0).abs() < 0.1, "{top}");
     }
 
     #[test]

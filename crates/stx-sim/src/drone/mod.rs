@@ -500,6 +500,13 @@ impl Drone {
         }
     }
 
+    /// Whether `name` may take `value` now (range, kind, the rules between parameters, the
+    /// servo travel), without changing anything: the link's table asks this before it takes a
+    /// set from the station or echoes it.
+    pub fn check_param(&self, name: &str, value: f32) -> Result<(), ParamError> {
+        self.onboard.check_param(name, value).map(drop)
+    }
+
     /// Sets a parameter from the station (checked against the shared catalog); effective at
     /// the next period. On refusal nothing changes and the reason goes to the operator's log.
     pub fn set_param(&mut self, name: &str, value: f32) -> Result<(), ParamError> {
@@ -715,8 +722,9 @@ impl Drone {
             StageEvent::Launched => (
                 Severity::Notice,
                 format!(
-                    "launched: ascending at {:.1} m/s to burst at {:.0} m",
-                    self.config.balloon.ascent_rate_mps,
+                    "launched: ascending at {:.1} m/s on average ({:.1} m/s now) to burst at {:.0} m",
+                    self.config.balloon.mean_ascent_rate_mps,
+                    self.physics.balloon().launch_rate_mps(),
                     self.physics.burst_altitude_msl_m()
                 ),
             ),

@@ -41,6 +41,11 @@
 //! - `0`: it keeps flying the plan on the dead-reckoned estimate.
 //! - `2`: servos neutral: the parafoil glides straight and lands unflared.
 //!
+//! A loss in a mode that does not steer on position (heading, manual) is announced and flown
+//! through; if the operator then selects a mode that does (course, localizer, spiral landing)
+//! while the GPS is still out, the action is taken at once — the drone never steers on a
+//! position it has lost for longer than `FS_GPS_LOSS_S` unless `FS_GPS_ACTION` says so (`0`).
+//!
 //! When fixes return it says so, and a spiral landing replans from its approximation (the
 //! dead-reckoned position may have jumped).
 //!
@@ -267,10 +272,9 @@ impl Onboard {
         self.texts.push_back((severity, text));
     }
 
-    /// Sets a parameter: its catalog range and kind, the servo travel for `GN_LINE_MAX`, and
-    /// the rules between parameters are checked; on refusal nothing changes. It takes effect
-    /// at the next control period.
-    pub fn set_param(&mut self, name: &str, value: f32) -> Result<(), ParamError> {
+    /// The settings `name = value` would give, or why it is refused (the checks of
+    /// [`set_param`](Self::set_param)); nothing changes.
+    pub fn check_param(&self, name: &str, value: f32) -> Result<OnboardSettings, ParamError> {
         let value = f64::from(value);
         if name == MAIN_LINE_LIMIT && value > self.main_line_travel_m {
             return Err(ParamError::OutOfRange {
@@ -280,7 +284,16 @@ impl Onboard {
                 max: self.main_line_travel_m,
             });
         }
-        self.settings.apply(name, value)?;
+        let mut settings = self.settings;
+        settings.apply(name, value)?;
+        Ok(settings)
+    }
+
+    /// Sets a parameter: its catalog range and kind, the servo travel for `GN_LINE_MAX`, and
+    /// the rules between parameters are checked; on refusal nothing changes. It takes effect
+    /// at the next control period.
+    pub fn set_param(&mut self, name: &str, value: f32) -> Result<(), ParamError> {
+        self.settings = self.check_param(name, value)?;
         self.guidance.set_gains(self.settings.guidance.gains);
         self.guidance
             .set_spiral_config(self.settings.guidance.spiral);
@@ -574,7 +587,7 @@ impl Onboard {
                         Severity::Notice,
                         format!("GPS back after {:.0} s", time_s - since_s),
                     );
-                } else if !acted
+                } else if (!acted || self.gps_action_pending())
                     && stage == FlightStage::Parafoil
                     && time_s - since_s >= self.settings.failsafe.gps_loss_s
                     && let Some(est) = est
@@ -600,6 +613,13 @@ impl Onboard {
                 }
             }
         }
+    }
+
+    /// After the loss was flown through in a mode that does not need the GPS: whether the
+    /// mode now steers on position and the policy has an action for that.
+    fn gps_action_pending(&self) -> bool {
+        steers_on_position(self.mode())
+            && self.settings.failsafe.gps_loss_action != GpsLossAction::Continue
     }
 
     fn act_on_gps_loss(&mut self, time_s: f64, since_s: f64, est: &Estimate) {
