@@ -103,14 +103,15 @@ pub fn run(args: ServeArgs) -> anyhow::Result<()> {
         });
         let mut drone_task = None;
         let station = stx_station::daemon::run(config, stopped(stop_rx.clone()), |running| {
-            println!(
-                "stx station: open {}://{}/?token={operator}",
+            let mut banner = format!(
+                "stx station: open {}://{}/?token={operator}\n",
                 running.scheme, running.http
             );
             if let Some(link) = running.link_local {
                 // For a drone started separately against a port the system chose.
-                println!("stx station: drone link listening on {link}");
+                banner.push_str(&format!("stx station: drone link listening on {link}\n"));
             }
+            announce(&banner);
             if let (Some(mut options), Some(link)) = (sim, running.link_local) {
                 options.connect = format!("udpout:{}", loopback_if_unspecified(link));
                 drone_task = Some(tokio::spawn(fly_beside(options, stopped(stop_rx))));
@@ -223,6 +224,17 @@ async fn shutdown_signal() {
     #[cfg(not(unix))]
     let _ = interrupt.await;
     tracing::info!("shutting down");
+}
+
+/// Writes the start banner to stdout. A station must not stop because nobody reads its
+/// stdout any more (a closed pipe, a supervisor that went away): `println!` would panic on
+/// the broken pipe, so a failed write is only logged.
+fn announce(banner: &str) {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    if let Err(e) = out.write_all(banner.as_bytes()).and_then(|()| out.flush()) {
+        tracing::warn!(error = %e, "could not print the start banner on stdout");
+    }
 }
 
 #[cfg(test)]

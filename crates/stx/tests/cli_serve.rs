@@ -196,3 +196,31 @@ fn serve_sim_refuses_a_link_it_cannot_fly_on_and_an_unknown_mission() {
         assert!(!stderr.is_empty(), "{args:?} says why");
     }
 }
+
+/// Regression: the start banner grew a second line, and a reader that closed stdout after the
+/// first (as `serve` above does) made `println!` panic on the broken pipe and took the station
+/// down with it, now and then, mid-request.
+#[test]
+fn serve_keeps_running_when_nobody_reads_its_stdout() {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_stx"))
+        .args([
+            "serve",
+            "--listen",
+            "127.0.0.1:0",
+            "--link",
+            "udpin:127.0.0.1:0",
+        ])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::null())
+        .spawn()
+        .expect("stx serve starts");
+    drop(child.stdout.take());
+    std::thread::sleep(Duration::from_millis(1500));
+    let early_exit = child.try_wait().expect("wait");
+    let _ = child.kill();
+    let _ = child.wait();
+    assert!(
+        early_exit.is_none(),
+        "the station stopped with its stdout closed: {early_exit:?}"
+    );
+}
