@@ -20,18 +20,7 @@ fn get(address: &str, path: &str, token: &str) -> String {
 
 #[test]
 fn serve_prints_its_url_answers_and_stops_on_sigterm() {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_stx"))
-        .args([
-            "serve",
-            "--listen",
-            "127.0.0.1:0",
-            "--link",
-            "udpin:127.0.0.1:0",
-        ])
-        .stdout(Stdio::piped())
-        .stderr(Stdio::null())
-        .spawn()
-        .expect("stx serve starts");
+    let mut child = spawn_serve(&["--listen", "127.0.0.1:0", "--link", "udpin:127.0.0.1:0"]);
     let mut line = String::new();
     BufReader::new(child.stdout.take().expect("stdout"))
         .read_line(&mut line)
@@ -93,15 +82,20 @@ fn a_bad_station_config_exits_2_and_names_the_field() {
     assert_eq!(missing.status.code(), Some(2));
 }
 
-/// Starts `stx serve` with `args` and returns the child and the address and token it printed.
-fn serve(args: &[&str]) -> (std::process::Child, String, String) {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_stx"))
+/// Starts `stx serve` with `args`, its stdout piped.
+fn spawn_serve(args: &[&str]) -> std::process::Child {
+    Command::new(env!("CARGO_BIN_EXE_stx"))
         .arg("serve")
         .args(args)
         .stdout(Stdio::piped())
         .stderr(Stdio::null())
         .spawn()
-        .expect("stx serve starts");
+        .expect("stx serve starts")
+}
+
+/// Starts `stx serve` with `args` and returns the child and the address and token it printed.
+fn serve(args: &[&str]) -> (std::process::Child, String, String) {
+    let mut child = spawn_serve(args);
     let mut line = String::new();
     BufReader::new(child.stdout.take().expect("stdout"))
         .read_line(&mut line)
@@ -202,18 +196,7 @@ fn serve_sim_refuses_a_link_it_cannot_fly_on_and_an_unknown_mission() {
 /// down with it, now and then, mid-request.
 #[test]
 fn serve_keeps_running_when_nobody_reads_its_stdout() {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_stx"))
-        .args([
-            "serve",
-            "--listen",
-            "127.0.0.1:0",
-            "--link",
-            "udpin:127.0.0.1:0",
-        ])
-        .stdout(Stdio::piped())
-        .stderr(Stdio::null())
-        .spawn()
-        .expect("stx serve starts");
+    let mut child = spawn_serve(&["--listen", "127.0.0.1:0", "--link", "udpin:127.0.0.1:0"]);
     drop(child.stdout.take());
     std::thread::sleep(Duration::from_millis(1500));
     let early_exit = child.try_wait().expect("wait");
