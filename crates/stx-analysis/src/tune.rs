@@ -29,7 +29,7 @@ use stx_dynamics::model::ParafoilModel;
 use stx_dynamics::rotation::wrap_pi;
 use stx_dynamics::state::{Controls, StateVector, idx};
 use stx_dynamics::vehicle::Vehicle;
-use stx_gnc::control::{ControlGains, GlidePath, Localizer};
+use stx_gnc::control::{ControlGains, Localizer};
 use stx_gnc::estimate::Estimate;
 use stx_gnc::guidance::{Guidance, GuidanceConfig, Plan};
 use stx_gnc::mission::FlightMode;
@@ -367,7 +367,13 @@ impl Experiment {
         let linear = linearize(vehicle, &t);
         let outputs_at_trim = crate::linearize::outputs(vehicle, &t.state, 0.0);
         let drone_velocity = Vector3::from(t.drone_velocity_ned_mps);
-        let (plan, mode) = plan_for(controller, step, &outputs_at_trim, &drone_velocity);
+        let (plan, mode) = plan_for(
+            controller,
+            step,
+            &outputs_at_trim,
+            &drone_velocity,
+            base.spiral.hang_height_m,
+        );
         let model = ParafoilModel::new(vehicle.clone(), calm_environment());
         let mut template = truth_estimate(&model, 0.0, &t.state);
         template.position_sigma_m = Vector3::zeros();
@@ -462,12 +468,10 @@ impl Experiment {
             Controller::Heading => est.heading_rad,
             Controller::Course => est.course_rad,
             Controller::Localizer => self.plan.localizer.cross_track_m(position),
-            Controller::Vertical => GlidePath {
-                line: self.plan.localizer,
-                aim_height_m: -self.plan.target_ned_m.z,
-                slope: self.plan.localizer_glide_slope.unwrap_or_default(),
-            }
-            .altitude_error_m(position, est.height_m()),
+            Controller::Vertical => self
+                .plan
+                .localizer_glide_path(self.base.spiral.hang_height_m)
+                .map_or(0.0, |path| path.altitude_error_m(position, est.height_m())),
         }
     }
 
@@ -635,12 +639,14 @@ impl Experiment {
 }
 
 /// The plan and mode of a controller's experiment, from the drone's outputs `y0` and velocity
-/// at trim.
+/// at trim; `hang_height_m` places the vertical experiment's glide path as guidance flies it
+/// ([`Plan::localizer_glide_path`]).
 fn plan_for(
     controller: Controller,
     step: f64,
     y0: &DVector<f64>,
     v_drone: &Vector3<f64>,
+    hang_height_m: f64,
 ) -> (Plan, FlightMode) {
     let on_track = Localizer {
         point_ne_m: [y0[0], y0[1]],
@@ -667,11 +673,12 @@ fn plan_for(
             (plan, FlightMode::Localizer)
         }
         Controller::Vertical => {
-            // Along the trimmed track at the trimmed glide slope, `step` below the vehicle.
+            // Along the trimmed track at the trimmed glide slope, `step` below the vehicle: the
+            // path's aim height is the target's ground plus the hang height.
             plan.localizer = on_track;
             plan.localizer_glide_slope = Some(v_drone.z / v_drone.x);
             let height = -y0[2];
-            plan.target_ned_m = Vector3::new(0.0, 0.0, -(height - step));
+            plan.target_ned_m = Vector3::new(0.0, 0.0, -(height - step - hang_height_m));
             (plan, FlightMode::Localizer)
         }
     }
@@ -1146,6 +1153,37 @@ mod tests {
         let (lr, nr) = (l.rise_time_s.expect("rises"), n.rise_time_s.expect("rises"));
         assert!((lr - nr).abs() < 0.5, "{lr} vs {nr}");
         assert!((l.overshoot_pct - n.overshoot_pct).abs() < 3.0);
+    }
+
+    /// Regression: guidance's glide path began to end with the lowest body, not the drone, on
+    /// the ground (8.4 m higher) while the experiment still measured the error against the old
+    /// path; the vehicle started below the path it flew and never "arrived" for any gains.
+    #[test]
+    fn the_vertical_experiment_starts_its_step_above_the_path_guidance_flies_and_settles_on_it() {
+        let vehicle = Vehicle::straplex();
+        let g = ControlGains::default();
+        let exp = Experiment::new(
+            Controller::Vertical,
+            &vehicle,
+            600.0,
+            GuidanceConfig::default(),
+            Controller::Vertical.step(),
+        )
+        .expect("trim");
+        let linear = exp.linear_response(&g);
+        let first = linear.output[0];
+        assert!(
+            (first - exp.step).abs() < 0.5,
+            "starts {first:.2} m above the flown path, not {} m",
+            exp.step
+        );
+        for m in [
+            exp.score(&linear, &g),
+            exp.score(&exp.nonlinear_response(&g).expect("flies"), &g),
+        ] {
+            let settle = m.settling_time_s.expect("settles on the path");
+            assert!(settle < 40.0, "{m:?}");
+        }
     }
 
     #[test]

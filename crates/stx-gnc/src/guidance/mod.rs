@@ -47,6 +47,21 @@ pub struct Plan {
     pub localizer_glide_slope: Option<f64>,
 }
 
+impl Plan {
+    /// The glide path localizer mode flies when the plan has a glide slope: down the localizer
+    /// to its point, ending with the lowest hanging body — `hang_height_m` below the drone — on
+    /// the target's ground. Aimed with the drone, the stack touched down the hang height's glide
+    /// short of the point (13 m on `vertical`). Guidance flies it, and the tuner measures the
+    /// vertical law's error against it.
+    pub fn localizer_glide_path(&self, hang_height_m: f64) -> Option<GlidePath> {
+        self.localizer_glide_slope.map(|slope| GlidePath {
+            line: self.localizer,
+            aim_height_m: -self.target_ned_m.z + hang_height_m,
+            slope,
+        })
+    }
+}
+
 impl Default for Plan {
     fn default() -> Self {
         Self {
@@ -257,17 +272,11 @@ impl Guidance {
                     est.heading_rate_rad_s,
                 );
                 let mut vertical_phase = None;
-                let brake = match self.plan.localizer_glide_slope {
-                    Some(slope) => {
-                        // The path ends at the localizer's point with the lowest body, not the
-                        // drone, on the ground: aimed with the drone, the stack touched down
-                        // the hang height's glide short of the point (13 m on `vertical`).
-                        let path = GlidePath {
-                            line: self.plan.localizer,
-                            aim_height_m: -self.plan.target_ned_m.z
-                                + self.config.spiral.hang_height_m,
-                            slope,
-                        };
+                let brake = match self
+                    .plan
+                    .localizer_glide_path(self.config.spiral.hang_height_m)
+                {
+                    Some(path) => {
                         let out = control::vertical(
                             g,
                             &path,
