@@ -332,6 +332,7 @@ function buildState() {
     link: {
       connected: !down, stale: down, age_s: r2(age), rate_hz: down ? 0 : r2(31.5 + noise(1.5)), loss_percent: down ? 100 : r2(0.4 + rand() * 0.4),
       crc_errors: 0, parse_errors: 0, signature_errors: 0,
+      radios: [{ address: "udpin:127.0.0.1:14550", transmitting: true, stale: down, age_s: r2(age), rate_hz: down ? 0 : 31.5, loss_percent: 0.4, duplicates: 0 }],
       ages_s: { HEARTBEAT: msgAge(1), GPS_RAW_INT: msgAge(0.2), ATTITUDE: msgAge(0.05), SCALED_PRESSURE: msgAge(0.2), SERVO_OUTPUT_RAW: msgAge(0.1), WIND_COV: msgAge(0.25) },
     },
     vehicle: lastGood?.vehicle ?? null,

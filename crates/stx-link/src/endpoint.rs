@@ -49,6 +49,9 @@ use crate::param::{
     ParamChange, ParamClient, ParamConfig, ParamEvent, ParamRefusal, ParamRequestError, ParamSpec,
     ParamTable, ParamTableError, ParamValidator, RangeOnly,
 };
+use crate::paths::{
+    Deduplicator, PathStats, RadioPath, signature_failures, total_decoder_stats, transmit_path,
+};
 use crate::plan::{PlanClient, PlanConfig, PlanEvent, PlanItem, PlanRequestError, PlanServer};
 use crate::signing::SigningConfig;
 use crate::telemetry::{
@@ -72,6 +75,9 @@ pub struct LinkConfig {
     pub accept_v1: bool,
     /// MAVLink 2 signing; `None` = off.
     pub signing: Option<SigningConfig>,
+    /// Radios (transports) carrying this link to the same peer, numbered from 0 in order of
+    /// preference (0 is taken as 1). With more than one, see [`crate::paths`].
+    pub paths: usize,
 }
 
 impl LinkConfig {
@@ -94,12 +100,19 @@ impl LinkConfig {
             rate_window: Duration::from_secs(5),
             accept_v1: true,
             signing: None,
+            paths: 1,
         }
     }
 
     /// Sets signing.
     pub fn with_signing(mut self, signing: Option<SigningConfig>) -> Self {
         self.signing = signing;
+        self
+    }
+
+    /// Sets the number of radios carrying the link.
+    pub fn with_paths(mut self, paths: usize) -> Self {
+        self.paths = paths.max(1);
         self
     }
 }
@@ -129,7 +142,8 @@ pub struct SenderStats {
     pub received: u64,
     /// Frames missing, from sequence-number gaps (less those that arrived late).
     pub lost: u64,
-    /// Frames repeating the previous sequence number.
+    /// Frames repeating the previous sequence number (a copy heard over a second radio is
+    /// removed before this count).
     pub duplicates: u64,
     /// Frames that arrived after a later one (at most [`MAX_REORDER_DEPTH`] behind).
     pub reordered: u64,
@@ -171,6 +185,26 @@ impl SenderStats {
     }
 }
 
+/// Each sender's last sequence number and loss figures.
+pub(crate) type SenderTable = HashMap<(u8, u8), (u8, SenderStats)>;
+
+/// Accounts the frame with header `h` to its sender in `senders`.
+pub(crate) fn account_sender(senders: &mut SenderTable, h: &FrameHeader) {
+    let key = (h.system_id, h.component_id);
+    match senders.get_mut(&key) {
+        Some((last_seq, s)) => *last_seq = s.account(*last_seq, h.sequence),
+        None => {
+            let first = SenderStats {
+                system_id: h.system_id,
+                component_id: h.component_id,
+                received: 1,
+                ..Default::default()
+            };
+            senders.insert(key, (h.sequence, first));
+        }
+    }
+}
+
 /// Link quality, for the dashboard and recordings.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct LinkStats {
@@ -204,8 +238,12 @@ pub struct LinkStats {
     pub senders: Vec<SenderStats>,
     /// Seconds since the last message of each kind, by MAVLink message name.
     pub last_message_age_s: BTreeMap<String, f64>,
-    /// Every decoder counter.
+    /// Every decoder counter (all paths together).
     pub decoder: DecoderStats,
+    /// Frames dropped as the second copy of one heard over another radio.
+    pub duplicates_dropped: u64,
+    /// Each radio's own figures (one entry per path).
+    pub paths: Vec<PathStats>,
 }
 
 /// Most arrival times kept for the rate window.
@@ -215,7 +253,9 @@ const MAX_RATE_SAMPLES: usize = 65_536;
 #[derive(Debug)]
 struct LinkCore {
     config: LinkConfig,
-    decoder: FrameDecoder,
+    /// One per radio; at least one.
+    paths: Vec<RadioPath>,
+    copies: Deduplicator,
     encoder: FrameEncoder,
     out: VecDeque<Vec<u8>>,
     events: VecDeque<LinkEvent>,
@@ -224,7 +264,7 @@ struct LinkCore {
     last_peer_heartbeat: Option<Duration>,
     connected: bool,
     arrivals: VecDeque<Duration>,
-    senders: HashMap<(u8, u8), (u8, SenderStats)>,
+    senders: SenderTable,
     last_by_kind: HashMap<u32, (&'static str, Duration)>,
     frames_out: u64,
     bytes_out: u64,
@@ -232,18 +272,25 @@ struct LinkCore {
 
 impl LinkCore {
     fn new(config: LinkConfig, now: Duration) -> Self {
-        let mut decoder = FrameDecoder::new(DecoderPolicy {
-            accept_v1: config.accept_v1,
-        });
+        let paths = (0..config.paths.max(1))
+            .map(|_| {
+                let mut decoder = FrameDecoder::new(DecoderPolicy {
+                    accept_v1: config.accept_v1,
+                });
+                if let Some(s) = &config.signing {
+                    decoder.set_verifier(Some(s.build(now).1));
+                }
+                RadioPath::new(decoder)
+            })
+            .collect();
         let mut encoder = FrameEncoder::new(config.system_id, config.component_id);
         if let Some(s) = &config.signing {
-            let (signer, verifier) = s.build(now);
-            encoder.set_signer(Some(signer));
-            decoder.set_verifier(Some(verifier));
+            encoder.set_signer(Some(s.build(now).0));
         }
         let mut core = Self {
             config,
-            decoder,
+            paths,
+            copies: Deduplicator::default(),
             encoder,
             out: VecDeque::new(),
             events: VecDeque::new(),
@@ -265,13 +312,16 @@ impl LinkCore {
     fn set_signing(&mut self, now: Duration, signing: Option<SigningConfig>) {
         match &signing {
             Some(s) => {
-                let (signer, verifier) = s.build(now);
-                self.encoder.set_signer(Some(signer));
-                self.decoder.set_verifier(Some(verifier));
+                self.encoder.set_signer(Some(s.build(now).0));
+                for path in &mut self.paths {
+                    path.decoder.set_verifier(Some(s.build(now).1));
+                }
             }
             None => {
                 self.encoder.set_signer(None);
-                self.decoder.set_verifier(None);
+                for path in &mut self.paths {
+                    path.decoder.set_verifier(None);
+                }
             }
         }
         tracing::info!(on = signing.is_some(), "signing switched");
@@ -302,24 +352,46 @@ impl LinkCore {
         self.check_persist();
     }
 
-    /// Decodes `bytes`, returning the frames for the endpoint to dispatch.
-    fn ingest(&mut self, now: Duration, bytes: &[u8]) -> Vec<Frame> {
-        self.decoder.push(bytes);
-        self.drain_decoder(now)
+    /// Decodes `bytes` received on `path`, returning the frames for the endpoint to
+    /// dispatch.
+    fn ingest(&mut self, path: usize, now: Duration, bytes: &[u8]) -> Vec<Frame> {
+        let Some(p) = self.paths.get_mut(path) else {
+            tracing::warn!(
+                path,
+                paths = self.paths.len(),
+                "bytes on a path that does not exist dropped"
+            );
+            return Vec::new();
+        };
+        p.decoder.push(bytes);
+        self.drain_decoder(path, now)
     }
 
-    /// The connection carrying the byte stream ended: what is buffered can no longer
+    /// The connection carrying `path`'s byte stream ended: what is buffered can no longer
     /// complete. Returns the frames still found behind a cut-off candidate.
-    fn stream_end(&mut self, now: Duration) -> Vec<Frame> {
-        self.decoder.finish();
-        self.drain_decoder(now)
+    fn stream_end(&mut self, path: usize, now: Duration) -> Vec<Frame> {
+        let Some(p) = self.paths.get_mut(path) else {
+            return Vec::new();
+        };
+        p.decoder.finish();
+        self.drain_decoder(path, now)
     }
 
-    fn drain_decoder(&mut self, now: Duration) -> Vec<Frame> {
+    fn drain_decoder(&mut self, path: usize, now: Duration) -> Vec<Frame> {
         let mut frames = Vec::new();
-        while let Some(r) = self.decoder.poll(now) {
+        let several = self.paths.len() > 1;
+        while let Some(p) = self.paths.get_mut(path)
+            && let Some(r) = p.decoder.poll(now)
+        {
             match r {
                 Ok(frame) => {
+                    if several {
+                        p.heard(now, &frame.header);
+                        if self.copies.is_copy(now, &frame.header) {
+                            p.count_duplicate();
+                            continue;
+                        }
+                    }
                     self.account(now, &frame.header, &frame.message);
                     frames.push(frame);
                 }
@@ -340,24 +412,7 @@ impl LinkCore {
         self.prune_arrivals(now);
         self.last_by_kind
             .insert(h.message_id, (msg.message_name(), now));
-        let key = (h.system_id, h.component_id);
-        match self.senders.get_mut(&key) {
-            Some((last_seq, s)) => *last_seq = s.account(*last_seq, h.sequence),
-            None => {
-                self.senders.insert(
-                    key,
-                    (
-                        h.sequence,
-                        SenderStats {
-                            system_id: h.system_id,
-                            component_id: h.component_id,
-                            received: 1,
-                            ..Default::default()
-                        },
-                    ),
-                );
-            }
-        }
+        account_sender(&mut self.senders, h);
     }
 
     fn prune_arrivals(&mut self, now: Duration) {
@@ -420,9 +475,22 @@ impl LinkCore {
         t
     }
 
+    /// The path frames go out on now (see [`crate::paths`]).
+    fn transmit_path(&self, now: Duration) -> usize {
+        if self.paths.len() == 1 {
+            return 0;
+        }
+        transmit_path(&self.paths, now, self.config.link_timeout)
+    }
+
     fn stats(&mut self, now: Duration) -> LinkStats {
         self.prune_arrivals(now);
-        let d = *self.decoder.stats();
+        let d = total_decoder_stats(self.paths.iter().map(|p| p.decoder.stats()));
+        let signing_required = self
+            .paths
+            .first()
+            .is_some_and(|p| p.decoder.signing_required());
+        let duplicates_dropped: u64 = self.paths.iter().map(RadioPath::duplicates).sum();
         let window = self.config.rate_window.as_secs_f64().max(1e-9);
         let mut senders: Vec<SenderStats> = self
             .senders
@@ -443,33 +511,56 @@ impl LinkCore {
         let (lost, received) = senders
             .iter()
             .fold((0, 0), |(l, r), s| (l + s.lost, r + s.received));
+        let packet_loss_pct = if lost + received == 0 {
+            0.0
+        } else {
+            100.0 * lost as f64 / (lost + received) as f64
+        };
+        let signature_failures = signature_failures(&d, signing_required);
+        let messages_per_s = self.arrivals.len() as f64 / window;
+        let paths = if self.paths.len() == 1 {
+            // One radio: its figures are the link's.
+            vec![PathStats {
+                path: 0,
+                transmitting: true,
+                last_heard_age_s: self
+                    .last_by_kind
+                    .values()
+                    .map(|(_, t)| now.saturating_sub(*t).as_secs_f64())
+                    .reduce(f64::min),
+                messages_per_s,
+                frames_in: d.frames_ok,
+                duplicates: 0,
+                bytes_in: d.bytes_in,
+                crc_errors: d.crc_errors,
+                signature_failures,
+                packet_loss_pct,
+            }]
+        } else {
+            let transmitting = self.transmit_path(now);
+            let window = self.config.rate_window;
+            self.paths
+                .iter_mut()
+                .enumerate()
+                .map(|(i, p)| p.stats(i, now, window, i == transmitting))
+                .collect()
+        };
         LinkStats {
             connected: self.connected,
             last_heartbeat_age_s: self
                 .last_peer_heartbeat
                 .map(|t| now.saturating_sub(t).as_secs_f64()),
-            messages_per_s: self.arrivals.len() as f64 / window,
-            frames_in: d.frames_ok,
+            messages_per_s,
+            frames_in: d.frames_ok - duplicates_dropped,
             frames_out: self.frames_out,
             bytes_in: d.bytes_in,
             bytes_out: self.bytes_out,
             crc_errors: d.crc_errors,
             parse_errors: d.parse_errors,
             unknown_message_ids: d.unknown_message_ids,
-            signature_failures: d.bad_signatures
-                + d.replays_refused
-                + d.unsigned_refused
-                + if self.decoder.signing_required() {
-                    d.v1_refused
-                } else {
-                    0
-                },
+            signature_failures,
             bytes_discarded: d.bytes_discarded,
-            packet_loss_pct: if lost + received == 0 {
-                0.0
-            } else {
-                100.0 * lost as f64 / (lost + received) as f64
-            },
+            packet_loss_pct,
             senders,
             last_message_age_s: self
                 .last_by_kind
@@ -477,6 +568,8 @@ impl LinkCore {
                 .map(|(name, t)| ((*name).to_string(), now.saturating_sub(*t).as_secs_f64()))
                 .collect(),
             decoder: d,
+            duplicates_dropped,
+            paths,
         }
     }
 }
@@ -565,9 +658,14 @@ impl GroundEndpoint {
         }
     }
 
-    /// Feeds bytes received from the transport.
+    /// Feeds bytes received from the transport (the primary one, with several radios).
     pub fn handle_bytes(&mut self, now: Duration, bytes: &[u8]) {
-        for frame in self.core.ingest(now, bytes) {
+        self.handle_bytes_on(0, now, bytes);
+    }
+
+    /// Feeds bytes received on radio `path` ([`LinkConfig::paths`]).
+    pub fn handle_bytes_on(&mut self, path: usize, now: Duration, bytes: &[u8]) {
+        for frame in self.core.ingest(path, now, bytes) {
             self.dispatch(now, frame);
         }
     }
@@ -575,9 +673,19 @@ impl GroundEndpoint {
     /// The stream connection (TCP, serial) ended: a frame cut off by it is counted as
     /// truncated and any frame behind it still delivered.
     pub fn handle_stream_end(&mut self, now: Duration) {
-        for frame in self.core.stream_end(now) {
+        self.handle_stream_end_on(0, now);
+    }
+
+    /// [`handle_stream_end`](Self::handle_stream_end) for radio `path`.
+    pub fn handle_stream_end_on(&mut self, path: usize, now: Duration) {
+        for frame in self.core.stream_end(path, now) {
             self.dispatch(now, frame);
         }
+    }
+
+    /// The radio that frames from [`poll_transmit`](Self::poll_transmit) go out on now.
+    pub fn transmit_path(&self, now: Duration) -> usize {
+        self.core.transmit_path(now)
     }
 
     /// The signing timestamp high-water mark in force, to be persisted before frames signed
@@ -880,8 +988,46 @@ impl VehicleEndpoint {
         bytes: &[u8],
         validator: &mut impl ParamValidator,
     ) {
-        let frames = self.core.ingest(now, bytes);
+        self.handle_bytes_on_with(0, now, bytes, validator);
+    }
+
+    /// [`handle_bytes_with`](Self::handle_bytes_with) for radio `path`
+    /// ([`LinkConfig::paths`]).
+    pub fn handle_bytes_on_with(
+        &mut self,
+        path: usize,
+        now: Duration,
+        bytes: &[u8],
+        validator: &mut impl ParamValidator,
+    ) {
+        let frames = self.core.ingest(path, now, bytes);
         self.dispatch(now, frames, validator);
+    }
+
+    /// [`handle_bytes`](Self::handle_bytes) for radio `path`.
+    pub fn handle_bytes_on(&mut self, path: usize, now: Duration, bytes: &[u8]) {
+        self.handle_bytes_on_with(path, now, bytes, &mut RangeOnly);
+    }
+
+    /// [`handle_stream_end`](Self::handle_stream_end) for radio `path`.
+    pub fn handle_stream_end_on(&mut self, path: usize, now: Duration) {
+        self.handle_stream_end_on_with(path, now, &mut RangeOnly);
+    }
+
+    /// [`handle_stream_end_with`](Self::handle_stream_end_with) for radio `path`.
+    pub fn handle_stream_end_on_with(
+        &mut self,
+        path: usize,
+        now: Duration,
+        validator: &mut impl ParamValidator,
+    ) {
+        let frames = self.core.stream_end(path, now);
+        self.dispatch(now, frames, validator);
+    }
+
+    /// The radio that frames from [`poll_transmit`](Self::poll_transmit) go out on now.
+    pub fn transmit_path(&self, now: Duration) -> usize {
+        self.core.transmit_path(now)
     }
 
     /// The stream connection (TCP, serial) ended: a frame cut off by it is counted as
@@ -892,8 +1038,7 @@ impl VehicleEndpoint {
 
     /// [`handle_stream_end`](Self::handle_stream_end) with the application's parameter rules.
     pub fn handle_stream_end_with(&mut self, now: Duration, validator: &mut impl ParamValidator) {
-        let frames = self.core.stream_end(now);
-        self.dispatch(now, frames, validator);
+        self.handle_stream_end_on_with(0, now, validator);
     }
 
     /// The signing timestamp high-water mark in force, to be persisted before frames signed

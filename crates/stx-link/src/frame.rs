@@ -73,6 +73,9 @@ pub struct FrameHeader {
     pub payload_len: u8,
     /// Signature block, for signed frames (verified only when signing is on).
     pub signature: Option<SignatureBlock>,
+    /// The frame's CRC as received (checked): with the sender and sequence it tells a second
+    /// copy of a frame, heard over another radio, from a new frame.
+    pub checksum: u16,
 }
 
 impl FrameHeader {
@@ -436,6 +439,7 @@ impl FrameDecoder {
                     message_id,
                     payload_len,
                     signature,
+                    checksum: received,
                 };
                 Step::Frame(Frame { header, message }, total)
             }
@@ -499,6 +503,7 @@ impl FrameDecoder {
                     message_id,
                     payload_len: len,
                     signature: None,
+                    checksum: received,
                 };
                 Step::Frame(Frame { header, message }, crc_end)
             }

@@ -33,6 +33,7 @@
 //! - [`plan`]: upload / download of the landing target and localizer points (mission protocol).
 //! - [`manual`]: joystick streaming and stick staleness.
 //! - [`endpoint`]: the two ends composing all of the above, with [`endpoint::LinkStats`].
+//! - [`paths`]: one link over several radios: copies dropped, sends on the radio that works.
 //! - [`transport`]: tokio adapters and [`transport::drive`], which runs an endpoint over an
 //!   address string such as `udpin:0.0.0.0:14550`.
 //!
@@ -49,6 +50,7 @@ pub mod endpoint;
 pub mod frame;
 pub mod manual;
 pub mod param;
+pub mod paths;
 pub mod plan;
 pub mod signing;
 pub mod telemetry;

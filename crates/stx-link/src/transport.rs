@@ -16,6 +16,7 @@
 //!   [`IoEvent`]) rate-limited, because a link without a peer fails every frame — the first
 //!   failure at once, then one report with the count per [`IO_ERROR_REPORT_INTERVAL`] while
 //!   failures go on.
+//! - [`drive_paths`] does the same over several radios to one peer (see [`crate::paths`]).
 //! - With signing on, [`drive`] writes the signing timestamp's high-water mark to the
 //!   [`DriveOptions::signing_timestamp_file`] whenever it moves, before the frames signed under
 //!   it are sent, so a restart (even with the wall clock set back) continues above every
@@ -717,8 +718,8 @@ impl Transport {
 pub trait SansIo: Send + 'static {
     /// The endpoint's event type.
     type Event: Send + 'static;
-    /// Feeds received bytes.
-    fn handle_bytes(&mut self, now: Duration, bytes: &[u8]);
+    /// Feeds bytes received on radio `path` (0 with one transport).
+    fn handle_bytes_on(&mut self, path: usize, now: Duration, bytes: &[u8]);
     /// Runs timers.
     fn handle_timeout(&mut self, now: Duration);
     /// Next timer.
@@ -727,8 +728,11 @@ pub trait SansIo: Send + 'static {
     fn poll_transmit(&mut self, now: Duration) -> Option<Vec<u8>>;
     /// Next event.
     fn poll_event(&mut self) -> Option<Self::Event>;
-    /// The stream connection ended (TCP, serial): flush what can no longer complete.
-    fn handle_stream_end(&mut self, now: Duration);
+    /// The stream connection of radio `path` ended (TCP, serial): flush what can no longer
+    /// complete.
+    fn handle_stream_end_on(&mut self, path: usize, now: Duration);
+    /// The radio that frames from [`poll_transmit`](Self::poll_transmit) go out on now.
+    fn transmit_path(&self, now: Duration) -> usize;
     /// The signing timestamp high-water mark in force (`None`: signing off); [`drive`]
     /// persists it whenever it moves, before sending frames signed under it.
     fn signing_timestamp_mark(&self) -> Option<u64>;
@@ -738,8 +742,8 @@ macro_rules! impl_sans_io {
     ($ty:ty, $ev:ty) => {
         impl SansIo for $ty {
             type Event = $ev;
-            fn handle_bytes(&mut self, now: Duration, bytes: &[u8]) {
-                <$ty>::handle_bytes(self, now, bytes)
+            fn handle_bytes_on(&mut self, path: usize, now: Duration, bytes: &[u8]) {
+                <$ty>::handle_bytes_on(self, path, now, bytes)
             }
             fn handle_timeout(&mut self, now: Duration) {
                 <$ty>::handle_timeout(self, now)
@@ -753,8 +757,11 @@ macro_rules! impl_sans_io {
             fn poll_event(&mut self) -> Option<$ev> {
                 <$ty>::poll_event(self)
             }
-            fn handle_stream_end(&mut self, now: Duration) {
-                <$ty>::handle_stream_end(self, now)
+            fn handle_stream_end_on(&mut self, path: usize, now: Duration) {
+                <$ty>::handle_stream_end_on(self, path, now)
+            }
+            fn transmit_path(&self, now: Duration) -> usize {
+                <$ty>::transmit_path(self, now)
             }
             fn signing_timestamp_mark(&self) -> Option<u64> {
                 <$ty>::signing_timestamp_mark(self)
@@ -771,8 +778,8 @@ impl_sans_io!(VehicleEndpoint, VehicleEvent);
 pub enum DriverEvent<E> {
     /// An endpoint event.
     Endpoint(E),
-    /// A transport event.
-    Io(IoEvent),
+    /// A transport event, on radio `path` (0 with one transport).
+    Io { path: usize, event: IoEvent },
 }
 
 /// An action the application runs on the driven endpoint, given `now`.
@@ -849,14 +856,30 @@ pub fn store_signing_timestamp(path: &Path, value: u64) -> io::Result<()> {
 /// transport's counters. Endpoint and I/O events go to `events` (if the receiver is gone they
 /// are dropped, and the driver stops).
 pub async fn drive<E: SansIo>(
-    mut transport: Transport,
+    transport: Transport,
+    endpoint: E,
+    actions: mpsc::Receiver<Action<E>>,
+    events: mpsc::Sender<DriverEvent<E::Event>>,
+    options: DriveOptions,
+) -> (E, IoStats) {
+    let (endpoint, mut stats) =
+        drive_paths(vec![transport], endpoint, actions, events, options).await;
+    (endpoint, stats.pop().unwrap_or_default())
+}
+
+/// [`drive`] over several radios to the same peer: `transports[i]` is the endpoint's path
+/// `i` (see [`crate::paths`]); bytes from each go to its path, and what the endpoint sends
+/// goes out on its [`transmit_path`](SansIo::transmit_path). Returns each transport's
+/// counters, in order.
+pub async fn drive_paths<E: SansIo>(
+    mut transports: Vec<Transport>,
     mut endpoint: E,
     mut actions: mpsc::Receiver<Action<E>>,
     events: mpsc::Sender<DriverEvent<E::Event>>,
     options: DriveOptions,
-) -> (E, IoStats) {
+) -> (E, Vec<IoStats>) {
     let start = Instant::now();
-    let mut buf = vec![0_u8; 65_536];
+    let mut bufs = vec![vec![0_u8; 65_536]; transports.len()];
     let mut open = true;
     // The last mark written, or the last one that failed (not retried: it is reported once,
     // and the mark moves on within seconds).
@@ -879,24 +902,35 @@ pub async fn drive<E: SansIo>(
                 // The link matters more than the guarantee: send anyway, and say so.
                 Err(err) => {
                     tracing::error!(path = %path.display(), error = %err, "cannot persist signing timestamp");
-                    transport.events.push_back(IoEvent::PersistFailed {
-                        path: path.to_path_buf(),
-                        error: err.to_string(),
-                    });
+                    if let Some(t) = transports.first_mut() {
+                        t.events.push_back(IoEvent::PersistFailed {
+                            path: path.to_path_buf(),
+                            error: err.to_string(),
+                        });
+                    }
                 }
             }
         }
-        for frame in frames.drain(..) {
-            transport.send(&frame).await;
+        if !frames.is_empty() {
+            let out = endpoint
+                .transmit_path(now)
+                .min(transports.len().saturating_sub(1));
+            if let Some(transport) = transports.get_mut(out) {
+                for frame in frames.drain(..) {
+                    transport.send(&frame).await;
+                }
+            }
         }
         while let Some(e) = endpoint.poll_event() {
             if events.send(DriverEvent::Endpoint(e)).await.is_err() {
                 open = false;
             }
         }
-        while let Some(e) = transport.poll_event() {
-            if events.send(DriverEvent::Io(e)).await.is_err() {
-                open = false;
+        for (path, transport) in transports.iter_mut().enumerate() {
+            while let Some(event) = transport.poll_event() {
+                if events.send(DriverEvent::Io { path, event }).await.is_err() {
+                    open = false;
+                }
             }
         }
         if !open {
@@ -907,12 +941,13 @@ pub async fn drive<E: SansIo>(
             .map(|t| start + t)
             .unwrap_or_else(|| Instant::now() + Duration::from_secs(1));
         tokio::select! {
-            n = transport.recv(&mut buf) => {
+            (path, n) = recv_any(&mut transports, &mut bufs) => {
                 if n > 0 {
-                    endpoint.handle_bytes(start.elapsed(), buf.get(..n).unwrap_or(&[]));
+                    let bytes = bufs.get(path).and_then(|b| b.get(..n)).unwrap_or(&[]);
+                    endpoint.handle_bytes_on(path, start.elapsed(), bytes);
                 }
-                if transport.take_stream_ended() {
-                    endpoint.handle_stream_end(start.elapsed());
+                if transports.get_mut(path).is_some_and(Transport::take_stream_ended) {
+                    endpoint.handle_stream_end_on(path, start.elapsed());
                 }
             }
             action = actions.recv() => match action {
@@ -922,7 +957,25 @@ pub async fn drive<E: SansIo>(
             _ = tokio::time::sleep_until(deadline) => {}
         }
     }
-    (endpoint, transport.stats())
+    let stats = transports.iter().map(Transport::stats).collect();
+    (endpoint, stats)
+}
+
+/// Waits for bytes on any transport: `(which, how many)` (see [`Transport::recv`]).
+/// Cancel-safe, as each transport's `recv` is.
+async fn recv_any(transports: &mut [Transport], bufs: &mut [Vec<u8>]) -> (usize, usize) {
+    match (transports, bufs) {
+        ([], _) | (_, []) => std::future::pending().await,
+        ([only], [buf, ..]) => (0, only.recv(buf).await),
+        (transports, bufs) => {
+            let receivers = transports
+                .iter_mut()
+                .zip(bufs.iter_mut())
+                .enumerate()
+                .map(|(i, (t, buf))| Box::pin(async move { (i, t.recv(buf).await) }));
+            futures_util::future::select_all(receivers).await.0
+        }
+    }
 }
 
 /// Opens `address` and drives `endpoint` over it (see [`drive`]).

@@ -795,3 +795,96 @@ fn long_status_text_arrives_whole() {
     );
     let _ = HEARTBEAT;
 }
+
+#[test]
+fn two_radios_deliver_each_signed_frame_once_and_refuse_a_replay_on_either() {
+    use stx_link::endpoint::VehicleEndpoint;
+    let mut vehicle = VehicleEndpoint::new(
+        VehicleConfig {
+            link: LinkConfig::vehicle().with_signing(Some(signing(7, 2, JAN_2026))),
+            ..Default::default()
+        },
+        Duration::ZERO,
+    )
+    .expect("vehicle");
+    let mut ground = GroundEndpoint::new(
+        GroundConfig {
+            link: LinkConfig::ground()
+                .with_signing(Some(signing(7, 1, JAN_2026)))
+                .with_paths(2),
+            ..Default::default()
+        },
+        Duration::ZERO,
+    );
+    let mut frames = Vec::new();
+    for i in 0..10_u32 {
+        let now = secs(0.1 * f64::from(i));
+        vehicle.send_telemetry(
+            now,
+            &Telemetry::Attitude(Attitude {
+                time_boot_ms: i * 100,
+                roll_rad: 0.0,
+                pitch_rad: 0.0,
+                yaw_rad: 0.0,
+                roll_rate_radps: 0.0,
+                pitch_rate_radps: 0.0,
+                yaw_rate_radps: 0.0,
+            }),
+        );
+        while let Some(f) = vehicle.poll_transmit(now) {
+            frames.push((now, f));
+        }
+    }
+    // Radio 2 delivers each frame 50 ms after radio 1; radio 1 misses the fourth frame.
+    for (i, (t, f)) in frames.iter().enumerate() {
+        if i != 3 {
+            ground.handle_bytes_on(0, *t, f);
+        }
+        ground.handle_bytes_on(1, *t + secs(0.05), f);
+    }
+    let attitudes = std::iter::from_fn(|| ground.poll_event())
+        .filter(|e| {
+            matches!(
+                e,
+                GroundEvent::Telemetry {
+                    telemetry: Telemetry::Attitude(_),
+                    ..
+                }
+            )
+        })
+        .count();
+    assert_eq!(
+        attitudes, 10,
+        "each attitude once, the one radio 1 missed from radio 2"
+    );
+    let now = secs(1.5);
+    let s = ground.link_stats(now);
+    assert_eq!(s.signature_failures, 0, "a copy is not a replay: {s:?}");
+    assert_eq!(s.duplicates_dropped, frames.len() as u64 - 1, "{s:?}");
+    assert_eq!(s.packet_loss_pct, 0.0, "nothing lost on the merged link");
+    assert!(
+        s.paths[0].packet_loss_pct > 0.0,
+        "radio 1 lost a frame: {s:?}"
+    );
+    assert_eq!(s.paths[1].packet_loss_pct, 0.0);
+    // A captured frame played again later is refused on either radio.
+    let (_, old) = &frames[5];
+    ground.handle_bytes_on(0, secs(4.0), old);
+    ground.handle_bytes_on(1, secs(4.0), old);
+    let s = ground.link_stats(secs(4.0));
+    assert_eq!(s.decoder.replays_refused, 2, "{s:?}");
+    assert!(
+        std::iter::from_fn(|| ground.poll_event())
+            .all(|e| !matches!(e, GroundEvent::Telemetry { .. }))
+    );
+}
+
+#[test]
+fn bytes_for_a_radio_that_does_not_exist_are_dropped_without_harm() {
+    let mut ground = GroundEndpoint::new(GroundConfig::default(), Duration::ZERO);
+    ground.handle_bytes_on(3, Duration::ZERO, &[0xFD, 9, 0, 0, 0, 1, 1, 0, 0, 0]);
+    ground.handle_stream_end_on(3, Duration::ZERO);
+    let s = ground.link_stats(Duration::ZERO);
+    assert_eq!((s.frames_in, s.decoder.bytes_in), (0, 0));
+    assert_eq!(ground.transmit_path(Duration::ZERO), 0);
+}

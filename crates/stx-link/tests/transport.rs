@@ -129,7 +129,13 @@ async fn udp_in_and_out_carry_a_command_and_its_ack() {
     let mut g = spawn(g, ground());
     // The ground heartbeats before anyone was heard: queued, not silently dropped.
     wait_for(&mut g.events, |e| {
-        matches!(e, DriverEvent::Io(IoEvent::QueuedWithoutPeer { .. }))
+        matches!(
+            e,
+            DriverEvent::Io {
+                event: IoEvent::QueuedWithoutPeer { .. },
+                ..
+            }
+        )
     })
     .await;
 
@@ -139,7 +145,13 @@ async fn udp_in_and_out_carry_a_command_and_its_ack() {
     let (v_actions, v_app) = vehicle_app(spawn(v, vehicle()));
 
     wait_for(&mut g.events, |e| {
-        matches!(e, DriverEvent::Io(IoEvent::PeerChanged { .. }))
+        matches!(
+            e,
+            DriverEvent::Io {
+                event: IoEvent::PeerChanged { .. },
+                ..
+            }
+        )
     })
     .await;
     g.actions
@@ -219,12 +231,24 @@ async fn tcp_server_reports_client_leaving() {
         .await
         .expect("connect");
     wait_for(&mut vd.events, |e| {
-        matches!(e, DriverEvent::Io(IoEvent::Connected { .. }))
+        matches!(
+            e,
+            DriverEvent::Io {
+                event: IoEvent::Connected { .. },
+                ..
+            }
+        )
     })
     .await;
     drop(client);
     wait_for(&mut vd.events, |e| {
-        matches!(e, DriverEvent::Io(IoEvent::Disconnected { .. }))
+        matches!(
+            e,
+            DriverEvent::Io {
+                event: IoEvent::Disconnected { .. },
+                ..
+            }
+        )
     })
     .await;
     drop(vd.actions);
@@ -246,7 +270,13 @@ async fn udpin_without_peer_queues_every_send_and_counts_it() {
     assert_eq!(io.tx_bytes, 0);
     let mut queued = 0;
     while let Ok(e) = g.events.try_recv() {
-        if matches!(e, DriverEvent::Io(IoEvent::QueuedWithoutPeer { .. })) {
+        if matches!(
+            e,
+            DriverEvent::Io {
+                event: IoEvent::QueuedWithoutPeer { .. },
+                ..
+            }
+        ) {
             queued += 1;
         }
     }
@@ -439,7 +469,13 @@ async fn a_frame_cut_off_by_a_dropped_tcp_connection_is_counted_as_truncated() {
         .await
         .expect("connect");
     wait_for(&mut v.events, |e| {
-        matches!(e, DriverEvent::Io(IoEvent::Connected { .. }))
+        matches!(
+            e,
+            DriverEvent::Io {
+                event: IoEvent::Connected { .. },
+                ..
+            }
+        )
     })
     .await;
     // A whole frame and half of a second one, then the connection drops.
@@ -454,7 +490,13 @@ async fn a_frame_cut_off_by_a_dropped_tcp_connection_is_counted_as_truncated() {
     client.write_all(&bytes).await.expect("write");
     drop(client);
     wait_for(&mut v.events, |e| {
-        matches!(e, DriverEvent::Io(IoEvent::Disconnected { .. }))
+        matches!(
+            e,
+            DriverEvent::Io {
+                event: IoEvent::Disconnected { .. },
+                ..
+            }
+        )
     })
     .await;
     drop(v.actions);

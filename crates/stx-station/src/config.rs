@@ -58,8 +58,14 @@ pub struct TokenConfig {
 #[serde(deny_unknown_fields)]
 pub struct LinkSettings {
     /// stx-link address: `udpin:IP:PORT`, `udpout:…`, `tcp:HOST:PORT`, `tcpin:…`,
-    /// `serial:PATH:BAUD`.
+    /// `serial:PATH:BAUD`. With more radios (`more_addresses`), the primary.
     pub address: String,
+    /// Further radios to the same drone (a backup radio), in order of preference, in the
+    /// form of `address`. Telemetry is taken from every radio, a frame heard twice once;
+    /// commands go out on the first radio (the primary first) heard within the link timeout
+    /// (3.5 s). Each radio's rate, loss and age are shown beside the link's.
+    #[serde(default)]
+    pub more_addresses: Vec<String>,
     /// MAVLink 2 signing key written here, 64 hexadecimal characters (32 bytes). It is then
     /// as secret as this file (mode 0600); prefer `signing_key_file` or the environment
     /// variable `STX_SIGNING_KEY`. At most one of the three; none: signing off. Never shown:
@@ -101,6 +107,11 @@ pub struct TlsSettings {
 pub const SIGNING_TIMESTAMP_FILE_NAME: &str = "signing.timestamp";
 
 impl LinkSettings {
+    /// Every radio's address, the primary first.
+    pub fn addresses(&self) -> impl Iterator<Item = &String> {
+        std::iter::once(&self.address).chain(&self.more_addresses)
+    }
+
     /// Whether MAVLink 2 signing is on (a key is configured).
     pub fn signing_on(&self) -> bool {
         self.signing_key_hex.is_some() || self.signing_key_file.is_some()
@@ -264,6 +275,20 @@ impl StationConfig {
         if let Err(e) = self.link.address.parse::<stx_link::transport::Address>() {
             return invalid("link.address", &e.to_string());
         }
+        for (i, more) in self.link.more_addresses.iter().enumerate() {
+            use stx_link::transport::Address;
+            let field = format!("link.more_addresses[{i}]");
+            let parsed = match more.parse::<Address>() {
+                Ok(a) => a,
+                Err(e) => return invalid(&field, &e.to_string()),
+            };
+            // Port 0 asks for a fresh port each time: the same text is another socket.
+            let fresh_port =
+                matches!(parsed, Address::UdpIn(a) | Address::TcpServer(a) if a.port() == 0);
+            if !fresh_port && self.link.addresses().position(|a| a == more) != Some(i + 1) {
+                return invalid(&field, "is already one of the link's addresses");
+            }
+        }
         if self.link.signing_key_hex.is_some() && self.link.signing_key_file.is_some() {
             return invalid(
                 "link.signing_key_file",
@@ -335,6 +360,34 @@ mod tests {
         let c = StationConfig::from_toml_str(DEFAULT_STATION_TOML).expect("valid");
         assert!(c.tokens.iter().any(|t| t.role == Role::Operator));
         assert!(c.tokens.iter().any(|t| t.role == Role::Viewer));
+    }
+
+    #[test]
+    fn a_second_radio_is_taken_and_a_bad_or_repeated_one_is_named() {
+        let with = |more: &str| {
+            DEFAULT_STATION_TOML.replacen(
+                "[link]\n",
+                &format!("[link]\nmore_addresses = [{more}]\n"),
+                1,
+            )
+        };
+        let c = StationConfig::from_toml_str(&with("\"udpin:127.0.0.1:14551\""))
+            .expect("a backup radio");
+        assert_eq!(
+            c.link.addresses().collect::<Vec<_>>(),
+            ["udpin:127.0.0.1:14550", "udpin:127.0.0.1:14551"]
+        );
+        let err = StationConfig::from_toml_str(&with("\"udpin:127.0.0.1:14551\", \"radio\""))
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("link.more_addresses[1]"), "{err}");
+        let err = StationConfig::from_toml_str(&with("\"udpin:127.0.0.1:14550\""))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("link.more_addresses[0]") && err.contains("already"),
+            "{err}"
+        );
     }
 
     #[test]

@@ -11,7 +11,7 @@ use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
 use axum::extract::ws::Utf8Bytes;
 use stx_link::endpoint::{GroundConfig, GroundEndpoint, GroundEvent, LinkEvent};
 use stx_link::signing::SigningConfig;
-use stx_link::transport::{Action, DriveOptions, DriverEvent, Transport, drive};
+use stx_link::transport::{Action, DriveOptions, DriverEvent, Transport, drive_paths};
 use thiserror::Error;
 use tokio::sync::{broadcast, mpsc, watch};
 
@@ -192,8 +192,10 @@ pub struct Running {
     /// `https` with `[tls]`, else `http`.
     pub scheme: &'static str,
     /// The drone link's local socket address, for UDP and TCP servers (the port the drone
-    /// must send to when the config asked for port 0).
+    /// must send to when the config asked for port 0). With several radios, the primary's.
     pub link_local: Option<SocketAddr>,
+    /// Each radio's local socket address, the primary first.
+    pub link_locals: Vec<Option<SocketAddr>>,
     /// The shared state.
     pub shared: Arc<Shared>,
 }
@@ -238,20 +240,33 @@ pub async fn run(
             address: config.listen,
             source,
         })?;
-    let transport = Transport::open_str(&config.link.address)
-        .await
-        .map_err(|source| DaemonError::Link {
-            address: config.link.address.clone(),
-            source,
-        })?;
-    let link_local = transport.local_addr();
+    let mut transports = Vec::new();
+    for address in config.link.addresses() {
+        let transport = Transport::open_str(address)
+            .await
+            .map_err(|source| DaemonError::Link {
+                address: address.clone(),
+                source,
+            })?;
+        transports.push(transport);
+    }
+    let link_locals: Vec<_> = transports.iter().map(Transport::local_addr).collect();
     // For `udpin:…:0` / `tcpin:…:0`: the port the drone must be pointed at.
-    let link_shown = transport
-        .listening_address()
-        .map_or_else(|| config.link.address.clone(), |a| a.to_string());
+    let link_shown = transports
+        .iter()
+        .zip(config.link.addresses())
+        .map(|(t, a)| {
+            t.listening_address()
+                .map_or_else(|| a.clone(), |l| l.to_string())
+        })
+        .collect::<Vec<_>>()
+        .join(" + ");
     let start = Instant::now();
     let mut ground = GroundConfig::default();
-    ground.link = ground.link.with_signing(signing(&config)?);
+    ground.link = ground
+        .link
+        .with_signing(signing(&config)?)
+        .with_paths(transports.len());
     let endpoint = GroundEndpoint::new(ground, Duration::ZERO);
     // The first high-water mark is on disk before anything is signed, or the station does not
     // start.
@@ -266,7 +281,9 @@ pub async fn run(
         signing_timestamp_file: config.link.signing_timestamp_file.clone(),
     };
     let (stop_tx, stop_rx) = watch::channel(false);
-    let link_task = tokio::spawn(drive(transport, endpoint, actions_rx, events_tx, options));
+    let link_task = tokio::spawn(drive_paths(
+        transports, endpoint, actions_rx, events_tx, options,
+    ));
 
     let wall_origin_ms = SystemTime::now()
         .duration_since(UNIX_EPOCH)
@@ -328,7 +345,8 @@ pub async fn run(
     started(Running {
         http: http_address,
         scheme: if tls.is_some() { "https" } else { "http" },
-        link_local,
+        link_local: link_locals.first().copied().flatten(),
+        link_locals,
         shared: shared.clone(),
     });
     tracing::info!(address = %http_address, link = %link_shown, "station listening");
@@ -526,8 +544,8 @@ async fn handle_driver_event(
             }
             telemetry
         }
-        DriverEvent::Io(io) => {
-            lock(shared).on_io_event(now, io);
+        DriverEvent::Io { path, event } => {
+            lock(shared).on_io_event(now, path, event);
             false
         }
     }

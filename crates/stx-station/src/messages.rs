@@ -67,6 +67,27 @@ pub struct LinkView {
     pub signature_errors: u64,
     /// Age of the last message of each kind, s.
     pub ages_s: BTreeMap<String, f64>,
+    /// Each radio of the link (`link.address`, then `link.more_addresses`).
+    pub radios: Vec<RadioView>,
+}
+
+/// One radio of the drone link.
+#[derive(Debug, Clone, Serialize)]
+pub struct RadioView {
+    /// Its address in the config.
+    pub address: String,
+    /// Commands go out on it now.
+    pub transmitting: bool,
+    /// Nothing heard on it for the stale time.
+    pub stale: bool,
+    /// Seconds since it last carried a frame.
+    pub age_s: Option<f64>,
+    /// Frames per second it carries (copies of the other radio's included).
+    pub rate_hz: f64,
+    /// Its own packet loss from sequence numbers, %.
+    pub loss_percent: f64,
+    /// Frames it carried that the other radio had already delivered.
+    pub duplicates: u64,
 }
 
 /// GPS as the drone's receiver reports it.

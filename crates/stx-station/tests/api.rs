@@ -141,11 +141,7 @@ async fn a_mode_command_reaches_the_drone_and_its_result_comes_back() {
         .as_str()
         .expect("request id")
         .to_string();
-    let result = ws_until(&mut ws, 5.0, |m| {
-        m["type"] == "command_result" && m["request_id"] == id.as_str()
-    })
-    .await
-    .expect("command_result on the WebSocket");
+    let result = command_result(&mut ws, &id).await;
     assert_eq!(result["outcome"], "accepted", "{result}");
     assert!(drone.seen(|s| {
         s.commands
@@ -168,20 +164,7 @@ async fn a_mode_command_reaches_the_drone_and_its_result_comes_back() {
     .await;
     assert!(state.is_some(), "the state shows the drone's new mode");
     // The event log names who asked.
-    let (_, events) = http(
-        station.http(),
-        "GET",
-        "/api/events?since_s=0",
-        Some(VIEWER),
-        None,
-    )
-    .await;
-    let texts: Vec<String> = events["events"]
-        .as_array()
-        .expect("events")
-        .iter()
-        .map(|e| e["text"].as_str().unwrap_or_default().to_string())
-        .collect();
+    let texts = event_texts(station.http()).await;
     assert!(
         texts
             .iter()

@@ -661,12 +661,14 @@ fn log_event(event: DriverEvent<DroneEvent>) {
         DriverEvent::Endpoint(DroneEvent::PersistSigningTimestamp(_)) => {}
         // The transport logs these itself, rate-limited, and counts every one (the report's
         // `io`): logging each again flooded stderr while no station listened.
-        DriverEvent::Io(
-            IoEvent::RecvError { .. }
-            | IoEvent::SendError { .. }
-            | IoEvent::QueuedWithoutPeer { .. },
-        ) => {}
-        DriverEvent::Io(e) => tracing::info!(event = ?e, "link"),
+        DriverEvent::Io {
+            event:
+                IoEvent::RecvError { .. }
+                | IoEvent::SendError { .. }
+                | IoEvent::QueuedWithoutPeer { .. },
+            ..
+        } => {}
+        DriverEvent::Io { event, .. } => tracing::info!(?event, "link"),
     }
 }
 

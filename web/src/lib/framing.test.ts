@@ -10,7 +10,7 @@ function state(stage: string, extra: Partial<State> = {}): State {
   const v = at(-600, -500);
   return {
     type: "state", time_s: 10, wall_ms: null,
-    link: { connected: true, stale: false, age_s: 0.1, rate_hz: 30, loss_percent: 0, crc_errors: 0, parse_errors: 0, signature_errors: 0, ages_s: {} },
+    link: { connected: true, stale: false, age_s: 0.1, rate_hz: 30, loss_percent: 0, crc_errors: 0, parse_errors: 0, signature_errors: 0, ages_s: {}, radios: [] },
     vehicle: null,
     estimate: { lat_deg: v.lat_deg, lon_deg: v.lon_deg, alt_msl_m: 900, height_m: 655, velocity_ned_mps: null, ground_speed_mps: null, course_deg: null, heading_deg: null, heading_rate_dps: null, airspeed_mps: null, sink_rate_mps: null, glide_ratio_air: null, glide_ratio_ground: null, wind_ned_mps: null, wind_speed_mps: null, wind_from_deg: null, wind_sigma_mps: null, position_sigma_m: null, gps_ok: true },
     guidance: {

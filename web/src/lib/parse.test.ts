@@ -5,7 +5,8 @@ import { decodeMessage, MessageStats, parseSession } from "./parse";
 const STATE = {
   type: "state", time_s: 123.25, wall_ms: 1700000000000,
   link: { connected: true, stale: false, age_s: 0.21, rate_hz: 31.5, loss_percent: 0.4, crc_errors: 0, parse_errors: 0, signature_errors: 0,
-    ages_s: { HEARTBEAT: 0.4, GPS_RAW_INT: 0.2, ATTITUDE: 0.2, SCALED_PRESSURE: 0.2, SERVO_OUTPUT_RAW: 0.2, WIND_COV: 0.2 } },
+    ages_s: { HEARTBEAT: 0.4, GPS_RAW_INT: 0.2, ATTITUDE: 0.2, SCALED_PRESSURE: 0.2, SERVO_OUTPUT_RAW: 0.2, WIND_COV: 0.2 },
+    radios: [{ address: "udpin:127.0.0.1:14550", transmitting: true, stale: false, age_s: 0.2, rate_hz: 31.5, loss_percent: 0.4, duplicates: 0 }] },
   vehicle: {
     mode: "spiral_landing", stage: "parafoil", phase: "branch2",
     gps: { fix: "3d", satellites: 11, lat_deg: 38.53, lon_deg: -7.88, alt_msl_m: 812.4, velocity_ned_mps: [5.1, -1.2, 2.9], h_acc_m: 1.5 },
@@ -45,6 +46,14 @@ describe("decodeMessage: the API.md example", () => {
     // Forecast sorted by altitude for interpolation.
     expect(s.forecast_wind.map((f) => f.alt_msl_m)).toEqual([300, 1000]);
     expect(s.mission.cutdown_armed_until_s).toBeNull();
+  });
+  it("reads each radio and drops entries that are not objects", () => {
+    const radios = [STATE.link.radios[0], 7, { address: "serial:/dev/ttyUSB1:57600", transmitting: false, stale: true, age_s: null, rate_hz: "x", duplicates: 12 }];
+    const d = decodeMessage(j({ ...STATE, link: { ...STATE.link, radios } }));
+    if (!d.ok || d.msg.type !== "state") throw new Error("not a state");
+    expect(d.msg.link.radios).toHaveLength(2);
+    expect(d.msg.link.radios[0]).toMatchObject({ transmitting: true, rate_hz: 31.5 });
+    expect(d.msg.link.radios[1]).toMatchObject({ address: "serial:/dev/ttyUSB1:57600", stale: true, rate_hz: null, duplicates: 12 });
   });
   it("accepts null blocks before the first data", () => {
     const d = decodeMessage(j({ ...STATE, vehicle: null, estimate: null, guidance: null, prediction: null }));

@@ -16,6 +16,7 @@ import type {
   LatLon,
   Level,
   Link,
+  Radio,
   Mission,
   N,
   Outcome,
@@ -109,7 +110,7 @@ function parseLink(o: Obj | null): Link {
   if (o === null) {
     return {
       connected: false, stale: true, age_s: null, rate_hz: null, loss_percent: null,
-      crc_errors: null, parse_errors: null, signature_errors: null, ages_s: {},
+      crc_errors: null, parse_errors: null, signature_errors: null, ages_s: {}, radios: [],
     };
   }
   const ages: Record<string, number> = {};
@@ -127,8 +128,19 @@ function parseLink(o: Obj | null): Link {
     parse_errors: num(o, "parse_errors"),
     signature_errors: num(o, "signature_errors"),
     ages_s: ages,
+    radios: Array.isArray(o.radios) ? o.radios.filter(isObj).map(parseRadio) : [],
   };
 }
+
+const parseRadio = (o: Obj): Radio => ({
+  address: str(o, "address") ?? "?",
+  transmitting: bool(o, "transmitting") ?? false,
+  stale: bool(o, "stale") ?? true,
+  age_s: num(o, "age_s"),
+  rate_hz: num(o, "rate_hz"),
+  loss_percent: num(o, "loss_percent"),
+  duplicates: num(o, "duplicates"),
+});
 
 const parseGps = (o: Obj): Gps => ({
   fix: str(o, "fix"),

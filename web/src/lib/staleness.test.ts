@@ -4,7 +4,7 @@ import type { Link } from "./types";
 
 const link = (over: Partial<Link> = {}): Link => ({
   connected: true, stale: false, age_s: 0.2, rate_hz: 30, loss_percent: 0.4, crc_errors: 0, parse_errors: 0, signature_errors: 0,
-  ages_s: { HEARTBEAT: 0.4, GPS_RAW_INT: 0.2 }, ...over,
+  ages_s: { HEARTBEAT: 0.4, GPS_RAW_INT: 0.2 }, radios: [], ...over,
 });
 const T = 1_000_000;
 

@@ -37,6 +37,21 @@ export interface Link {
   signature_errors: N;
   /** Age of the last message of each MAVLink type, seconds. */
   ages_s: Record<string, number>;
+  /** Each radio of the link, the primary first. */
+  radios: Radio[];
+}
+
+/** One radio of the drone link (the station may hold a primary and backups). */
+export interface Radio {
+  address: string;
+  /** Commands go out on this radio now. */
+  transmitting: boolean;
+  stale: boolean;
+  age_s: N;
+  rate_hz: N;
+  loss_percent: N;
+  /** Frames it carried that another radio had already delivered. */
+  duplicates: N;
 }
 
 export interface Gps {

@@ -1,11 +1,12 @@
 // Link quality: rate, loss, age of the last message, error counters (the station's and this
-// page's own count of malformed WebSocket messages), and per-message ages in a details popover.
+// page's own count of malformed WebSocket messages), each radio's own figures when the station
+// holds more than one, and per-message ages in a details popover.
 
 import { h, panel, readout, setText } from "./dom";
 import { fmt } from "../lib/format";
 import { messageAges, type StaleVerdict } from "../lib/staleness";
 import type { MessageStats } from "../lib/parse";
-import type { Link } from "../lib/types";
+import type { Link, Radio } from "../lib/types";
 
 export class LinkPanel {
   readonly root: HTMLElement;
@@ -16,6 +17,8 @@ export class LinkPanel {
   private readonly bad: HTMLElement;
   private readonly state: HTMLElement;
   private readonly agesBody: HTMLTableSectionElement;
+  private readonly radiosTable: HTMLTableElement;
+  private readonly radiosBody: HTMLTableSectionElement;
 
   constructor() {
     const r = readout("Rate", "link-rate");
@@ -29,7 +32,10 @@ export class LinkPanel {
     const details = h("details", { class: "ages", "data-testid": "link-details" },
       h("summary", { "data-testid": "link-details-toggle" }, "Per-message ages"),
       h("table", { "data-testid": "link-ages-table" }, h("thead", {}, h("tr", {}, h("th", {}, "message"), h("th", {}, "age"))), this.agesBody));
-    this.root = panel("Link", "panel-link", h("div", { class: "ro-grid three" }, st.root, r.root, l.root, a.root, e.root, b.root), details);
+    this.radiosBody = h("tbody");
+    this.radiosTable = h("table", { class: "radios", "data-testid": "link-radios", hidden: true },
+      h("thead", {}, h("tr", {}, ...["radio", "rate", "loss", "age", "copies"].map((c) => h("th", {}, c)))), this.radiosBody);
+    this.root = panel("Link", "panel-link", h("div", { class: "ro-grid three" }, st.root, r.root, l.root, a.root, e.root, b.root), this.radiosTable, details);
   }
 
   update(link: Link | null, verdict: StaleVerdict, stats: MessageStats, receivedAtMs: number | null, nowMs: number): void {
@@ -41,6 +47,7 @@ export class LinkPanel {
     setText(this.errors, link ? `${link.crc_errors ?? "—"} / ${link.parse_errors ?? "—"} / ${link.signature_errors ?? "—"}` : "—");
     setText(this.bad, `${stats.bad}${stats.lastError ? ` (last: ${stats.lastError})` : ""}`);
     this.bad.classList.toggle("warn", stats.bad > 0);
+    this.showRadios(link?.radios ?? []);
     if (link === null || receivedAtMs === null) {
       this.agesBody.replaceChildren();
       return;
@@ -48,5 +55,20 @@ export class LinkPanel {
     const rows = messageAges(link, receivedAtMs, nowMs).map((m) =>
       h("tr", { class: m.old ? "old" : "", "data-testid": `link-age-${m.name}` }, h("td", {}, m.name), h("td", {}, `${m.age_s.toFixed(1)} s${m.old ? " OLD" : ""}`)));
     this.agesBody.replaceChildren(...rows);
+  }
+
+  /** One row per radio, only when there is a choice of radios: which one carries the commands
+   *  (▲) and which has fallen silent. */
+  private showRadios(radios: Radio[]): void {
+    this.radiosTable.hidden = radios.length < 2;
+    if (radios.length < 2) return;
+    const rows = radios.map((r, i) =>
+      h("tr", { class: r.stale ? "old" : "", "data-testid": `link-radio-${i + 1}`, title: r.address },
+        h("td", {}, `${r.transmitting ? "▲ " : ""}${i + 1} ${r.address}`),
+        h("td", {}, fmt(r.rate_hz, "Hz", 0)),
+        h("td", {}, fmt(r.loss_percent, "%")),
+        h("td", {}, `${fmt(r.age_s, "s", 1)}${r.stale ? " STALE" : ""}`),
+        h("td", {}, r.duplicates === null ? "—" : String(r.duplicates))));
+    this.radiosBody.replaceChildren(...rows);
   }
 }

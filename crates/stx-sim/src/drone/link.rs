@@ -188,12 +188,17 @@ impl LinkedDrone {
 
     /// Feeds one datagram (or stream chunk) received at `link_now`.
     pub fn handle_bytes(&mut self, link_now: Duration, bytes: &[u8]) {
+        self.handle_bytes_on(0, link_now, bytes);
+    }
+
+    /// Bytes received on radio `path` of the drone's link.
+    pub fn handle_bytes_on(&mut self, path: usize, link_now: Duration, bytes: &[u8]) {
         if self.faults.drops_datagram(self.drone.time_s()) {
             return;
         }
         let drone = &self.drone;
         self.endpoint
-            .handle_bytes_with(link_now, bytes, &mut |name: &str, value: f32| {
+            .handle_bytes_on_with(path, link_now, bytes, &mut |name: &str, value: f32| {
                 drone.check_param(name, value).map_err(|e| e.to_string())
             });
         self.process(link_now);
@@ -201,9 +206,14 @@ impl LinkedDrone {
 
     /// The stream connection carrying the link ended (TCP, serial).
     pub fn handle_stream_end(&mut self, link_now: Duration) {
+        self.handle_stream_end_on(0, link_now);
+    }
+
+    /// The stream connection of radio `path` ended.
+    pub fn handle_stream_end_on(&mut self, path: usize, link_now: Duration) {
         let drone = &self.drone;
         self.endpoint
-            .handle_stream_end_with(link_now, &mut |name: &str, value: f32| {
+            .handle_stream_end_on_with(path, link_now, &mut |name: &str, value: f32| {
                 drone.check_param(name, value).map_err(|e| e.to_string())
             });
         self.process(link_now);
@@ -367,8 +377,8 @@ impl LinkedDrone {
 impl SansIo for LinkedDrone {
     type Event = DroneEvent;
 
-    fn handle_bytes(&mut self, now: Duration, bytes: &[u8]) {
-        LinkedDrone::handle_bytes(self, now, bytes);
+    fn handle_bytes_on(&mut self, path: usize, now: Duration, bytes: &[u8]) {
+        LinkedDrone::handle_bytes_on(self, path, now, bytes);
     }
 
     fn handle_timeout(&mut self, now: Duration) {
@@ -387,8 +397,12 @@ impl SansIo for LinkedDrone {
         LinkedDrone::poll_event(self)
     }
 
-    fn handle_stream_end(&mut self, now: Duration) {
-        LinkedDrone::handle_stream_end(self, now);
+    fn handle_stream_end_on(&mut self, path: usize, now: Duration) {
+        LinkedDrone::handle_stream_end_on(self, path, now);
+    }
+
+    fn transmit_path(&self, now: Duration) -> usize {
+        self.endpoint.transmit_path(now)
     }
 
     fn signing_timestamp_mark(&self) -> Option<u64> {

@@ -223,6 +223,11 @@ impl StationCore {
         std::mem::take(&mut self.outbound)
     }
 
+    /// The link statistics last sampled.
+    pub fn link_stats(&self) -> &LinkStats {
+        &self.link
+    }
+
     /// Link statistics sampled by the daemon.
     pub fn set_link_stats(&mut self, now_s: f64, stats: LinkStats) {
         if self.last_connected != Some(stats.connected) {
@@ -240,12 +245,29 @@ impl StationCore {
                 self.log(now_s, level, "link", text);
             }
         }
+        let transmitting = stats.paths.iter().position(|p| p.transmitting);
+        let before = self.link.paths.iter().position(|p| p.transmitting);
+        if stats.paths.len() > 1
+            && before.is_some()
+            && transmitting != before
+            && let Some(now) = transmitting
+        {
+            let text = format!("commands now go out on {}", self.radio_name(now));
+            self.log(now_s, Level::Warning, "link", text);
+        }
         self.link = stats;
+    }
+
+    /// How the operators know radio `path`: its number and address.
+    fn radio_name(&self, path: usize) -> String {
+        let address = self.config.link.addresses().nth(path).map_or("?", |a| a);
+        format!("radio {} ({address})", path + 1)
     }
 
     /// Reports what happened on the drone link's socket, worded for the operators. Waiting
     /// for the drone is said once, not at every heartbeat.
-    pub fn on_io_event(&mut self, now_s: f64, event: IoEvent) {
+    /// With several radios the text names the one it happened on.
+    pub fn on_io_event(&mut self, now_s: f64, path: usize, event: IoEvent) {
         let (level, text) = match event {
             IoEvent::QueuedWithoutPeer { queued: 1 } => (
                 Level::Info,
@@ -276,6 +298,11 @@ impl StationCore {
                 Level::Error,
                 format!("signing timestamp not saved to {}: {error}", path.display()),
             ),
+        };
+        let text = if self.config.link.more_addresses.is_empty() {
+            text
+        } else {
+            format!("{}: {text}", self.radio_name(path))
         };
         self.log(now_s, level, "link", text);
     }
@@ -1086,6 +1113,7 @@ mod tests {
         for queued in 1..10 {
             core.on_io_event(
                 f64::from(queued as u32),
+                0,
                 IoEvent::QueuedWithoutPeer { queued },
             );
         }

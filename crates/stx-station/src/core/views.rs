@@ -9,7 +9,7 @@ use super::StationCore;
 use crate::messages::{
     AirView, AttitudeView, CommandsView, EstimateView, GpsView, GuidanceView, LatLonAlt, LinkView,
     LocalizerView, MissionView, OnboardLandingView, ParamView, ParamsMsg, PatternView, PowerView,
-    PredictionView, ServosView, StateMsg, TouchdownView, VehicleView,
+    PredictionView, RadioView, ServosView, StateMsg, TouchdownView, VehicleView,
 };
 
 fn snake<T: serde::Serialize + std::fmt::Debug>(v: T) -> String {
@@ -42,6 +42,21 @@ impl StationCore {
             parse_errors: self.link.parse_errors,
             signature_errors: self.link.signature_failures,
             ages_s: self.link.last_message_age_s.clone(),
+            radios: self
+                .config
+                .link
+                .addresses()
+                .zip(&self.link.paths)
+                .map(|(address, p)| RadioView {
+                    address: address.clone(),
+                    transmitting: p.transmitting,
+                    stale: p.last_heard_age_s.is_none_or(|a| a > stale_after),
+                    age_s: p.last_heard_age_s,
+                    rate_hz: p.messages_per_s,
+                    loss_percent: p.packet_loss_pct,
+                    duplicates: p.duplicates,
+                })
+                .collect(),
         };
         let l = &self.latest;
         let vehicle = l.any_s.map(|any_s| VehicleView {

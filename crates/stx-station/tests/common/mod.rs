@@ -291,6 +291,27 @@ pub async fn ws_until(ws: &mut Ws, secs: f64, pred: impl Fn(&Value) -> bool) -> 
     }
 }
 
+/// The texts of the station's whole event log, as a viewer reads it.
+pub async fn event_texts(addr: SocketAddr) -> Vec<String> {
+    let (status, events) = http(addr, "GET", "/api/events?since_s=0", Some(VIEWER), None).await;
+    assert_eq!(status, 200, "{events}");
+    events["events"]
+        .as_array()
+        .expect("events")
+        .iter()
+        .filter_map(|e| e["text"].as_str().map(str::to_string))
+        .collect()
+}
+
+/// The `command_result` of request `id`, within 5 s.
+pub async fn command_result(ws: &mut Ws, id: &str) -> Value {
+    ws_until(ws, 5.0, |m| {
+        m["type"] == "command_result" && m["request_id"] == id
+    })
+    .await
+    .expect("command_result on the WebSocket")
+}
+
 pub async fn ws_send(ws: &mut Ws, value: Value) {
     ws.send(Message::Text(value.to_string().into()))
         .await
