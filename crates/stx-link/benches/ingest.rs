@@ -5,6 +5,8 @@
 //!   link statistics, per-sender loss, per-kind ages, the micro-protocols' dispatch) and every
 //!   [`GroundEvent`] drained, as the station's link task does; the goal is
 //!   1,000,000 frames/s.
+//! - `two_radios`: the same stream heard on two radios (`LinkConfig::paths = 2`), each frame
+//!   decoded twice and its copy dropped; elements are the frames delivered once.
 //! - `bytes_to_telemetry`: the decoder and the telemetry mapping alone, for comparison.
 //!
 //! The stream mixes the telemetry the drone sends (attitude, position, GPS, air data, HUD,
@@ -16,7 +18,7 @@ use std::time::Duration;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use stx_gnc::mission::{FlightMode, FlightStage, GuidancePhase};
-use stx_link::endpoint::{GroundConfig, GroundEndpoint, GroundEvent};
+use stx_link::endpoint::{GroundConfig, GroundEndpoint, GroundEvent, LinkConfig};
 use stx_link::frame::{FrameDecoder, FrameEncoder};
 use stx_link::telemetry::*;
 
@@ -130,6 +132,30 @@ fn ingest(c: &mut Criterion) {
             }
             assert_eq!(n, FRAMES);
             assert_eq!(ground.link_stats(now).frames_in, u64::from(FRAMES));
+            n
+        })
+    });
+    group.bench_function("two_radios", |b| {
+        b.iter(|| {
+            let config = GroundConfig {
+                link: LinkConfig::ground().with_paths(2),
+                ..Default::default()
+            };
+            let mut ground = GroundEndpoint::new(config, Duration::ZERO);
+            let mut now = Duration::ZERO;
+            let mut n = 0_u32;
+            for chunk in stream.chunks(4096) {
+                now += Duration::from_millis(3);
+                ground.handle_bytes_on(0, now, black_box(chunk));
+                ground.handle_bytes_on(1, now, black_box(chunk));
+                while let Some(event) = ground.poll_event() {
+                    if let GroundEvent::Telemetry { telemetry, .. } = &event {
+                        black_box(telemetry);
+                        n += 1;
+                    }
+                }
+            }
+            assert_eq!(n, FRAMES);
             n
         })
     });

@@ -6,9 +6,9 @@
 //! has carried anything newer, and within [`DUPLICATE_WINDOW`] it is a copy anyway).
 //!
 //! - Receiving: a frame heard on two radios is delivered once. A copy is recognised by sender,
-//!   sequence number, message id and checksum within [`DUPLICATE_WINDOW`]: the drone's
-//!   sequence wraps every 256 frames (several seconds at its rates), so a new frame cannot
-//!   match an earlier one inside the window unless it repeats it byte for byte.
+//!   sequence number, message id and checksum, within [`DUPLICATE_WINDOW`] and while fewer
+//!   than 256 frames from that sender have been delivered since: the sequence number comes
+//!   round again after 256 frames, so at any rate a later frame with the same number is new.
 //! - Sending: every frame goes out on one radio, the *transmit path*: the lowest-numbered
 //!   path heard within the link timeout (the primary while it works), else the one heard last.
 //!   Retries of the command, parameter and plan protocols are new sends, so a transfer that
@@ -180,11 +180,17 @@ struct FrameKey {
     checksum: u16,
 }
 
+/// Frames from one sender after which its sequence number comes round again.
+const SEQUENCE_PERIOD: u64 = 256;
+
 /// Remembers recent frames to drop the second copy of each.
 #[derive(Debug, Default)]
 pub(crate) struct Deduplicator {
-    seen: HashMap<FrameKey, Duration>,
+    /// When each remembered frame was delivered, and how many frames its sender had delivered
+    /// before it.
+    seen: HashMap<FrameKey, (Duration, u64)>,
     order: VecDeque<(Duration, FrameKey)>,
+    delivered: HashMap<(u8, u8), u64>,
 }
 
 impl Deduplicator {
@@ -199,16 +205,24 @@ impl Deduplicator {
             message_id: header.message_id,
             checksum: header.checksum,
         };
-        if self.seen.contains_key(&key) {
+        let delivered = self
+            .delivered
+            .entry((header.system_id, header.component_id))
+            .or_default();
+        if let Some(&(_, index)) = self.seen.get(&key)
+            && *delivered - index < SEQUENCE_PERIOD
+        {
             return true;
         }
+        let index = *delivered;
+        *delivered += 1;
         if self.order.len() >= MAX_REMEMBERED
             && let Some((t, old)) = self.order.pop_front()
-            && self.seen.get(&old) == Some(&t)
+            && self.seen.get(&old).is_some_and(|&(at, _)| at == t)
         {
             self.seen.remove(&old);
         }
-        self.seen.insert(key, now);
+        self.seen.insert(key, (now, index));
         self.order.push_back((now, key));
         false
     }
@@ -219,7 +233,7 @@ impl Deduplicator {
                 break;
             }
             self.order.pop_front();
-            if self.seen.get(&key) == Some(&t) {
+            if self.seen.get(&key).is_some_and(|&(at, _)| at == t) {
                 self.seen.remove(&key);
             }
         }
@@ -279,6 +293,33 @@ mod tests {
         assert!(!d.is_copy(S(0.5), &header(8, 0xBEEF)), "next sequence");
         // After the window the sequence has wrapped: the same key is a new frame.
         assert!(!d.is_copy(S(0.0) + DUPLICATE_WINDOW + S(0.1), &header(7, 0xBEEF)));
+    }
+
+    #[test]
+    fn at_a_high_rate_the_same_frame_a_sequence_round_later_is_new() {
+        let mut d = Deduplicator::default();
+        // 256 frames in 0.1 s: the sequence comes round well inside the time window, and a
+        // heartbeat repeats byte for byte.
+        for i in 0..=256_u32 {
+            let sequence = (i % 256) as u8;
+            let h = if i == 0 || i == 256 {
+                header(sequence, 0xAAAA)
+            } else {
+                FrameHeader {
+                    message_id: 1,
+                    ..header(sequence, i as u16)
+                }
+            };
+            let now = S(f64::from(i) * 0.1 / 256.0);
+            assert!(!d.is_copy(now, &h), "frame {i} is new");
+            if i == 254 {
+                // 255 frames on, the sequence has not come round: still the first one's copy.
+                assert!(
+                    d.is_copy(now, &header(0, 0xAAAA)),
+                    "the first frame's copy, late"
+                );
+            }
+        }
     }
 
     #[test]
