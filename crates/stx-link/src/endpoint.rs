@@ -49,9 +49,7 @@ use crate::param::{
     ParamChange, ParamClient, ParamConfig, ParamEvent, ParamRefusal, ParamRequestError, ParamSpec,
     ParamTable, ParamTableError, ParamValidator, RangeOnly,
 };
-use crate::paths::{
-    Deduplicator, PathStats, RadioPath, signature_failures, total_decoder_stats, transmit_path,
-};
+use crate::paths::{Deduplicator, PathStats, RadioPath, signature_failures, transmit_path};
 use crate::plan::{PlanClient, PlanConfig, PlanEvent, PlanItem, PlanRequestError, PlanServer};
 use crate::signing::SigningConfig;
 use crate::telemetry::{
@@ -187,6 +185,14 @@ impl SenderStats {
 
 /// Each sender's last sequence number and loss figures.
 pub(crate) type SenderTable = HashMap<(u8, u8), (u8, SenderStats)>;
+
+/// `lost / (lost + received)`, %; 0 before anything was expected.
+pub(crate) fn loss_pct(lost: u64, received: u64) -> f64 {
+    match lost + received {
+        0 => 0.0,
+        expected => 100.0 * lost as f64 / expected as f64,
+    }
+}
 
 /// Accounts the frame with header `h` to its sender in `senders`.
 pub(crate) fn account_sender(senders: &mut SenderTable, h: &FrameHeader) {
@@ -485,7 +491,7 @@ impl LinkCore {
 
     fn stats(&mut self, now: Duration) -> LinkStats {
         self.prune_arrivals(now);
-        let d = total_decoder_stats(self.paths.iter().map(|p| p.decoder.stats()));
+        let d: DecoderStats = self.paths.iter().map(|p| p.decoder.stats()).sum();
         let signing_required = self
             .paths
             .first()
@@ -495,27 +501,16 @@ impl LinkCore {
         let mut senders: Vec<SenderStats> = self
             .senders
             .values()
-            .map(|(_, s)| {
-                let total = s.lost + s.received;
-                SenderStats {
-                    loss_pct: if total == 0 {
-                        0.0
-                    } else {
-                        100.0 * s.lost as f64 / total as f64
-                    },
-                    ..*s
-                }
+            .map(|(_, s)| SenderStats {
+                loss_pct: loss_pct(s.lost, s.received),
+                ..*s
             })
             .collect();
         senders.sort_by_key(|s| (s.system_id, s.component_id));
         let (lost, received) = senders
             .iter()
             .fold((0, 0), |(l, r), s| (l + s.lost, r + s.received));
-        let packet_loss_pct = if lost + received == 0 {
-            0.0
-        } else {
-            100.0 * lost as f64 / (lost + received) as f64
-        };
+        let packet_loss_pct = loss_pct(lost, received);
         let signature_failures = signature_failures(&d, signing_required);
         let messages_per_s = self.arrivals.len() as f64 / window;
         let paths = if self.paths.len() == 1 {

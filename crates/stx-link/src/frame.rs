@@ -172,6 +172,28 @@ pub struct DecoderStats {
     pub truncated: u64,
 }
 
+/// Counters of several decoders (one per radio) added up.
+impl<'a> std::iter::Sum<&'a DecoderStats> for DecoderStats {
+    fn sum<I: Iterator<Item = &'a DecoderStats>>(decoders: I) -> Self {
+        decoders.fold(DecoderStats::default(), |a, d| DecoderStats {
+            bytes_in: a.bytes_in + d.bytes_in,
+            frames_ok: a.frames_ok + d.frames_ok,
+            bytes_discarded: a.bytes_discarded + d.bytes_discarded,
+            crc_errors: a.crc_errors + d.crc_errors,
+            unknown_message_ids: a.unknown_message_ids + d.unknown_message_ids,
+            parse_errors: a.parse_errors + d.parse_errors,
+            bad_headers: a.bad_headers + d.bad_headers,
+            v1_accepted: a.v1_accepted + d.v1_accepted,
+            v1_refused: a.v1_refused + d.v1_refused,
+            signed_frames: a.signed_frames + d.signed_frames,
+            unsigned_refused: a.unsigned_refused + d.unsigned_refused,
+            bad_signatures: a.bad_signatures + d.bad_signatures,
+            replays_refused: a.replays_refused + d.replays_refused,
+            truncated: a.truncated + d.truncated,
+        })
+    }
+}
+
 /// What the decoder accepts.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct DecoderPolicy {

@@ -17,7 +17,7 @@
 
 use std::collections::{HashMap, VecDeque};
 
-use crate::endpoint::{SenderTable, account_sender};
+use crate::endpoint::{SenderTable, account_sender, loss_pct};
 use std::time::Duration;
 
 use serde::{Deserialize, Serialize};
@@ -131,11 +131,7 @@ impl RadioPath {
             bytes_in: d.bytes_in,
             crc_errors: d.crc_errors,
             signature_failures: signature_failures(d, self.decoder.signing_required()),
-            packet_loss_pct: if lost + received == 0 {
-                0.0
-            } else {
-                100.0 * lost as f64 / (lost + received) as f64
-            },
+            packet_loss_pct: loss_pct(lost, received),
         }
     }
 }
@@ -146,28 +142,6 @@ pub(crate) fn signature_failures(d: &DecoderStats, signing_required: bool) -> u6
         + d.replays_refused
         + d.unsigned_refused
         + if signing_required { d.v1_refused } else { 0 }
-}
-
-/// Adds up the decoder counters of every path.
-pub(crate) fn total_decoder_stats<'a>(
-    decoders: impl Iterator<Item = &'a DecoderStats>,
-) -> DecoderStats {
-    decoders.fold(DecoderStats::default(), |a, d| DecoderStats {
-        bytes_in: a.bytes_in + d.bytes_in,
-        frames_ok: a.frames_ok + d.frames_ok,
-        bytes_discarded: a.bytes_discarded + d.bytes_discarded,
-        crc_errors: a.crc_errors + d.crc_errors,
-        unknown_message_ids: a.unknown_message_ids + d.unknown_message_ids,
-        parse_errors: a.parse_errors + d.parse_errors,
-        bad_headers: a.bad_headers + d.bad_headers,
-        v1_accepted: a.v1_accepted + d.v1_accepted,
-        v1_refused: a.v1_refused + d.v1_refused,
-        signed_frames: a.signed_frames + d.signed_frames,
-        unsigned_refused: a.unsigned_refused + d.unsigned_refused,
-        bad_signatures: a.bad_signatures + d.bad_signatures,
-        replays_refused: a.replays_refused + d.replays_refused,
-        truncated: a.truncated + d.truncated,
-    })
 }
 
 /// What identifies a frame across radios.
