@@ -12,8 +12,8 @@
 //! Duration` go in, events and bytes come out, nothing here owns a socket, a clock or a sleep.
 //!
 //! ```text
-//!  transport (tokio: udpin/udpout/tcp/tcpin/serial)          ← thin adapter, the only I/O
-//!        │ bytes                         ▲ bytes
+//!  stx-link-tokio (udpin/udpout/tcp/tcpin/serial)           ← thin adapter, the only I/O
+//!        │ bytes       sansio::SansIo     ▲ bytes
 //!        ▼                               │
 //!  endpoint::{GroundEndpoint, VehicleEndpoint}               ← heartbeats, liveness, LinkStats
 //!        │ frames                        ▲ messages
@@ -34,8 +34,13 @@
 //! - [`manual`]: joystick streaming and stick staleness.
 //! - [`endpoint`]: the two ends composing all of the above, with [`endpoint::LinkStats`].
 //! - [`paths`]: one link over several radios: copies dropped, sends on the radio that works.
-//! - [`transport`]: tokio adapters and [`transport::drive`], which runs an endpoint over an
-//!   address string such as `udpin:0.0.0.0:14550`.
+//! - [`sansio`]: the [`sansio::SansIo`] trait both endpoints implement for an I/O adapter,
+//!   and the [`sansio::IoEvent`]s and [`sansio::IoStats`] adapters report;
+//!   [`address`]: the link address strings such as `udpin:0.0.0.0:14550`. The adapter itself
+//!   (sockets, serial ports, the driver loop) is the `stx-link-tokio` crate: this one has no
+//!   tokio, so the station core and the drone's onboard logic stay pure.
+//! - [`signing::persist`]: the signing timestamp kept across restarts and the one signing
+//!   start-up the station and the drone share.
 //!
 //! # Conventions
 //! Units are in names (`lat_deg`, `alt_msl_m`, `airspeed_mps`); nothing panics on data from
@@ -45,6 +50,7 @@
 //! The mission vocabulary ([`stx_gnc::mission`]: flight mode, flight stage, guidance phase)
 //! travels in HEARTBEAT's `custom_mode` as `mode | stage << 8 | phase << 16`.
 
+pub mod address;
 pub mod command;
 pub mod endpoint;
 pub mod frame;
@@ -52,8 +58,8 @@ pub mod manual;
 pub mod param;
 pub mod paths;
 pub mod plan;
+pub mod sansio;
 pub mod signing;
 pub mod telemetry;
-pub mod transport;
 
 pub use mavlink::dialects::common::MavMessage;

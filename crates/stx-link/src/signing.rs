@@ -23,6 +23,8 @@
 //! the encoder calls the signer. The policy "when signing is on, refuse unsigned and MAVLink 1
 //! frames" is applied by the decoder, which counts every refusal.
 
+pub mod persist;
+
 use std::collections::HashMap;
 use std::fmt;
 use std::time::Duration;

@@ -240,7 +240,7 @@ impl StationConfig {
             self.link.signing_key_hex = Some(KeyText::new(text));
         }
         if self.link.signing_on() && self.link.signing_timestamp_file.is_none() {
-            self.link.signing_timestamp_file = stx_link::transport::default_state_dir(&env)
+            self.link.signing_timestamp_file = stx_link::signing::persist::default_state_dir(&env)
                 .map(|dir| dir.join(SIGNING_TIMESTAMP_FILE_NAME));
         }
         Ok(())
@@ -272,11 +272,11 @@ impl StationConfig {
                 return invalid(&format!("tokens[{i}].name"), "must not be empty");
             }
         }
-        if let Err(e) = self.link.address.parse::<stx_link::transport::Address>() {
+        if let Err(e) = self.link.address.parse::<stx_link::address::Address>() {
             return invalid("link.address", &e.to_string());
         }
         for (i, more) in self.link.more_addresses.iter().enumerate() {
-            use stx_link::transport::Address;
+            use stx_link::address::Address;
             let field = format!("link.more_addresses[{i}]");
             let parsed = match more.parse::<Address>() {
                 Ok(a) => a,

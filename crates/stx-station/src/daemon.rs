@@ -11,7 +11,7 @@ use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
 use axum::extract::ws::Utf8Bytes;
 use stx_link::endpoint::{GroundConfig, GroundEndpoint, GroundEvent, LinkEvent};
 use stx_link::signing::SigningConfig;
-use stx_link::transport::{Action, DriveOptions, DriverEvent, Transport, drive_paths};
+use stx_link_tokio::{Action, DriveOptions, DriverEvent, Transport, drive_paths};
 use thiserror::Error;
 use tokio::sync::{broadcast, mpsc, watch};
 
@@ -35,7 +35,7 @@ pub enum DaemonError {
     Link {
         address: String,
         #[source]
-        source: stx_link::transport::TransportError,
+        source: stx_link_tokio::TransportError,
     },
     /// The signing key or its timestamp file is unusable.
     #[error("signing: {0}")]
@@ -211,13 +211,13 @@ fn signing(config: &StationConfig) -> Result<Option<SigningConfig>, DaemonError>
     let unix_s = SystemTime::now()
         .duration_since(UNIX_EPOCH)
         .map_err(|e| DaemonError::Signing(e.to_string()))?;
-    let mut signing = SigningConfig::new(key, 0, unix_s);
-    if let Some(path) = &config.link.signing_timestamp_file {
-        let persisted = stx_link::transport::load_signing_timestamp(path)
-            .map_err(|e| DaemonError::Signing(format!("{}: {e}", path.display())))?;
-        signing = signing.with_persisted_timestamp(persisted);
-    }
-    Ok(Some(signing))
+    stx_link::signing::persist::start_signing(
+        key,
+        unix_s,
+        config.link.signing_timestamp_file.as_deref(),
+    )
+    .map(Some)
+    .map_err(|e| DaemonError::Signing(e.to_string()))
 }
 
 /// Starts the station; `started(running)` is called once it listens; returns when `shutdown`
@@ -270,7 +270,7 @@ pub async fn run(
     let endpoint = GroundEndpoint::new(ground, Duration::ZERO);
     // The first high-water mark is on disk before anything is signed, or the station does not
     // start.
-    stx_link::transport::persist_signing_mark(
+    stx_link::signing::persist::persist_signing_mark(
         &endpoint,
         config.link.signing_timestamp_file.as_deref(),
     )

@@ -56,11 +56,10 @@ use stx_dynamics::vehicle::Vehicle;
 use stx_gnc::control::ControlGains;
 use stx_gnc::mission::{FlightMode, FlightStage, GuidancePhase};
 use stx_link::endpoint::LinkConfig;
-use stx_link::signing::{SIGNING_KEY_ENV, SigningConfig, SigningKey};
-use stx_link::transport::{
-    Action, DriveOptions, DriverEvent, IoEvent, IoStats, Transport, default_state_dir, drive,
-    load_signing_timestamp, persist_signing_mark,
-};
+use stx_link::sansio::{IoEvent, IoStats};
+use stx_link::signing::persist::{default_state_dir, persist_signing_mark};
+use stx_link::signing::{SIGNING_KEY_ENV, SigningKey};
+use stx_link_tokio::{Action, DriveOptions, DriverEvent, Transport, drive};
 use stx_sim::drone::failures::{StuckServo, parse_window};
 use stx_sim::drone::link::{DroneEvent, LinkCounters, LinkedDrone};
 use stx_sim::drone::{Drone, MissionConfig, MissionSummary, stage_name};
@@ -458,16 +457,16 @@ pub async fn fly(
                 "signing needs a timestamp file, so the timestamps stay monotonic across restarts"
             ))
         })?;
-        let persisted = load_signing_timestamp(path)
-            .with_context(|| format!("signing timestamp file {}", path.display()))
-            .map_err(BadInput)?;
         let unix = match options.signing_clock_unix {
             Some(t) => t,
             None => SystemTime::now()
                 .duration_since(UNIX_EPOCH)
                 .context("the system clock is before 1970")?,
         };
-        link.signing = Some(SigningConfig::new(key, 0, unix).with_persisted_timestamp(persisted));
+        link.signing = Some(
+            stx_link::signing::persist::start_signing(key, unix, Some(path))
+                .map_err(|e| BadInput(e.into()))?,
+        );
     }
     tracing::info!(
         mission = %drone.config().name,
@@ -865,7 +864,7 @@ mod tests {
         };
         let jan_2026 = Duration::from_secs(1_767_225_600);
         let first = signed_timestamps(options(jan_2026), 20).await;
-        let mark = stx_link::transport::load_signing_timestamp(&file)
+        let mark = stx_link::signing::persist::load_signing_timestamp(&file)
             .expect("readable")
             .expect("written");
         let last = *first.iter().max().expect("frames");

@@ -18,7 +18,7 @@ use stx_link::command::{Command as LinkCommand, CommandOutcome, CommandResult, R
 use stx_link::endpoint::{GroundConfig, GroundEndpoint, GroundEvent};
 use stx_link::param::ParamEvent;
 use stx_link::telemetry::Telemetry;
-use stx_link::transport::{Action, DriveOptions, DriverEvent, Transport, drive};
+use stx_link_tokio::{Action, DriveOptions, DriverEvent, Transport, drive};
 use tokio::sync::mpsc;
 
 fn stx() -> Command {

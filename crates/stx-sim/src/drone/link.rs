@@ -26,8 +26,8 @@ use stx_link::command::{Command, CommandResult};
 use stx_link::endpoint::{
     LinkConfig, LinkEvent, LinkStats, VehicleConfig, VehicleEndpoint, VehicleEvent,
 };
+use stx_link::sansio::SansIo;
 use stx_link::telemetry::{Severity, Telemetry, VehicleStatus};
-use stx_link::transport::SansIo;
 
 use crate::drone::failures::LinkFaults;
 use crate::drone::{Drone, DroneError, Output};
@@ -82,7 +82,7 @@ pub enum DroneEvent {
         /// Number of items.
         items: usize,
     },
-    /// Signing's timestamp high-water mark moved (stx-link's `transport::drive` persists the
+    /// Signing's timestamp high-water mark moved (stx-link-tokio's `drive` persists the
     /// mark itself, before the frames signed under it leave).
     PersistSigningTimestamp(u64),
 }
@@ -372,7 +372,7 @@ impl LinkedDrone {
     }
 }
 
-/// So that stx-link's `transport::drive` runs the linked drone over a socket like any
+/// So that stx-link-tokio's `drive` runs the linked drone over a socket like any
 /// endpoint; the simulation's steps go in as its actions (`|d, now| d.step(now)`).
 impl SansIo for LinkedDrone {
     type Event = DroneEvent;

@@ -25,8 +25,8 @@ use stx_gnc::measurement::{AirDataSample, AttitudeSample, GpsFix, Measurement};
 use stx_gnc::mission::FlightMode;
 use stx_gnc::predict::{LandingPrediction, PredictorConfig, predict};
 use stx_link::endpoint::{GroundEvent, LinkEvent, LinkStats};
+use stx_link::sansio::IoEvent;
 use stx_link::telemetry::{Severity, Telemetry};
-use stx_link::transport::IoEvent;
 
 use crate::config::StationConfig;
 use crate::messages::{EventMsg, Level, StateMsg, TrackPoint};

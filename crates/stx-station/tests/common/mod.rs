@@ -15,7 +15,7 @@ use stx_link::endpoint::{LinkConfig, VehicleConfig, VehicleEndpoint, VehicleEven
 use stx_link::manual::ManualEvent;
 use stx_link::param::ParamSpec;
 use stx_link::telemetry::{Attitude, SystemState, Telemetry, VehicleStatus};
-use stx_link::transport::{Action, DriveOptions, DriverEvent, Transport, drive};
+use stx_link_tokio::{Action, DriveOptions, DriverEvent, Transport, drive};
 use stx_station::config::{DEFAULT_STATION_TOML, StationConfig};
 use stx_station::daemon::{Running, run};
 use tokio::io::{AsyncReadExt, AsyncWriteExt};

@@ -9,9 +9,9 @@ use stx_link::endpoint::{
     VehicleEvent,
 };
 use stx_link::param::{ParamEvent, ParamSpec};
-use stx_link::transport::{
-    Action, DriveOptions, DriverEvent, IO_ERROR_REPORT_INTERVAL, IoEvent, Transport,
-    TransportError, drive,
+use stx_link::sansio::IoEvent;
+use stx_link_tokio::{
+    Action, DriveOptions, DriverEvent, IO_ERROR_REPORT_INTERVAL, Transport, TransportError, drive,
 };
 use tokio::sync::mpsc;
 use tokio::task::JoinHandle;
@@ -22,13 +22,13 @@ fn fast(mut link: LinkConfig) -> LinkConfig {
     link
 }
 
-struct Driven<E: stx_link::transport::SansIo> {
+struct Driven<E: stx_link::sansio::SansIo> {
     actions: mpsc::Sender<Action<E>>,
     events: mpsc::Receiver<DriverEvent<E::Event>>,
-    task: JoinHandle<(E, stx_link::transport::IoStats)>,
+    task: JoinHandle<(E, stx_link::sansio::IoStats)>,
 }
 
-fn spawn<E: stx_link::transport::SansIo>(transport: Transport, endpoint: E) -> Driven<E> {
+fn spawn<E: stx_link::sansio::SansIo>(transport: Transport, endpoint: E) -> Driven<E> {
     let (atx, arx) = mpsc::channel(16);
     let (etx, erx) = mpsc::channel(1024);
     let task = tokio::spawn(drive(
@@ -359,7 +359,7 @@ async fn signing_timestamp_file_is_written_and_read_back() {
     let path = dir.join("signing_ts");
     let _ = std::fs::remove_file(&path);
     assert_eq!(
-        stx_link::transport::load_signing_timestamp(&path).expect("read"),
+        stx_link::signing::persist::load_signing_timestamp(&path).expect("read"),
         None
     );
     let key = stx_link::signing::SigningKey::from_bytes([3; 32]);
@@ -396,7 +396,7 @@ async fn signing_timestamp_file_is_written_and_read_back() {
     .await;
     drop(atx);
     let _ = task.await;
-    let stored = stx_link::transport::load_signing_timestamp(&path)
+    let stored = stx_link::signing::persist::load_signing_timestamp(&path)
         .expect("read")
         .expect("written");
     // 2026-01-01 is 347 155 200 s = 34 715 520 000 000 units of 10 µs after 2015-01-01; the
@@ -541,7 +541,7 @@ impl tokio::io::AsyncWrite for WatchingStream {
         let mark = self
             .file
             .as_deref()
-            .and_then(|f| stx_link::transport::load_signing_timestamp(f).expect("readable"));
+            .and_then(|f| stx_link::signing::persist::load_signing_timestamp(f).expect("readable"));
         self.writes.lock().expect("lock").push((mark, buf.to_vec()));
         std::task::Poll::Ready(Ok(buf.len()))
     }
@@ -581,7 +581,7 @@ async fn signed_timestamps_stay_monotonic_across_a_restart_with_the_clock_set_ba
     let run = |unix: Duration, file: Option<std::path::PathBuf>| async move {
         let persisted = file
             .as_deref()
-            .and_then(|f| stx_link::transport::load_signing_timestamp(f).expect("readable"));
+            .and_then(|f| stx_link::signing::persist::load_signing_timestamp(f).expect("readable"));
         let signing = SigningConfig::new(SigningKey::from_bytes([5; 32]), 0, unix)
             .with_persisted_timestamp(persisted);
         let ep = VehicleEndpoint::new(

@@ -1,0 +1,161 @@
+#!/usr/bin/env python3
+"""The shape of the code, checked: no file of a crate's `src/` over the line budget (code
+before its first `#[cfg(test)]`) unless it is listed below with the reason it is one idea,
+and no import circle between the files of a crate.
+
+Why a script of our own: `cargo-modules` and similar tools need a nightly or a download; what
+is checked here is small and textual. A `use`, or a path written out in the code
+(`crate::a::b::c`, `super::x`), makes an edge from the file that writes it to the file that
+defines the module it names. A module's own `mod`/`pub use` lines do not count: re-exporting a
+child is how a module shows its parts, not a dependency of the parent's logic.
+
+Run from the repository root: `python3 tests/structure.py`; exits 1 and says what is wrong.
+"""
+
+import re
+import sys
+from pathlib import Path
+
+BUDGET = 600
+# Files allowed past the budget: path -> why it is one idea.
+ONE_IDEA: dict[str, str] = {}
+
+USE_PATH = re.compile(r"\b(crate|super|self)((?:::\w+)+)")
+
+
+def code_lines(text: str) -> list[str]:
+    out = []
+    for line in text.splitlines():
+        if line.strip().startswith("#[cfg(test)]"):
+            break
+        out.append(line)
+    return out
+
+
+def module_files(src: Path) -> dict[tuple[str, ...], Path]:
+    """Module path (relative to the crate root) -> the file that defines it."""
+    mods = {}
+    for f in src.rglob("*.rs"):
+        rel = f.relative_to(src).with_suffix("")
+        parts = list(rel.parts)
+        if parts[-1] in ("lib", "main") and len(parts) == 1:
+            parts = []
+        elif parts[-1] == "mod":
+            parts = parts[:-1]
+        mods[tuple(parts)] = f
+    return mods
+
+
+def strip_comments(text: str) -> str:
+    text = re.sub(r"//[^\n]*", "", text)
+    return re.sub(r"/\*.*?\*/", "", text, flags=re.S)
+
+
+def edges_of(mod: tuple[str, ...], f: Path, mods: dict) -> set[Path]:
+    text = strip_comments("\n".join(code_lines(f.read_text())))
+    # Lines that only declare or re-export children are the module's table of contents.
+    text = "\n".join(
+        l for l in text.splitlines()
+        if not re.match(r"\s*(pub(\(crate\))?\s+)?mod\s+\w+\s*;", l)
+        and not re.match(r"\s*pub(\(crate\))?\s+use\s+(self::)?\w+::", l)
+    )
+    is_dir_mod = f.name in ("mod.rs", "lib.rs", "main.rs")
+    out = set()
+    # Expand `use a::{b, c::{d}}` groups into paths.
+    for m in USE_PATH.finditer(text):
+        root, rest = m.group(1), m.group(2).split("::")[1:]
+        if root == "crate":
+            base = []
+        elif root == "self":
+            base = list(mod) if is_dir_mod else list(mod)
+        else:  # super
+            base = list(mod)[:-1]
+            while rest and rest[0] == "super":
+                base = base[:-1]
+                rest = rest[1:]
+        path = base + rest
+        # The longest prefix that is a module file.
+        for n in range(len(path), -1, -1):
+            target = mods.get(tuple(path[:n]))
+            if target is not None:
+                if target != f:
+                    out.add(target)
+                break
+    # `use crate::x::{a, b::c}`: the braces name modules too.
+    for m in re.finditer(r"\buse\s+crate((?:::\w+)*)::\{([^;]*)\};", text, flags=re.S):
+        base = m.group(1).split("::")[1:]
+        for item in re.split(r"[,{}]", m.group(2)):
+            item = item.strip().split(" as ")[0]
+            if not item:
+                continue
+            path = base + item.split("::")
+            for n in range(len(path), -1, -1):
+                target = mods.get(tuple(path[:n]))
+                if target is not None:
+                    if target != f:
+                        out.add(target)
+                    break
+    return out
+
+
+def cycles(graph: dict[Path, set[Path]]) -> list[list[Path]]:
+    """Strongly connected components with more than one file (Tarjan)."""
+    index, low, stack, on, comps = {}, {}, [], set(), []
+    counter = [0]
+
+    def visit(v):
+        index[v] = low[v] = counter[0]
+        counter[0] += 1
+        stack.append(v)
+        on.add(v)
+        for w in graph.get(v, ()):
+            if w not in index:
+                visit(w)
+                low[v] = min(low[v], low[w])
+            elif w in on:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            comp = []
+            while True:
+                w = stack.pop()
+                on.discard(w)
+                comp.append(w)
+                if w == v:
+                    break
+            if len(comp) > 1:
+                comps.append(sorted(comp))
+
+    sys.setrecursionlimit(10_000)
+    for v in graph:
+        if v not in index:
+            visit(v)
+    return comps
+
+
+def main() -> int:
+    root = Path(__file__).resolve().parent.parent
+    problems = []
+    for src in sorted(root.glob("crates/*/src")):
+        mods = module_files(src)
+        graph = {f: edges_of(m, f, mods) for m, f in mods.items()}
+        for comp in cycles(graph):
+            names = " ↔ ".join(str(p.relative_to(root)) for p in comp)
+            problems.append(f"import circle: {names}")
+        for f in mods.values():
+            rel = str(f.relative_to(root))
+            if f.name == "tests.rs":
+                continue
+            n = len(code_lines(f.read_text()))
+            if n > BUDGET and rel not in ONE_IDEA:
+                problems.append(f"{rel}: {n} lines of code (budget {BUDGET}): split it by idea")
+    for p in problems:
+        print(p)
+    if problems:
+        print(f"structure: {len(problems)} problem(s)")
+        return 1
+    print("structure: every crate file within budget, no import circles")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
