@@ -16,12 +16,11 @@
 //! - Statistics: per path ([`PathStats`]), next to the merged link's ([`crate::endpoint::LinkStats`]).
 
 use std::collections::{HashMap, VecDeque};
-
-use crate::endpoint::{SenderTable, account_sender, loss_pct};
 use std::time::Duration;
 
 use serde::{Deserialize, Serialize};
 
+use crate::endpoint::senders::{SenderTable, account_sender, loss_pct};
 use crate::frame::{DecoderStats, FrameDecoder, FrameHeader};
 
 /// How long a frame is remembered to recognise its copy arriving over another radio.
