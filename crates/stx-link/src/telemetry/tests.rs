@@ -1,7 +1,11 @@
-use super::*;
+use mavlink::dialects::common as mc;
+use mavlink::dialects::common::MavMessage;
 use mavlink::{MavlinkVersion, Message};
 use proptest::prelude::*;
 use serde_json::Value;
+use stx_gnc::mission::{FlightMode, FlightStage, GuidancePhase};
+
+use super::*;
 
 /// Half a wire quantum for the fields that are scaled integers; `None` for f32 fields.
 fn quantum(kind: &str, field: &str) -> Option<f64> {
