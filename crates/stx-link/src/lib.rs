@@ -23,17 +23,27 @@
 //! ```
 //!
 //! - [`frame`]: the sans-io decoder (any chunk in, checked frames out, resync after garbage,
-//!   everything counted) and the MAVLink 2 encoder with sequence numbers.
+//!   everything counted) and the MAVLink 2 encoder with sequence numbers (`frame/`: `format`,
+//!   `crc`, `decoder`, `encoder`).
 //! - [`signing`]: MAVLink 2 signing: key that never prints, constant-time check, replay
 //!   refusal, outgoing timestamps monotonic across restarts.
-//! - [`telemetry`]: [`telemetry::Telemetry`] and its exact two-way mapping to MAVLink messages.
+//! - [`telemetry`]: [`telemetry::Telemetry`] and its exact two-way mapping to MAVLink messages,
+//!   one file per message family (status and health, navigation, actuators, text, guidance).
 //! - [`command`]: operator commands, retried until acknowledged (ground) and de-duplicated and
 //!   acknowledged (vehicle).
 //! - [`param`]: the PARAM_* protocol, both sides.
 //! - [`plan`]: upload / download of the landing target and localizer points (mission protocol).
+//!
+//!   Each of these three protocols is a directory of the same shape: `client.rs` is the
+//!   ground side, `server.rs` (`table.rs` for parameters) the vehicle side, and a file for
+//!   what both share (`encoding.rs`: the command and its encoding; `value.rs`: a parameter
+//!   on the wire; `item.rs` and `mission.rs`: a plan item and the mission messages).
 //! - [`manual`]: joystick streaming and stick staleness.
-//! - [`endpoint`]: the two ends composing all of the above, with [`endpoint::LinkStats`].
-//! - [`paths`]: one link over several radios: copies dropped, sends on the radio that works.
+//! - [`endpoint`]: the two ends composing all of the above (`ground.rs`, `vehicle.rs`) over a
+//!   shared link core (`core.rs`), with [`endpoint::LinkStats`] and the per-sender loss
+//!   accounting (`senders.rs`).
+//! - [`paths`]: one link over several radios: copies dropped, sends on the radio that works,
+//!   each radio's loss counted with the endpoint's per-sender accounting.
 //! - [`sansio`]: the [`sansio::SansIo`] trait both endpoints implement for an I/O adapter,
 //!   and the [`sansio::IoEvent`]s and [`sansio::IoStats`] adapters report;
 //!   [`address`]: the link address strings such as `udpin:0.0.0.0:14550`. The adapter itself
