@@ -39,7 +39,7 @@ pub fn pwm_us_to_unit(us: u16) -> f64 {
 
 impl Actuators {
     /// The SERVO_OUTPUT_RAW carrying it.
-    pub(super) fn to_mavlink(&self) -> MavMessage {
+    pub(super) fn to_mavlink(self) -> MavMessage {
         MavMessage::SERVO_OUTPUT_RAW(mc::SERVO_OUTPUT_RAW_DATA {
             time_usec: self.time_usec,
             servo1_raw: signed_to_pwm_us(self.main_line),

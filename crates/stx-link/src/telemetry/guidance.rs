@@ -34,7 +34,7 @@ pub struct Wind {
 
 impl Wind {
     /// The WIND_COV carrying it.
-    pub(super) fn to_mavlink(&self) -> MavMessage {
+    pub(super) fn to_mavlink(self) -> MavMessage {
         MavMessage::WIND_COV(mc::WIND_COV_DATA {
             time_usec: self.time_usec,
             wind_x: none_to_nan(self.wind_north_mps),
@@ -83,7 +83,7 @@ pub struct GuidanceStatus {
 
 impl GuidanceStatus {
     /// The NAV_CONTROLLER_OUTPUT carrying it.
-    pub(super) fn to_mavlink(&self) -> MavMessage {
+    pub(super) fn to_mavlink(self) -> MavMessage {
         MavMessage::NAV_CONTROLLER_OUTPUT(mc::NAV_CONTROLLER_OUTPUT_DATA {
             nav_roll: self.desired_roll_deg as f32,
             nav_pitch: 0.0,
@@ -139,7 +139,7 @@ fn predicted_landing_mask() -> mc::PositionTargetTypemask {
 
 impl PredictedLanding {
     /// The POSITION_TARGET_GLOBAL_INT carrying it.
-    pub(super) fn to_mavlink(&self) -> MavMessage {
+    pub(super) fn to_mavlink(self) -> MavMessage {
         MavMessage::POSITION_TARGET_GLOBAL_INT(mc::POSITION_TARGET_GLOBAL_INT_DATA {
             time_boot_ms: self.time_boot_ms,
             lat_int: deg_to_e7(self.lat_deg),

@@ -85,7 +85,7 @@ pub struct GpsRaw {
 
 impl GpsRaw {
     /// The GPS_RAW_INT carrying it.
-    pub(super) fn to_mavlink(&self) -> MavMessage {
+    pub(super) fn to_mavlink(self) -> MavMessage {
         MavMessage::GPS_RAW_INT(mc::GPS_RAW_INT_DATA {
             time_usec: self.time_usec,
             lat: deg_to_e7(self.lat_deg),
@@ -159,7 +159,7 @@ pub struct GlobalPosition {
 
 impl GlobalPosition {
     /// The GLOBAL_POSITION_INT carrying it.
-    pub(super) fn to_mavlink(&self) -> MavMessage {
+    pub(super) fn to_mavlink(self) -> MavMessage {
         MavMessage::GLOBAL_POSITION_INT(mc::GLOBAL_POSITION_INT_DATA {
             time_boot_ms: self.time_boot_ms,
             lat: deg_to_e7(self.lat_deg),
@@ -210,7 +210,7 @@ pub struct Attitude {
 
 impl Attitude {
     /// The ATTITUDE carrying it.
-    pub(super) fn to_mavlink(&self) -> MavMessage {
+    pub(super) fn to_mavlink(self) -> MavMessage {
         MavMessage::ATTITUDE(mc::ATTITUDE_DATA {
             time_boot_ms: self.time_boot_ms,
             roll: self.roll_rad as f32,
@@ -254,7 +254,7 @@ pub struct AirData {
 
 impl AirData {
     /// The SCALED_PRESSURE carrying it.
-    pub(super) fn to_mavlink(&self) -> MavMessage {
+    pub(super) fn to_mavlink(self) -> MavMessage {
         MavMessage::SCALED_PRESSURE(mc::SCALED_PRESSURE_DATA {
             time_boot_ms: self.time_boot_ms,
             press_abs: (self.abs_pressure_pa / 100.0) as f32,
@@ -303,7 +303,7 @@ pub struct Hud {
 
 impl Hud {
     /// The VFR_HUD carrying it.
-    pub(super) fn to_mavlink(&self) -> MavMessage {
+    pub(super) fn to_mavlink(self) -> MavMessage {
         MavMessage::VFR_HUD(mc::VFR_HUD_DATA {
             airspeed: self.airspeed_mps as f32,
             groundspeed: self.groundspeed_mps as f32,

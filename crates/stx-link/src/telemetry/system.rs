@@ -94,7 +94,7 @@ impl VehicleStatus {
     }
 
     /// The HEARTBEAT carrying it.
-    pub(super) fn to_mavlink(&self) -> MavMessage {
+    pub(super) fn to_mavlink(self) -> MavMessage {
         MavMessage::HEARTBEAT(mc::HEARTBEAT_DATA {
             custom_mode: self.custom_mode(),
             mavtype: mc::MavType::MAV_TYPE_PARAFOIL,
@@ -149,7 +149,7 @@ pub struct SystemStatus {
 
 impl SystemStatus {
     /// The SYS_STATUS carrying it.
-    pub(super) fn to_mavlink(&self) -> MavMessage {
+    pub(super) fn to_mavlink(self) -> MavMessage {
         MavMessage::SYS_STATUS(mc::SYS_STATUS_DATA {
             onboard_control_sensors_present: mc::MavSysStatusSensor::from_bits_retain(
                 self.sensors_present,
@@ -213,7 +213,7 @@ pub struct BatteryStatus {
 
 impl BatteryStatus {
     /// The BATTERY_STATUS carrying it.
-    pub(super) fn to_mavlink(&self) -> MavMessage {
+    pub(super) fn to_mavlink(self) -> MavMessage {
         let mut voltages = [u16::MAX; 10];
         voltages[0] = volts_to_mv(self.voltage_v);
         MavMessage::BATTERY_STATUS(mc::BATTERY_STATUS_DATA {
