@@ -58,7 +58,7 @@ pub async fn drive<E: SansIo>(
 }
 
 /// [`drive`] over several radios to the same peer: `transports[i]` is the endpoint's path
-/// `i` (see [`crate::paths`]); bytes from each go to its path, and what the endpoint sends
+/// `i` (see [`stx_link::paths`]); bytes from each go to its path, and what the endpoint sends
 /// goes out on its [`transmit_path`](SansIo::transmit_path). Returns each transport's
 /// counters, in order.
 pub async fn drive_paths<E: SansIo>(

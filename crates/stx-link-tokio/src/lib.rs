@@ -3,12 +3,11 @@
 //! `stx-link` is sans-io (bytes and `now` in, events and bytes out); this crate puts its
 //! endpoints on the wire with tokio, in the way quinn puts quinn-proto on UDP:
 //!
-//! - [`transport`]: [`Transport`](transport::Transport), an open `udpin:`/`udpout:`/`tcp:`/
-//!   `tcpin:`/`serial:` address (`stx_link::address`), with every I/O error counted and
-//!   reported rate-limited;
-//! - [`drive`]: [`drive`](drive::drive) / [`drive_paths`](drive::drive_paths) run any
-//!   [`SansIo`](stx_link::sansio::SansIo) endpoint over one transport or several radios,
-//!   persisting the signing timestamp before frames signed under it leave.
+//! - [`transport`]: [`Transport`], an open `udpin:`/`udpout:`/`tcp:`/`tcpin:`/`serial:`
+//!   address (`stx_link::address`), with every I/O error counted and reported rate-limited;
+//! - [`mod@drive`]: [`drive()`] / [`drive_paths`] run any [`SansIo`](stx_link::sansio::SansIo)
+//!   endpoint over one transport or several radios, persisting the signing timestamp before
+//!   frames signed under it leave.
 //!
 //! The station daemon, the simulated drone's paced runner and the tests use it; nothing pure
 //! (`stx-gnc`, the station core, the drone's onboard logic) depends on it.

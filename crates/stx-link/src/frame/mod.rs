@@ -6,7 +6,7 @@
 //!
 //! [`FrameDecoder`] is sans-io: [`FrameDecoder::push`] any chunk, then call
 //! [`FrameDecoder::poll`] until it returns `None`. Each call yields either a [`Frame`] (header
-//! plus [`MavMessage`]) or a [`FrameError`] saying why a candidate frame was dropped. After a
+//! plus [`MavMessage`](crate::MavMessage)) or a [`FrameError`] saying why a candidate frame was dropped. After a
 //! bad checksum it resynchronises on the next magic byte after the failed candidate's start,
 //! so a valid frame hidden inside a corrupted one is still found. Nothing is silently
 //! swallowed: [`DecoderStats`] counts CRC errors, unknown message ids, parse errors, bytes
