@@ -81,6 +81,26 @@ def edges_of(mod: tuple[str, ...], f: Path, mods: dict) -> set[Path]:
                 if target != f:
                     out.add(target)
                 break
+    # `use child::x` (a path relative to this module, edition 2018+): an edge to the child,
+    # unless the line only re-exports it (filtered above).
+    own = list(mod)
+    for m in re.finditer(r"\buse\s+(\w+)((?:::\w+)*)", text):
+        first = m.group(1)
+        if first in ("crate", "super", "self", "std", "core", "alloc"):
+            continue
+        path = own + [first] + m.group(2).split("::")[1:]
+        for n in range(len(path), len(own), -1):
+            target = mods.get(tuple(path[:n]))
+            if target is not None:
+                if target != f:
+                    out.add(target)
+                break
+    # Paths written inline through a child (`spiral::Spiral::new()`).
+    for child in {k[len(own)] for k in mods if len(k) == len(own) + 1 and k[: len(own)] == tuple(own)}:
+        if re.search(rf"(?<![\w:]){child}::\w", text):
+            target = mods[tuple(own) + (child,)]
+            if target != f:
+                out.add(target)
     # `use crate::x::{a, b::c}`: the braces name modules too.
     for m in re.finditer(r"\buse\s+crate((?:::\w+)*)::\{([^;]*)\};", text, flags=re.S):
         base = m.group(1).split("::")[1:]
