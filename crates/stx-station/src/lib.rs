@@ -14,8 +14,8 @@
 //!   and meanings come from the onboard catalogue, `stx_gnc::params`, shared with the drone).
 //!
 //! With the default feature `daemon`, the adapters:
-//! - [`http`]: the axum routes (auth, REST, WebSocket, KML, static files);
-//! - [`daemon`]: the tokio wiring of link driver, core and HTTP, with graceful shutdown.
+//! - `http`: the axum routes (auth, REST, WebSocket, KML, static files);
+//! - `daemon`: the tokio wiring of link driver, core and HTTP, with graceful shutdown.
 
 pub mod config;
 pub mod core;

@@ -1,18 +1,18 @@
 //! The station's state and logic, free of I/O: telemetry and link events in, JSON messages and
 //! link actions out, the mission clock (`now_s`, seconds since the station started) passed in.
 //!
-//! - [`navigation`]: telemetry feeds the station's own estimator (the same code as onboard);
+//! - `navigation`: telemetry feeds the station's own estimator (the same code as onboard);
 //!   each [`StationCore::tick`] runs the guidance replica and the timers, and landing
 //!   predictions run as detached [`PredictionJob`]s;
-//! - [`sync`]: the replica follows the plan the drone holds, read back from it;
-//! - operators' requests are checked ([`requests`]), followed through their whole life
-//!   ([`commands`]: sent, answered, retried, timed out) and become [`LinkAction`]s with ids
-//!   and deadlines ([`actions`]); the link driver's outcome of each comes back through
+//! - `sync`: the replica follows the plan the drone holds, read back from it;
+//! - operators' requests are checked (`requests`), followed through their whole life
+//!   (`commands`: sent, answered, retried, timed out) and become [`LinkAction`]s with ids
+//!   and deadlines (`actions`); the link driver's outcome of each comes back through
 //!   [`StationCore::on_action_outcome`], the drone's answers through
 //!   [`StationCore::on_link_event`], and every request ends in a `command_result`
-//!   ([`operator`] ties these together; [`cutdown`] arms and confirms the cutdown, [`manual`]
+//!   (`operator` ties these together; `cutdown` arms and confirms the cutdown, `manual`
 //!   holds and releases the sticks);
-//! - [`params`]: the drone's parameter table; [`views`]: the `state` and `params` messages.
+//! - `params`: the drone's parameter table; `views`: the `state` and `params` messages.
 
 mod actions;
 mod commands;

@@ -1,7 +1,7 @@
 //! The daemon's tokio wiring: the link driver (`stx_link_tokio::drive_paths` running the
-//! station's [`StationLink`] over every configured radio), the [`station_loop`] (messages
+//! station's [`StationLink`] over every configured radio), the `station_loop` (messages
 //! between the driver, the core and the pages), and the HTTP server (HTTPS with `[tls]`, see
-//! [`tls`]), all stopped together by one shutdown signal. Nothing here decides anything: the
+//! `tls`), all stopped together by one shutdown signal. Nothing here decides anything: the
 //! core does.
 
 mod station_loop;

@@ -1,11 +1,11 @@
 //! The HTTP side (axum): the REST endpoints and the WebSocket of `API.md`, the KML feed,
 //! offline tiles and the built dashboard.
 //!
-//! - [`shared`]: what every handler shares ([`Shared`]) and the `{error, reason}` answers;
-//! - [`auth`]: tokens, names and roles;
-//! - [`rest`]: the reading endpoints; [`commands`]: the commanding ones (operators only);
-//! - [`ws`]: the WebSocket (state, events, command results; operators' sticks);
-//! - [`kml`]: the Google Earth feed.
+//! - `shared`: what every handler shares ([`Shared`]) and the `{error, reason}` answers;
+//! - `auth`: tokens, names and roles;
+//! - `rest`: the reading endpoints; `commands`: the commanding ones (operators only);
+//! - `ws`: the WebSocket (state, events, command results; operators' sticks);
+//! - `kml`: the Google Earth feed.
 //!
 //! Handlers only lock the core for a moment, build their answer, and wake the daemon when they
 //! gave the core something for the link ([`Shared::link_due`]); nothing here waits on the
