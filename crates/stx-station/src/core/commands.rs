@@ -20,7 +20,7 @@ use stx_link::param::ParamEvent;
 use stx_link::plan::PlanEvent;
 
 use super::actions::{APPLY_WITHIN_S, ActionError, ActionId, LinkOp, Outbox, Purpose};
-use super::requests::{Checked, Payload, PlanChange};
+use super::requests::{Payload, PlanChange};
 use crate::messages::{CommandResultMsg, Outcome};
 
 /// Seconds an upload that met another plan transfer waits before it is offered again …
@@ -82,11 +82,18 @@ pub(crate) struct Commands {
 }
 
 impl Commands {
-    /// Records a checked request and queues its link action; its id.
-    pub fn open(&mut self, now_s: f64, outbox: &mut Outbox, checked: Checked) -> String {
+    /// Records a request for `command` and queues its link action; its id.
+    pub fn open(
+        &mut self,
+        now_s: f64,
+        outbox: &mut Outbox,
+        command: &'static str,
+        payload: Payload,
+        change: Option<PlanChange>,
+    ) -> String {
         self.last += 1;
         let n = self.last;
-        let op = match checked.payload {
+        let op = match payload {
             Payload::Command(command) => LinkOp::Command {
                 request_id: RequestId(n),
                 command,
@@ -102,14 +109,14 @@ impl Commands {
                 result: CommandResultMsg {
                     kind: "command_result",
                     request_id: request_id.clone(),
-                    command: checked.command.to_string(),
+                    command: command.to_string(),
                     outcome: Outcome::InProgress,
                     attempts: 0,
                     detail: "queued for the link".into(),
                     value: None,
                 },
                 op,
-                change: checked.change,
+                change,
                 stage: Stage::Sending(action),
                 tries: 1,
             },
@@ -117,16 +124,29 @@ impl Commands {
         request_id
     }
 
-    /// The link driver applied request `n`'s action, or did not: its result if that
+    /// The link driver applied request `n`'s `action`, or did not: its result if that
     /// settles it (or reopens one the station had given up on).
     pub fn on_applied(
         &mut self,
         now_s: f64,
         n: u64,
+        action: ActionId,
         result: Result<(), ActionError>,
     ) -> Option<CommandResultMsg> {
         let r = self.records.get_mut(&n)?;
-        let late = r.stage == Stage::Done;
+        let late = match r.stage {
+            Stage::Sending(current) if current == action => false,
+            // Settled as not sent, and the outcome came after all.
+            Stage::Done => true,
+            _ => {
+                tracing::warn!(
+                    ?action,
+                    request = n,
+                    "outcome of an action the request no longer waits for"
+                );
+                return None;
+            }
+        };
         match result {
             Ok(()) => {
                 r.stage = Stage::Answering {

@@ -24,10 +24,16 @@ impl StationCore {
         who: &str,
         request: CommandRequest,
     ) -> Result<String, ApiError> {
-        let checked = check(&self.frame, &self.params, request)?;
-        let text = format!("{who}: {}", checked.text);
-        let id = self.commands.open(now_s, &mut self.outbox, checked);
-        self.log(now_s, Level::Info, "command", text);
+        let Checked {
+            command,
+            payload,
+            change,
+            text,
+        } = check(&self.frame, &self.params, request)?;
+        let id = self
+            .commands
+            .open(now_s, &mut self.outbox, command, payload, change);
+        self.log(now_s, Level::Info, "command", format!("{who}: {text}"));
         Ok(id)
     }
 
@@ -54,13 +60,10 @@ impl StationCore {
         arm_id: &str,
     ) -> Result<String, ApiError> {
         self.cutdown.confirm(now_s, who, arm_id)?;
-        let checked = Checked {
-            command: "cutdown",
-            payload: Payload::Command(stx_link::command::Command::Cutdown),
-            change: None,
-            text: String::new(),
-        };
-        let id = self.commands.open(now_s, &mut self.outbox, checked);
+        let cutdown = Payload::Command(stx_link::command::Command::Cutdown);
+        let id = self
+            .commands
+            .open(now_s, &mut self.outbox, "cutdown", cutdown, None);
         self.log(
             now_s,
             Level::Warning,
@@ -114,7 +117,7 @@ impl StationCore {
     ) {
         match purpose {
             Purpose::Request(n) => {
-                if let Some(msg) = self.commands.on_applied(now_s, n, result) {
+                if let Some(msg) = self.commands.on_applied(now_s, n, id, result) {
                     self.after_command_result(now_s, &msg);
                 }
             }

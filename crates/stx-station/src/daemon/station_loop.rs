@@ -64,6 +64,9 @@ pub(super) async fn station_loop(mut io: StationLoop) {
     let mut last_state = tokio::time::Instant::now();
     // For the driver, oldest first, until it has room.
     let mut outgoing: VecDeque<Action<StationLink>> = VecDeque::new();
+    // The driver stopped (it panicked): actions are dropped here, and the core reports each
+    // request as not sent at its deadline.
+    let mut driver_gone = false;
     loop {
         let burst_due = async {
             match burst_deadline {
@@ -78,10 +81,17 @@ pub(super) async fn station_loop(mut io: StationLoop) {
                     burst_deadline = Some(tokio::time::Instant::now() + COALESCE);
                 }
             }
-            permit = io.actions.reserve(), if !outgoing.is_empty() => {
-                let Ok(permit) = permit else { break };
-                if let Some(action) = outgoing.pop_front() {
-                    permit.send(action);
+            permit = io.actions.reserve(), if !outgoing.is_empty() && !driver_gone => {
+                match permit {
+                    Ok(permit) => {
+                        if let Some(action) = outgoing.pop_front() {
+                            permit.send(action);
+                        }
+                    }
+                    Err(_) => {
+                        tracing::error!("the link driver stopped: nothing more goes to the drone");
+                        driver_gone = true;
+                    }
                 }
             }
             () = shared.link_due.notified() => {}
@@ -122,6 +132,9 @@ pub(super) async fn station_loop(mut io: StationLoop) {
             (core.take_link_actions(now), core.drain_outbound())
         };
         outgoing.extend(actions.into_iter().map(|a| apply(shared.started, a)));
+        if driver_gone {
+            outgoing.clear();
+        }
         send_outbound(&shared, outbound);
     }
 }
