@@ -13,11 +13,14 @@
 //! - [`tune`] closes the loop with the onboard control laws of `stx-gnc` on the linear model,
 //!   optimises the gains of one controller with [`nelder_mead`], and checks them with step
 //!   responses of the nonlinear model flown by `stx-sim`;
-//! - [`svg`] draws the eigenvalue map and the step responses.
+//! - [`svg`] draws plots; [`figures`] makes the eigenvalue map and the step responses of an
+//!   analysis and of a tuning with it, and [`gains_file`] the gains file a tuning writes.
 //!
 //! Pure: no files, no clocks, no randomness. The `stx` binary reads and writes files.
 
 pub mod analysis;
+pub mod figures;
+pub mod gains_file;
 pub mod jacobian;
 pub mod linearize;
 pub mod lti;

@@ -30,7 +30,9 @@ fn temp_dir(name: &str) -> PathBuf {
 
 /// A socket standing for the station, and the address the drone sends to.
 async fn station() -> (UdpSocket, String) {
-    let socket = UdpSocket::bind("127.0.0.1:0").await.expect("station socket");
+    let socket = UdpSocket::bind("127.0.0.1:0")
+        .await
+        .expect("station socket");
     let port = socket.local_addr().expect("bound").port();
     (socket, format!("udpout:127.0.0.1:{port}"))
 }
@@ -198,7 +200,11 @@ async fn each_step_reports_the_attitude_it_sent_and_queries_read_the_drone_betwe
     assert!(stamps.windows(2).all(|w| w[0] < w[1]), "{stamps:?}");
     let last = steps.last().expect("steps");
     assert!(last.time_s <= report.mission.mission_time_s);
-    assert!(steps.windows(2).all(|w| w[0].finished_at <= w[1].finished_at));
+    assert!(
+        steps
+            .windows(2)
+            .all(|w| w[0].finished_at <= w[1].finished_at)
+    );
 }
 
 #[tokio::test]
@@ -206,9 +212,13 @@ async fn a_drone_that_cannot_be_built_is_refused_before_the_link_opens() {
     let mut mission = rehearsal();
     // The main-line limit beyond the vehicle's servo travel.
     mission.onboard.guidance.gains.main_line_limit_m = 1.0;
-    let err = fly(FlyOptions::new("carrier-pigeon:1", mission), std::future::pending(), ())
-        .await
-        .expect_err("refused");
+    let err = fly(
+        FlyOptions::new("carrier-pigeon:1", mission),
+        std::future::pending(),
+        (),
+    )
+    .await
+    .expect_err("refused");
     assert!(matches!(err, FlyError::Drone { .. }), "{err}");
     assert!(err.is_input());
     let err = fly(
