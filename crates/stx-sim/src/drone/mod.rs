@@ -7,9 +7,9 @@
 //! sends goes in through methods ([`Drone::handle_command`], [`Drone::set_param`],
 //! [`Drone::handle_plan`], [`Drone::set_sticks`], [`Drone::link_changed`]) and everything the
 //! drone sends comes out of [`Drone::poll_output`]. The same seed and the same calls give the
-//! same flight, bit for bit. `stx drone` (crate `stx`) is the thin tokio adapter that puts a
-//! [`stx_link::endpoint::VehicleEndpoint`] and a socket around it and paces it in real or
-//! accelerated time.
+//! same flight, bit for bit. [`link::LinkedDrone`] puts it behind a
+//! [`stx_link::endpoint::VehicleEndpoint`]; the runner (`crate::runner`, feature `runner`) is
+//! the thin tokio adapter that adds a socket and paces it in real or accelerated time.
 //!
 //! How the parts fit, one control period:
 //!
