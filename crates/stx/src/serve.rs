@@ -10,10 +10,9 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 use clap::Args;
-use stx_station::config::{DEFAULT_STATION_TOML, StationConfig};
-
 use stx_sim::drone::MissionOverrides;
 use stx_sim::runner::{FlyOptions, ProgressLog, Signing, Speed};
+use stx_station::config::{DEFAULT_STATION_TOML, StationConfig};
 
 use crate::BadInput;
 use crate::drone::{fly_error, mission};
