@@ -9,6 +9,7 @@ mod bench;
 mod bench_memory;
 mod bench_station;
 mod drone;
+mod inputs;
 mod montecarlo;
 mod serve;
 mod sim;

@@ -1,16 +1,8 @@
-//! Monte Carlo of spiral landings: many guided flights with the full model from random release
-//! points, headings and winds (sheared and turbulent), sensors on, scored on what the operators
-//! care about — distance to the target, landing into the wind, touchdown speed — and on the
-//! wind estimate.
-//!
-//! Every run draws its conditions from its own generator seeded from `(seed, run index)`, so a
-//! report depends only on the seed and the run count, never on how the runs were spread over
-//! threads.
+//! One run of a campaign: its conditions drawn from `(seed, index)`, its wind, its flight from
+//! the steady-glide template, and what it gave.
 
 use std::f64::consts::PI;
 use std::sync::Arc;
-use std::sync::atomic::{AtomicUsize, Ordering};
-use std::time::Instant;
 
 use nalgebra::Vector3;
 use rand::{RngExt, SeedableRng};
@@ -25,51 +17,12 @@ use stx_dynamics::vehicle::Vehicle;
 use stx_dynamics::wind::{
     ProfileRow, Turbulence, TurbulenceParams, WindComposite, WindField, WindProfile,
 };
-use stx_gnc::guidance::{Guidance, GuidanceConfig, PhaseEvent, Plan};
+use stx_gnc::guidance::{Guidance, PhaseEvent, Plan};
 use stx_gnc::mission::{FlightMode, GuidancePhase};
 
+use super::config::MonteCarloConfig;
 use crate::closed_loop::{GuidedFlight, Navigator};
-
-/// What to run.
-#[derive(Debug, Clone, Serialize)]
-pub struct MonteCarloConfig {
-    /// Number of runs.
-    pub runs: usize,
-    /// Seed of the whole campaign.
-    pub seed: u64,
-    /// Largest mean wind speed drawn, m/s.
-    pub wind_max_mps: f64,
-    /// Release height above the target, m.
-    pub altitude_m: f64,
-    /// Release points are drawn uniformly within this distance of the target, m.
-    pub release_radius_m: f64,
-    /// Whether guidance flares (a campaign without it measures what the flare is worth).
-    pub flare: bool,
-    /// Worker threads.
-    pub threads: usize,
-    /// Fly only this run (by index), keeping its phase events and track: replays one run of a
-    /// campaign exactly, since its conditions depend only on the seed and the index.
-    pub only_run: Option<usize>,
-    /// Guidance settings.
-    #[serde(skip)]
-    pub guidance: GuidanceConfig,
-}
-
-impl Default for MonteCarloConfig {
-    fn default() -> Self {
-        Self {
-            runs: 100,
-            seed: 1,
-            wind_max_mps: 4.0,
-            altitude_m: 600.0,
-            release_radius_m: 400.0,
-            flare: true,
-            threads: 2,
-            only_run: None,
-            guidance: GuidanceConfig::default(),
-        }
-    }
-}
+use crate::guided::{CONTROL_PERIOD_S, STEP_S};
 
 /// The conditions of one run.
 #[derive(Debug, Clone, Serialize)]
@@ -154,129 +107,11 @@ pub struct TrackPoint {
     pub brake: f64,
 }
 
-/// A run among the worst of a campaign, enough to replay it (`only_run`).
-#[derive(Debug, Clone, Serialize)]
-pub struct WorstRun {
-    /// Index in the campaign.
-    pub index: usize,
-    /// Miss distance, m.
-    pub miss_m: f64,
-    /// Long (+) or short (−) along the upwind direction, m.
-    pub long_short_m: f64,
-    /// Right (+) or left (−) of it, m.
-    pub left_right_m: f64,
-    /// Heading at touchdown minus upwind, degrees.
-    pub heading_vs_upwind_deg: f64,
-    /// Its conditions.
-    pub conditions: RunConditions,
-}
-
-/// Median, 95th percentile, maximum and mean of a sample.
-#[derive(Debug, Clone, Copy, Serialize, Default)]
-pub struct Stats {
-    /// Median.
-    pub median: f64,
-    /// 95th percentile (nearest rank).
-    pub p95: f64,
-    /// Largest.
-    pub max: f64,
-    /// Mean.
-    pub mean: f64,
-}
-
-impl Stats {
-    /// Statistics of `values` (NaN-free).
-    pub fn of(values: &[f64]) -> Self {
-        if values.is_empty() {
-            return Self::default();
-        }
-        let mut sorted = values.to_vec();
-        sorted.sort_by(f64::total_cmp);
-        let rank =
-            |q: f64| sorted[((q * sorted.len() as f64).ceil() as usize).clamp(1, sorted.len()) - 1];
-        Self {
-            median: if sorted.len() % 2 == 1 {
-                sorted[sorted.len() / 2]
-            } else {
-                0.5 * (sorted[sorted.len() / 2 - 1] + sorted[sorted.len() / 2])
-            },
-            p95: rank(0.95),
-            max: sorted[sorted.len() - 1],
-            mean: sorted.iter().sum::<f64>() / sorted.len() as f64,
-        }
-    }
-}
-
-/// The campaign's result (printed by `stx montecarlo --json`).
-#[derive(Debug, Clone, Serialize)]
-pub struct MonteCarloReport {
-    /// Runs flown.
-    pub runs: usize,
-    /// Campaign seed.
-    pub seed: u64,
-    /// Largest mean wind, m/s.
-    pub wind_max_mps: f64,
-    /// Release height above the target, m.
-    pub altitude_m: f64,
-    /// Whether guidance flared.
-    pub flare: bool,
-    /// Distance from the target at touchdown, m.
-    pub miss_m: Stats,
-    /// Share of touchdowns with the heading within 30° of upwind (runs in calm air, where no
-    /// upwind exists, count as into the wind).
-    pub into_wind_fraction: f64,
-    /// The same share with calm runs judged like the others, against the instantaneous wind
-    /// (gusts included) where they touched down.
-    pub into_wind_fraction_strict: f64,
-    /// Runs that touched down in calm air (mean wind below [`CALM_WIND_MPS`]).
-    pub calm_runs: usize,
-    /// Vertical speed at touchdown, m/s.
-    pub touchdown_vertical_speed_mps: Stats,
-    /// RMS of the wind-estimate error from 30 s after release, over all runs, m/s.
-    pub wind_estimate_rmse_mps: f64,
-    /// Per-run wind-estimate RMS errors, m/s.
-    pub wind_estimate_rmse_per_run_mps: Stats,
-    /// Runs in which guidance found the target out of reach.
-    pub unreachable_runs: usize,
-    /// Over those runs, the distance from the best reachable point guidance first announced
-    /// to the touchdown, m.
-    pub unreachable_from_best_m: Stats,
-    /// The same from the best reachable point announced last, m.
-    pub unreachable_from_last_best_m: Stats,
-    /// Runs that failed to fly (integration error), with their index and reason.
-    pub failed_runs: Vec<(usize, String)>,
-    /// Wall-clock time, s.
-    pub wall_time_s: f64,
-    /// The runs with the largest misses, worst first (at most [`WORST_RUNS`]).
-    pub worst: Vec<WorstRun>,
-    /// Every run.
-    pub results: Vec<RunResult>,
-}
-
 /// Below this mean surface wind, m/s (about 1 kn), the air counts as calm: weather reports
 /// (METAR) give a wind under 1 kn as calm, with no direction. Below it the gusts of a run outweigh its mean
 /// wind and turn the instantaneous wind through any direction in seconds, so "upwind" at
 /// touchdown is not something guidance could have known a final approach earlier.
 pub const CALM_WIND_MPS: f64 = 0.5;
-
-/// Largest angle between heading and upwind at touchdown that counts as into the wind, degrees.
-pub const INTO_WIND_DEG: f64 = 30.0;
-
-/// Share of `results` that touched down into the wind (within [`INTO_WIND_DEG`] of upwind);
-/// with `calm_counts`, runs in calm air count as into the wind whatever their heading.
-pub fn into_wind_fraction(results: &[RunResult], calm_counts: bool) -> f64 {
-    if results.is_empty() {
-        return 0.0;
-    }
-    let into_wind = results
-        .iter()
-        .filter(|r| (calm_counts && r.calm) || r.heading_vs_upwind_deg.abs() <= INTO_WIND_DEG)
-        .count();
-    into_wind as f64 / results.len() as f64
-}
-
-/// How many of the worst runs a report names.
-pub const WORST_RUNS: usize = 5;
 
 /// A steady glide (after the seed's initial conditions settle in still air), heading north at
 /// the origin: the template every run's release state is rotated and moved from.
@@ -410,8 +245,8 @@ pub fn run_one<N: Navigator>(
         0.0,
         guidance,
         navigator(&c)?,
-        crate::guided::STEP_S,
-        crate::guided::CONTROL_PERIOD_S,
+        STEP_S,
+        CONTROL_PERIOD_S,
     );
     let mut wind_error_sq = 0.0;
     let mut wind_samples = 0usize;
@@ -508,157 +343,4 @@ pub fn run_one<N: Navigator>(
         },
         track,
     })
-}
-
-/// Flies every run on `config.threads` threads, calling `progress(done)` as runs finish.
-pub fn run_all<N: Navigator>(
-    config: &MonteCarloConfig,
-    navigator: impl Fn(&RunConditions) -> Result<N, String> + Sync,
-    progress: impl Fn(usize) + Sync,
-) -> Result<MonteCarloReport, IntegrateError> {
-    let started = Instant::now();
-    let vehicle = Vehicle::straplex();
-    let template = steady_glide_state(&vehicle)?;
-    let next = AtomicUsize::new(0);
-    let done = AtomicUsize::new(0);
-    let mut outcomes: Vec<(usize, Result<RunResult, String>)> = std::thread::scope(|scope| {
-        let workers: Vec<_> = (0..config.threads.max(1))
-            .map(|_| {
-                scope.spawn(|| {
-                    let mut mine = Vec::new();
-                    loop {
-                        let index = match config.only_run {
-                            Some(only) if next.fetch_add(1, Ordering::Relaxed) == 0 => only,
-                            Some(_) => break mine,
-                            None => next.fetch_add(1, Ordering::Relaxed),
-                        };
-                        if index >= config.runs && config.only_run.is_none() {
-                            break mine;
-                        }
-                        mine.push((
-                            index,
-                            run_one(config, &vehicle, &template, index, &navigator),
-                        ));
-                        progress(done.fetch_add(1, Ordering::Relaxed) + 1);
-                    }
-                })
-            })
-            .collect();
-        workers
-            .into_iter()
-            .flat_map(|w| w.join().unwrap_or_default())
-            .collect()
-    });
-    outcomes.sort_by_key(|(i, _)| *i);
-    let mut results = Vec::new();
-    let mut failed_runs = Vec::new();
-    for (index, outcome) in outcomes {
-        match outcome {
-            Ok(r) => results.push(r),
-            Err(e) => failed_runs.push((index, e)),
-        }
-    }
-    let misses: Vec<f64> = results.iter().map(|r| r.miss_m).collect();
-    let speeds: Vec<f64> = results
-        .iter()
-        .map(|r| r.touchdown_vertical_speed_mps)
-        .collect();
-    let wind_errors: Vec<f64> = results.iter().map(|r| r.wind_estimate_rmse_mps).collect();
-    let pooled = if results.is_empty() {
-        0.0
-    } else {
-        (wind_errors.iter().map(|e| e * e).sum::<f64>() / wind_errors.len() as f64).sqrt()
-    };
-    let mut by_miss: Vec<&RunResult> = results.iter().collect();
-    by_miss.sort_by(|a, b| b.miss_m.total_cmp(&a.miss_m));
-    let worst = by_miss
-        .iter()
-        .take(WORST_RUNS)
-        .map(|r| WorstRun {
-            index: r.index,
-            miss_m: r.miss_m,
-            long_short_m: r.long_short_m,
-            left_right_m: r.left_right_m,
-            heading_vs_upwind_deg: r.heading_vs_upwind_deg,
-            conditions: r.conditions.clone(),
-        })
-        .collect();
-    Ok(MonteCarloReport {
-        runs: results.len() + failed_runs.len(),
-        seed: config.seed,
-        wind_max_mps: config.wind_max_mps,
-        altitude_m: config.altitude_m,
-        flare: config.flare,
-        miss_m: Stats::of(&misses),
-        into_wind_fraction: into_wind_fraction(&results, true),
-        into_wind_fraction_strict: into_wind_fraction(&results, false),
-        calm_runs: results.iter().filter(|r| r.calm).count(),
-        touchdown_vertical_speed_mps: Stats::of(&speeds),
-        wind_estimate_rmse_mps: pooled,
-        wind_estimate_rmse_per_run_mps: Stats::of(&wind_errors),
-        unreachable_runs: results.iter().filter(|r| r.unreachable).count(),
-        unreachable_from_best_m: Stats::of(
-            &results
-                .iter()
-                .filter_map(|r| r.from_best_reachable_m)
-                .collect::<Vec<_>>(),
-        ),
-        unreachable_from_last_best_m: Stats::of(
-            &results
-                .iter()
-                .filter_map(|r| r.from_last_best_reachable_m)
-                .collect::<Vec<_>>(),
-        ),
-        failed_runs,
-        wall_time_s: started.elapsed().as_secs_f64(),
-        worst,
-        results,
-    })
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn landed(heading_vs_upwind_deg: f64, calm: bool) -> RunResult {
-        RunResult {
-            index: 0,
-            conditions: conditions(&MonteCarloConfig::default(), 0),
-            miss_m: 1.0,
-            heading_vs_upwind_deg,
-            calm,
-            touchdown_vertical_speed_mps: 2.5,
-            wind_estimate_rmse_mps: 0.2,
-            unreachable: false,
-            best_reachable_ne_m: None,
-            from_best_reachable_m: None,
-            last_best_reachable_ne_m: None,
-            from_last_best_reachable_m: None,
-            flight_time_s: 200.0,
-            long_short_m: 0.0,
-            left_right_m: 0.0,
-            events: Vec::new(),
-            track: Vec::new(),
-        }
-    }
-
-    #[test]
-    fn into_the_wind_means_within_30_degrees_of_upwind_on_either_side() {
-        let runs = [
-            landed(29.0, false),
-            landed(-30.0, false),
-            landed(31.0, false),
-            landed(-179.0, false),
-        ];
-        assert_eq!(into_wind_fraction(&runs, true), 0.5);
-        assert_eq!(into_wind_fraction(&runs, false), 0.5);
-    }
-
-    #[test]
-    fn a_calm_touchdown_counts_as_into_the_wind_whatever_its_heading_except_when_strict() {
-        let runs = [landed(150.0, true), landed(150.0, false)];
-        assert_eq!(into_wind_fraction(&runs, true), 0.5);
-        assert_eq!(into_wind_fraction(&runs, false), 0.0);
-        assert_eq!(into_wind_fraction(&[], true), 0.0);
-    }
 }
