@@ -56,7 +56,8 @@ pub enum IndexSource {
     Summary,
     /// A pass over the file, which has no (readable) summary.
     Scan {
-        /// Offset of the record the file ends inside, if it was cut.
+        /// Where the file stops short of a whole data section (the offset of the record it
+        /// ends inside, or its length); `None` when only the summary is unreadable.
         cut_at: Option<u64>,
         /// Whole chunks that could not be read, skipped.
         bad_chunks: u32,

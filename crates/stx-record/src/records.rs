@@ -9,6 +9,7 @@ use std::io::{self, Read};
 use std::sync::Arc;
 
 use mcap::records::{ChunkHeader, Record, op};
+use mcap::sans_io::{LinearReadEvent, LinearReader, LinearReaderOptions};
 use mcap::{Channel, McapError, Schema};
 
 /// The largest chunk we decompress, B: stx writes chunks of about 1 MiB and other writers
@@ -26,10 +27,11 @@ pub(crate) enum Step {
         opcode: u8,
         body: Vec<u8>,
     },
-    /// The file ends inside the record at `offset`; `body` is what there is of it.
+    /// The file ends inside the record at `offset` of `declared_len` bytes (when its length
+    /// could be read); `body` is what there is of it.
     Cut {
-        offset: u64,
         opcode: Option<u8>,
+        declared_len: u64,
         body: Vec<u8>,
     },
 }
@@ -59,6 +61,11 @@ impl<R: Read> Walk<R> {
         }))
     }
 
+    /// Where the walk is: the offset after the last whole record (the start of a cut one).
+    pub(crate) fn offset(&self) -> u64 {
+        self.offset
+    }
+
     /// The next record; `None` at the end of the stream, and after a footer or a cut record.
     pub(crate) fn next_step(&mut self) -> io::Result<Option<Step>> {
         if self.done {
@@ -77,8 +84,8 @@ impl<R: Read> Walk<R> {
         let Ok(len_bytes) = <[u8; 8]>::try_from(prefix.get(1..9).unwrap_or_default()) else {
             self.done = true;
             return Ok(Some(Step::Cut {
-                offset,
                 opcode: Some(opcode),
+                declared_len: 0,
                 body: Vec::new(),
             }));
         };
@@ -89,8 +96,8 @@ impl<R: Read> Walk<R> {
         if (body.len() as u64) < len {
             self.done = true;
             return Ok(Some(Step::Cut {
-                offset,
                 opcode: Some(opcode),
+                declared_len: len,
                 body,
             }));
         }
@@ -113,63 +120,120 @@ pub(crate) struct ChunkContents {
     pub(crate) error: Option<McapError>,
 }
 
-/// The records of a whole chunk record's `body`, its CRC checked (a CRC mismatch is in
-/// `error`; the records read before it are not to be trusted then).
-pub(crate) fn whole_chunk(body: &[u8]) -> ChunkContents {
-    match mcap::parse_record(op::CHUNK, body) {
-        Ok(Record::Chunk { header, data }) => read_chunk(header, &data),
-        Ok(_) => ChunkContents {
-            header: None,
-            records: Vec::new(),
-            error: Some(McapError::BadIndex),
-        },
-        Err(e) => ChunkContents {
-            header: None,
-            records: Vec::new(),
-            error: Some(e),
-        },
-    }
+/// Decodes chunk records with one `mcap` sans-io reader kept across chunks, so its
+/// decompressors are made once, not once a chunk.
+pub(crate) struct ChunkDecoder {
+    reader: LinearReader,
 }
 
-/// What can be read from the first `body.len()` bytes of a chunk record: the records that
-/// decompress whole from the bytes present (a true prefix of the chunk, though its CRC,
-/// which covers the whole chunk, cannot be checked).
-pub(crate) fn cut_chunk(body: &[u8]) -> ChunkContents {
-    match parse_chunk_header(body) {
-        Some((header, data_start)) => read_chunk(header, &body[data_start..]),
-        None => ChunkContents {
-            header: None,
-            records: Vec::new(),
-            error: Some(McapError::UnexpectedEof),
-        },
+impl ChunkDecoder {
+    pub(crate) fn new() -> Self {
+        Self {
+            reader: Self::fresh(),
+        }
     }
-}
 
-fn read_chunk(header: ChunkHeader, data: &[u8]) -> ChunkContents {
-    let mut contents = ChunkContents {
-        header: Some(header.clone()),
-        records: Vec::new(),
-        error: None,
-    };
-    if header.uncompressed_size > MAX_CHUNK_BYTES {
-        contents.error = Some(McapError::ChunkTooLarge(header.uncompressed_size));
-        return contents;
+    fn fresh() -> LinearReader {
+        LinearReader::new_with_options(
+            LinearReaderOptions::default()
+                .with_skip_start_magic(true)
+                .with_skip_end_magic(true)
+                .with_validate_chunk_crcs(true)
+                .with_record_length_limit(MAX_CHUNK_BYTES as usize),
+        )
     }
-    match mcap::read::ChunkReader::new(header, data) {
-        Ok(reader) => {
-            for record in reader {
-                match record {
-                    Ok(r) => contents.records.push(r.into_owned()),
-                    Err(e) => {
-                        contents.error = Some(e);
-                        break;
+
+    /// The records of a whole chunk record's `body`, its CRC checked. With an `error`, the
+    /// records are not to be trusted (the CRC is checked after they decompress).
+    pub(crate) fn whole(&mut self, body: &[u8]) -> ChunkContents {
+        let header = parse_chunk_header(body);
+        // The compressed data must fill the record exactly, or the reader would run on into
+        // whatever we feed it next.
+        match header {
+            Some((header, data_start))
+                if data_start as u64 + header.compressed_size == body.len() as u64 =>
+            {
+                self.decode(header, body.len() as u64, body, true)
+            }
+            Some((header, _)) => ChunkContents {
+                header: Some(header),
+                records: Vec::new(),
+                error: Some(McapError::BadChunkLength {
+                    header: body.len() as u64,
+                    available: body.len() as u64,
+                }),
+            },
+            None => ChunkContents {
+                header: None,
+                records: Vec::new(),
+                error: Some(McapError::UnexpectedEof),
+            },
+        }
+    }
+
+    /// What can be read from the first `body.len()` bytes of a chunk record of `declared_len`
+    /// bytes: the records that decompress whole from the bytes present (a true prefix of the
+    /// chunk, though its CRC, which covers the whole chunk, cannot be checked).
+    pub(crate) fn cut(&mut self, declared_len: u64, body: &[u8]) -> ChunkContents {
+        match parse_chunk_header(body) {
+            Some((header, _)) => self.decode(header, declared_len, body, false),
+            None => ChunkContents {
+                header: None,
+                records: Vec::new(),
+                error: Some(McapError::UnexpectedEof),
+            },
+        }
+    }
+
+    fn decode(
+        &mut self,
+        header: ChunkHeader,
+        declared_len: u64,
+        body: &[u8],
+        whole: bool,
+    ) -> ChunkContents {
+        let mut contents = ChunkContents {
+            header: Some(header.clone()),
+            records: Vec::new(),
+            error: None,
+        };
+        if header.uncompressed_size > MAX_CHUNK_BYTES {
+            contents.error = Some(McapError::ChunkTooLarge(header.uncompressed_size));
+            return contents;
+        }
+        let mut prefix = [0u8; RECORD_PREFIX as usize];
+        prefix[0] = op::CHUNK;
+        prefix[1..].copy_from_slice(&declared_len.to_le_bytes());
+        for part in [&prefix[..], body] {
+            self.reader.insert(part.len()).copy_from_slice(part);
+            self.reader.notify_read(part.len());
+        }
+        // Records until the reader asks for more: the chunk is done (whole), or the bytes
+        // present are used up (cut).
+        while let Some(event) = self.reader.next_event() {
+            match event {
+                Ok(LinearReadEvent::Record { data, opcode }) => {
+                    match mcap::parse_record(opcode, data) {
+                        Ok(record) => contents.records.push(record.into_owned()),
+                        Err(e) => {
+                            contents.error = Some(e);
+                            break;
+                        }
                     }
+                }
+                Ok(LinearReadEvent::ReadRequest(_)) => break,
+                Err(e) => {
+                    contents.error = Some(e);
+                    break;
                 }
             }
         }
-        Err(e) => contents.error = Some(e),
+        if contents.error.is_some() || !whole {
+            // Mid-chunk or failed: the next chunk needs a reader in a known state.
+            self.reader = Self::fresh();
+        }
+        contents
     }
-    contents
 }
 
 /// The schemas and channels met so far, linked as `mcap`'s messages want them.
@@ -257,10 +321,8 @@ mod tests {
         let mut bytes = mcap::MAGIC.to_vec();
         bytes.extend([op::METADATA, 5, 0, 0]);
         let mut walk = Walk::new(&bytes[..]).unwrap().unwrap();
-        assert!(matches!(
-            walk.next_step().unwrap(),
-            Some(Step::Cut { offset: 8, .. })
-        ));
+        assert!(matches!(walk.next_step().unwrap(), Some(Step::Cut { .. })));
+        assert_eq!(walk.offset(), 8);
         assert!(walk.next_step().unwrap().is_none());
 
         let mut bytes = mcap::MAGIC.to_vec();
@@ -276,7 +338,7 @@ mod tests {
 
     #[test]
     fn a_chunk_header_cut_short_reads_nothing() {
-        let contents = cut_chunk(&[0; 20]);
+        let contents = ChunkDecoder::new().cut(1000, &[0; 20]);
         assert!(contents.records.is_empty());
         assert!(contents.error.is_some());
     }

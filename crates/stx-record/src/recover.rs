@@ -17,7 +17,7 @@ use mcap::records::{Record, op};
 use mcap::{Attachment, McapError, Message, Writer};
 use thiserror::Error;
 
-use crate::records::{Catalog, ChunkContents, Step, Walk, cut_chunk, whole_chunk};
+use crate::records::{Catalog, ChunkContents, ChunkDecoder, Step, Walk};
 
 /// Why a recovery failed.
 #[derive(Debug, Error)]
@@ -48,10 +48,10 @@ pub struct RecoverReport {
     pub orphan_messages: u64,
     /// Metadata records copied.
     pub metadata: u64,
-    /// Where the input was cut (the offset of the record it ends inside), if it was.
+    /// Where the input stops short of a whole data section: the offset of the record it ends
+    /// inside, or its length if it ends between records. `None`: the data section was whole
+    /// (the input reached its data-end record).
     pub cut_at: Option<u64>,
-    /// Whether the input's data section was whole (it reached its data-end record).
-    pub data_section_whole: bool,
 }
 
 /// Copies what can be read of the recording in `input` to `output`, finished.
@@ -75,10 +75,12 @@ pub fn recover<R: Read, W: Write + Seek>(
         catalog: Catalog::default(),
         report: RecoverReport::default(),
     };
+    let mut data_end = false;
+    let mut decoder = ChunkDecoder::new();
     while let Some(step) = walk.next_step().map_err(RecoverError::Read)? {
         match step {
             Step::Whole { opcode, body, .. } if opcode == op::CHUNK => {
-                let contents = whole_chunk(&body);
+                let contents = decoder.whole(&body);
                 if contents.error.is_some() {
                     copy.report.bad_chunks += 1;
                 } else {
@@ -87,7 +89,7 @@ pub fn recover<R: Read, W: Write + Seek>(
                 }
             }
             Step::Whole { opcode, .. } if opcode == op::DATA_END => {
-                copy.report.data_section_whole = true;
+                data_end = true;
                 break;
             }
             Step::Whole { opcode, body, .. } => match mcap::parse_record(opcode, &body) {
@@ -96,16 +98,18 @@ pub fn recover<R: Read, W: Write + Seek>(
                 Err(_) => continue,
             },
             Step::Cut {
-                offset,
                 opcode,
+                declared_len,
                 body,
             } => {
-                copy.report.cut_at = Some(offset);
                 if opcode == Some(op::CHUNK) {
-                    copy.chunk(cut_chunk(&body), true)?;
+                    copy.chunk(decoder.cut(declared_len, &body), true)?;
                 }
             }
         }
+    }
+    if !data_end {
+        copy.report.cut_at = Some(walk.offset());
     }
     let writer = copy.writer()?;
     writer.finish().map_err(RecoverError::Write)?;

@@ -11,13 +11,14 @@ use mcap::records::{ChunkIndex, Metadata, Record, Statistics, op};
 use mcap::{McapError, Summary};
 
 use crate::read::ReadError;
-use crate::records::{Catalog, Step, Walk, whole_chunk};
+use crate::records::{Catalog, ChunkDecoder, Step, Walk};
 
 /// What the scan found.
 pub(crate) struct Scanned {
     pub(crate) summary: Summary,
     pub(crate) metadata: Vec<Metadata>,
-    /// Offset of the record the file ends inside, if it is cut.
+    /// Where the file stops short of a whole data section (the offset of the record it ends
+    /// inside, or its length); `None` when the data section is whole.
     pub(crate) cut_at: Option<u64>,
     /// Whole chunks that could not be read (bad CRC, bad compression), skipped.
     pub(crate) bad_chunks: u32,
@@ -26,11 +27,12 @@ pub(crate) struct Scanned {
 pub(crate) fn scan(reader: impl Read) -> Result<Scanned, ReadError> {
     let mut walk = Walk::new(reader)?.ok_or(ReadError::NotMcap)?;
     let mut catalog = Catalog::default();
+    let mut decoder = ChunkDecoder::new();
     let mut chunk_indexes = Vec::new();
     let mut metadata = Vec::new();
     let mut counts: BTreeMap<u16, u64> = BTreeMap::new();
     let mut bounds: Option<(u64, u64)> = None;
-    let mut cut_at = None;
+    let mut data_end = false;
     let mut bad_chunks = 0;
     while let Some(step) = walk.next_step()? {
         let (offset, opcode, body) = match step {
@@ -39,14 +41,11 @@ pub(crate) fn scan(reader: impl Read) -> Result<Scanned, ReadError> {
                 opcode,
                 body,
             } => (offset, opcode, body),
-            Step::Cut { offset, .. } => {
-                cut_at = Some(offset);
-                break;
-            }
+            Step::Cut { .. } => break,
         };
         match opcode {
             op::CHUNK => {
-                let contents = whole_chunk(&body);
+                let contents = decoder.whole(&body);
                 let Some(header) = contents.header.filter(|_| contents.error.is_none()) else {
                     bad_chunks += 1;
                     continue;
@@ -84,10 +83,14 @@ pub(crate) fn scan(reader: impl Read) -> Result<Scanned, ReadError> {
             }
             op::MESSAGE => return Err(ReadError::NotChunked { offset }),
             // The data section ends here; what follows is a summary that did not read.
-            op::DATA_END => break,
+            op::DATA_END => {
+                data_end = true;
+                break;
+            }
             _ => {}
         }
     }
+    let cut_at = (!data_end).then(|| walk.offset());
     let (message_start_time, message_end_time) = bounds.unwrap_or((0, 0));
     let stats = Statistics {
         message_count: counts.values().sum(),
