@@ -29,9 +29,15 @@ pub struct Made {
     pub written: Vec<Written>,
 }
 
-pub const TOPICS: [&str; 4] = ["/vehicle/fix", "/events", "/mavlink", "/estimate"];
+pub const TOPICS: [&str; 5] = [
+    "/vehicle/fix",
+    "/events",
+    "/mavlink",
+    "/estimate",
+    "/vehicle/attitude",
+];
 
-/// `n` messages over the four channels, one every `step_ms` of the core's clock (chunks close
+/// `n` messages over the five channels (in turn), one every `step_ms` of the core's clock (chunks close
 /// each second or at `chunk_bytes`); log times are the clock, so they rise with the file.
 pub fn make(n: u64, step_ms: u64, chunk_bytes: u64, compression: Compression) -> Made {
     let options = CoreOptions {
@@ -53,17 +59,18 @@ pub fn make(n: u64, step_ms: u64, chunk_bytes: u64, compression: Compression) ->
             &json!({"type": "object", "properties": {"i": {"type": "integer"}}}),
         )
         .unwrap(),
+        foxglove::frame_transform_channel(TOPICS[4]).unwrap(),
     ];
     let ids: Vec<_> = specs
         .into_iter()
         .map(|s| core.add_channel(Duration::ZERO, s).unwrap())
         .collect();
-    let mut sequences = [0u32; 4];
+    let mut sequences = [0u32; 5];
     let mut written = Vec::new();
     for i in 0..n {
         let now = Duration::from_millis(i * step_ms);
         let log_time = T0 + now.as_nanos() as u64;
-        let k = (i % 4) as usize;
+        let k = (i % 5) as usize;
         let data = payload(k, i, log_time);
         core.write(now, ids[k], log_time, log_time, &data).unwrap();
         written.push(Written {
@@ -84,6 +91,11 @@ pub fn make(n: u64, step_ms: u64, chunk_bytes: u64, compression: Compression) ->
         }
     }
     Made { bytes, written }
+}
+
+/// The bytes of the MAVLink frame written as message `i`.
+pub fn frame_bytes(i: u64) -> Vec<u8> {
+    (0..(12 + i % 40)).map(|b| (b * 7 + i) as u8).collect()
 }
 
 fn payload(k: usize, i: u64, log_time: u64) -> Vec<u8> {
@@ -108,11 +120,25 @@ fn payload(k: usize, i: u64, log_time: u64) -> Vec<u8> {
             line: 0,
         })
         .unwrap(),
-        2 => {
-            let frame: Vec<u8> = (0..(12 + i % 40)).map(|b| (b * 7 + i) as u8).collect();
-            MavlinkFrame::encode(Direction::Rx, (i % 2) as u16, log_time, &frame)
-        }
-        _ => serde_json::to_vec(&json!({"i": i})).unwrap(),
+        2 => MavlinkFrame::encode(Direction::Rx, (i % 2) as u16, log_time, &frame_bytes(i)),
+        3 => serde_json::to_vec(&json!({"i": i})).unwrap(),
+        _ => serde_json::to_vec(&foxglove::FrameTransform {
+            timestamp: ts,
+            parent_frame_id: "mission".into(),
+            child_frame_id: "vehicle".into(),
+            translation: foxglove::Vector3 {
+                x: i as f64,
+                y: 0.5,
+                z: -(i as f64),
+            },
+            rotation: foxglove::Quaternion {
+                x: 0.0,
+                y: 0.0,
+                z: (i as f64 * 0.01).sin(),
+                w: (i as f64 * 0.01).cos(),
+            },
+        })
+        .unwrap(),
     }
 }
 
