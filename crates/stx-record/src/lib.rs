@@ -18,7 +18,7 @@
 //!   directory unless the station says otherwise.
 //! - Reading. [`Recording`] ([`read`]) lists channels, counts, time range and metadata from
 //!   the file's summary (or, for a file cut before its summary, from one scan of it —
-//!   [`scan`]) and iterates messages in log-time order from any time through the chunk
+//!   `read::scan`) and iterates messages in log-time order from any time through the chunk
 //!   indexes. [`recover()`] ([`recover`]) writes a clean, finished copy of a cut file.
 //!   Both walk cut files with [`records`].
 //!
@@ -33,7 +33,6 @@ pub mod info;
 pub mod read;
 mod records;
 pub mod recover;
-mod scan;
 pub mod status;
 
 pub use channel::{ChannelError, ChannelId, ChannelSpec};

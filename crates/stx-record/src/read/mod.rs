@@ -1,7 +1,7 @@
 //! Reading a recording: what it holds, from its summary (an index read at the end of the
 //! file, not a scan) when the file is whole, or from one pass over it when it is not; and
 //! its messages in log-time order from any time, through the chunk indexes, so a seek reads
-//! only the chunks after it.
+//! only the chunks after it. A file without summary is indexed by [`scan`].
 
 use std::collections::HashMap;
 use std::fs::File;
@@ -15,39 +15,15 @@ use mcap::sans_io::{
     SummaryReaderOptions,
 };
 use mcap::{McapError, Summary};
-use thiserror::Error;
 
 use crate::info::RecordingInfo;
 use crate::records::MAX_CHUNK_BYTES;
-use crate::scan::scan;
+use scan::scan;
 
-/// Why a recording could not be read.
-#[derive(Debug, Error)]
-pub enum ReadError {
-    /// The file could not be read.
-    #[error("reading the recording: {0}")]
-    Io(#[from] io::Error),
-    /// The file does not start with MCAP's magic bytes.
-    #[error("not an MCAP file (no MCAP magic at its start)")]
-    NotMcap,
-    /// A message outside any chunk: this reader seeks through chunks only.
-    #[error("message outside a chunk at byte {offset}: rewrite the file with `stx record recover`")]
-    NotChunked {
-        /// Offset of the message record.
-        offset: u64,
-    },
-    /// A record that does not parse.
-    #[error("malformed record at byte {offset}: {source}")]
-    Corrupt {
-        /// Offset of the record.
-        offset: u64,
-        /// What `mcap` said.
-        source: McapError,
-    },
-    /// `mcap` refused the file's index or a chunk.
-    #[error("MCAP: {0}")]
-    Mcap(#[from] McapError),
-}
+mod error;
+mod scan;
+
+pub use error::ReadError;
 
 /// Where a recording's index came from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

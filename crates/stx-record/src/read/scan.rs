@@ -10,7 +10,7 @@ use std::io::Read;
 use mcap::records::{ChunkIndex, Metadata, Record, Statistics, op};
 use mcap::{McapError, Summary};
 
-use crate::read::ReadError;
+use super::error::ReadError;
 use crate::records::{Catalog, ChunkDecoder, Step, Walk};
 
 /// What the scan found.
