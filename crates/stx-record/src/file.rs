@@ -25,8 +25,8 @@ use std::time::{Duration, Instant, SystemTime};
 use serde::Serialize;
 
 use crate::channel::ChannelId;
-use crate::core::{Output, RecorderCore};
 use crate::status::{IssueKind, RecorderStatus, Shared};
+use crate::writer::{Output, RecorderCore};
 
 /// Name of the recordings directory inside the station's state directory.
 pub const RECORDINGS_DIR_NAME: &str = "recordings";
@@ -340,7 +340,7 @@ impl Writer {
                     {
                         self.shared.lost(1);
                         self.shared.report(IssueKind::Core, e.to_string());
-                        if matches!(e, crate::core::WriteError::Mcap(_)) {
+                        if matches!(e, crate::writer::WriteError::Mcap(_)) {
                             let _ = self.core.start_new_file(now);
                         }
                     }
@@ -353,7 +353,15 @@ impl Writer {
                     self.apply_outputs();
                     let _ = ack.send(());
                 }
-                Ok(Command::Finish) | Err(RecvTimeoutError::Disconnected) => break,
+                Ok(Command::Finish) | Err(RecvTimeoutError::Disconnected) => {
+                    // Messages other handles queued after the finish will not be written.
+                    let late = rx
+                        .try_iter()
+                        .filter(|c| matches!(c, Command::Message { .. }))
+                        .count();
+                    self.shared.lost(late as u64);
+                    break;
+                }
                 Err(RecvTimeoutError::Timeout) => {
                     let now = self.now();
                     if let Err(e) = self.core.handle_timeout(now) {
@@ -386,6 +394,7 @@ impl Writer {
                 Output::StartFile { part } => self.open(part),
                 Output::Bytes { data, messages } => self.append(&data, messages),
                 Output::EndFile => self.close(),
+                Output::Lost { messages } => self.shared.lost(messages),
             }
         }
     }

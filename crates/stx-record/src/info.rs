@@ -92,7 +92,7 @@ impl RecordingInfo {
         }
     }
 
-    /// Reads back what [`Self::to_metadata`] wrote, with the file's part number; `None` when
+    /// Reads back what the recorder wrote, with the file's part number; `None` when
     /// the record is not stx's.
     pub fn from_metadata(record: &mcap::records::Metadata) -> Option<(Self, u32)> {
         if record.name != METADATA_NAME {

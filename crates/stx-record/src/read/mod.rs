@@ -1,7 +1,7 @@
 //! Reading a recording: what it holds, from its summary (an index read at the end of the
 //! file, not a scan) when the file is whole, or from one pass over it when it is not; and
 //! its messages in log-time order from any time, through the chunk indexes, so a seek reads
-//! only the chunks after it. A file without summary is indexed by [`scan`].
+//! only the chunks after it. A file without summary is indexed by one pass over it (`scan`).
 
 use std::collections::HashMap;
 use std::fs::File;

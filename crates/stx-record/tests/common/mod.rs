@@ -88,6 +88,7 @@ pub fn make(n: u64, step_ms: u64, chunk_bytes: u64, compression: Compression) ->
             Output::Bytes { data, .. } => bytes.extend(data),
             Output::StartFile { part } => assert_eq!(part, 1, "one file"),
             Output::EndFile => {}
+            Output::Lost { messages } => panic!("{messages} messages lost"),
         }
     }
     Made { bytes, written }

@@ -56,6 +56,7 @@ fn files(outputs: &[Output]) -> Vec<Vec<u8>> {
                 files.last_mut().expect("bytes before a file").extend(data)
             }
             Output::EndFile => {}
+            Output::Lost { messages } => panic!("{messages} messages lost"),
         }
     }
     files

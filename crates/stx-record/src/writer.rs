@@ -85,6 +85,12 @@ pub enum Output {
     },
     /// The current file is whole (the last bytes were its summary and footer): close it.
     EndFile,
+    /// `messages` accepted earlier will be in no file: the MCAP writer failed with their
+    /// chunk open. The adapter counts them lost.
+    Lost {
+        /// Messages lost.
+        messages: u64,
+    },
 }
 
 /// Why the core refused a call.
@@ -380,7 +386,10 @@ impl RecorderCore {
     fn close_chunk(&mut self, now: Duration) -> Result<(), WriteError> {
         let messages = self.chunk.take().map_or(0, |c| c.messages);
         let writer = self.writer.as_mut().ok_or(WriteError::Finished)?;
-        writer.flush()?;
+        if let Err(e) = writer.flush() {
+            self.output.push_back(Output::Lost { messages });
+            return Err(e.into());
+        }
         self.stats.chunks += 1;
         self.emit(messages);
         let too_big = self
@@ -404,7 +413,13 @@ impl RecorderCore {
             Some(mut writer) => writer.finish().map(|_| ()).map_err(WriteError::from),
             None => Ok(()),
         };
-        self.emit(messages);
+        if result.is_ok() {
+            self.emit(messages);
+        } else {
+            // Whatever the failed writer left is no file; its open chunk is lost.
+            self.emit(0);
+            self.output.push_back(Output::Lost { messages });
+        }
         self.output.push_back(Output::EndFile);
         result
     }
