@@ -10,7 +10,8 @@
 //! [`RecorderConfig::log_every`].
 //!
 //! Files are named by the run's start (UTC) and part number —
-//! `stx-20261105T143012Z-001.mcap` — in the directory the caller chose, by default
+//! `stx-20261105T143012Z-001.mcap`; a failed attempt uses up its number — in the directory
+//! the caller chose, by default
 //! [`recordings_dir`] of the station's state directory. Each chunk is one `write` to the OS,
 //! so a killed process leaves whole chunks behind; files are synced when they end.
 

@@ -264,9 +264,9 @@ impl RecorderCore {
             log_time,
             publish_time,
         };
-        ch.sequence = ch.sequence.wrapping_add(1);
         let writer = self.writer.as_mut().ok_or(WriteError::Finished)?;
         writer.write_to_known_channel(&header, payload)?;
+        ch.sequence = ch.sequence.wrapping_add(1);
         self.stats.messages += 1;
         let chunk = self.chunk.get_or_insert(OpenChunk {
             opened: now,

@@ -103,6 +103,17 @@ impl<R: Read + Seek> Recording<R> {
         });
         let (summary, metadata, index) = match indexed {
             Some(summary) => {
+                // An index pointing past the end of the file is corruption, caught here
+                // rather than as a short read in the middle of a replay.
+                for chunk in &summary.chunk_indexes {
+                    let end = chunk.chunk_start_offset.checked_add(chunk.chunk_length);
+                    if end.is_none_or(|end| end > len) {
+                        return Err(ReadError::Corrupt {
+                            offset: chunk.chunk_start_offset,
+                            source: McapError::BadIndex,
+                        });
+                    }
+                }
                 let metadata = read_metadata(&mut source, &summary, len)?;
                 (summary, metadata, IndexSource::Summary)
             }
