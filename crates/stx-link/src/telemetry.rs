@@ -163,6 +163,7 @@ impl VehicleStatus {
 
 /// GNSS fix type (GPS_FIX_TYPE).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(rename_all = "snake_case")]
 pub enum GpsFix {
     NoGps,

@@ -35,7 +35,15 @@ use tower_http::services::{ServeDir, ServeFile};
 
 use crate::config::{Role, StationConfig};
 use crate::core::{ApiError, CommandRequest, LinkAction, StationCore};
-use crate::messages::{ErrorBody, Session, StationInfo};
+use crate::messages::{ErrorBody, EventMsg, Level, Session, StationInfo};
+use crate::replies::{
+    ClientView, ClientsBody, CommandAccepted, EventsBody, HelloMsg, HistoryMsg, LaggedMsg, PongMsg,
+    TrackBody,
+};
+use crate::requests::{
+    ClientMessage, ConfirmBody, CourseBody, HeadingBody, LocalizerBody, ModeBody, ParamBody,
+    PlanBody, PlanItemBody, TargetBody,
+};
 
 /// What the daemon's link task is asked to do.
 #[derive(Debug, Clone, PartialEq)]
@@ -118,21 +126,21 @@ pub struct ClientCounters {
 }
 
 impl ClientCounters {
-    fn view(&self, id: u64, total: u64) -> serde_json::Value {
+    fn view(&self, id: u64, total: u64) -> ClientView {
         let n = |c: &AtomicU64| c.load(Ordering::Relaxed);
         let done = self.base + n(&self.messages_sent) + n(&self.messages_missed);
-        serde_json::json!({
-            "messages_behind": total.saturating_sub(done),
-            "id": id,
-            "name": self.name,
-            "role": self.role,
-            "connected_s": self.connected_s,
-            "states_sent": n(&self.states_sent),
-            "states_coalesced": n(&self.states_coalesced),
-            "messages_sent": n(&self.messages_sent),
-            "messages_missed": n(&self.messages_missed),
-            "lag_episodes": n(&self.lag_episodes),
-        })
+        ClientView {
+            id,
+            name: self.name.clone(),
+            role: self.role,
+            connected_s: self.connected_s,
+            states_sent: n(&self.states_sent),
+            states_coalesced: n(&self.states_coalesced),
+            messages_sent: n(&self.messages_sent),
+            messages_missed: n(&self.messages_missed),
+            messages_behind: total.saturating_sub(done),
+            lag_episodes: n(&self.lag_episodes),
+        }
     }
 }
 
@@ -368,14 +376,14 @@ async fn api_not_found(uri: axum::http::Uri) -> HttpError {
 }
 
 async fn clients(State(state): State<AppState>, _caller: Caller) -> Response {
-    let list: Vec<serde_json::Value> = state
+    let clients = state
         .clients
         .lock()
         .unwrap_or_else(|e| e.into_inner())
         .iter()
         .map(|(id, c)| c.view(*id, state.broadcast_total.load(Ordering::Relaxed)))
         .collect();
-    Json(serde_json::json!({ "clients": list })).into_response()
+    Json(ClientsBody { clients }).into_response()
 }
 
 async fn session(State(state): State<AppState>, caller: Caller) -> Json<Session> {
@@ -406,7 +414,7 @@ async fn events(
     let events = state
         .core()
         .events_since(q.since_s.unwrap_or(f64::NEG_INFINITY));
-    Json(serde_json::json!({ "events": events })).into_response()
+    Json(EventsBody { events }).into_response()
 }
 
 #[derive(Deserialize)]
@@ -420,7 +428,7 @@ async fn track(
     Query(q): Query<EveryQuery>,
 ) -> Response {
     let points = state.core().track(q.every_s.unwrap_or(0.0).max(0.0));
-    Json(serde_json::json!({ "points": points })).into_response()
+    Json(TrackBody { points }).into_response()
 }
 
 async fn command_result(
@@ -471,7 +479,10 @@ async fn queue(
         })?;
     Ok((
         StatusCode::ACCEPTED,
-        Json(serde_json::json!({ "request_id": request_id, "status": "sent" })),
+        Json(CommandAccepted {
+            request_id,
+            status: "sent",
+        }),
     )
         .into_response())
 }
@@ -492,22 +503,10 @@ async fn command<B: CommandBody>(
     submit(&state, &caller, request).await
 }
 
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct ModeBody {
-    mode: FlightMode,
-}
-
 impl CommandBody for ModeBody {
     fn into_request(self) -> CommandRequest {
         CommandRequest::Mode(self.mode)
     }
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct HeadingBody {
-    heading_deg: f64,
 }
 
 impl CommandBody for HeadingBody {
@@ -518,28 +517,12 @@ impl CommandBody for HeadingBody {
     }
 }
 
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct CourseBody {
-    course_deg: f64,
-}
-
 impl CommandBody for CourseBody {
     fn into_request(self) -> CommandRequest {
         CommandRequest::Course {
             course_deg: self.course_deg,
         }
     }
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct LocalizerBody {
-    lat_deg: f64,
-    lon_deg: f64,
-    course_deg: f64,
-    #[serde(default)]
-    glide_slope: Option<f64>,
 }
 
 impl CommandBody for LocalizerBody {
@@ -553,16 +536,6 @@ impl CommandBody for LocalizerBody {
     }
 }
 
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct TargetBody {
-    lat_deg: f64,
-    lon_deg: f64,
-    alt_msl_m: f64,
-    #[serde(default)]
-    approach_course_deg: Option<f64>,
-}
-
 impl CommandBody for TargetBody {
     fn into_request(self) -> CommandRequest {
         CommandRequest::Target {
@@ -572,30 +545,6 @@ impl CommandBody for TargetBody {
             approach_course_deg: self.approach_course_deg,
         }
     }
-}
-
-/// A plan item as the API spells it (`approach_course_deg`, like the target endpoint).
-#[derive(Deserialize)]
-#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
-enum PlanItemBody {
-    Waypoint {
-        lat_deg: f64,
-        lon_deg: f64,
-        alt_msl_m: f64,
-    },
-    Land {
-        lat_deg: f64,
-        lon_deg: f64,
-        alt_msl_m: f64,
-        #[serde(default)]
-        approach_course_deg: Option<f64>,
-    },
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct PlanBody {
-    items: Vec<PlanItemBody>,
 }
 
 impl CommandBody for PlanBody {
@@ -630,12 +579,6 @@ impl CommandBody for PlanBody {
     }
 }
 
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct ParamBody {
-    value: f64,
-}
-
 async fn set_param(
     State(state): State<AppState>,
     caller: Caller,
@@ -660,12 +603,6 @@ async fn arm_cutdown(State(state): State<AppState>, caller: Caller) -> Result<Re
     let now = state.now_s();
     let arm = state.core().arm_cutdown(now, &caller.name);
     Ok(Json(arm).into_response())
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct ConfirmBody {
-    arm_id: String,
 }
 
 async fn confirm_cutdown(
@@ -760,26 +697,6 @@ async fn websocket(
     upgrade.on_upgrade(move |socket| serve_socket(state, caller, socket))
 }
 
-#[derive(Deserialize)]
-#[serde(tag = "type", rename_all = "snake_case")]
-enum ClientMessage {
-    Manual {
-        #[serde(default)]
-        x: f64,
-        #[serde(default)]
-        y: f64,
-        #[serde(default)]
-        z: f64,
-        #[serde(default)]
-        r: f64,
-        #[serde(default)]
-        buttons: u32,
-    },
-    /// The dead-man was let go or the page lost focus: stop the sticks now.
-    ManualRelease,
-    Ping,
-}
-
 async fn serve_socket(state: AppState, caller: Caller, mut socket: WebSocket) {
     let mut updates = state.broadcast.subscribe();
     let base = state.broadcast_total.load(Ordering::Relaxed);
@@ -801,19 +718,24 @@ async fn serve_socket(state: AppState, caller: Caller, mut socket: WebSocket) {
     let greeting = {
         let now = state.now_s();
         let core = state.core();
-        let hello = serde_json::json!({ "type": "hello", "session": session_of(&state, &caller),
-            "role": caller.role, "name": caller.name });
-        let history = serde_json::json!({
-            "type": "history",
-            "track": core.track(1.0),
-            "events": core.events_since(f64::NEG_INFINITY).into_iter().rev().take(500).rev().collect::<Vec<_>>(),
-            "states": core.history(),
-        });
+        let hello = HelloMsg {
+            kind: "hello",
+            session: session_of(&state, &caller),
+            role: caller.role,
+            name: caller.name.clone(),
+        };
+        let mut events = core.events_since(f64::NEG_INFINITY);
+        let history = HistoryMsg {
+            kind: "history",
+            track: core.track(1.0),
+            events: events.split_off(events.len().saturating_sub(500)),
+            states: core.history(),
+        };
         let state_msg = core.state_msg_now(now);
         [
-            hello.to_string(),
+            serde_json::to_string(&hello).unwrap_or_default(),
             serde_json::to_string(&state_msg).unwrap_or_default(),
-            history.to_string(),
+            serde_json::to_string(&history).unwrap_or_default(),
         ]
     };
     let mut open = true;
@@ -837,14 +759,15 @@ async fn serve_socket(state: AppState, caller: Caller, mut socket: WebSocket) {
                     let episodes = counters.lag_episodes.fetch_add(1, Ordering::Relaxed) + 1;
                     tracing::warn!(client = id, name = %caller.name, missed, episodes,
                         "a page fell behind: it is told what it missed");
-                    let notice = serde_json::json!({
-                        "type": "lagged",
-                        "missed": missed,
-                        "missed_total": counters.messages_missed.load(Ordering::Relaxed),
-                        "time_s": state.now_s(),
-                        "refetch": "/api/events",
-                    });
-                    open = socket.send(Message::Text(notice.to_string().into())).await.is_ok();
+                    let notice = LaggedMsg {
+                        kind: "lagged",
+                        missed,
+                        missed_total: counters.messages_missed.load(Ordering::Relaxed),
+                        time_s: state.now_s(),
+                        refetch: "/api/events",
+                    };
+                    let text = serde_json::to_string(&notice).unwrap_or_default();
+                    open = socket.send(Message::Text(text.into())).await.is_ok();
                 }
                 Err(broadcast::error::RecvError::Closed) => break,
             },
@@ -877,11 +800,18 @@ async fn serve_socket(state: AppState, caller: Caller, mut socket: WebSocket) {
         .remove(&id);
 }
 
-/// The `event` a page gets back when its message is refused.
+/// The `event` a page gets back when its message is refused (to that page only, not logged).
 fn refusal(state: &Shared, text: &str) -> Message {
-    let reply = serde_json::json!({"type":"event","time_s":state.now_s(),"wall_ms":0,
-        "level":"error","source":"station","text":text});
-    Message::Text(reply.to_string().into())
+    let now = state.now_s();
+    let reply = EventMsg {
+        kind: "event",
+        time_s: now,
+        wall_ms: state.core().wall_ms(now),
+        level: Level::Error,
+        source: "station",
+        text: text.to_string(),
+    };
+    Message::Text(serde_json::to_string(&reply).unwrap_or_default().into())
 }
 
 async fn handle_client(state: &Shared, caller: &Caller, socket: &mut WebSocket, text: &str) {
@@ -908,9 +838,8 @@ async fn handle_client(state: &Shared, caller: &Caller, socket: &mut WebSocket, 
             let _ = state.link.send(LinkRequest::ManualRelease).await;
         }
         Ok(ClientMessage::Ping) => {
-            let _ = socket
-                .send(Message::Text(r#"{"type":"pong"}"#.into()))
-                .await;
+            let pong = serde_json::to_string(&PongMsg { kind: "pong" }).unwrap_or_default();
+            let _ = socket.send(Message::Text(pong.into())).await;
         }
         Ok(ClientMessage::Manual {
             x,

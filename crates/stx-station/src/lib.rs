@@ -5,14 +5,19 @@
 //! - [`config`]: the station's TOML, validated before anything starts;
 //! - [`core`]: the station's state and logic, pure (events and the mission clock in, messages
 //!   and link actions out);
-//! - [`messages`]: the API's JSON; [`kml`]: the Google Earth feed (parameter ranges, units
-//!   and meanings come from the onboard catalogue, `stx_gnc::params`, shared with the drone);
+//! - [`messages`] and [`replies`]: the API's JSON the station sends, [`requests`]: what it reads
+//!   (parameter ranges, units and meanings come from the onboard catalogue, `stx_gnc::params`,
+//!   shared with the drone); [`contract`]: all of them as one JSON Schema, the contract the
+//!   dashboard's TypeScript types are generated from; [`kml`]: the Google Earth feed;
 //! - [`http`]: the axum routes (auth, REST, WebSocket, static files);
 //! - [`daemon`]: the tokio wiring of link, core and HTTP, with graceful shutdown.
 
 pub mod config;
+pub mod contract;
 pub mod core;
 pub mod daemon;
 pub mod http;
 pub mod kml;
 pub mod messages;
+pub mod replies;
+pub mod requests;

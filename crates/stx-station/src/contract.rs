@@ -1,0 +1,153 @@
+//! The API's contract: one JSON Schema (draft 7) of every message, both ways, derived from the
+//! Rust types the daemon serialises ([`crate::messages`], [`crate::replies`]) and parses
+//! ([`crate::requests`]). It is committed as `web/src/generated/api.schema.json` (written by
+//! `cargo run -p stx-station --example api_schema`; a test fails while the file is stale), the
+//! dashboard's TypeScript types are generated from it, and the browser test validates every
+//! message the daemon sends against it. `API.md` explains it for people.
+//!
+//! What the station sends is described as it serialises it (every field present, `null` when
+//! empty, nothing else); what it reads, as it parses it (optional fields may be left out,
+//! unknown fields are refused).
+
+use schemars::generate::{Contract, SchemaSettings};
+use schemars::transform::RecursiveTransform;
+use schemars::{JsonSchema, Schema, SchemaGenerator};
+use serde_json::{Map, Value, json};
+use thiserror::Error;
+
+use crate::core::CutdownArm;
+use crate::messages::{CommandResultMsg, ErrorBody, EventMsg, ParamsMsg, Session, StateMsg};
+use crate::replies::{
+    ClientsBody, CommandAccepted, EventsBody, HelloMsg, HistoryMsg, LaggedMsg, PongMsg, TrackBody,
+};
+use crate::requests::{
+    ClientMessage, ConfirmBody, CourseBody, HeadingBody, LocalizerBody, ModeBody, ParamBody,
+    PlanBody, TargetBody,
+};
+
+/// Where the schema is committed, from the workspace root.
+pub const SCHEMA_PATH: &str = "web/src/generated/api.schema.json";
+
+/// Every message the station sends on the WebSocket, told apart by `type`.
+#[derive(JsonSchema)]
+#[schemars(untagged)]
+#[allow(dead_code)] // Only its schema is used: the daemon sends each message on its own.
+pub enum ServerMessage {
+    /// First on connecting.
+    Hello(HelloMsg),
+    /// At 4 Hz.
+    State(StateMsg),
+    /// As they happen.
+    Event(EventMsg),
+    /// Each step of a command.
+    CommandResult(CommandResultMsg),
+    /// When the parameter table changes.
+    Params(ParamsMsg),
+    /// Once, after connecting.
+    History(HistoryMsg),
+    /// When the page fell behind.
+    Lagged(LaggedMsg),
+    /// The answer to `ping`.
+    Pong(PongMsg),
+}
+
+/// Why the contract could not be assembled (a bug in the types, caught by the tests).
+#[derive(Debug, Error)]
+pub enum ContractError {
+    /// A type described differently as sent and as read.
+    #[error("`{0}` is both sent and read, and the two descriptions differ")]
+    Conflict(String),
+}
+
+/// Every object the station sends lists all its fields: nothing else may appear.
+fn closed_objects(schema: &mut Schema) {
+    if schema.get("properties").is_some() && schema.get("additionalProperties").is_none() {
+        schema.insert("additionalProperties".into(), Value::Bool(false));
+    }
+}
+
+fn generator(contract: Contract) -> SchemaGenerator {
+    let settings = SchemaSettings::draft07().with(|s| s.contract = contract);
+    match settings.contract {
+        // What the station reads is closed where serde refuses unknown fields
+        // (`deny_unknown_fields`), and only there.
+        Contract::Deserialize => settings.into_generator(),
+        _ => settings
+            .with_transform(RecursiveTransform(closed_objects))
+            .into_generator(),
+    }
+}
+
+/// The whole contract: a schema whose `definitions` name every message.
+pub fn schema() -> Result<Value, ContractError> {
+    let mut sent = generator(Contract::Serialize);
+    sent.subschema_for::<ServerMessage>();
+    sent.subschema_for::<Session>();
+    sent.subschema_for::<ParamsMsg>();
+    sent.subschema_for::<EventsBody>();
+    sent.subschema_for::<TrackBody>();
+    sent.subschema_for::<ClientsBody>();
+    sent.subschema_for::<CommandAccepted>();
+    sent.subschema_for::<CutdownArm>();
+    sent.subschema_for::<ErrorBody>();
+    let mut read = generator(Contract::Deserialize);
+    read.subschema_for::<ClientMessage>();
+    read.subschema_for::<ModeBody>();
+    read.subschema_for::<HeadingBody>();
+    read.subschema_for::<CourseBody>();
+    read.subschema_for::<LocalizerBody>();
+    read.subschema_for::<TargetBody>();
+    read.subschema_for::<PlanBody>();
+    read.subschema_for::<ParamBody>();
+    read.subschema_for::<ConfirmBody>();
+
+    let mut definitions: Map<String, Value> = sent.take_definitions(true);
+    let mut read_definitions = read.take_definitions(true);
+    // A type both sent and read must be described the same way both times.
+    for (name, schema) in std::mem::take(&mut read_definitions) {
+        match definitions.get(&name) {
+            Some(other) if *other != schema => return Err(ContractError::Conflict(name)),
+            _ => {
+                definitions.insert(name, schema);
+            }
+        }
+    }
+    Ok(json!({
+        "$schema": "http://json-schema.org/draft-07/schema#",
+        "title": "stx station API",
+        "description": "Every message of the stx station's HTTP and WebSocket API (crates/stx-station/API.md), generated from the daemon's Rust types by `cargo run -p stx-station --example api_schema`: do not edit. The root is a WebSocket message either way: ServerMessage (station to page) or ClientMessage (page to station); the definitions also name the REST bodies (requests: *Body; answers: Session, StateMsg, ParamsMsg, EventsBody, TrackBody, ClientsBody, CommandResultMsg, CommandAccepted, CutdownArm, ErrorBody).",
+        "anyOf": [
+            { "$ref": "#/definitions/ServerMessage" },
+            { "$ref": "#/definitions/ClientMessage" },
+        ],
+        "definitions": definitions,
+    }))
+}
+
+/// The schema as committed: pretty JSON, one trailing newline.
+pub fn schema_text() -> Result<String, ContractError> {
+    let value = schema()?;
+    let mut text = serde_json::to_string_pretty(&value).unwrap_or_default();
+    text.push('\n');
+    Ok(text)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_committed_schema_is_the_one_the_types_give() {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../..")
+            .join(SCHEMA_PATH);
+        let committed = std::fs::read_to_string(&path).unwrap_or_default();
+        let fresh = schema_text().expect("the contract assembles");
+        assert!(
+            committed == fresh,
+            "{} is stale: run `cargo run -p stx-station --example api_schema`, then \
+             `npm run gen:api` in web/, and commit both",
+            path.display()
+        );
+    }
+}
