@@ -81,30 +81,31 @@ fn generator(contract: Contract) -> SchemaGenerator {
 /// The whole contract: a schema whose `definitions` name every message.
 pub fn schema() -> Result<Value, ContractError> {
     let mut sent = generator(Contract::Serialize);
-    sent.subschema_for::<ServerMessage>();
-    sent.subschema_for::<Session>();
-    sent.subschema_for::<ParamsMsg>();
-    sent.subschema_for::<EventsBody>();
-    sent.subschema_for::<TrackBody>();
-    sent.subschema_for::<ClientsBody>();
-    sent.subschema_for::<CommandAccepted>();
-    sent.subschema_for::<CutdownArm>();
-    sent.subschema_for::<ErrorBody>();
     let mut read = generator(Contract::Deserialize);
-    read.subschema_for::<ClientMessage>();
-    read.subschema_for::<ModeBody>();
-    read.subschema_for::<HeadingBody>();
-    read.subschema_for::<CourseBody>();
-    read.subschema_for::<LocalizerBody>();
-    read.subschema_for::<TargetBody>();
-    read.subschema_for::<PlanBody>();
-    read.subschema_for::<ParamBody>();
-    read.subschema_for::<ConfirmBody>();
-
+    // The root names each message once: what the station sends, then what it reads.
+    let messages = [
+        sent.subschema_for::<ServerMessage>(),
+        sent.subschema_for::<Session>(),
+        sent.subschema_for::<ParamsMsg>(),
+        sent.subschema_for::<EventsBody>(),
+        sent.subschema_for::<TrackBody>(),
+        sent.subschema_for::<ClientsBody>(),
+        sent.subschema_for::<CommandAccepted>(),
+        sent.subschema_for::<CutdownArm>(),
+        sent.subschema_for::<ErrorBody>(),
+        read.subschema_for::<ClientMessage>(),
+        read.subschema_for::<ModeBody>(),
+        read.subschema_for::<HeadingBody>(),
+        read.subschema_for::<CourseBody>(),
+        read.subschema_for::<LocalizerBody>(),
+        read.subschema_for::<TargetBody>(),
+        read.subschema_for::<PlanBody>(),
+        read.subschema_for::<ParamBody>(),
+        read.subschema_for::<ConfirmBody>(),
+    ];
     let mut definitions: Map<String, Value> = sent.take_definitions(true);
-    let mut read_definitions = read.take_definitions(true);
     // A type both sent and read must be described the same way both times.
-    for (name, schema) in std::mem::take(&mut read_definitions) {
+    for (name, schema) in read.take_definitions(true) {
         match definitions.get(&name) {
             Some(other) if *other != schema => return Err(ContractError::Conflict(name)),
             _ => {
@@ -115,11 +116,8 @@ pub fn schema() -> Result<Value, ContractError> {
     Ok(json!({
         "$schema": "http://json-schema.org/draft-07/schema#",
         "title": "stx station API",
-        "description": "Every message of the stx station's HTTP and WebSocket API (crates/stx-station/API.md), generated from the daemon's Rust types by `cargo run -p stx-station --example api_schema`: do not edit. The root is a WebSocket message either way: ServerMessage (station to page) or ClientMessage (page to station); the definitions also name the REST bodies (requests: *Body; answers: Session, StateMsg, ParamsMsg, EventsBody, TrackBody, ClientsBody, CommandResultMsg, CommandAccepted, CutdownArm, ErrorBody).",
-        "anyOf": [
-            { "$ref": "#/definitions/ServerMessage" },
-            { "$ref": "#/definitions/ClientMessage" },
-        ],
+        "description": "Every message of the stx station's HTTP and WebSocket API (crates/stx-station/API.md), generated from the daemon's Rust types by `cargo run -p stx-station --example api_schema`: do not edit. The root is any one of them: on the WebSocket ServerMessage (station to page) and ClientMessage (page to station); over REST the bodies the station answers (Session, StateMsg, ParamsMsg, EventsBody, TrackBody, ClientsBody, CommandResultMsg, CommandAccepted, CutdownArm, ErrorBody) and the bodies of the commands (*Body).",
+        "anyOf": messages,
         "definitions": definitions,
     }))
 }

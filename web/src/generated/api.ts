@@ -2,9 +2,27 @@
 // the daemon's Rust types by `cargo run -p stx-station --example api_schema`): do not edit.
 
 /**
- * Every message of the stx station's HTTP and WebSocket API (crates/stx-station/API.md), generated from the daemon's Rust types by `cargo run -p stx-station --example api_schema`: do not edit. The root is a WebSocket message either way: ServerMessage (station to page) or ClientMessage (page to station); the definitions also name the REST bodies (requests: *Body; answers: Session, StateMsg, ParamsMsg, EventsBody, TrackBody, ClientsBody, CommandResultMsg, CommandAccepted, CutdownArm, ErrorBody).
+ * Every message of the stx station's HTTP and WebSocket API (crates/stx-station/API.md), generated from the daemon's Rust types by `cargo run -p stx-station --example api_schema`: do not edit. The root is any one of them: on the WebSocket ServerMessage (station to page) and ClientMessage (page to station); over REST the bodies the station answers (Session, StateMsg, ParamsMsg, EventsBody, TrackBody, ClientsBody, CommandResultMsg, CommandAccepted, CutdownArm, ErrorBody) and the bodies of the commands (*Body).
  */
-export type StxStationAPI = ServerMessage | ClientMessage;
+export type StxStationAPI =
+  | ServerMessage
+  | Session
+  | ParamsMsg
+  | EventsBody
+  | TrackBody
+  | ClientsBody
+  | CommandAccepted
+  | CutdownArm
+  | ErrorBody
+  | ClientMessage
+  | ModeBody
+  | HeadingBody
+  | CourseBody
+  | LocalizerBody
+  | TargetBody
+  | PlanBody
+  | ParamBody
+  | ConfirmBody;
 /**
  * Every message the station sends on the WebSocket, told apart by `type`.
  */
@@ -84,6 +102,44 @@ export type ClientMessage =
     }
   | {
       type: "ping";
+    };
+/**
+ * A plan item as the API spells it (`approach_course_deg`, like the target endpoint).
+ */
+export type PlanItemBody =
+  | {
+      /**
+       * Altitude above mean sea level, m.
+       */
+      alt_msl_m: number;
+      kind: "waypoint";
+      /**
+       * Latitude, degrees.
+       */
+      lat_deg: number;
+      /**
+       * Longitude, degrees.
+       */
+      lon_deg: number;
+    }
+  | {
+      /**
+       * Altitude above mean sea level, m.
+       */
+      alt_msl_m: number;
+      /**
+       * Final-approach course, degrees from north; absent or `null`: into the wind.
+       */
+      approach_course_deg?: number | null;
+      kind: "land";
+      /**
+       * Latitude, degrees.
+       */
+      lat_deg: number;
+      /**
+       * Longitude, degrees.
+       */
+      lon_deg: number;
     };
 
 /**
@@ -970,4 +1026,213 @@ export interface PongMsg {
    * Always `pong`.
    */
   type: "pong";
+}
+/**
+ * `GET /api/events`.
+ */
+export interface EventsBody {
+  /**
+   * The event log since `since_s`, oldest first.
+   */
+  events: EventMsg[];
+}
+/**
+ * `GET /api/track`.
+ */
+export interface TrackBody {
+  /**
+   * The track, a point at most every `every_s`.
+   */
+  points: TrackPoint[];
+}
+/**
+ * `GET /api/clients`.
+ */
+export interface ClientsBody {
+  /**
+   * The connected pages.
+   */
+  clients: ClientView[];
+}
+/**
+ * One connected WebSocket page and what it was sent or missed.
+ */
+export interface ClientView {
+  /**
+   * Mission time it connected, s.
+   */
+  connected_s: number;
+  /**
+   * The page's number, from 1 in order of connection.
+   */
+  id: number;
+  /**
+   * Times it fell that far behind.
+   */
+  lag_episodes: number;
+  /**
+   * Events, command results and tables queued for it and not yet sent; past the backlog
+   * (4096) it gets `lagged`.
+   */
+  messages_behind: number;
+  /**
+   * Events, command results and parameter tables missed by falling more than the backlog
+   * behind.
+   */
+  messages_missed: number;
+  /**
+   * Events, command results and parameter tables sent.
+   */
+  messages_sent: number;
+  /**
+   * The token's name.
+   */
+  name: string;
+  /**
+   * The token's role.
+   */
+  role: Role | null;
+  /**
+   * `state` messages skipped because the page was behind (a newer one was sent instead).
+   */
+  states_coalesced: number;
+  /**
+   * `state` messages sent.
+   */
+  states_sent: number;
+}
+/**
+ * The `202` of a command: it is on its way; the outcome follows as `command_result`.
+ */
+export interface CommandAccepted {
+  /**
+   * The request, as `command_result` and `GET /api/commands/{id}` name it.
+   */
+  request_id: string;
+  /**
+   * Always `sent`.
+   */
+  status: "sent";
+}
+/**
+ * An armed cutdown, as `POST /api/cutdown/arm` answers it.
+ */
+export interface CutdownArm {
+  /**
+   * The id to confirm with.
+   */
+  arm_id: string;
+  /**
+   * Seconds left to confirm.
+   */
+  expires_in_s: number;
+}
+/**
+ * Error bodies.
+ */
+export interface ErrorBody {
+  /**
+   * Machine-readable kind.
+   */
+  error: "unauthorized" | "forbidden" | "bad_request" | "not_found" | "not_armed" | "link_down";
+  /**
+   * For people: what is wrong.
+   */
+  reason: string;
+}
+/**
+ * `POST /api/commands/mode`.
+ */
+export interface ModeBody {
+  /**
+   * The mode to fly.
+   */
+  mode: FlightMode;
+}
+/**
+ * `POST /api/commands/heading`.
+ */
+export interface HeadingBody {
+  /**
+   * Heading to hold, degrees from north.
+   */
+  heading_deg: number;
+}
+/**
+ * `POST /api/commands/course`.
+ */
+export interface CourseBody {
+  /**
+   * Course over the ground to hold, degrees from north.
+   */
+  course_deg: number;
+}
+/**
+ * `POST /api/commands/localizer`.
+ */
+export interface LocalizerBody {
+  /**
+   * The line's course, degrees from north.
+   */
+  course_deg: number;
+  /**
+   * Glide slope (sink over ground speed) down the line to its point; absent or `null`: none.
+   */
+  glide_slope?: number | null;
+  /**
+   * Latitude of the line's point, degrees.
+   */
+  lat_deg: number;
+  /**
+   * Longitude of the line's point, degrees.
+   */
+  lon_deg: number;
+}
+/**
+ * `POST /api/commands/target`.
+ */
+export interface TargetBody {
+  /**
+   * Altitude above mean sea level of the touchdown point, m.
+   */
+  alt_msl_m: number;
+  /**
+   * Final-approach course, degrees from north; absent or `null`: into the wind.
+   */
+  approach_course_deg?: number | null;
+  /**
+   * Latitude, degrees.
+   */
+  lat_deg: number;
+  /**
+   * Longitude, degrees.
+   */
+  lon_deg: number;
+}
+/**
+ * `POST /api/commands/plan`.
+ */
+export interface PlanBody {
+  /**
+   * Waypoints and the land item, at most 512.
+   */
+  items: PlanItemBody[];
+}
+/**
+ * `POST /api/params/{name}`.
+ */
+export interface ParamBody {
+  /**
+   * The new value.
+   */
+  value: number;
+}
+/**
+ * `POST /api/cutdown/confirm`.
+ */
+export interface ConfirmBody {
+  /**
+   * The id `POST /api/cutdown/arm` answered.
+   */
+  arm_id: string;
 }
