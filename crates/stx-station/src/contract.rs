@@ -148,4 +148,73 @@ mod tests {
             path.display()
         );
     }
+
+    /// `API.md` is the people's reference: it must name every message of the contract, show
+    /// every WebSocket message's `type`, and name no message the contract does not have.
+    #[test]
+    fn api_md_agrees_with_the_contract() {
+        let doc_path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("API.md");
+        let doc = std::fs::read_to_string(&doc_path).expect("API.md is readable");
+        let schema = schema().expect("the contract assembles");
+        let definitions = schema["definitions"].as_object().expect("definitions");
+        let name_of = |r: &Value| {
+            r["$ref"]
+                .as_str()
+                .and_then(|r| r.strip_prefix("#/definitions/"))
+                .map(str::to_string)
+        };
+        let messages: Vec<String> = schema["anyOf"]
+            .as_array()
+            .expect("the root lists the messages")
+            .iter()
+            .filter_map(name_of)
+            .collect();
+        assert!(messages.len() > 10, "{messages:?}");
+        for name in &messages {
+            assert!(
+                doc.contains(&format!("`{name}`")),
+                "API.md does not name `{name}`"
+            );
+        }
+        // The `type` of each WebSocket message, either way.
+        let server = definitions["ServerMessage"]["anyOf"]
+            .as_array()
+            .expect("a union");
+        let client = definitions["ClientMessage"]["oneOf"]
+            .as_array()
+            .expect("a union");
+        let types: Vec<String> = server
+            .iter()
+            .filter_map(|m| name_of(&m["allOf"][0]))
+            .map(|name| &definitions[&name])
+            .chain(client)
+            .filter_map(|m| {
+                m["properties"]["type"]["const"]
+                    .as_str()
+                    .map(str::to_string)
+            })
+            .collect();
+        assert_eq!(types.len(), server.len() + client.len(), "{types:?}");
+        for t in &types {
+            assert!(
+                doc.contains(&format!(r#""type":"{t}""#)),
+                "API.md shows no `{t}` message"
+            );
+        }
+        // Every message API.md names by its schema name exists.
+        // (A text between two backticks that is one such word can only be a name in backticks.)
+        for name in doc.split('`') {
+            let looks_like_one = name.chars().next().is_some_and(|c| c.is_ascii_uppercase())
+                && name.chars().all(|c| c.is_ascii_alphanumeric())
+                && ["Msg", "Body", "View", "Message"]
+                    .iter()
+                    .any(|e| name.ends_with(e));
+            if looks_like_one {
+                assert!(
+                    definitions.contains_key(name),
+                    "API.md names `{name}`, which the contract does not have"
+                );
+            }
+        }
+    }
 }
