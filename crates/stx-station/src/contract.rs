@@ -28,15 +28,15 @@ use crate::requests::{
 /// Where the schema is committed, from the workspace root.
 pub const SCHEMA_PATH: &str = "web/src/generated/api.schema.json";
 
+// Only its schema is used: the daemon serialises each message on its own.
 /// Every message the station sends on the WebSocket, told apart by `type`.
 #[derive(JsonSchema)]
 #[schemars(untagged)]
-#[allow(dead_code)] // Only its schema is used: the daemon sends each message on its own.
 pub enum ServerMessage {
     /// First on connecting.
     Hello(HelloMsg),
     /// At 4 Hz.
-    State(StateMsg),
+    State(Box<StateMsg>),
     /// As they happen.
     Event(EventMsg),
     /// Each step of a command.
