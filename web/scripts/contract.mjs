@@ -26,7 +26,8 @@ const FORMATS = {
 /**
  * The contract's validator: `check(name, value)` is null when `value` is a valid `name` (a
  * definition of the schema: "ServerMessage", "StateMsg", "Session", …), else the first error,
- * with the path to the offending value.
+ * with the path to the offending value. For a union of messages told apart by `type`
+ * (ServerMessage, ClientMessage) the error is the one of the message that `type` names.
  */
 export function contract(schemaText = readFileSync(SCHEMA_FILE, "utf8")) {
   const schema = JSON.parse(schemaText);
@@ -34,18 +35,43 @@ export function contract(schemaText = readFileSync(SCHEMA_FILE, "utf8")) {
   ajv.addSchema(schema, "api");
   const names = Object.keys(schema.definitions);
   const validators = new Map();
+  const validator = (pointer) => {
+    let v = validators.get(pointer);
+    if (v === undefined) {
+      v = ajv.getSchema(`api#${pointer}`);
+      validators.set(pointer, v);
+    }
+    return v;
+  };
+  const firstError = (label, validate) => {
+    const e = validate.errors?.[0];
+    return e ? `${label}${e.instancePath || ""}: ${e.message}${e.params ? ` ${JSON.stringify(e.params)}` : ""}` : `${label}: invalid`;
+  };
+  /** The member of union `name` whose `type` is `value.type`: its pointer and name; undefined if none. */
+  const member = (name, value) => {
+    const def = schema.definitions[name];
+    const key = def.anyOf ? "anyOf" : def.oneOf ? "oneOf" : null;
+    if (key === null || typeof value !== "object" || value === null || typeof value.type !== "string") return null;
+    for (const [i, branch] of def[key].entries()) {
+      const ref = branch.$ref ?? branch.allOf?.[0]?.$ref;
+      const target = ref ? schema.definitions[ref.replace("#/definitions/", "")] : branch;
+      if (target?.properties?.type?.const === value.type) {
+        return ref ? { pointer: ref.slice(1), label: ref.replace("#/definitions/", "") } : { pointer: `/definitions/${name}/${key}/${i}`, label: `${name}(${value.type})` };
+      }
+    }
+    return undefined;
+  };
   return {
     names,
     check(name, value) {
       if (!names.includes(name)) return `the contract has no message ${name}`;
-      let validate = validators.get(name);
-      if (validate === undefined) {
-        validate = ajv.getSchema(`api#/definitions/${name}`);
-        validators.set(name, validate);
-      }
+      const validate = validator(`/definitions/${name}`);
       if (validate(value)) return null;
-      const e = validate.errors?.[0];
-      return e ? `${name}${e.instancePath || ""}: ${e.message}${e.params ? ` ${JSON.stringify(e.params)}` : ""}` : `${name}: invalid`;
+      const m = member(name, value);
+      if (m === undefined) return `${name}: no message has the type ${JSON.stringify(value.type)}`;
+      if (m === null) return firstError(name, validate);
+      const one = validator(m.pointer);
+      return one(value) ? firstError(name, validate) : firstError(m.label, one);
     },
   };
 }
