@@ -55,11 +55,7 @@ export type Station = Omit<Lenient<Wire.StationInfo, "name" | "tile_attribution"
   origin: Position;
 };
 
-export interface Session {
-  role: Wire.Role;
-  name: string;
-  station: Station;
-}
+export type Session = Omit<Lenient<Wire.Session, "role" | "name">, "station"> & { station: Station };
 
 /** One radio of the drone link (the station may hold a primary and backups). */
 export type Radio = Lenient<Wire.RadioView, "address" | "transmitting" | "stale">;
@@ -127,17 +123,14 @@ export type ParamsMsg = Omit<Lenient<Wire.ParamsMsg, "type" | "complete">, "para
 
 export type TrackPoint = Lenient<Wire.TrackPoint, "time_s" | "lat_deg" | "lon_deg">;
 
-export interface History {
-  type: "history";
+export type History = Omit<Lenient<Wire.HistoryMsg, "type">, "track" | "events" | "states"> & {
   track: TrackPoint[];
   events: EventMsg[];
   states: State[];
-}
+};
 
-export interface Hello {
-  type: "hello";
-  session: Session;
-}
+/** `hello` as the page keeps it: the session (the role and name beside it repeat the session's). */
+export type Hello = Pick<Wire.HelloMsg, "type"> & { session: Session };
 
 export type Lagged = Lenient<Wire.LaggedMsg, "type">;
 
