@@ -10,14 +10,18 @@
 //!   own timers;
 //! - [`link`]: the ground endpoint as the link driver runs it, applying the core's link
 //!   actions and reporting their outcomes with the endpoint's events;
-//! - [`messages`]: the API's JSON; [`kml`]: the Google Earth feed (parameter ranges, units
-//!   and meanings come from the onboard catalogue, `stx_gnc::params`, shared with the drone).
+//! - [`messages`] and [`replies`]: the API's JSON the station sends, [`requests`]: what it
+//!   reads (parameter ranges, units and meanings come from the onboard catalogue,
+//!   `stx_gnc::params`, shared with the drone); [`contract`]: all of them as one JSON Schema,
+//!   the contract the dashboard's TypeScript types are generated from; [`kml`]: the Google
+//!   Earth feed.
 //!
 //! With the default feature `daemon`, the adapters:
 //! - `http`: the axum routes (auth, REST, WebSocket, KML, static files);
 //! - `daemon`: the tokio wiring of link driver, core and HTTP, with graceful shutdown.
 
 pub mod config;
+pub mod contract;
 pub mod core;
 #[cfg(feature = "daemon")]
 pub mod daemon;
@@ -26,3 +30,5 @@ pub mod http;
 pub mod kml;
 pub mod link;
 pub mod messages;
+pub mod replies;
+pub mod requests;

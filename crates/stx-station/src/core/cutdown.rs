@@ -5,7 +5,7 @@
 use super::requests::ApiError;
 
 /// An armed cutdown, as `POST /api/cutdown/arm` answers it.
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, schemars::JsonSchema)]
 pub struct CutdownArm {
     /// The id to confirm with.
     pub arm_id: String,

@@ -7,14 +7,17 @@ use axum::extract::rejection::JsonRejection;
 use axum::extract::{Path, State};
 use axum::http::StatusCode;
 use axum::response::{IntoResponse, Response};
-use serde::Deserialize;
 use serde::de::DeserializeOwned;
-use stx_gnc::mission::FlightMode;
 use stx_link::plan::PlanItem;
 
 use super::auth::Caller;
 use super::shared::{AppState, HttpError, Shared, json_body};
 use crate::core::CommandRequest;
+use crate::replies::CommandAccepted;
+use crate::requests::{
+    ConfirmBody, CourseBody, HeadingBody, LocalizerBody, ModeBody, ParamBody, PlanBody,
+    PlanItemBody, TargetBody,
+};
 
 /// Records a request in the core, which queues it for the link; answers 202 with its id.
 fn submit(state: &Shared, caller: &Caller, request: CommandRequest) -> Result<Response, HttpError> {
@@ -29,7 +32,10 @@ fn accepted(state: &Shared, request_id: String) -> Response {
     state.link_due.notify_one();
     (
         StatusCode::ACCEPTED,
-        Json(serde_json::json!({ "request_id": request_id, "status": "sent" })),
+        Json(CommandAccepted {
+            request_id,
+            status: "sent",
+        }),
     )
         .into_response()
 }
@@ -50,22 +56,10 @@ pub(crate) async fn command<B: CommandBody>(
     submit(&state, &caller, request)
 }
 
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-pub(crate) struct ModeBody {
-    mode: FlightMode,
-}
-
 impl CommandBody for ModeBody {
     fn into_request(self) -> CommandRequest {
         CommandRequest::Mode(self.mode)
     }
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-pub(crate) struct HeadingBody {
-    heading_deg: f64,
 }
 
 impl CommandBody for HeadingBody {
@@ -76,28 +70,12 @@ impl CommandBody for HeadingBody {
     }
 }
 
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-pub(crate) struct CourseBody {
-    course_deg: f64,
-}
-
 impl CommandBody for CourseBody {
     fn into_request(self) -> CommandRequest {
         CommandRequest::Course {
             course_deg: self.course_deg,
         }
     }
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-pub(crate) struct LocalizerBody {
-    lat_deg: f64,
-    lon_deg: f64,
-    course_deg: f64,
-    #[serde(default)]
-    glide_slope: Option<f64>,
 }
 
 impl CommandBody for LocalizerBody {
@@ -111,16 +89,6 @@ impl CommandBody for LocalizerBody {
     }
 }
 
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-pub(crate) struct TargetBody {
-    lat_deg: f64,
-    lon_deg: f64,
-    alt_msl_m: f64,
-    #[serde(default)]
-    approach_course_deg: Option<f64>,
-}
-
 impl CommandBody for TargetBody {
     fn into_request(self) -> CommandRequest {
         CommandRequest::Target {
@@ -130,30 +98,6 @@ impl CommandBody for TargetBody {
             approach_course_deg: self.approach_course_deg,
         }
     }
-}
-
-/// A plan item as the API spells it (`approach_course_deg`, like the target endpoint).
-#[derive(Deserialize)]
-#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
-pub(crate) enum PlanItemBody {
-    Waypoint {
-        lat_deg: f64,
-        lon_deg: f64,
-        alt_msl_m: f64,
-    },
-    Land {
-        lat_deg: f64,
-        lon_deg: f64,
-        alt_msl_m: f64,
-        #[serde(default)]
-        approach_course_deg: Option<f64>,
-    },
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-pub(crate) struct PlanBody {
-    items: Vec<PlanItemBody>,
 }
 
 impl CommandBody for PlanBody {
@@ -188,12 +132,6 @@ impl CommandBody for PlanBody {
     }
 }
 
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-pub(crate) struct ParamBody {
-    value: f64,
-}
-
 pub(crate) async fn set_param(
     State(state): State<AppState>,
     caller: Caller,
@@ -220,12 +158,6 @@ pub(crate) async fn arm_cutdown(
     let now = state.now_s();
     let arm = state.core().arm_cutdown(now, &caller.name);
     Ok(Json(arm).into_response())
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-pub(crate) struct ConfirmBody {
-    arm_id: String,
 }
 
 pub(crate) async fn confirm_cutdown(

@@ -25,10 +25,8 @@ use tower_http::services::{ServeDir, ServeFile};
 pub use auth::Caller;
 pub use shared::{ClientCounters, HttpError, Shared, StateFrame};
 
-use commands::{
-    CourseBody, HeadingBody, LocalizerBody, ModeBody, PlanBody, TargetBody, arm_cutdown, command,
-    confirm_cutdown, set_param,
-};
+use crate::requests::{CourseBody, HeadingBody, LocalizerBody, ModeBody, PlanBody, TargetBody};
+use commands::{arm_cutdown, command, confirm_cutdown, set_param};
 use rest::{api_not_found, clients, command_result, events, params, session, state_now, track};
 
 /// The router of the whole station.

@@ -13,6 +13,7 @@ use stx_gnc::mission::FlightMode;
 use super::auth::Caller;
 use super::shared::{AppState, HttpError, Shared, error};
 use crate::messages::{Session, StationInfo};
+use crate::replies::{ClientsBody, EventsBody, TrackBody};
 
 pub(crate) fn session_of(state: &Shared, caller: &Caller) -> Session {
     let c = &state.config;
@@ -51,14 +52,14 @@ pub(crate) async fn api_not_found(uri: axum::http::Uri) -> HttpError {
 }
 
 pub(crate) async fn clients(State(state): State<AppState>, _caller: Caller) -> Response {
-    let list: Vec<serde_json::Value> = state
+    let clients = state
         .clients
         .lock()
         .unwrap_or_else(|e| e.into_inner())
         .iter()
         .map(|(id, c)| c.view(*id, state.broadcast_total.load(Ordering::Relaxed)))
         .collect();
-    Json(serde_json::json!({ "clients": list })).into_response()
+    Json(ClientsBody { clients }).into_response()
 }
 
 pub(crate) async fn session(State(state): State<AppState>, caller: Caller) -> Json<Session> {
@@ -89,7 +90,7 @@ pub(crate) async fn events(
     let events = state
         .core()
         .events_since(q.since_s.unwrap_or(f64::NEG_INFINITY));
-    Json(serde_json::json!({ "events": events })).into_response()
+    Json(EventsBody { events }).into_response()
 }
 
 #[derive(Deserialize)]
@@ -103,7 +104,7 @@ pub(crate) async fn track(
     Query(q): Query<EveryQuery>,
 ) -> Response {
     let points = state.core().track(q.every_s.unwrap_or(0.0).max(0.0));
-    Json(serde_json::json!({ "points": points })).into_response()
+    Json(TrackBody { points }).into_response()
 }
 
 pub(crate) async fn command_result(

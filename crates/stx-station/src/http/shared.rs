@@ -16,6 +16,7 @@ use tokio::sync::{Notify, broadcast, watch};
 use crate::config::{Role, StationConfig};
 use crate::core::{ApiError, StationCore};
 use crate::messages::ErrorBody;
+use crate::replies::ClientView;
 
 /// State shared by every handler.
 pub struct Shared {
@@ -76,21 +77,21 @@ pub struct ClientCounters {
 }
 
 impl ClientCounters {
-    pub(crate) fn view(&self, id: u64, total: u64) -> serde_json::Value {
+    pub(crate) fn view(&self, id: u64, total: u64) -> ClientView {
         let n = |c: &AtomicU64| c.load(Ordering::Relaxed);
         let done = self.base + n(&self.messages_sent) + n(&self.messages_missed);
-        serde_json::json!({
-            "messages_behind": total.saturating_sub(done),
-            "id": id,
-            "name": self.name,
-            "role": self.role,
-            "connected_s": self.connected_s,
-            "states_sent": n(&self.states_sent),
-            "states_coalesced": n(&self.states_coalesced),
-            "messages_sent": n(&self.messages_sent),
-            "messages_missed": n(&self.messages_missed),
-            "lag_episodes": n(&self.lag_episodes),
-        })
+        ClientView {
+            id,
+            name: self.name.clone(),
+            role: self.role,
+            connected_s: self.connected_s,
+            states_sent: n(&self.states_sent),
+            states_coalesced: n(&self.states_coalesced),
+            messages_sent: n(&self.messages_sent),
+            messages_missed: n(&self.messages_missed),
+            messages_behind: total.saturating_sub(done),
+            lag_episodes: n(&self.lag_episodes),
+        }
     }
 }
 

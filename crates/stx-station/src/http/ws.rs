@@ -11,7 +11,6 @@ use std::sync::atomic::Ordering;
 use axum::extract::State;
 use axum::extract::ws::{Message, WebSocket, WebSocketUpgrade};
 use axum::response::Response;
-use serde::Deserialize;
 use stx_link::manual::Sticks;
 use tokio::sync::broadcast;
 
@@ -19,6 +18,9 @@ use super::auth::Caller;
 use super::rest::session_of;
 use super::shared::{AppState, ClientCounters, Shared};
 use crate::config::Role;
+use crate::messages::{EventMsg, Level};
+use crate::replies::{HelloMsg, HistoryMsg, LaggedMsg, PongMsg};
+use crate::requests::ClientMessage;
 
 pub(crate) async fn websocket(
     State(state): State<AppState>,
@@ -26,26 +28,6 @@ pub(crate) async fn websocket(
     upgrade: WebSocketUpgrade,
 ) -> Response {
     upgrade.on_upgrade(move |socket| serve_socket(state, caller, socket))
-}
-
-#[derive(Deserialize)]
-#[serde(tag = "type", rename_all = "snake_case")]
-enum ClientMessage {
-    Manual {
-        #[serde(default)]
-        x: f64,
-        #[serde(default)]
-        y: f64,
-        #[serde(default)]
-        z: f64,
-        #[serde(default)]
-        r: f64,
-        #[serde(default)]
-        buttons: u32,
-    },
-    /// The dead-man was let go or the page lost focus: stop the sticks now.
-    ManualRelease,
-    Ping,
 }
 
 async fn serve_socket(state: AppState, caller: Caller, mut socket: WebSocket) {
@@ -69,19 +51,24 @@ async fn serve_socket(state: AppState, caller: Caller, mut socket: WebSocket) {
     let greeting = {
         let now = state.now_s();
         let core = state.core();
-        let hello = serde_json::json!({ "type": "hello", "session": session_of(&state, &caller),
-            "role": caller.role, "name": caller.name });
-        let history = serde_json::json!({
-            "type": "history",
-            "track": core.track(1.0),
-            "events": core.events_since(f64::NEG_INFINITY).into_iter().rev().take(500).rev().collect::<Vec<_>>(),
-            "states": core.history(),
-        });
+        let hello = HelloMsg {
+            kind: "hello",
+            session: session_of(&state, &caller),
+            role: caller.role,
+            name: caller.name.clone(),
+        };
+        let mut events = core.events_since(f64::NEG_INFINITY);
+        let history = HistoryMsg {
+            kind: "history",
+            track: core.track(1.0),
+            events: events.split_off(events.len().saturating_sub(500)),
+            states: core.history(),
+        };
         let state_msg = core.state_msg_now(now);
         [
-            hello.to_string(),
+            serde_json::to_string(&hello).unwrap_or_default(),
             serde_json::to_string(&state_msg).unwrap_or_default(),
-            history.to_string(),
+            serde_json::to_string(&history).unwrap_or_default(),
         ]
     };
     let mut open = true;
@@ -105,14 +92,15 @@ async fn serve_socket(state: AppState, caller: Caller, mut socket: WebSocket) {
                     let episodes = counters.lag_episodes.fetch_add(1, Ordering::Relaxed) + 1;
                     tracing::warn!(client = id, name = %caller.name, missed, episodes,
                         "a page fell behind: it is told what it missed");
-                    let notice = serde_json::json!({
-                        "type": "lagged",
-                        "missed": missed,
-                        "missed_total": counters.messages_missed.load(Ordering::Relaxed),
-                        "time_s": state.now_s(),
-                        "refetch": "/api/events",
-                    });
-                    open = socket.send(Message::Text(notice.to_string().into())).await.is_ok();
+                    let notice = LaggedMsg {
+                        kind: "lagged",
+                        missed,
+                        missed_total: counters.messages_missed.load(Ordering::Relaxed),
+                        time_s: state.now_s(),
+                        refetch: "/api/events",
+                    };
+                    let text = serde_json::to_string(&notice).unwrap_or_default();
+                    open = socket.send(Message::Text(text.into())).await.is_ok();
                 }
                 Err(broadcast::error::RecvError::Closed) => break,
             },
@@ -145,11 +133,18 @@ async fn serve_socket(state: AppState, caller: Caller, mut socket: WebSocket) {
         .remove(&id);
 }
 
-/// The `event` a page gets back when its message is refused.
+/// The `event` a page gets back when its message is refused (to that page only, not logged).
 fn refusal(state: &Shared, text: &str) -> Message {
-    let reply = serde_json::json!({"type":"event","time_s":state.now_s(),"wall_ms":0,
-        "level":"error","source":"station","text":text});
-    Message::Text(reply.to_string().into())
+    let now = state.now_s();
+    let reply = EventMsg {
+        kind: "event",
+        time_s: now,
+        wall_ms: state.core().wall_ms(now),
+        level: Level::Error,
+        source: "station",
+        text: text.to_string(),
+    };
+    Message::Text(serde_json::to_string(&reply).unwrap_or_default().into())
 }
 
 async fn handle_client(state: &Shared, caller: &Caller, socket: &mut WebSocket, text: &str) {
@@ -173,9 +168,8 @@ async fn handle_client(state: &Shared, caller: &Caller, socket: &mut WebSocket, 
             state.link_due.notify_one();
         }
         Ok(ClientMessage::Ping) => {
-            let _ = socket
-                .send(Message::Text(r#"{"type":"pong"}"#.into()))
-                .await;
+            let pong = serde_json::to_string(&PongMsg { kind: "pong" }).unwrap_or_default();
+            let _ = socket.send(Message::Text(pong.into())).await;
         }
         Ok(ClientMessage::Manual {
             x,
