@@ -49,10 +49,9 @@ pub struct CanopyConfig {
     pub main_line_length_m: f64,
     /// Anti-twist beam length B of the control geometry, m.
     pub beam_length_m: f64,
-    /// Whether the canopy feels the Munk moment `−V_rel × (M_app·V_rel)` of its apparent
-    /// mass (Kirchhoff's equations; the seed's A.11 leaves it out). A file that does not say
-    /// gets [`default_munk_moment`].
-    #[serde(default = "default_munk_moment")]
+    /// Whether the canopy feels the Munk moment `−V_rel × (M_app·V_rel)` of its apparent mass
+    /// (Kirchhoff). If not given, no: the seed's model (its A.11) leaves it out.
+    #[serde(default)]
     pub munk_moment: bool,
     /// Aerodynamic coefficients.
     pub aero: CanopyAeroConfig,
@@ -93,12 +92,6 @@ pub struct CanopyAeroConfig {
 /// `config/vehicle/straplex.toml` for the reasoning).
 pub fn default_alpha_range_deg() -> [f64; 2] {
     [0.0, 45.0]
-}
-
-/// Whether a vehicle file that does not say flies with the Munk moment: no, as the seed's
-/// model (MODEL_NOTES.md, "The Munk moment", has the measurement behind the choice).
-pub fn default_munk_moment() -> bool {
-    false
 }
 
 /// Brake coefficients per unit of normalised deflection (0 released … 1 fully pulled).
@@ -725,8 +718,7 @@ mod tests {
         // A file written before the switch existed flies the model it was written for.
         let without = STRAPLEX_TOML.replace("munk_moment = false", "");
         let v = Vehicle::from_toml_str(&without).expect("valid without the switch");
-        assert_eq!(v.config.canopy.munk_moment, default_munk_moment());
-        assert!(!default_munk_moment());
+        assert!(!v.config.canopy.munk_moment);
         // Anything but a boolean is refused, naming the field.
         let bad = STRAPLEX_TOML.replace("munk_moment = false", "munk_moment = 1");
         let err = chain(&Vehicle::from_toml_str(&bad).unwrap_err());
