@@ -357,7 +357,7 @@ fn seed_4_6_released_at_35_km_speed_peaks_near_300_kmh_with_the_canopy_near_minu
     };
     assert!(
         horizontal_at(dive_s + 5.0) > horizontal_at(dive_s),
-        "forward speed grows after the steepest dive at {dive_s} s"
+        "forward speed grows after the downward speed peaks at {dive_s} s"
     );
     // ... and "the velocity decreases as the system descends" after the peak.
     let at = |t: f64| {

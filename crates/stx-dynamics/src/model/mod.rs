@@ -11,6 +11,8 @@
 //! - the main lines' mean vectors stand for the seed's summed `R_TC/CMC`, `R_TD/TC`, `R_CMD/TD`;
 //! - a line pulls along its full 3-D direction (the seed drops the line-frame x component);
 //! - apparent mass acts at the canopy CM for a wind that is steady over a step (eq. 4.65);
+//! - no Munk moment unless the vehicle file switches it on (`canopy.munk_moment`; the seed's
+//!   N4 has none, and its coefficients were tuned without it: MODEL_NOTES.md);
 //! - the whole 12-m stack sees the density and wind at the canopy.
 
 pub mod aero;
