@@ -63,7 +63,8 @@ pub struct TrimReport {
     pub airspeed_mps: f64,
     /// Canopy angle of attack, degrees.
     pub alpha_deg: f64,
-    /// Canopy CM velocity in the canopy frame, u and w, m/s (seed Table 6.1's u, w).
+    /// Canopy CM velocity in the canopy frame, u and w, m/s. (Table 6.1's "u" and "w" are not
+    /// these but the ground speeds, `horizontal_speed_mps` and `sink_rate_mps`, in km/h.)
     pub u_c_mps: f64,
     /// See `u_c_mps`.
     pub w_c_mps: f64,

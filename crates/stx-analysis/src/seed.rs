@@ -130,8 +130,8 @@ pub fn reference() -> SeedReference {
         controllability_rank: CONTROLLABILITY_RANK,
         observability_rank: OBSERVABILITY_RANK,
         n_states: 31,
-        trim_table_6_1: "u = 22, w = 11 (printed m/s, read km/h: 6.1 and 3.1 m/s), \
-                         θ_C/I = −8.1°, θ_L/C = −5.3°, θ_D/L = 6.1°, θ_CAP/D = −7.1°, \
+        trim_table_6_1: "u = 22, w = 11 (printed m/s; the canopy's ground speeds forward and \
+                         down in km/h, 6.1 and 3.1 m/s as A.12 prints them), θ_C/I = −8.1°, θ_L/C = −5.3°, θ_D/L = 6.1°, θ_CAP/D = −7.1°, \
                          θ_T/CAP = 5.4°",
         gains: [HEADING, COURSE, LOCALIZER, VERTICAL],
         source: "seed §6.1–6.3, Table 6.1, appendix A.13; shared/spec/flight-model.md item 4",

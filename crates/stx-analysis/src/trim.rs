@@ -16,6 +16,9 @@
 //! so the equations also balance flying backwards or falling flat. The canopy must fly
 //! forwards, sink, and hold an angle of attack inside the range its coefficients are stated
 //! for (`canopy.aero.alpha_range_deg`); anything else is refused as [`TrimError::NotAGlide`].
+//! When Newton from the guess does not converge, or converges to a balance that is not such a
+//! glide (with the Munk moment the guess lies in the basin of a nose-down balance the stack
+//! never flies), the model flies itself for a minute and Newton starts again from there.
 
 use std::sync::Arc;
 
@@ -222,11 +225,14 @@ pub fn trim(vehicle: &Vehicle, altitude_m: f64, controls: Controls) -> Result<Tr
     model.set_controls(controls);
 
     let guess = initial_guess(altitude_m, density, &controls);
-    let solved = match levenberg_marquardt(&model, &guess) {
-        Ok(done) => Ok(done),
+    let glide = |solved: (StateVector, usize, f64)| glide_at(&model, altitude_m, density, solved);
+    match levenberg_marquardt(&model, &guess).and_then(glide) {
+        Ok(trimmed) => Ok(trimmed),
         // Far from sea level, or for an unusual vehicle, the guess may lie outside Newton's
-        // basin: let the model fly itself towards its glide for a minute, then polish.
-        Err(_) => {
+        // basin, or in the basin of a balance the model does not fly (with the Munk moment, a
+        // nose-down one at α ≈ −5°, beside the glide at 46°): let the model fly itself towards
+        // its glide for a minute, then polish.
+        Err(first) => {
             let settled = integrate(
                 &mut Rk4::new(0.01),
                 &mut model.clone(),
@@ -235,20 +241,36 @@ pub fn trim(vehicle: &Vehicle, altitude_m: f64, controls: Controls) -> Result<Tr
                 60.0,
                 Hooks::default(),
             );
-            match settled {
+            let retried = match settled {
                 Ok(outcome) if outcome.state.iter().all(|v| v.is_finite()) => {
                     let mut x = outcome.state;
                     for i in 0..3 {
                         x[i] = guess[i];
                     }
                     x[idx::CANOPY_EULER + 2] = 0.0;
-                    levenberg_marquardt(&model, &x)
+                    levenberg_marquardt(&model, &x).and_then(glide)
                 }
-                _ => levenberg_marquardt(&model, &guess),
-            }
+                _ => Err(first.clone()),
+            };
+            // What the model flies to says more than the guess's balance; a retry that does
+            // not converge says less than whatever the guess found.
+            retried.map_err(|again| match again {
+                TrimError::NotConverged { .. } => first,
+                refused => refused,
+            })
         }
-    };
-    let (state, iterations, residual) = solved?;
+    }
+}
+
+/// The trim at a converged state, if it is a glide: every line taut, inside the model's domain.
+fn glide_at(
+    model: &ParafoilModel,
+    altitude_m: f64,
+    density: f64,
+    (state, iterations, residual): (StateVector, usize, f64),
+) -> Result<Trim, TrimError> {
+    let vehicle = &model.vehicle;
+    let controls = model.controls();
     let evaluation = model.evaluate(0.0, &state);
     let tensions = evaluation.tensions;
     if tensions.min() <= 0.0 {
@@ -523,6 +545,33 @@ mod tests {
         ]);
         let t = trim(&wide, 100.0, Controls::default()).expect("inside the stated range");
         assert!(t.alpha_rad.to_degrees() > 80.0);
+    }
+
+    #[test]
+    fn a_balance_the_model_does_not_fly_is_passed_over_for_the_glide_it_flies() {
+        // With the Munk moment, Newton from the Table 6.1 guess balances the canopy nose-down
+        // at α ≈ −5°, outside the coefficients' range; the stack itself glides at α ≈ 46°.
+        let munk = [("munk_moment = false", "munk_moment = true")];
+        let err = trim(&vehicle_with(&munk), 100.0, Controls::default())
+            .expect_err("46° is outside the shipped 0…45°");
+        match err {
+            TrimError::NotAGlide { value, .. } => assert!((45.0..48.0).contains(&value), "{value}"),
+            other => panic!("expected the flown glide's α to be refused, got {other:?}"),
+        }
+        let wide = vehicle_with(&[
+            munk[0],
+            (
+                "alpha_range_deg = [0.0, 45.0]",
+                "alpha_range_deg = [0.0, 60.0]",
+            ),
+        ]);
+        let t = trim(&wide, 100.0, Controls::default()).expect("inside the stated range");
+        assert!(t.residual < RESIDUAL_TOLERANCE);
+        let alpha_deg = t.alpha_rad.to_degrees();
+        assert!((45.0..48.0).contains(&alpha_deg), "{alpha_deg}");
+        // The shipped vehicle converges from the guess, as before.
+        let shipped = trim(&Vehicle::straplex(), 100.0, Controls::default()).expect("trims");
+        assert!(shipped.iterations < 10);
     }
 
     #[test]

@@ -49,6 +49,10 @@ pub struct CanopyConfig {
     pub main_line_length_m: f64,
     /// Anti-twist beam length B of the control geometry, m.
     pub beam_length_m: f64,
+    /// Whether the canopy feels the Munk moment `−V_rel × (M_app·V_rel)` of its apparent mass
+    /// (Kirchhoff). If not given, no: the seed's model (its A.11) leaves it out.
+    #[serde(default)]
+    pub munk_moment: bool,
     /// Aerodynamic coefficients.
     pub aero: CanopyAeroConfig,
     /// Brake coefficients.
@@ -697,6 +701,28 @@ mod tests {
             let err = Vehicle::from_toml_str(&text).unwrap_err().to_string();
             assert!(err.contains("canopy.aero.alpha_range_deg"), "{bad}: {err}");
         }
+    }
+
+    #[test]
+    fn the_munk_moment_switch_is_read_and_defaults_to_the_seeds_model() {
+        assert!(!Vehicle::straplex().config.canopy.munk_moment);
+        let on = STRAPLEX_TOML.replace("munk_moment = false", "munk_moment = true");
+        assert_ne!(on, STRAPLEX_TOML);
+        assert!(
+            Vehicle::from_toml_str(&on)
+                .expect("valid")
+                .config
+                .canopy
+                .munk_moment
+        );
+        // A file written before the switch existed flies the model it was written for.
+        let without = STRAPLEX_TOML.replace("munk_moment = false", "");
+        let v = Vehicle::from_toml_str(&without).expect("valid without the switch");
+        assert!(!v.config.canopy.munk_moment);
+        // Anything but a boolean is refused, naming the field.
+        let bad = STRAPLEX_TOML.replace("munk_moment = false", "munk_moment = 1");
+        let err = chain(&Vehicle::from_toml_str(&bad).unwrap_err());
+        assert!(err.contains("munk_moment"), "{err}");
     }
 
     #[test]

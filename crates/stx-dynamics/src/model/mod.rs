@@ -11,6 +11,8 @@
 //! - the main lines' mean vectors stand for the seed's summed `R_TC/CMC`, `R_TD/TC`, `R_CMD/TD`;
 //! - a line pulls along its full 3-D direction (the seed drops the line-frame x component);
 //! - apparent mass acts at the canopy CM for a wind that is steady over a step (eq. 4.65);
+//! - no Munk moment unless the vehicle file switches it on (`canopy.munk_moment`; the seed's
+//!   N4 has none, and its coefficients were tuned without it: MODEL_NOTES.md);
 //! - the whole 12-m stack sees the density and wind at the canopy.
 
 pub mod aero;
@@ -92,7 +94,8 @@ pub struct Evaluation {
     /// velocity terms), in its own frame, N: what Newton's law balances with the tensions.
     pub external_force_n: [Vector3<f64>; 4],
     /// Applied external moment about the CM of the canopy and the drone (aerodynamic,
-    /// including the aerodynamic force's moment from the pressure centre), own frame, N·m.
+    /// including the aerodynamic force's moment from the pressure centre, and the canopy's
+    /// Munk moment when the vehicle has it), own frame, N·m.
     pub external_moment_nm: [Vector3<f64>; 2],
 }
 
@@ -285,6 +288,15 @@ impl ParafoilModel {
         let m_app = Matrix3::from_diagonal(&(v.apparent.mass_per_density_m3 * rho[0]));
         let i_app = Matrix3::from_diagonal(&(v.apparent.inertia_per_density_m5 * rho[0]));
         let canopy_inertia = v.canopy_inertia + i_app;
+        // Kirchhoff's moment of the air carried along: the rate of the apparent angular
+        // momentum about the moving canopy CM lacks `V_rel × (M_app·V_rel)`, which turns a
+        // body with unequal apparent masses broadside to the flow (nose-up at a glide).
+        let munk_moment = if v.config.canopy.munk_moment {
+            -v_rel[0].cross(&(m_app * v_rel[0]))
+        } else {
+            Vector3::zeros()
+        };
+        let canopy_moment = canopy_wrench.moment_nm + munk_moment;
 
         let e_main_c = kin.main_line_dir.map(|e| kin.t_c_l.transpose() * e);
         let e_main_d = kin.main_line_dir.map(|e| kin.t_l_d * e);
@@ -318,7 +330,7 @@ impl ParafoilModel {
         );
         eq.set_rhs(
             row::CANOPY_MOMENT,
-            &(canopy_wrench.moment_nm
+            &(canopy_moment
                 - omega_c.cross(&(canopy_inertia * omega_c))
                 - canopy_inertia * alpha_c.bias),
         );
@@ -422,7 +434,7 @@ impl ParafoilModel {
             },
             canopy_air,
             external_force_n: external,
-            external_moment_nm: [canopy_wrench.moment_nm, drone_wrench.moment_nm],
+            external_moment_nm: [canopy_moment, drone_wrench.moment_nm],
         }
     }
 }
