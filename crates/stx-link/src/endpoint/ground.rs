@@ -116,6 +116,22 @@ impl GroundEndpoint {
         }
     }
 
+    /// Feeds one whole datagram (UDP) received on radio `path`; returns whether it carried a
+    /// frame accepted from the drone's system (CRC checked and, with signing on, correctly
+    /// signed), the only kind of datagram whose source a UDP-in transport may take as the
+    /// drone's address. A frame left incomplete at the datagram's end is dropped as
+    /// truncated, so a datagram cannot finish a frame that another one began.
+    pub fn handle_datagram_on(&mut self, path: usize, now: Duration, datagram: &[u8]) -> bool {
+        let drone = self.vehicle.0;
+        let (frames, from_drone) = self
+            .core
+            .ingest_datagram(path, now, datagram, |f| f.header.system_id == drone);
+        for frame in frames {
+            self.dispatch(now, frame);
+        }
+        from_drone
+    }
+
     /// The stream connection (TCP, serial) ended: a frame cut off by it is counted as
     /// truncated and any frame behind it still delivered.
     pub fn handle_stream_end(&mut self, now: Duration) {
