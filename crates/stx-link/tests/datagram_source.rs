@@ -1,7 +1,8 @@
-//! Which datagrams may move a UDP-in transport's peer: the endpoints' verdicts from
-//! `handle_datagram_on` on garbage, frames from other systems, split frames and, with signing
-//! on, unsigned and badly signed frames — without sockets (the transport's side is tested in
-//! stx-link-tokio).
+//! A hostile sender's datagrams at the endpoints, without sockets (the transport's side is
+//! tested in stx-link-tokio): which datagrams may move a UDP-in transport's peer (the verdicts
+//! of `handle_datagram_on` on garbage, frames from other systems, split frames and, with
+//! signing on, unsigned and badly signed frames), and that another system's frames are never
+//! taken for the drone's.
 
 use std::time::Duration;
 
@@ -10,10 +11,11 @@ use mavlink::dialects::common::MavMessage;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use stx_link::endpoint::{
-    GroundConfig, GroundEndpoint, LinkConfig, VehicleConfig, VehicleEndpoint,
+    GroundConfig, GroundEndpoint, GroundEvent, LinkConfig, VehicleConfig, VehicleEndpoint,
 };
 use stx_link::frame::FrameEncoder;
 use stx_link::signing::{SigningConfig, SigningKey};
+use stx_link::telemetry::{Severity, Telemetry, split_status_text};
 
 const T: Duration = Duration::ZERO;
 const JAN_2026: Duration = Duration::from_secs(1_767_225_600);
@@ -29,8 +31,9 @@ fn heartbeat(mavtype: mc::MavType) -> MavMessage {
     })
 }
 
+/// The drone's status heartbeat, as stx drones send it.
 fn drone_heartbeat() -> MavMessage {
-    heartbeat(mc::MavType::MAV_TYPE_GENERIC)
+    Telemetry::Status(VehicleConfig::default().initial_status).to_mavlink()
 }
 
 fn gcs_heartbeat() -> MavMessage {
@@ -159,4 +162,38 @@ fn a_vehicle_follows_the_ground_station_it_serves() {
     assert!(v.handle_datagram_on(0, T, &frame(254, &gcs_heartbeat())));
     assert!(v.handle_datagram_on(0, T, &frame(254, &ping)));
     assert!(!v.handle_datagram_on(0, T, &frame(255, &ping)));
+}
+
+/// Regression: the station read any system's HEARTBEAT and STATUSTEXT as the drone's, so a
+/// sender of another system's frames changed the mode and texts the operators saw.
+#[test]
+fn another_system_s_frames_are_never_the_drone_s_telemetry() {
+    let mut g = ground(None);
+    let text = split_status_text(Severity::Critical, "cutdown fired", 1)
+        .into_iter()
+        .map(|chunk| Telemetry::StatusText(chunk).to_mavlink())
+        .next()
+        .expect("one chunk");
+    for message in [drone_heartbeat(), text] {
+        g.handle_datagram_on(0, T, &frame(7, &message));
+        let mut events = Vec::new();
+        while let Some(e) = g.poll_event() {
+            events.push(e);
+        }
+        assert!(
+            matches!(&events[..], [GroundEvent::Other(f)] if f.header.system_id == 7),
+            "{events:?}"
+        );
+    }
+    assert!(
+        !g.is_connected(),
+        "another system's heartbeat is not the drone's"
+    );
+    g.handle_datagram_on(0, T, &frame(1, &drone_heartbeat()));
+    let mut telemetry = 0;
+    while let Some(e) = g.poll_event() {
+        telemetry += usize::from(matches!(e, GroundEvent::Telemetry { from: (1, 1), .. }));
+    }
+    assert_eq!(telemetry, 1);
+    assert!(g.is_connected());
 }

@@ -55,7 +55,7 @@ impl Default for GroundConfig {
 pub enum GroundEvent {
     /// Link state, dropped frames, signing timestamp to persist.
     Link(LinkEvent),
-    /// A telemetry item from the drone.
+    /// A telemetry item from the drone (its system; any component).
     Telemetry {
         from: (u8, u8),
         telemetry: Telemetry,
@@ -72,7 +72,8 @@ pub enum GroundEvent {
     Param(ParamEvent),
     /// Outcome of a plan transfer.
     Plan(PlanEvent),
-    /// Any other message from anyone (for recording and other tools).
+    /// Any other message from the drone, and every message from another system (for
+    /// recording and other tools).
     Other(Box<Frame>),
 }
 
@@ -158,18 +159,23 @@ impl GroundEndpoint {
 
     fn dispatch(&mut self, now: Duration, frame: Frame) {
         let from = (frame.header.system_id, frame.header.component_id);
-        let msg = &frame.message;
-        if from.0 == self.vehicle.0 {
-            if let MavMessage::HEARTBEAT(h) = msg
-                && h.mavtype != mc::MavType::MAV_TYPE_GCS
-            {
-                self.core.peer_heartbeat(now, from);
-            }
-            let our = self.core.config.system_id;
-            self.commands.handle_message(now, from.0, our, msg);
-            self.params.handle_message(now, from.0, msg);
-            self.plan.handle_message(now, from.0, msg);
+        // Another system's frames (another vehicle, a ground station, someone on the network
+        // forging them) are passed on as they are, never read as the drone's telemetry or
+        // texts.
+        if from.0 != self.vehicle.0 {
+            self.events.push_back(GroundEvent::Other(Box::new(frame)));
+            return;
         }
+        let msg = &frame.message;
+        if let MavMessage::HEARTBEAT(h) = msg
+            && h.mavtype != mc::MavType::MAV_TYPE_GCS
+        {
+            self.core.peer_heartbeat(now, from);
+        }
+        let our = self.core.config.system_id;
+        self.commands.handle_message(now, from.0, our, msg);
+        self.params.handle_message(now, from.0, msg);
+        self.plan.handle_message(now, from.0, msg);
         match Telemetry::from_mavlink(msg) {
             Some(telemetry) => {
                 if let Telemetry::StatusText(chunk) = &telemetry
@@ -194,7 +200,7 @@ impl GroundEndpoint {
                         | MavMessage::MISSION_COUNT(_)
                         | MavMessage::MISSION_ACK(_)
                 );
-                if !protocol || from.0 != self.vehicle.0 {
+                if !protocol {
                     self.events.push_back(GroundEvent::Other(Box::new(frame)));
                 }
             }
