@@ -2,6 +2,12 @@
 //! an I/O adapter drives (bytes and `now` in; frames, timers and events out), and the
 //! [`IoEvent`]s and [`IoStats`] an adapter reports back. Nothing here does I/O: the tokio
 //! adapter is the `stx-link-tokio` crate, and tests drive endpoints by hand.
+//!
+//! Datagram transports (UDP) feed each datagram whole with
+//! [`SansIo::handle_datagram_on`], whose answer says whether it carried a frame accepted from
+//! the expected peer system: a datagram's source address is anyone's to forge, and only the
+//! endpoint can tell a frame from its peer, so a `udpin:` adapter moves its peer only on that
+//! verdict.
 
 use std::net::SocketAddr;
 use std::path::PathBuf;
