@@ -131,19 +131,21 @@ impl Station {
         let pid = self.child.id().to_string();
         let _ = Command::new("kill").args(["-TERM", &pid]).status();
         let deadline = Instant::now() + Duration::from_secs(10);
-        while self.child.try_wait().expect("wait").is_none() {
-            if Instant::now() > deadline {
-                let _ = self.child.kill();
-                let _ = self.child.wait();
-                break;
-            }
+        while self.child.try_wait().expect("wait").is_none() && Instant::now() < deadline {
             std::thread::sleep(Duration::from_millis(50));
         }
-        let log = std::fs::read_to_string(&self.log).expect("log");
+        std::fs::read_to_string(&self.log).expect("log")
+    }
+}
+
+/// A failed assertion does not leave the daemon running.
+impl Drop for Station {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
         if let Some(dir) = self.log.parent() {
             let _ = std::fs::remove_dir_all(dir);
         }
-        log
     }
 }
 
