@@ -1,6 +1,6 @@
 // Vite builds the two pages (live dashboard and recovery) into dist/, which the daemon serves.
-// In development the dev server proxies the API, the KML feed and the tiles to a daemon: the mock
-// (`npm run mock`) or `stx serve`, at STX_DAEMON (default http://127.0.0.1:8080).
+// In development the dev server proxies the API, the KML feed and the tiles to a daemon
+// (`stx serve --sim` for a simulated drone, or `stx serve`) at STX_DAEMON (default http://127.0.0.1:8080).
 import { defineConfig } from "vitest/config";
 import { fileURLToPath } from "node:url";
 
@@ -33,6 +33,6 @@ export default defineConfig({
   },
   test: {
     environment: "node",
-    include: ["src/**/*.test.ts"],
+    include: ["src/**/*.test.ts", "scripts/**/*.test.mjs"],
   },
 });

@@ -2,7 +2,10 @@
 // End-to-end test of the whole station in a real browser: `stx serve` with a simulated drone over
 // loopback MAVLink, and Debian's chromium driven by playwright-core. Every check reads what the
 // drone itself reports back through the link, never the page's own echo. Screenshots go to
-// tests/output/browser/. Exit code 0 only if every check holds.
+// tests/output/browser/. Exit code 0 only if every check holds. Every WebSocket message and REST
+// body the pages (and the test itself) exchange with the station is validated against the API's
+// contract, web/src/generated/api.schema.json: the first one that breaks it fails the test, with
+// its path.
 //
 // Two flights:
 //  1. `mission-short` during the balloon ascent, with `stx drone` run beside `stx serve` so its
@@ -22,12 +25,13 @@ import { createSocket } from "node:dgram";
 import { mkdir, readFile } from "node:fs/promises";
 import { createRequire } from "node:module";
 import { dirname, join, resolve } from "node:path";
-import { fileURLToPath } from "node:url";
+import { fileURLToPath, pathToFileURL } from "node:url";
 
 const here = dirname(fileURLToPath(import.meta.url));
 const root = resolve(here, "../..");
 // playwright-core comes from the dashboard's own locked dependencies (web/package-lock.json).
 const { chromium } = createRequire(join(root, "web/package.json"))("playwright-core");
+const { contract } = await import(pathToFileURL(join(root, "web/scripts/contract.mjs")).href);
 const out = join(root, "tests/output/browser");
 await mkdir(out, { recursive: true });
 
@@ -45,6 +49,102 @@ function check(name, ok, detail = "") {
   results.push(`${ok ? "PASS" : "FAIL"}  ${name}${detail ? ` — ${detail}` : ""}`);
   console.log(results[results.length - 1]);
   if (!ok) failed = true;
+}
+
+// ------------------------------------------------------------------ the API's contract
+const api = contract();
+const seen = new Map(); // contract name (or WebSocket type) -> how many were valid
+let broken = null; // the first message that broke the contract
+const pendingBodies = [];
+let lastRequestId = null;
+/** Checks one message against the contract's definition `name`; remembers the first that breaks it. */
+function conform(where, name, value) {
+  const error = api.check(name, value);
+  if (error !== null) {
+    if (broken === null) {
+      broken = `${where}: ${error} in ${JSON.stringify(value).slice(0, 300)}`;
+      console.log(`CONTRACT BROKEN  ${broken}`);
+    }
+    return;
+  }
+  const key = name === "ServerMessage" || name === "ClientMessage" ? `${name}:${value.type}` : name;
+  seen.set(key, (seen.get(key) ?? 0) + 1);
+}
+/** What the contract calls a REST body: `[request body or null, response body]` for one call. */
+function restNames(method, path, status) {
+  if (status >= 400) return [null, "ErrorBody"];
+  const gets = { "/api/session": "Session", "/api/state": "StateMsg", "/api/params": "ParamsMsg", "/api/events": "EventsBody", "/api/track": "TrackBody", "/api/clients": "ClientsBody" };
+  if (method === "GET" && gets[path]) return [null, gets[path]];
+  if (method === "GET" && /^\/api\/commands\/[^/]+$/.test(path)) return [null, "CommandResultMsg"];
+  const commands = { mode: "ModeBody", heading: "HeadingBody", course: "CourseBody", localizer: "LocalizerBody", target: "TargetBody", plan: "PlanBody" };
+  const command = /^\/api\/commands\/(\w+)$/.exec(path)?.[1];
+  if (method === "POST" && command && commands[command]) return [commands[command], "CommandAccepted"];
+  if (method === "POST" && /^\/api\/params\/[^/]+$/.test(path)) return ["ParamBody", "CommandAccepted"];
+  if (method === "POST" && path === "/api/cutdown/arm") return [null, "CutdownArm"];
+  if (method === "POST" && path === "/api/cutdown/confirm") return ["ConfirmBody", "CommandAccepted"];
+  return [null, null];
+}
+function conformRest(where, method, path, status, request, body) {
+  const [requestName, responseName] = restNames(method, path, status);
+  if (responseName === null) {
+    broken ??= `${where}: ${method} ${path} (${status}) is not in the contract`;
+    return;
+  }
+  if (requestName !== null && request !== undefined) conform(`${where} ${method} ${path} request`, requestName, request);
+  conform(`${where} ${method} ${path} → ${status}`, responseName, body);
+  if (responseName === "CommandAccepted" && typeof body?.request_id === "string") lastRequestId = body.request_id;
+}
+/** Validates everything a browser context's pages exchange with the station. */
+function watchContract(ctx, label) {
+  const frames = (page) => page.on("websocket", (ws) => {
+    if (!new URL(ws.url()).pathname.startsWith("/api/ws")) return;
+    const json = (f, dir) => {
+      try {
+        return JSON.parse(f.payload);
+      } catch {
+        broken ??= `${label} WebSocket ${dir}: not JSON: ${String(f.payload).slice(0, 80)}`;
+        return undefined;
+      }
+    };
+    ws.on("framereceived", (f) => {
+      const m = json(f, "received");
+      if (m !== undefined) conform(`${label} WebSocket, station → page`, "ServerMessage", m);
+    });
+    ws.on("framesent", (f) => {
+      const m = json(f, "sent");
+      if (m !== undefined) conform(`${label} WebSocket, page → station`, "ClientMessage", m);
+    });
+  });
+  ctx.on("page", frames);
+  ctx.on("response", (r) => {
+    const url = new URL(r.url());
+    if (!url.pathname.startsWith("/api/") || url.pathname === "/api/ws") return;
+    const req = r.request();
+    let request;
+    try {
+      request = req.postData() === null ? undefined : req.postDataJSON();
+    } catch {
+      request = req.postData();
+    }
+    pendingBodies.push(r.text().then(
+      (text) => {
+        let body;
+        try {
+          body = JSON.parse(text);
+        } catch {
+          broken ??= `${label} ${req.method()} ${url.pathname} → ${r.status()}: not JSON: ${text.slice(0, 80)}`;
+          return;
+        }
+        conformRest(label, req.method(), url.pathname, r.status(), request, body);
+      },
+      () => {}, // the page went away before the body arrived
+    ));
+  });
+}
+async function newContext(label, options) {
+  const ctx = await browser.newContext(options);
+  watchContract(ctx, label);
+  return ctx;
 }
 
 // ------------------------------------------------------------------ geodesy for the checks
@@ -105,7 +205,10 @@ async function freeUdpPort() {
 function apiOf(base) {
   return async (path, token = VIEWER, init = {}) => {
     const r = await fetch(`${base}${path}`, { ...init, headers: { authorization: `Bearer ${token}`, "content-type": "application/json", ...(init.headers ?? {}) } });
-    return { status: r.status, body: await r.json().catch(() => null) };
+    const body = await r.json().catch(() => null);
+    const request = typeof init.body === "string" ? JSON.parse(init.body) : undefined;
+    conformRest("test", init.method ?? "GET", new URL(r.url).pathname, r.status, request, body);
+    return { status: r.status, body };
   };
 }
 async function until(what, pred, timeoutMs, everyMs = 200) {
@@ -175,7 +278,7 @@ async function missionShort() {
   console.log(`mission-short: station at ${base}, drone (pid ${drone.proc.pid}) at 5× real time`);
   const vehicle = async () => (await api("/api/state")).body?.vehicle ?? null;
 
-  const ctx = await browser.newContext({ viewport: { width: 1440, height: 900 } });
+  const ctx = await newContext("mission-short", { viewport: { width: 1440, height: 900 } });
   const page = await ctx.newPage();
   watchErrors(page, "mission-short");
   const cutdownRequests = [];
@@ -251,7 +354,7 @@ async function rehearsal() {
   const vehicle = async () => (await api("/api/state")).body?.vehicle ?? null;
 
   // ---------------------------------------------------------------- operator page with a scripted gamepad
-  const ctx = await browser.newContext({ viewport: { width: 1440, height: 900 } });
+  const ctx = await newContext("operator", { viewport: { width: 1440, height: 900 } });
   await ctx.addInitScript(() => {
     // A gamepad in the browser's standard layout; the test moves it through window.__pad.
     const pad = {
@@ -306,7 +409,7 @@ async function rehearsal() {
   await page.screenshot({ path: join(out, "live-operator.png") });
 
   // ---------------------------------------------------------------- a viewer watches but cannot command
-  const vctx = await browser.newContext({ viewport: { width: 1440, height: 900 } });
+  const vctx = await newContext("viewer", { viewport: { width: 1440, height: 900 } });
   const vpage = await vctx.newPage();
   watchErrors(vpage, "viewer");
   const viewerPosts = [];
@@ -326,7 +429,7 @@ async function rehearsal() {
   await vctx.close();
 
   // ---------------------------------------------------------------- the page on a phone
-  const pctx = await browser.newContext({ viewport: { width: 390, height: 844 }, isMobile: true, hasTouch: true });
+  const pctx = await newContext("phone", { viewport: { width: 390, height: 844 }, isMobile: true, hasTouch: true });
   const ppage = await pctx.newPage();
   watchErrors(ppage, "phone");
   await ppage.goto(`${base}/?token=${VIEWER}`);
@@ -516,8 +619,19 @@ async function rehearsal() {
   await rec.screenshot({ path: join(out, "recovery-phone.png"), fullPage: true });
   await rec.close();
 
+  // ---------------------------------------------------------------- the REST bodies the pages do not read, against the contract
+  const rest = {
+    clients: await api("/api/clients"),
+    track: await api("/api/track?every_s=5"),
+    events: await api("/api/events?since_s=0"),
+    result: lastRequestId === null ? null : await api(`/api/commands/${encodeURIComponent(lastRequestId)}`),
+    unknown: await api("/api/no-such-endpoint"),
+  };
+  check("REST: clients, track, events, a command's result and a 404, as the contract has them", rest.clients.body?.clients?.length >= 1 && rest.track.body?.points?.length > 0 && rest.events.body?.events?.length > 0 && rest.result?.status === 200 && rest.unknown.status === 404,
+    `${rest.clients.body?.clients?.length} clients, ${rest.track.body?.points?.length} track points, ${rest.events.body?.events?.length} events, result of ${lastRequestId}: ${rest.result?.status}, unknown endpoint: ${rest.unknown.status}`);
+
   // ---------------------------------------------------------------- recovery page without the phone's position
-  const nctx = await browser.newContext({ viewport: { width: 390, height: 844 }, isMobile: true, hasTouch: true });
+  const nctx = await newContext("recovery without position", { viewport: { width: 390, height: 844 }, isMobile: true, hasTouch: true });
   await nctx.grantPermissions(["clipboard-read", "clipboard-write"], { origin: base });
   const npage = await nctx.newPage();
   watchErrors(npage, "recovery without position");
@@ -559,6 +673,14 @@ async function rehearsal() {
 }
 
 check("no page errors", pageErrors.length === 0, pageErrors.slice(0, 5).join(" | "));
+await Promise.allSettled(pendingBodies);
+// Each kind the pages must have met, so that the check below cannot pass on silence.
+const expected = ["ServerMessage:hello", "ServerMessage:state", "ServerMessage:history", "ServerMessage:event", "ServerMessage:command_result", "ServerMessage:params",
+  "ClientMessage:manual", "ClientMessage:manual_release", "Session", "StateMsg", "ParamsMsg", "EventsBody", "TrackBody", "ClientsBody", "CommandResultMsg", "CommandAccepted",
+  "CutdownArm", "ErrorBody", "ModeBody", "TargetBody", "ParamBody", "ConfirmBody"];
+const missing = expected.filter((k) => !seen.has(k));
+check("every message between the station and the pages matches the contract (web/src/generated/api.schema.json)", broken === null && missing.length === 0,
+  broken ?? (missing.length > 0 ? `never seen: ${missing.join(", ")}` : [...seen].map(([k, n]) => `${k} ${n}`).join(", ")));
 const passed = results.filter((r) => r.startsWith("PASS")).length;
 console.log(`\n${passed} passed, ${results.length - passed} failed in ${((Date.now() - started) / 1000).toFixed(0)} s; screenshots in ${out}`);
 if (failed) for (const c of logs) console.log(`${c.label} stderr (tail):\n${c.err.split("\n").slice(-20).join("\n")}`);

@@ -12,12 +12,19 @@
 //!   published values ([`seed`]);
 //! - [`tune`] closes the loop with the onboard control laws of `stx-gnc` on the linear model,
 //!   optimises the gains of one controller with [`nelder_mead`], and checks them with step
-//!   responses of the nonlinear model flown by `stx-sim`;
-//! - [`svg`] draws the eigenvalue map and the step responses.
+//!   responses of the nonlinear model flown by `stx-sim` (its parts: the controllers, the
+//!   step metrics and cost, the experiments, the optimiser's driver);
+//! - [`forced_response`] flies the nonlinear model and its linearisation side by side from the
+//!   same perturbed trim, to show how far the linear model holds;
+//! - [`svg`] draws plots; [`figures`] makes the eigenvalue map and the step responses of an
+//!   analysis and of a tuning with it, and [`gains_file`] the gains file a tuning writes.
 //!
 //! Pure: no files, no clocks, no randomness. The `stx` binary reads and writes files.
 
 pub mod analysis;
+pub mod figures;
+pub mod forced_response;
+pub mod gains_file;
 pub mod jacobian;
 pub mod linearize;
 pub mod lti;

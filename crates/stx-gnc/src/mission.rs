@@ -10,6 +10,7 @@ use serde::{Deserialize, Serialize};
 /// Stage of a STRAPLEX mission, from the launch pad to the landing field (gnc.md, "Flight
 /// stages").
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(rename_all = "snake_case")]
 #[repr(u8)]
 pub enum FlightStage {
@@ -29,6 +30,7 @@ pub enum FlightStage {
 
 /// Control mode the operator selected (seed §2.2: manual and the autonomous modes of ch. 5).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(rename_all = "snake_case")]
 #[repr(u8)]
 pub enum FlightMode {
@@ -49,6 +51,7 @@ pub enum FlightMode {
 /// Phase of spiral-landing guidance (seed §5.3, Fig. 5.7), plus the phases a real operator
 /// needs around it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(rename_all = "snake_case")]
 #[repr(u8)]
 pub enum GuidancePhase {

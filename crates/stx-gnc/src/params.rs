@@ -115,6 +115,7 @@ pub struct OnboardSettings {
 
 /// Which part of the onboard software a parameter belongs to.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(rename_all = "snake_case")]
 pub enum ParamGroup {
     /// Control-law gains ([`crate::control::ControlGains`]).

@@ -18,7 +18,7 @@ use stx_gnc::estimator::{Estimator, EstimatorConfig, EstimatorConfigError};
 use stx_gnc::guidance::{Guidance, PhaseEvent};
 use stx_gnc::mission::{FlightMode, GuidancePhase};
 
-use crate::open_loop::{height_above_ground_m, lowest_point};
+use crate::geometry::{height_above_ground_m, lowest_point};
 use crate::sensors::{
     Delivery, DeliveryQueue, SensorConfig, SensorConfigError, SensorSuite, Truth,
 };

@@ -16,7 +16,8 @@ use stx_dynamics::wind::{Calm, WindField};
 use stx_gnc::guidance::Guidance;
 
 use crate::closed_loop::{GuidedFlight, SensedNavigation};
-use crate::open_loop::{Run, RunError, max_line_length_error_m};
+use crate::geometry::max_line_length_error_m;
+use crate::run::{Run, RunError};
 use crate::scenario::{Scenario, ScenarioError};
 use crate::summary::{Landing, PhaseStart, StepRecord, summarise};
 

@@ -2,17 +2,33 @@
 //! predictor as the drone on the live telemetry, keeps the mission's state and serves the
 //! dashboard and the API described in `API.md`.
 //!
+//! The pure station (no tokio, no sockets; `--no-default-features` builds only this):
 //! - [`config`]: the station's TOML, validated before anything starts;
-//! - [`core`]: the station's state and logic, pure (events and the mission clock in, messages
-//!   and link actions out);
-//! - [`messages`]: the API's JSON; [`kml`]: the Google Earth feed (parameter ranges, units
-//!   and meanings come from the onboard catalogue, `stx_gnc::params`, shared with the drone);
-//! - [`http`]: the axum routes (auth, REST, WebSocket, static files);
-//! - [`daemon`]: the tokio wiring of link, core and HTTP, with graceful shutdown.
+//! - [`core`]: the station's state and logic: telemetry, link events and operators' requests
+//!   in, with the mission clock; messages for the dashboards and link actions (with ids and
+//!   deadlines) out; the link's outcome of each action back in; retries and time-outs are its
+//!   own timers;
+//! - [`link`]: the ground endpoint as the link driver runs it, applying the core's link
+//!   actions and reporting their outcomes with the endpoint's events;
+//! - [`messages`] and [`replies`]: the API's JSON the station sends, [`requests`]: what it
+//!   reads (parameter ranges, units and meanings come from the onboard catalogue,
+//!   `stx_gnc::params`, shared with the drone); [`contract`]: all of them as one JSON Schema,
+//!   the contract the dashboard's TypeScript types are generated from; [`kml`]: the Google
+//!   Earth feed.
+//!
+//! With the default feature `daemon`, the adapters:
+//! - `http`: the axum routes (auth, REST, WebSocket, KML, static files);
+//! - `daemon`: the tokio wiring of link driver, core and HTTP, with graceful shutdown.
 
 pub mod config;
+pub mod contract;
 pub mod core;
+#[cfg(feature = "daemon")]
 pub mod daemon;
+#[cfg(feature = "daemon")]
 pub mod http;
 pub mod kml;
+pub mod link;
 pub mod messages;
+pub mod replies;
+pub mod requests;

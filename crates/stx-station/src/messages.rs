@@ -3,12 +3,17 @@
 
 use std::collections::BTreeMap;
 
+use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
+
+use stx_gnc::mission::{FlightMode, FlightStage, GuidancePhase};
+use stx_gnc::params::ParamGroup;
+use stx_link::telemetry::GpsFix;
 
 use crate::config::{ForecastRow, Role};
 
 /// `GET /api/session` and the WebSocket's `hello`.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, JsonSchema)]
 pub struct Session {
     /// The caller's role.
     pub role: Role,
@@ -19,7 +24,7 @@ pub struct Session {
 }
 
 /// What the dashboard needs to know about the station.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, JsonSchema)]
 pub struct StationInfo {
     /// Display name.
     pub name: String,
@@ -32,11 +37,12 @@ pub struct StationInfo {
     /// Tiles are served by the station itself (no internet needed).
     pub offline_tiles: bool,
     /// Modes the operator may select.
+    #[schemars(with = "Vec<FlightMode>")]
     pub modes: Vec<String>,
 }
 
 /// A geodetic position.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
 pub struct LatLonAlt {
     /// Latitude, degrees.
     pub lat_deg: f64,
@@ -47,7 +53,7 @@ pub struct LatLonAlt {
 }
 
 /// Link quality.
-#[derive(Debug, Clone, Default, Serialize)]
+#[derive(Debug, Clone, Default, Serialize, JsonSchema)]
 pub struct LinkView {
     /// Heartbeats arriving.
     pub connected: bool,
@@ -72,7 +78,7 @@ pub struct LinkView {
 }
 
 /// One radio of the drone link.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, JsonSchema)]
 pub struct RadioView {
     /// Its address in the config.
     pub address: String,
@@ -91,9 +97,10 @@ pub struct RadioView {
 }
 
 /// GPS as the drone's receiver reports it.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, JsonSchema)]
 pub struct GpsView {
     /// Fix type.
+    #[schemars(with = "GpsFix")]
     pub fix: String,
     /// Satellites used.
     pub satellites: Option<u8>,
@@ -110,7 +117,7 @@ pub struct GpsView {
 }
 
 /// Attitude from the AHRS.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, JsonSchema)]
 pub struct AttitudeView {
     /// The drone's clock when the attitude was measured (ms since its boot): which sample
     /// this is.
@@ -124,7 +131,7 @@ pub struct AttitudeView {
 }
 
 /// Pitot and static pressure.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, JsonSchema)]
 pub struct AirView {
     /// Static pressure, Pa.
     pub static_pressure_pa: f64,
@@ -137,7 +144,7 @@ pub struct AirView {
 }
 
 /// Servo positions.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, JsonSchema)]
 pub struct ServosView {
     /// Main line, −1…1.
     pub main_line: f64,
@@ -148,7 +155,7 @@ pub struct ServosView {
 }
 
 /// Battery.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, JsonSchema)]
 pub struct PowerView {
     /// Voltage, V.
     pub voltage_v: Option<f64>,
@@ -159,13 +166,16 @@ pub struct PowerView {
 }
 
 /// What the drone reports about itself.
-#[derive(Debug, Clone, Default, Serialize)]
+#[derive(Debug, Clone, Default, Serialize, JsonSchema)]
 pub struct VehicleView {
     /// Mode.
+    #[schemars(with = "Option<FlightMode>")]
     pub mode: Option<String>,
     /// Stage.
+    #[schemars(with = "Option<FlightStage>")]
     pub stage: Option<String>,
     /// Guidance phase (onboard).
+    #[schemars(with = "Option<GuidancePhase>")]
     pub phase: Option<String>,
     /// GPS.
     pub gps: Option<GpsView>,
@@ -189,7 +199,7 @@ pub struct VehicleView {
 }
 
 /// The drone's own predicted touchdown.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, JsonSchema)]
 pub struct OnboardLandingView {
     /// Latitude, degrees.
     pub lat_deg: f64,
@@ -204,7 +214,7 @@ pub struct OnboardLandingView {
 }
 
 /// The station's own estimate.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, JsonSchema)]
 pub struct EstimateView {
     /// Latitude, degrees.
     pub lat_deg: f64,
@@ -251,7 +261,7 @@ pub struct EstimateView {
 }
 
 /// The spiral's plan on the map.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, JsonSchema)]
 pub struct PatternView {
     /// Corners `[lat, lon]`.
     pub corners: Vec<[f64; 2]>,
@@ -268,7 +278,7 @@ pub struct PatternView {
 }
 
 /// The localizer line the replica follows.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, JsonSchema)]
 pub struct LocalizerView {
     /// The line's point `[lat, lon]`.
     pub point: [f64; 2],
@@ -279,17 +289,20 @@ pub struct LocalizerView {
 }
 
 /// The guidance replica's view.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, JsonSchema)]
 pub struct GuidanceView {
     /// Mode.
+    #[schemars(with = "FlightMode")]
     pub mode: String,
     /// Phase.
+    #[schemars(with = "GuidancePhase")]
     pub phase: String,
     /// Landing target; `null` while the drone's target is not known.
     pub target: Option<LatLonAlt>,
     /// Where the target comes from: `drone_plan` (read from the drone), `drone_telemetry`
     /// (from its bearing and distance to the target, about 1 % of the distance), `operator`
     /// (a command the drone acknowledged, until it is read back); `null`: unknown.
+    #[schemars(extend("enum" = ["drone_plan", "drone_telemetry", "operator", null]))]
     pub target_source: Option<&'static str>,
     /// The localizer line, once known.
     pub localizer: Option<LocalizerView>,
@@ -305,7 +318,7 @@ pub struct GuidanceView {
 }
 
 /// Servo commands of the replica.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, JsonSchema)]
 pub struct CommandsView {
     /// Main line, −1…1 of its travel.
     pub main_line: f64,
@@ -314,7 +327,7 @@ pub struct CommandsView {
 }
 
 /// A predicted touchdown.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, JsonSchema)]
 pub struct TouchdownView {
     /// Latitude, degrees.
     pub lat_deg: f64,
@@ -331,7 +344,7 @@ pub struct TouchdownView {
 }
 
 /// Both predictions of the station.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, JsonSchema)]
 pub struct PredictionView {
     /// Flying the plan; `null` while the plan of the drone's mode is not known.
     pub planned: Option<TouchdownView>,
@@ -344,19 +357,21 @@ pub struct PredictionView {
 }
 
 /// Mission state.
-#[derive(Debug, Clone, Default, Serialize)]
+#[derive(Debug, Clone, Default, Serialize, JsonSchema)]
 pub struct MissionView {
     /// Stage.
+    #[schemars(with = "Option<FlightStage>")]
     pub stage: Option<String>,
     /// When an armed cutdown expires, s.
     pub cutdown_armed_until_s: Option<f64>,
 }
 
 /// The `state` message.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, JsonSchema)]
 pub struct StateMsg {
     /// Always `state`.
     #[serde(rename = "type")]
+    #[schemars(extend("const" = "state"))]
     pub kind: &'static str,
     /// Mission clock, s.
     pub time_s: f64,
@@ -379,7 +394,7 @@ pub struct StateMsg {
 }
 
 /// Event levels.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, JsonSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum Level {
     /// Information.
@@ -391,10 +406,11 @@ pub enum Level {
 }
 
 /// The `event` message.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, JsonSchema)]
 pub struct EventMsg {
     /// Always `event`.
     #[serde(rename = "type")]
+    #[schemars(extend("const" = "event"))]
     pub kind: &'static str,
     /// Mission clock, s.
     pub time_s: f64,
@@ -403,13 +419,14 @@ pub struct EventMsg {
     /// Level.
     pub level: Level,
     /// Where it comes from: guidance, link, command, station, vehicle.
+    #[schemars(extend("enum" = ["guidance", "link", "command", "station", "vehicle"]))]
     pub source: &'static str,
     /// Text.
     pub text: String,
 }
 
 /// Outcomes of commands.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, JsonSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum Outcome {
     /// Still waiting.
@@ -427,10 +444,11 @@ pub enum Outcome {
 }
 
 /// The `command_result` message (and `GET /api/commands/{id}`).
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, JsonSchema)]
 pub struct CommandResultMsg {
     /// Always `command_result`.
     #[serde(rename = "type")]
+    #[schemars(extend("const" = "command_result"))]
     pub kind: &'static str,
     /// The request.
     pub request_id: String,
@@ -447,7 +465,7 @@ pub struct CommandResultMsg {
 }
 
 /// A parameter as the dashboard shows it.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, JsonSchema)]
 pub struct ParamView {
     /// Name.
     pub name: String,
@@ -462,16 +480,18 @@ pub struct ParamView {
     /// What it does.
     pub description: String,
     /// Part of the onboard software (`gains`, `spiral`, `failsafe`, `mission`), if known.
+    #[schemars(with = "Option<ParamGroup>")]
     pub group: Option<String>,
     /// For flags and choices, the name of each whole value from 0 up; empty for numbers.
     pub choices: Vec<&'static str>,
 }
 
 /// The `params` message and `GET /api/params`.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, JsonSchema)]
 pub struct ParamsMsg {
     /// Always `params`.
     #[serde(rename = "type")]
+    #[schemars(extend("const" = "params"))]
     pub kind: &'static str,
     /// The table.
     pub params: Vec<ParamView>,
@@ -482,7 +502,7 @@ pub struct ParamsMsg {
 }
 
 /// A point of the track.
-#[derive(Debug, Clone, Copy, Serialize)]
+#[derive(Debug, Clone, Copy, Serialize, JsonSchema)]
 pub struct TrackPoint {
     /// Mission clock, s.
     pub time_s: f64,
@@ -495,9 +515,10 @@ pub struct TrackPoint {
 }
 
 /// Error bodies.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, JsonSchema)]
 pub struct ErrorBody {
     /// Machine-readable kind.
+    #[schemars(extend("enum" = ["unauthorized", "forbidden", "bad_request", "not_found", "not_armed"]))]
     pub error: &'static str,
     /// For people: what is wrong.
     pub reason: String,

@@ -2,19 +2,15 @@
 //! and its plots.
 
 use std::fs;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use anyhow::{Context, anyhow};
 use clap::Args;
 use stx_analysis::analysis::{AnalysisReport, analyze};
-use stx_analysis::linearize::LinearModel;
-use stx_analysis::svg::{COLORS, Corner, Panel, Series, Style, render};
-use stx_analysis::tune::forced_responses;
-use stx_dynamics::state::idx;
-use stx_dynamics::vehicle::Vehicle;
+use stx_analysis::figures::analysis_figures;
 
 use crate::BadInput;
-use crate::sim::load_vehicle;
+use crate::inputs::load_vehicle;
 
 #[derive(Args)]
 pub struct AnalyzeArgs {
@@ -41,7 +37,14 @@ pub fn run(args: AnalyzeArgs) -> anyhow::Result<()> {
     let path = args.out_dir.join("report.json");
     fs::write(&path, serde_json::to_string_pretty(&report)?)
         .with_context(|| format!("writing {}", path.display()))?;
-    write_plots(&args.out_dir, &vehicle, &report, &lin)?;
+    let figures = analysis_figures(&vehicle, &report, &lin);
+    for warning in &figures.warnings {
+        eprintln!("warning: {warning}");
+    }
+    for figure in &figures.figures {
+        let path = args.out_dir.join(figure.file_name);
+        fs::write(&path, &figure.svg).with_context(|| format!("writing {}", path.display()))?;
+    }
     if args.json {
         println!("{}", serde_json::to_string(&report)?);
         for warning in &report.warnings {
@@ -195,205 +198,4 @@ fn print_tables(r: &AnalysisReport) {
     for warning in &r.warnings {
         println!("warning: {warning}");
     }
-}
-
-fn write_plots(
-    dir: &Path,
-    vehicle: &Vehicle,
-    r: &AnalysisReport,
-    lin: &LinearModel,
-) -> anyhow::Result<()> {
-    let ours: Vec<(f64, f64)> = r.eigenvalues.iter().map(|e| (e[0], e[1])).collect();
-    let seed: Vec<(f64, f64)> = r.seed.eigenvalues.iter().map(|e| (e[0], e[1])).collect();
-    let series = |label: &str| {
-        vec![
-            Series {
-                label: format!("stx ({label})"),
-                points: ours.clone(),
-                color: COLORS[0],
-                style: Style::Circles,
-            },
-            Series {
-                label: "seed §6.2.1".into(),
-                points: seed.clone(),
-                color: COLORS[1],
-                style: Style::Crosses,
-            },
-        ]
-    };
-    let panels = [
-        Panel {
-            title: "all eigenvalues".into(),
-            x_label: "real part, 1/s".into(),
-            y_label: "imaginary part, rad/s".into(),
-            series: series("31 states"),
-            x_range: Some((-20.0, 1.0)),
-            y_range: Some((-36.0, 36.0)),
-            legend: Corner::TopLeft,
-            ..Default::default()
-        },
-        Panel {
-            title: "slow modes".into(),
-            x_label: "real part, 1/s".into(),
-            y_label: "imaginary part, rad/s".into(),
-            series: series("zoom"),
-            x_range: Some((-6.0, 0.5)),
-            y_range: Some((-9.0, 9.0)),
-            legend: Corner::TopLeft,
-            ..Default::default()
-        },
-    ];
-    let title = format!(
-        "Eigenvalues of the linearised model at {:.0} m (trim airspeed {:.2} m/s)",
-        r.trim.altitude_m, r.trim.airspeed_mps
-    );
-    write(
-        dir,
-        "eigenvalues.svg",
-        &render(&title, &panels, 2, 520.0, 460.0),
-    )?;
-
-    // Open-loop steps: linear against nonlinear, small and large.
-    let deg = 180.0 / std::f64::consts::PI;
-    let step_panel = |du: [f64; 2], state: usize, scale: f64, label: &str, title: String| {
-        // High up, a large step can take the nonlinear stack where its model ends (a dive
-        // through the Euler angles' singularity): the panel says so instead of the whole
-        // analysis failing.
-        let responses = match forced_responses(vehicle, lin, &[], du, 20.0, 0.1) {
-            Ok(responses) => responses,
-            Err(e) => {
-                eprintln!("warning: {title}: the nonlinear flight failed ({e}); panel left empty");
-                return Ok(Panel {
-                    title: format!("{title}: nonlinear flight failed"),
-                    x_label: "time, s".into(),
-                    y_label: label.into(),
-                    ..Default::default()
-                });
-            }
-        };
-        Ok::<Panel, anyhow::Error>(Panel {
-            title,
-            x_label: "time, s".into(),
-            y_label: label.into(),
-            series: vec![
-                Series {
-                    label: "nonlinear".into(),
-                    points: responses
-                        .iter()
-                        .map(|(t, n, _)| (*t, n[state] * scale))
-                        .collect(),
-                    color: COLORS[0],
-                    style: Style::Line,
-                },
-                Series {
-                    label: "linear".into(),
-                    points: responses
-                        .iter()
-                        .map(|(t, _, l)| (*t, l[state] * scale))
-                        .collect(),
-                    color: COLORS[1],
-                    style: Style::Dashed,
-                },
-            ],
-            // Bottom right for a response that rises, top right for one that falls.
-            legend: if responses.last().is_some_and(|(_, n, _)| n[state] > 0.0) {
-                Corner::BottomRight
-            } else {
-                Corner::TopRight
-            },
-            ..Default::default()
-        })
-    };
-    let psi = idx::CANOPY_EULER + 2;
-    let phi = idx::CANOPY_EULER;
-    let main_line = [
-        step_panel(
-            [0.002, 0.0],
-            psi,
-            deg,
-            "Δψ canopy, deg",
-            "main line +2 mm: heading".into(),
-        )?,
-        step_panel(
-            [0.002, 0.0],
-            phi,
-            deg,
-            "Δφ canopy, deg",
-            "main line +2 mm: roll".into(),
-        )?,
-        step_panel(
-            [0.015, 0.0],
-            psi,
-            deg,
-            "Δψ canopy, deg",
-            "main line +15 mm (full): heading".into(),
-        )?,
-        step_panel(
-            [0.015, 0.0],
-            phi,
-            deg,
-            "Δφ canopy, deg",
-            "main line +15 mm (full): roll".into(),
-        )?,
-    ];
-    write(
-        dir,
-        "step-main-line.svg",
-        &render(
-            "Open-loop main-line step from the trim: nonlinear model against its linearisation",
-            &main_line,
-            2,
-            520.0,
-            340.0,
-        ),
-    )?;
-    let w = idx::CANOPY_VELOCITY + 2;
-    let u = idx::CANOPY_VELOCITY;
-    let brake = [
-        step_panel(
-            [0.0, 0.1],
-            u,
-            1.0,
-            "Δu canopy, m/s",
-            "brake 0.1: forward speed".into(),
-        )?,
-        step_panel(
-            [0.0, 0.1],
-            w,
-            1.0,
-            "Δw canopy, m/s",
-            "brake 0.1: normal speed".into(),
-        )?,
-        step_panel(
-            [0.0, 1.0],
-            u,
-            1.0,
-            "Δu canopy, m/s",
-            "brake 1.0 (full): forward speed".into(),
-        )?,
-        step_panel(
-            [0.0, 1.0],
-            w,
-            1.0,
-            "Δw canopy, m/s",
-            "brake 1.0 (full): normal speed".into(),
-        )?,
-    ];
-    write(
-        dir,
-        "step-brake.svg",
-        &render(
-            "Open-loop brake step from the trim: nonlinear model against its linearisation",
-            &brake,
-            2,
-            520.0,
-            340.0,
-        ),
-    )?;
-    Ok(())
-}
-
-fn write(dir: &Path, name: &str, text: &str) -> anyhow::Result<()> {
-    let path = dir.join(name);
-    fs::write(&path, text).with_context(|| format!("writing {}", path.display()))
 }

@@ -9,8 +9,10 @@ mod bench;
 mod bench_memory;
 mod bench_station;
 mod drone;
+mod inputs;
 mod logging;
 mod montecarlo;
+mod record;
 mod serve;
 mod sim;
 mod tune;
@@ -50,6 +52,8 @@ enum Command {
     Tune(tune::TuneArgs),
     /// The simulated drone flying a whole mission over a MAVLink link.
     Drone(drone::DroneArgs),
+    /// Flight recordings (MCAP): `stx record recover FILE` repairs a cut one.
+    Record(record::RecordArgs),
 }
 
 /// An error that is the user's input, not the program's failure (exit code 2).
@@ -75,6 +79,7 @@ fn main() -> ExitCode {
         Command::Analyze(args) => analyze::run(args),
         Command::Tune(args) => tune::run(args),
         Command::Drone(args) => drone::run(args),
+        Command::Record(args) => record::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -79,7 +79,7 @@ pub fn run(args: MonteCarloArgs) -> anyhow::Result<()> {
         ..MonteCarloConfig::default()
     };
     if let Some(path) = &args.gains {
-        config.guidance.gains = crate::tune::load_gains(path)?;
+        config.guidance.gains = crate::inputs::load_gains(path)?;
     }
     let sensors = SensorConfig::default();
     let estimator = EstimatorConfig::default();

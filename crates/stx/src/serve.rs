@@ -10,10 +10,13 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 use clap::Args;
+use stx_sim::drone::MissionOverrides;
+use stx_sim::runner::{FlyOptions, ProgressLog, Signing, Speed};
 use stx_station::config::{DEFAULT_STATION_TOML, StationConfig};
 
 use crate::BadInput;
-use crate::drone::{DroneOptions, Speed};
+use crate::drone::{fly_error, mission};
+use crate::inputs::load_gains;
 
 #[derive(Args)]
 pub struct ServeArgs {
@@ -134,7 +137,7 @@ pub fn run(args: ServeArgs) -> anyhow::Result<()> {
 }
 
 /// The simulated drone's options from the command line, checked before anything starts.
-fn sim_options(config: &StationConfig, args: &ServeArgs) -> anyhow::Result<DroneOptions> {
+fn sim_options(config: &StationConfig, args: &ServeArgs) -> anyhow::Result<FlyOptions> {
     if !config.link.address.starts_with("udpin:") {
         return Err(BadInput(anyhow::anyhow!(
             "--sim flies the drone over loopback UDP: the station's link must be `udpin:…`, not `{}`",
@@ -142,45 +145,61 @@ fn sim_options(config: &StationConfig, args: &ServeArgs) -> anyhow::Result<Drone
         ))
         .into());
     }
-    let mut options = DroneOptions::new("udpout:127.0.0.1:0", &args.sim_scenario);
+    let overrides = MissionOverrides {
+        seed: args.sim_seed,
+        gains: args.sim_gains.as_deref().map(load_gains).transpose()?,
+        ..MissionOverrides::default()
+    };
+    // Fail on an unknown mission now, with exit code 2, not after the dashboard is up.
+    let mut options = FlyOptions::new(
+        "udpout:127.0.0.1:0",
+        mission(&args.sim_scenario, &overrides)?,
+    );
     options.speed = args.sim_speed;
-    options.seed = args.sim_seed;
     // On the ground it keeps answering (parameters, replay of the landing) until the station stops.
     options.linger = None;
-    options.signing_key = config.link.signing_key().map_err(|e| BadInput(e.into()))?;
-    // The drone's own high-water mark, beside the station's.
-    options.signing_timestamp_file = config
-        .link
-        .signing_timestamp_file
-        .as_ref()
-        .map(|p| p.with_file_name("sim-drone.signing.timestamp"));
-    options.gains = args
-        .sim_gains
-        .as_deref()
-        .map(crate::tune::load_gains)
-        .transpose()?;
-    // Fail on an unknown mission now, with exit code 2, not after the dashboard is up.
-    crate::drone::check_mission(&options)?;
+    if let Some(key) = config.link.signing_key().map_err(|e| BadInput(e.into()))? {
+        // The drone's own high-water mark, beside the station's.
+        let timestamp_file = config
+            .link
+            .signing_timestamp_file
+            .as_ref()
+            .map(|p| p.with_file_name("sim-drone.signing.timestamp"))
+            .ok_or_else(|| {
+                BadInput(anyhow::anyhow!(
+                    "--sim with signing needs link.signing_timestamp_file, so the simulated \
+                     drone's timestamps stay monotonic across restarts"
+                ))
+            })?;
+        options.signing = Some(Signing {
+            key,
+            timestamp_file,
+            clock_unix: None,
+        });
+    }
     Ok(options)
 }
 
 /// The drone's flight, its outcome logged: a simulated drone that fails does not stop the
 /// station (the operator sees the link go quiet, as with a real one).
-async fn fly_beside(options: DroneOptions, shutdown: impl Future<Output = ()> + Send) {
+async fn fly_beside(options: FlyOptions, shutdown: impl Future<Output = ()> + Send) {
     tracing::info!(
-        mission = %options.scenario,
+        mission = %options.mission.name,
         speed = %options.speed,
         to = %options.connect,
         "simulated drone taking off"
     );
-    match crate::drone::fly(options, shutdown).await {
+    match stx_sim::runner::fly(options, shutdown, ProgressLog::default()).await {
         Ok(report) => tracing::info!(
             landed = report.landed,
             miss_m = ?report.mission.landing.as_ref().and_then(|l| l.miss_m),
             wall_time_s = report.wall_time_s,
             "simulated drone finished"
         ),
-        Err(e) => tracing::error!(error = format!("{e:#}"), "simulated drone failed"),
+        Err(e) => tracing::error!(
+            error = format!("{:#}", fly_error(e)),
+            "simulated drone failed"
+        ),
     }
 }
 
@@ -263,7 +282,7 @@ mod sim_gains_tests {
                 .serve
         };
         let options = sim_options(&config, &args(path.to_str().expect("utf-8"))).expect("valid");
-        assert_eq!(options.gains, Some(gains));
+        assert_eq!(options.mission.onboard.guidance.gains, gains);
         let err = sim_options(&config, &args("/nonexistent/gains.toml")).expect_err("refused");
         assert!(err.downcast_ref::<BadInput>().is_some(), "{err}");
         let _ = std::fs::remove_file(&path);

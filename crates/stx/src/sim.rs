@@ -6,11 +6,10 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, anyhow};
 use clap::Args;
-use stx_dynamics::vehicle::Vehicle;
 use stx_sim::open_loop;
-use stx_sim::scenario::Scenario;
 
 use crate::BadInput;
+use crate::inputs::{load_gains, load_scenario, load_vehicle};
 
 #[derive(Args)]
 pub struct SimArgs {
@@ -32,38 +31,10 @@ pub struct SimArgs {
     gains: Option<PathBuf>,
 }
 
-/// Reads a scenario by built-in name or path.
-pub fn load_scenario(name_or_path: &str) -> anyhow::Result<Scenario> {
-    let path = Path::new(name_or_path);
-    if name_or_path.ends_with(".toml") || path.exists() {
-        let text = fs::read_to_string(path)
-            .with_context(|| format!("cannot read scenario file {}", path.display()))
-            .map_err(BadInput)?;
-        Scenario::from_toml_str(name_or_path, &text).map_err(|e| BadInput(e.into()).into())
-    } else {
-        Scenario::builtin(name_or_path).map_err(|e| BadInput(e.into()).into())
-    }
-}
-
-/// Reads a vehicle file, or the shipped one.
-pub fn load_vehicle(path: Option<&Path>) -> anyhow::Result<Vehicle> {
-    match path {
-        None => Ok(Vehicle::straplex()),
-        Some(path) => {
-            let text = fs::read_to_string(path)
-                .with_context(|| format!("cannot read vehicle file {}", path.display()))
-                .map_err(BadInput)?;
-            Vehicle::from_toml_str(&text)
-                .with_context(|| format!("vehicle file {}", path.display()))
-                .map_err(|e| BadInput(e).into())
-        }
-    }
-}
-
 pub fn run(args: SimArgs) -> anyhow::Result<()> {
     let mut scenario = load_scenario(&args.scenario)?;
     if let Some(path) = &args.gains {
-        let gains = crate::tune::load_gains(path)?;
+        let gains = load_gains(path)?;
         match scenario.guidance.as_mut() {
             Some(guidance) => guidance.config.gains = gains,
             None => {

@@ -3,18 +3,19 @@
 
 use std::fs;
 use std::io::IsTerminal;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use anyhow::{Context, anyhow};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use stx_analysis::svg::{COLORS, Corner, Panel, Series, Style, render};
-use stx_analysis::tune::{Candidate, Controller, StepMetrics, Trial, TuneReport, tune};
+use stx_analysis::figures::tune_figure;
+use stx_analysis::gains_file::gains_file;
+use stx_analysis::tune::{Controller, StepMetrics, TuneReport, tune};
 use stx_gnc::control::ControlGains;
 use stx_gnc::guidance::GuidanceConfig;
 
 use crate::BadInput;
-use crate::sim::load_vehicle;
+use crate::inputs::{load_gains, load_vehicle};
 
 #[derive(Args)]
 pub struct TuneArgs {
@@ -47,16 +48,6 @@ pub struct TuneArgs {
 /// Where `stx tune` writes its gains unless told: untracked, so that tuning never rewrites the
 /// shipped defaults (`config/gains.toml`, which guidance's tests pin).
 pub const DEFAULT_OUT: &str = "target/tune/gains.toml";
-
-/// Reads and validates a gains file (`stx tune` writes them).
-pub fn load_gains(path: &Path) -> anyhow::Result<ControlGains> {
-    let text = fs::read_to_string(path)
-        .with_context(|| format!("cannot read gains file {}", path.display()))
-        .map_err(BadInput)?;
-    ControlGains::from_toml_str(&text)
-        .with_context(|| format!("gains file {}", path.display()))
-        .map_err(|e| BadInput(e).into())
-}
 
 pub fn run(args: TuneArgs) -> anyhow::Result<()> {
     let vehicle = load_vehicle(args.vehicle.as_deref())?;
@@ -111,7 +102,7 @@ pub fn run(args: TuneArgs) -> anyhow::Result<()> {
     fs::write(&json_path, serde_json::to_string_pretty(&report)?)
         .with_context(|| format!("writing {}", json_path.display()))?;
     let svg_path = args.out_dir.join(format!("step-{name}.svg"));
-    fs::write(&svg_path, plot(&report))
+    fs::write(&svg_path, tune_figure(&report))
         .with_context(|| format!("writing {}", svg_path.display()))?;
 
     let wrote = format!(
@@ -168,26 +159,6 @@ fn gains_column(controller: Controller, current: &ControlGains, gains: &ControlG
     } else {
         format!("{} ({})", tuned.join(", "), others.join(", "))
     }
-}
-
-fn gains_file(r: &TuneReport, source: &str) -> String {
-    let cost = |c: &Candidate| c.nonlinear_cost.unwrap_or(f64::NAN);
-    format!(
-        "# Control gains read by guidance (`stx sim --gains`, `stx montecarlo --gains`).\n\
-         # They become the built-in defaults (config/gains.toml) only after the Monte Carlo \
-         gate of crates/stx-analysis/ANALYSIS_NOTES.md.\n\
-         # Written by `stx tune --controller {}` at a {:.0} m trim ({}).\n\
-         # {}: nonlinear step cost {:.3} before, {:.3} tuned, {:.3} with the seed's A.13 gains.\n\
-         # Gains of the other controllers carried over from {source}.\n{}",
-        r.controller.name(),
-        r.altitude_m,
-        r.experiment,
-        r.verdict,
-        cost(&r.current),
-        cost(&r.tuned),
-        cost(&r.seed),
-        r.gains_out.to_toml_string()
-    )
 }
 
 fn fmt_opt(v: Option<f64>) -> String {
@@ -270,93 +241,6 @@ fn print_report(r: &TuneReport) {
         );
     }
     println!("\n{}", r.verdict);
-}
-
-fn plot(r: &TuneReport) -> String {
-    let c = r.controller;
-    let (scale, command_scale) = match c {
-        Controller::Heading | Controller::Course => (180.0 / std::f64::consts::PI, 100.0),
-        Controller::Localizer => (1.0, 100.0),
-        Controller::Vertical => (1.0, 1.0),
-    };
-    let pts = |t: &[f64], y: &[f64], s: f64| -> Vec<(f64, f64)> {
-        t.iter().zip(y).map(|(t, y)| (*t, y * s)).collect()
-    };
-    let candidates = [&r.current, &r.tuned, &r.seed];
-    let response_panel = |pick: fn(&Candidate) -> &Trial, title: String| {
-        let mut series = Vec::new();
-        for (k, cand) in candidates.iter().enumerate() {
-            let (linear, nonlinear) = &pick(cand).responses;
-            if let Some(n) = nonlinear {
-                series.push(Series {
-                    label: format!("{} 14-DOF", cand.label),
-                    points: pts(&n.time_s, &n.output, scale),
-                    color: COLORS[k],
-                    style: Style::Line,
-                });
-            }
-            series.push(Series {
-                label: format!("{} linear", cand.label),
-                points: pts(&linear.time_s, &linear.output, scale),
-                color: COLORS[k],
-                style: Style::Dashed,
-            });
-        }
-        let first = &pick(&r.current).responses.0;
-        Panel {
-            title,
-            x_label: "time, s".into(),
-            y_label: c.response_label().into(),
-            series,
-            h_lines: vec![first.reference * scale],
-            legend: if first.reference > first.initial {
-                Corner::BottomRight
-            } else {
-                Corner::TopRight
-            },
-            ..Default::default()
-        }
-    };
-    let commands = candidates
-        .iter()
-        .enumerate()
-        .filter_map(|(k, cand)| {
-            cand.large.responses.1.as_ref().map(|n| Series {
-                label: format!("{} 14-DOF", cand.label),
-                points: pts(&n.time_s, &n.command, command_scale),
-                color: COLORS[k],
-                style: Style::Line,
-            })
-        })
-        .collect();
-    let unit = |step: f64| match c {
-        Controller::Heading | Controller::Course => format!("{:.0}°", step * scale),
-        _ => format!("{step:.0} m"),
-    };
-    let panels = [
-        response_panel(
-            |c| &c.small,
-            format!("small step ({})", unit(r.current.small.step)),
-        ),
-        response_panel(
-            |c| &c.large,
-            format!("large step ({})", unit(r.current.large.step)),
-        ),
-        Panel {
-            title: "actuator in the large step (nonlinear runs)".into(),
-            x_label: "time, s".into(),
-            y_label: c.command_label().into(),
-            series: commands,
-            ..Default::default()
-        },
-    ];
-    render(
-        &format!("stx tune --controller {}: step responses", c.name()),
-        &panels,
-        1,
-        900.0,
-        340.0,
-    )
 }
 
 #[cfg(test)]

@@ -1,7 +1,21 @@
 // HTTP calls to the station, with the token on every request. Errors carry the API's
 // `{error, reason}` so the page can say exactly why a command was refused.
 
+import type * as Wire from "../generated/api";
 import { isObj } from "./parse";
+
+/** Each command endpoint and its body, as the contract (../generated/api.ts) has them. */
+export interface CommandBodies {
+  "/api/commands/mode": Wire.ModeBody;
+  "/api/commands/heading": Wire.HeadingBody;
+  "/api/commands/course": Wire.CourseBody;
+  "/api/commands/localizer": Wire.LocalizerBody;
+  "/api/commands/target": Wire.TargetBody;
+  "/api/commands/plan": Wire.PlanBody;
+  "/api/cutdown/confirm": Wire.ConfirmBody;
+  [param: `/api/params/${string}`]: Wire.ParamBody;
+}
+export type CommandPath = keyof CommandBodies;
 
 export class ApiError extends Error {
   constructor(
@@ -30,7 +44,7 @@ export class Api {
   }
 
   /** POST of a command: resolves to the request id of the 202. */
-  async command(path: string, body: unknown): Promise<string> {
+  async command<P extends CommandPath>(path: P, body: CommandBodies[P]): Promise<string> {
     const r = await this.post(path, body);
     if (isObj(r) && typeof r.request_id === "string") return r.request_id;
     throw new ApiError(200, "bad_response", "no request_id in the station's answer");

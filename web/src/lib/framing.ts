@@ -34,8 +34,8 @@ export function keyPoints(s: State): LatLon[] {
   // On the ground the plan and the predictions are history: frame where it is and where it aimed.
   if (isLanded(s)) return out;
   if (g?.pattern) {
-    out.push(...g.pattern.corners);
-    if (g.pattern.final_entry) out.push(g.pattern.final_entry);
+    for (const [lat_deg, lon_deg] of g.pattern.corners) out.push({ lat_deg, lon_deg });
+    if (g.pattern.final_entry) out.push({ lat_deg: g.pattern.final_entry[0], lon_deg: g.pattern.final_entry[1] });
   }
   for (const p of [s.prediction?.planned, s.prediction?.uncontrolled]) {
     if (!p) continue;

@@ -187,7 +187,7 @@ describe("plan and inputs", () => {
     const land = { kind: "land" as const, lat_deg: 1, lon_deg: 2, alt_msl_m: 245 };
     const r = planBody([{ kind: "waypoint", lat_deg: 1.1, lon_deg: 2.1, alt_msl_m: 600 }], land);
     expect(r.ok && r.body.items.map((i) => i.kind)).toEqual(["waypoint", "land"]);
-    expect(r.ok && r.body.items[1]!.approach_course_deg).toBeNull();
+    expect(r.ok && r.body.items[1]).toMatchObject({ kind: "land", approach_course_deg: null });
     expect(planBody([], null).ok).toBe(false);
   });
   it("validates typed numbers, naming the field", () => {

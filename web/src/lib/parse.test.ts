@@ -1,7 +1,9 @@
 import { describe, expect, it } from "vitest";
+import { contract } from "../../scripts/contract.mjs";
 import { decodeMessage, MessageStats, parseSession } from "./parse";
 
-// The state example of API.md, with its elided values filled in.
+// The state example of API.md, with its elided values filled in: a message the contract accepts
+// (checked below), so the fixture cannot drift from what the daemon sends.
 const STATE = {
   type: "state", time_s: 123.25, wall_ms: 1700000000000,
   link: { connected: true, stale: false, age_s: 0.21, rate_hz: 31.5, loss_percent: 0.4, crc_errors: 0, parse_errors: 0, signature_errors: 0,
@@ -9,30 +11,55 @@ const STATE = {
     radios: [{ address: "udpin:127.0.0.1:14550", transmitting: true, stale: false, age_s: 0.2, rate_hz: 31.5, loss_percent: 0.4, duplicates: 0 }] },
   vehicle: {
     mode: "spiral_landing", stage: "parafoil", phase: "branch2",
-    gps: { fix: "3d", satellites: 11, lat_deg: 38.53, lon_deg: -7.88, alt_msl_m: 812.4, velocity_ned_mps: [5.1, -1.2, 2.9], h_acc_m: 1.5 },
-    attitude: { roll_deg: -12.0, pitch_deg: -3.1, yaw_deg: 141.2 },
+    gps: { fix: "fix3d", satellites: 11, lat_deg: 38.53, lon_deg: -7.88, alt_msl_m: 812.4, velocity_ned_mps: [5.1, -1.2, 2.9], h_acc_m: 1.5 },
+    attitude: { time_boot_ms: 123456, roll_deg: -12.0, pitch_deg: -3.1, yaw_deg: 141.2 },
     air: { static_pressure_pa: 92000, differential_pressure_pa: 25.2, temperature_c: 11.2, airspeed_mps: 6.6 },
     servos: { main_line: 0.35, brake_right: 0.0, brake_left: 0.0 },
     power: { voltage_v: 11.9, current_a: 0.8, remaining_percent: 78 },
     onboard_wind_ned_mps: [-1.2, 0.4, 0.0],
+    predicted_landing: { lat_deg: 38.5335, lon_deg: -7.8887, alt_msl_m: 245, age_s: 0.8, stale: false },
+    age_s: 0.05, stale: false,
   },
   estimate: { lat_deg: 38.53, lon_deg: -7.88, alt_msl_m: 812.4, height_m: 567.4, velocity_ned_mps: [5.1, -1.2, 2.9], ground_speed_mps: 5.3, course_deg: -12.0,
     heading_deg: -10.5, heading_rate_dps: 2.1, airspeed_mps: 6.7, sink_rate_mps: 2.95, glide_ratio_air: 2.04, glide_ratio_ground: 1.8,
-    wind_ned_mps: [-1.2, 0.4, 0.0], wind_speed_mps: 1.26, wind_from_deg: 341.6, wind_sigma_mps: 0.15, position_sigma_m: 1.8, gps_ok: true },
-  guidance: { mode: "spiral_landing", phase: "branch2", target: { lat_deg: 38.5333, lon_deg: -7.8889, alt_msl_m: 245 },
+    wind_ned_mps: [-1.2, 0.4, 0.0], wind_speed_mps: 1.26, wind_from_deg: 341.6, wind_sigma_mps: 0.15, position_sigma_m: 1.8, gps_ok: true, age_s: 0.05, stale: false },
+  guidance: { mode: "spiral_landing", phase: "branch2", target: { lat_deg: 38.5333, lon_deg: -7.8889, alt_msl_m: 245 }, target_source: "drone_plan",
+    localizer: { point: [38.5333, -7.8889], course_deg: 80.0, glide_slope: 0.3 },
     pattern: { corners: [[38.531, -7.889], [38.532, -7.887], [38.534, -7.888], [38.533, -7.890]], final_entry: [38.531, -7.889], final_course_deg: 161.6,
       final_approach_height_m: 172.0, target_reachable: true, reach_ratio: 0.41 },
-    commands: { main_line: 0.35, brake: 0.0 } },
+    commands: { main_line: 0.35, brake: 0.0 }, age_s: 0.05, stale: false },
   prediction: { planned: { lat_deg: 38.5334, lon_deg: -7.8888, time_to_land_s: 187.0, semi_major_m: 12.1, semi_minor_m: 6.0, major_axis_deg: 40.0 },
-    uncontrolled: { lat_deg: 38.52, lon_deg: -7.87, time_to_land_s: 190.0, semi_major_m: 80, semi_minor_m: 40, major_axis_deg: 100 } },
-  forecast_wind: [{ alt_msl_m: 1000, speed_mps: 4, from_deg: 280 }, { alt_msl_m: 300, speed_mps: 2.0, from_deg: 270 }],
+    uncontrolled: { lat_deg: 38.52, lon_deg: -7.87, time_to_land_s: 190.0, semi_major_m: 80, semi_minor_m: 40, major_axis_deg: 100 }, age_s: 0.6, stale: false },
+  forecast_wind: [{ alt_msl_m: 300, speed_mps: 2.0, from_deg: 270 }, { alt_msl_m: 1000, speed_mps: 4, from_deg: 280 }],
   mission: { stage: "parafoil", cutdown_armed_until_s: null },
 };
+const SESSION = {
+  role: "operator", name: "ops-1",
+  station: { name: "STRAPLEX ground", origin: { lat_deg: 38.5333, lon_deg: -7.8889, alt_msl_m: 245 }, tile_url: "/tiles/{z}/{x}/{y}.png", tile_attribution: "©",
+    offline_tiles: true, modes: ["uncontrolled", "manual", "heading", "course", "localizer", "spiral_landing"] },
+};
 const j = (v: unknown): string => JSON.stringify(v);
+const api = contract();
+
+describe("the fixtures are messages of the contract", () => {
+  it("state, session, hello, event, command_result, params", () => {
+    expect(api.check("StateMsg", STATE)).toBeNull();
+    expect(api.check("Session", SESSION)).toBeNull();
+    expect(api.check("ServerMessage", { type: "hello", session: SESSION, role: SESSION.role, name: SESSION.name })).toBeNull();
+    expect(api.check("ServerMessage", { type: "event", time_s: 1, wall_ms: 1700000000000, level: "info", source: "link", text: "ok" })).toBeNull();
+    expect(api.check("ServerMessage", { type: "command_result", request_id: "r1", command: "set_param", outcome: "accepted", attempts: 2, detail: "HK1", value: 0.015 })).toBeNull();
+    expect(api.check("StateMsg", { ...STATE, extra: 1 })).toMatch(/additional/);
+  });
+});
 
 describe("decodeMessage: the API.md example", () => {
-  it("parses a full state", () => {
+  it("reads a message of the contract as it is: nothing lost, nothing invented", () => {
     const d = decodeMessage(j(STATE));
+    expect(d).toEqual({ ok: true, msg: STATE, dropped: 0 });
+    expect(decodeMessage(j({ type: "hello", session: SESSION, role: "operator", name: "ops-1" }))).toEqual({ ok: true, msg: { type: "hello", session: SESSION }, dropped: 0 });
+  });
+  it("parses a full state", () => {
+    const d = decodeMessage(j({ ...STATE, forecast_wind: [...STATE.forecast_wind].reverse() }));
     expect(d.ok).toBe(true);
     if (!d.ok || d.msg.type !== "state") throw new Error("not a state");
     const s = d.msg;
@@ -41,11 +68,16 @@ describe("decodeMessage: the API.md example", () => {
     expect(s.vehicle?.servos?.main_line).toBe(0.35);
     expect(s.estimate?.wind_from_deg).toBe(341.6);
     expect(s.guidance?.pattern?.corners).toHaveLength(4);
-    expect(s.guidance?.pattern?.final_entry).toEqual({ lat_deg: 38.531, lon_deg: -7.889 });
+    expect(s.guidance?.pattern?.final_entry).toEqual([38.531, -7.889]);
     expect(s.prediction?.planned?.semi_major_m).toBe(12.1);
     // Forecast sorted by altitude for interpolation.
     expect(s.forecast_wind.map((f) => f.alt_msl_m)).toEqual([300, 1000]);
     expect(s.mission.cutdown_armed_until_s).toBeNull();
+  });
+  it("names the contract does not list become null", () => {
+    const d = decodeMessage(j({ ...STATE, vehicle: { ...STATE.vehicle, mode: "warp", gps: { ...STATE.vehicle.gps, fix: "3d" } } }));
+    if (!d.ok || d.msg.type !== "state") throw new Error("not a state");
+    expect([d.msg.vehicle?.mode, d.msg.vehicle?.gps?.fix, d.msg.vehicle?.stage]).toEqual([null, null, "parafoil"]);
   });
   it("reads each radio and drops entries that are not objects", () => {
     const radios = [STATE.link.radios[0], 7, { address: "serial:/dev/ttyUSB1:57600", transmitting: false, stale: true, age_s: null, rate_hz: "x", duplicates: 12 }];
@@ -133,7 +165,7 @@ describe("history, hello, command_result", () => {
     expect(d.msg.states).toHaveLength(1);
     expect(d.dropped).toBe(4);
   });
-  it("hello, flattened (as we read API.md) or nested", () => {
+  it("hello, nested (as the station sends it) or flattened", () => {
     const session = { role: "viewer", name: "v", station: { name: "s", origin: { lat_deg: 1, lon_deg: 2, alt_msl_m: 3 }, tile_url: "/t/{z}/{x}/{y}.png", modes: ["manual", 7] } };
     for (const msg of [{ type: "hello", ...session }, { type: "hello", session }]) {
       const d = decodeMessage(j(msg));

@@ -1,29 +1,39 @@
-// Parses what the station sends into the typed shapes of types.ts, defensively: the wire is
-// outside our control (a daemon version skew, a proxy truncating a frame), and a bad message must
-// never crash the page or be shown as data. Optional leaves that are missing or of the wrong type
-// become null; a message without what makes it meaningful (a state without time_s, an event
-// without text) is rejected with a reason, so the caller can count and show it.
+// Parses what the station sends into the typed shapes of types.ts (the generated contract, read
+// leniently), defensively: the wire is outside our control (a daemon version skew, a proxy
+// truncating a frame), and a bad message must never crash the page or be shown as data. Leaves
+// that are missing or of the wrong type become null, and so do positions out of range and names
+// the contract does not list; a message without what makes it meaningful (a state without time_s,
+// an event without text) is rejected with a reason, so the caller can count and show it.
 
 import type {
   CommandResult,
   Estimate,
   EventMsg,
+  FlightMode,
+  FlightStage,
   ForecastWind,
   Gps,
+  GpsFix,
   Guidance,
+  GuidancePhase,
   History,
-  LandingPrediction,
+  Lagged,
   LatLon,
+  LandingPrediction,
   Level,
   Link,
-  Radio,
+  Localizer,
   Mission,
   N,
+  OnboardLanding,
   Outcome,
   Param,
+  ParamGroup,
   ParamsMsg,
   Pattern,
+  Position,
   Prediction,
+  Radio,
   Role,
   ServerMessage,
   Session,
@@ -33,6 +43,10 @@ import type {
   Vec3,
   Vehicle,
 } from "./types";
+import type { ServerMessage as WireServerMessage } from "../generated/api";
+
+type WireServerType = WireServerMessage["type"];
+type WireServerMessageOf<T extends WireServerType> = Extract<WireServerMessage, { type: T }>;
 
 type Obj = Record<string, unknown>;
 
@@ -77,18 +91,40 @@ const sub = <T>(o: Obj, k: string, f: (x: Obj) => T): T | null => {
   return v === null ? null : f(v);
 };
 
-const ROLES: readonly Role[] = ["operator", "viewer"];
-const LEVELS: readonly Level[] = ["info", "warning", "error"];
-const OUTCOMES: readonly Outcome[] = ["accepted", "denied", "failed", "unsupported", "timed_out", "in_progress"];
+// The names each enumeration of the contract takes. `satisfies` makes the compiler hold each list
+// to the generated type: a name added or removed in the daemon's Rust fails the build here.
+const ROLES = { operator: true, viewer: true } as const satisfies Record<Role, true>;
+const LEVELS = { info: true, warning: true, error: true } as const satisfies Record<Level, true>;
+const OUTCOMES = { accepted: true, denied: true, failed: true, unsupported: true, timed_out: true, in_progress: true } as const satisfies Record<Outcome, true>;
+const MODES = { uncontrolled: true, manual: true, heading: true, course: true, localizer: true, spiral_landing: true } as const satisfies Record<FlightMode, true>;
+const STAGES = { pre_launch: true, ascent: true, round_chute: true, parafoil_deploy: true, parafoil: true, landed: true } as const satisfies Record<FlightStage, true>;
+const PHASES = {
+  idle: true, approximation: true, branch1: true, branch2: true, branch3: true, branch4: true, final_approach: true, flare: true, best_reachable: true, landed: true,
+} as const satisfies Record<GuidancePhase, true>;
+const FIXES = { no_gps: true, no_fix: true, fix2d: true, fix3d: true, dgps: true, rtk_float: true, rtk_fixed: true, static: true, ppp: true } as const satisfies Record<GpsFix, true>;
+const GROUPS = { gains: true, spiral: true, failsafe: true, mission: true } as const satisfies Record<ParamGroup, true>;
+const SOURCES = { guidance: true, link: true, command: true, station: true, vehicle: true } as const satisfies Record<WireServerMessageOf<"event">["source"], true>;
+const TARGET_SOURCES = { drone_plan: true, drone_telemetry: true, operator: true } as const satisfies Record<NonNullable<Guidance["target_source"]>, true>;
+
+/** The value of `o[k]` if it is one of the names of `names`, else null. */
+const oneOf = <T extends string>(o: Obj, k: string, names: Record<T, true>): T | null => {
+  const v = o[k];
+  return typeof v === "string" && Object.hasOwn(names, v) ? (v as T) : null;
+};
+
+/** A position the page can place: latitude and longitude in range (else null), altitude if a number. */
+const position = (v: unknown): Position | null => {
+  const ll = latLonObj(v);
+  return ll === null || !isObj(v) ? null : { ...ll, alt_msl_m: num(v, "alt_msl_m") };
+};
 
 function parseStation(o: Obj): Station | null {
-  const origin = obj(o, "origin");
-  const ll = latLonObj(origin);
-  if (ll === null || origin === null) return null;
-  const modes = Array.isArray(o.modes) ? o.modes.filter((m): m is string => typeof m === "string") : [];
+  const origin = position(o.origin);
+  if (origin === null) return null;
+  const modes = Array.isArray(o.modes) ? o.modes.filter((m): m is FlightMode => typeof m === "string" && Object.hasOwn(MODES, m)) : [];
   return {
     name: str(o, "name") ?? "station",
-    origin: { ...ll, alt_msl_m: num(origin, "alt_msl_m") },
+    origin,
     tile_url: str(o, "tile_url"),
     tile_attribution: str(o, "tile_attribution") ?? "",
     offline_tiles: bool(o, "offline_tiles") ?? false,
@@ -98,11 +134,11 @@ function parseStation(o: Obj): Station | null {
 
 export function parseSession(v: unknown): Parsed<Session> {
   if (!isObj(v)) return bad("session is not an object");
-  const role = str(v, "role");
-  if (role === null || !(ROLES as readonly string[]).includes(role)) return bad(`unknown role ${String(v.role)}`);
+  const role = oneOf(v, "role", ROLES);
+  if (role === null) return bad(`unknown role ${String(v.role)}`);
   const station = sub(v, "station", parseStation);
   if (station === null) return bad("session has no valid station (name, origin)");
-  return ok({ role: role as Role, name: str(v, "name") ?? "", station });
+  return ok({ role, name: str(v, "name") ?? "", station });
 }
 
 function parseLink(o: Obj | null): Link {
@@ -143,7 +179,7 @@ const parseRadio = (o: Obj): Radio => ({
 });
 
 const parseGps = (o: Obj): Gps => ({
-  fix: str(o, "fix"),
+  fix: oneOf(o, "fix", FIXES),
   satellites: num(o, "satellites"),
   lat_deg: isLat(o.lat_deg) ? o.lat_deg : null,
   lon_deg: isLon(o.lon_deg) ? o.lon_deg : null,
@@ -152,12 +188,18 @@ const parseGps = (o: Obj): Gps => ({
   h_acc_m: num(o, "h_acc_m"),
 });
 
+function parseOnboardLanding(v: unknown): OnboardLanding | null {
+  const p = position(v);
+  if (p === null || !isObj(v)) return null;
+  return { ...p, age_s: num(v, "age_s"), stale: bool(v, "stale") };
+}
+
 const parseVehicle = (o: Obj): Vehicle => ({
-  mode: str(o, "mode"),
-  stage: str(o, "stage"),
-  phase: str(o, "phase"),
+  mode: oneOf(o, "mode", MODES),
+  stage: oneOf(o, "stage", STAGES),
+  phase: oneOf(o, "phase", PHASES),
   gps: sub(o, "gps", parseGps),
-  attitude: sub(o, "attitude", (a) => ({ roll_deg: num(a, "roll_deg"), pitch_deg: num(a, "pitch_deg"), yaw_deg: num(a, "yaw_deg") })),
+  attitude: sub(o, "attitude", (a) => ({ time_boot_ms: num(a, "time_boot_ms"), roll_deg: num(a, "roll_deg"), pitch_deg: num(a, "pitch_deg"), yaw_deg: num(a, "yaw_deg") })),
   air: sub(o, "air", (a) => ({
     static_pressure_pa: num(a, "static_pressure_pa"),
     differential_pressure_pa: num(a, "differential_pressure_pa"),
@@ -167,6 +209,9 @@ const parseVehicle = (o: Obj): Vehicle => ({
   servos: sub(o, "servos", (s) => ({ main_line: num(s, "main_line"), brake_right: num(s, "brake_right"), brake_left: num(s, "brake_left") })),
   power: sub(o, "power", (p) => ({ voltage_v: num(p, "voltage_v"), current_a: num(p, "current_a"), remaining_percent: num(p, "remaining_percent") })),
   onboard_wind_ned_mps: vec3(o, "onboard_wind_ned_mps"),
+  predicted_landing: parseOnboardLanding(o.predicted_landing),
+  age_s: num(o, "age_s"),
+  stale: bool(o, "stale"),
 });
 
 const parseEstimate = (o: Obj): Estimate => ({
@@ -189,13 +234,18 @@ const parseEstimate = (o: Obj): Estimate => ({
   wind_sigma_mps: num(o, "wind_sigma_mps"),
   position_sigma_m: num(o, "position_sigma_m"),
   gps_ok: bool(o, "gps_ok"),
+  age_s: num(o, "age_s"),
+  stale: bool(o, "stale"),
 });
 
+/** A `[lat, lon]` pair in range, as the pattern and the localizer send points. */
+const pair = (v: unknown): [number, number] | null => (Array.isArray(v) && v.length === 2 && isLat(v[0]) && isLon(v[1]) ? [v[0], v[1]] : null);
+
 function parsePattern(o: Obj): Pattern {
-  const corners = Array.isArray(o.corners) ? o.corners.map(latLonPair).filter((c): c is LatLon => c !== null) : [];
+  const corners = Array.isArray(o.corners) ? o.corners.map(pair).filter((c): c is [number, number] => c !== null) : [];
   return {
     corners,
-    final_entry: latLonPair(o.final_entry),
+    final_entry: pair(o.final_entry),
     final_course_deg: num(o, "final_course_deg"),
     final_approach_height_m: num(o, "final_approach_height_m"),
     target_reachable: bool(o, "target_reachable"),
@@ -203,17 +253,22 @@ function parsePattern(o: Obj): Pattern {
   };
 }
 
-function parseGuidance(o: Obj): Guidance {
-  const t = obj(o, "target");
-  const tll = latLonObj(t);
-  return {
-    mode: str(o, "mode"),
-    phase: str(o, "phase"),
-    target: tll === null || t === null ? null : { ...tll, alt_msl_m: num(t, "alt_msl_m") },
-    pattern: sub(o, "pattern", parsePattern),
-    commands: sub(o, "commands", (c) => ({ main_line: num(c, "main_line"), brake: num(c, "brake") })),
-  };
+function parseLocalizer(o: Obj): Localizer | null {
+  const point = pair(o.point);
+  return point === null ? null : { point, course_deg: num(o, "course_deg"), glide_slope: num(o, "glide_slope") };
 }
+
+const parseGuidance = (o: Obj): Guidance => ({
+  mode: oneOf(o, "mode", MODES),
+  phase: oneOf(o, "phase", PHASES),
+  target: position(o.target),
+  target_source: oneOf(o, "target_source", TARGET_SOURCES),
+  localizer: obj(o, "localizer") === null ? null : parseLocalizer(obj(o, "localizer") as Obj),
+  pattern: sub(o, "pattern", parsePattern),
+  commands: sub(o, "commands", (c) => ({ main_line: num(c, "main_line"), brake: num(c, "brake") })),
+  age_s: num(o, "age_s"),
+  stale: bool(o, "stale"),
+});
 
 function parseLanding(v: unknown): LandingPrediction | null {
   const ll = latLonObj(v);
@@ -227,7 +282,12 @@ function parseLanding(v: unknown): LandingPrediction | null {
   };
 }
 
-const parsePrediction = (o: Obj): Prediction => ({ planned: parseLanding(o.planned), uncontrolled: parseLanding(o.uncontrolled) });
+const parsePrediction = (o: Obj): Prediction => ({
+  planned: parseLanding(o.planned),
+  uncontrolled: parseLanding(o.uncontrolled),
+  age_s: num(o, "age_s"),
+  stale: bool(o, "stale"),
+});
 
 function parseForecast(v: unknown): ForecastWind[] {
   if (!Array.isArray(v)) return [];
@@ -245,7 +305,7 @@ export function parseState(v: Obj): Parsed<State> {
   const time_s = num(v, "time_s");
   if (time_s === null) return bad("state without a numeric time_s");
   const mission = obj(v, "mission");
-  const m: Mission = { stage: mission ? str(mission, "stage") : null, cutdown_armed_until_s: mission ? num(mission, "cutdown_armed_until_s") : null };
+  const m: Mission = { stage: mission ? oneOf(mission, "stage", STAGES) : null, cutdown_armed_until_s: mission ? num(mission, "cutdown_armed_until_s") : null };
   return ok({
     type: "state",
     time_s,
@@ -263,28 +323,27 @@ export function parseState(v: Obj): Parsed<State> {
 export function parseEvent(v: Obj): Parsed<EventMsg> {
   const text = str(v, "text");
   if (text === null) return bad("event without text");
-  const level = str(v, "level");
   return ok({
     type: "event",
     time_s: num(v, "time_s"),
     wall_ms: num(v, "wall_ms"),
     // An unknown level is shown as a warning rather than dropped: the text may matter.
-    level: level !== null && (LEVELS as readonly string[]).includes(level) ? (level as Level) : "warning",
-    source: str(v, "source") ?? "?",
+    level: oneOf(v, "level", LEVELS) ?? "warning",
+    source: oneOf(v, "source", SOURCES),
     text,
   });
 }
 
 export function parseCommandResult(v: Obj): Parsed<CommandResult> {
   const request_id = str(v, "request_id");
-  const outcome = str(v, "outcome");
+  const outcome = oneOf(v, "outcome", OUTCOMES);
   if (request_id === null) return bad("command_result without request_id");
-  if (outcome === null || !(OUTCOMES as readonly string[]).includes(outcome)) return bad(`command_result with unknown outcome ${String(v.outcome)}`);
+  if (outcome === null) return bad(`command_result with unknown outcome ${String(v.outcome)}`);
   return ok({
     type: "command_result",
     request_id,
     command: str(v, "command") ?? "?",
-    outcome: outcome as Outcome,
+    outcome,
     attempts: num(v, "attempts"),
     detail: str(v, "detail") ?? "",
     value: num(v, "value"),
@@ -305,6 +364,8 @@ export function parseParams(v: Obj): Parsed<ParamsMsg> {
       max: num(p, "max"),
       units: str(p, "units") ?? "",
       description: str(p, "description") ?? "",
+      group: oneOf(p, "group", GROUPS),
+      choices: Array.isArray(p.choices) ? p.choices.filter((c): c is string => typeof c === "string") : [],
     });
   }
   return ok({ type: "params", params, complete: bool(v, "complete") ?? false, time_s: num(v, "time_s") });
@@ -345,11 +406,14 @@ function parseHistory(v: Obj): Parsed<History & { dropped: number }> {
 }
 
 function parseHello(v: Obj): Parsed<ServerMessage> {
-  // API.md says hello carries "session, as above": accept it either flattened into the message
-  // (our reading) or nested under "session".
+  // The session is under "session" (with role and name repeated beside it); a session flattened
+  // into the message is read too.
   const s = parseSession(obj(v, "session") ?? v);
   return s.ok ? ok({ type: "hello", session: s.value }) : bad(`hello: ${s.error}`);
 }
+
+const parseLagged = (v: Obj): Parsed<Lagged> =>
+  ok({ type: "lagged", missed: num(v, "missed"), missed_total: num(v, "missed_total"), time_s: num(v, "time_s"), refetch: str(v, "refetch") === "/api/events" ? "/api/events" : null });
 
 /** Result of decoding one WebSocket frame. `dropped` counts bad elements inside a good message. */
 export type Decoded = { ok: true; msg: ServerMessage; dropped: number } | { ok: false; error: string };
@@ -366,29 +430,28 @@ export function decodeMessage(raw: unknown): Decoded {
   const type = str(v, "type");
   if (type === null) return { ok: false, error: "no type" };
   const wrap = (p: Parsed<ServerMessage>, dropped = 0): Decoded => (p.ok ? { ok: true, msg: p.value, dropped } : { ok: false, error: p.error });
-  switch (type) {
-    case "hello":
-      return wrap(parseHello(v));
-    case "state":
-      return wrap(parseState(v));
-    case "event":
-      return wrap(parseEvent(v));
-    case "command_result":
-      return wrap(parseCommandResult(v));
-    case "params":
-      return wrap(parseParams(v));
-    case "history": {
-      const h = parseHistory(v);
-      if (!h.ok) return { ok: false, error: h.error };
-      const { dropped, ...history } = h.value;
-      return { ok: true, msg: history, dropped };
-    }
-    case "pong":
-      return { ok: true, msg: { type: "pong" }, dropped: 0 };
-    default:
-      return { ok: true, msg: { type: "unknown", raw_type: type }, dropped: 0 };
-  }
+  return Object.hasOwn(DECODERS, type) ? DECODERS[type as WireServerType](v, wrap) : { ok: true, msg: { type: "unknown", raw_type: type }, dropped: 0 };
 }
+
+type Wrap = (p: Parsed<ServerMessage>, dropped?: number) => Decoded;
+
+// One decoder for each message type of the contract: the compiler holds this table to the
+// generated ServerMessage, so a message added to the daemon must be added here.
+const DECODERS = {
+  hello: (v, wrap) => wrap(parseHello(v)),
+  state: (v, wrap) => wrap(parseState(v)),
+  event: (v, wrap) => wrap(parseEvent(v)),
+  command_result: (v, wrap) => wrap(parseCommandResult(v)),
+  params: (v, wrap) => wrap(parseParams(v)),
+  history: (v) => {
+    const h = parseHistory(v);
+    if (!h.ok) return { ok: false, error: h.error };
+    const { dropped, ...history } = h.value;
+    return { ok: true, msg: history, dropped };
+  },
+  lagged: (v, wrap) => wrap(parseLagged(v)),
+  pong: () => ({ ok: true, msg: { type: "pong" }, dropped: 0 }),
+} satisfies Record<WireServerType, (v: Obj, wrap: Wrap) => Decoded>;
 
 /** Counts what arrived, so loss and garbage are shown rather than hidden (style.md, lesson 9). */
 export class MessageStats {

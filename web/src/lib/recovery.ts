@@ -13,12 +13,9 @@ export interface RecoveryPoint extends LatLon {
   semi_major_m: N;
 }
 
-/** Stage names that mean the payload is on the ground (API.md does not list stages; assumed). */
-const LANDED = new Set(["landed", "ground", "on_ground"]);
-
+/** On the ground: the mission's stage (else the drone's) is `landed`. */
 export function isLanded(s: State): boolean {
-  const st = s.mission.stage ?? s.vehicle?.stage ?? null;
-  return st !== null && LANDED.has(st);
+  return (s.mission.stage ?? s.vehicle?.stage ?? null) === "landed";
 }
 
 export function recoveryPoint(s: State): RecoveryPoint | null {

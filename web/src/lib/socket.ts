@@ -4,7 +4,7 @@
 
 import { backoffMs } from "./backoff";
 import { decodeMessage, MessageStats } from "./parse";
-import type { ManualMsg, ManualReleaseMsg, ServerMessage } from "./types";
+import type { ClientMessage, ServerMessage } from "./types";
 
 export type SocketStatus =
   | { kind: "connecting"; attempt: number }
@@ -63,7 +63,7 @@ export class LiveSocket {
   }
 
   /** Sends a client message; false if the socket is not open (nothing queued: stale stick input is worse than none). */
-  send(m: ManualMsg | ManualReleaseMsg | { type: "ping" }): boolean {
+  send(m: ClientMessage): boolean {
     if (!this.open || this.ws === null) return false;
     try {
       this.ws.send(JSON.stringify(m));

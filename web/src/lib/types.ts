@@ -1,216 +1,140 @@
-// The API's messages as the page uses them, after parsing (see parse.ts and crates/stx-station/API.md).
-// Every leaf the wire may omit or garble is `number | null` (etc.): the parser never invents a value,
-// and the UI shows "—" for null. Units are in the field names, as on the wire.
+// The API's messages as the page holds them. Their shapes are not written here: they come from the
+// station's contract, ../generated/api.ts (generated from api.schema.json, itself generated from
+// the daemon's Rust types; see crates/stx-station/API.md). What this file adds is the page's
+// reading of them (parse.ts): a leaf the wire omits or garbles becomes null and the UI shows "—";
+// the parser never invents a value. Each type below is the wire's, with its leaves made nullable
+// except those the page requires (without them the block, or the message, is refused), so a
+// field added, renamed or retyped in Rust shows up here as a compile error in parse.ts.
 
-export type Role = "operator" | "viewer";
-export type Vec3 = [number, number, number];
+import type * as Wire from "../generated/api";
+
+export type {
+  FlightMode,
+  FlightStage,
+  GpsFix,
+  GuidancePhase,
+  Level,
+  Outcome,
+  ParamGroup,
+  PlanBody,
+  PlanItemBody,
+  Role,
+} from "../generated/api";
+
 export type N = number | null;
+export type Vec3 = [number, number, number];
 
 export interface LatLon {
   lat_deg: number;
   lon_deg: number;
 }
 
-export interface Station {
-  name: string;
-  origin: LatLon & { alt_msl_m: N };
-  tile_url: string | null;
-  tile_attribution: string;
-  offline_tiles: boolean;
-  modes: string[];
-}
+/** A field as the page reads it: a leaf or a list of leaves as on the wire, a sub-block (or a list of them) leniently. */
+type Read<T> = T extends readonly (infer U)[]
+  ? [U] extends [readonly unknown[]]
+    ? T
+    : [U] extends [object]
+      ? Lenient<U>[]
+      : T
+  : T extends object
+    ? Lenient<T>
+    : T;
 
-export interface Session {
-  role: Role;
-  name: string;
-  station: Station;
-}
+/**
+ * A wire block `T` as the page reads it: every field may be null (missing or garbled on the wire),
+ * except the `Kept` ones, which the parser always fills (it requires them or supplies a default).
+ */
+export type Lenient<T, Kept extends keyof T = never> = {
+  [K in keyof T]: K extends Kept ? Read<T[K]> : Read<NonNullable<T[K]>> | null;
+};
 
-export interface Link {
-  connected: boolean;
-  stale: boolean;
-  age_s: N;
-  rate_hz: N;
-  loss_percent: N;
-  crc_errors: N;
-  parse_errors: N;
-  signature_errors: N;
-  /** Age of the last message of each MAVLink type, seconds. */
+/** A position the page requires (latitude and longitude in range), with an optional altitude. */
+export type Position = Lenient<Wire.LatLonAlt, "lat_deg" | "lon_deg">;
+
+export type Station = Omit<Lenient<Wire.StationInfo, "name" | "tile_attribution" | "offline_tiles" | "modes">, "origin"> & {
+  origin: Position;
+};
+
+export type Session = Omit<Lenient<Wire.Session, "role" | "name">, "station"> & { station: Station };
+
+/** One radio of the drone link (the station may hold a primary and backups). */
+export type Radio = Lenient<Wire.RadioView, "address" | "transmitting" | "stale">;
+
+export type Link = Omit<Lenient<Wire.LinkView, "connected" | "stale">, "ages_s" | "radios"> & {
+  /** Age of the last message of each MAVLink type, seconds (the ones that arrived as numbers). */
   ages_s: Record<string, number>;
   /** Each radio of the link, the primary first. */
   radios: Radio[];
-}
+};
 
-/** One radio of the drone link (the station may hold a primary and backups). */
-export interface Radio {
-  address: string;
-  /** Commands go out on this radio now. */
-  transmitting: boolean;
-  stale: boolean;
-  age_s: N;
-  rate_hz: N;
-  loss_percent: N;
-  /** Frames it carried that another radio had already delivered. */
-  duplicates: N;
-}
+export type Gps = Lenient<Wire.GpsView>;
 
-export interface Gps {
-  fix: string | null;
-  satellites: N;
-  lat_deg: N;
-  lon_deg: N;
-  alt_msl_m: N;
-  velocity_ned_mps: Vec3 | null;
-  h_acc_m: N;
-}
+/** The drone's own predicted touchdown. */
+export type OnboardLanding = Lenient<Wire.OnboardLandingView, "lat_deg" | "lon_deg">;
 
-export interface Vehicle {
-  mode: string | null;
-  stage: string | null;
-  phase: string | null;
-  gps: Gps | null;
-  attitude: { roll_deg: N; pitch_deg: N; yaw_deg: N } | null;
-  air: { static_pressure_pa: N; differential_pressure_pa: N; temperature_c: N; airspeed_mps: N } | null;
-  servos: { main_line: N; brake_right: N; brake_left: N } | null;
-  power: { voltage_v: N; current_a: N; remaining_percent: N } | null;
-  onboard_wind_ned_mps: Vec3 | null;
-}
+export type Vehicle = Omit<Lenient<Wire.VehicleView>, "predicted_landing"> & {
+  predicted_landing: OnboardLanding | null;
+};
 
-export interface Estimate {
-  lat_deg: N;
-  lon_deg: N;
-  alt_msl_m: N;
-  height_m: N;
-  velocity_ned_mps: Vec3 | null;
-  ground_speed_mps: N;
-  course_deg: N;
-  heading_deg: N;
-  heading_rate_dps: N;
-  airspeed_mps: N;
-  sink_rate_mps: N;
-  glide_ratio_air: N;
-  glide_ratio_ground: N;
-  wind_ned_mps: Vec3 | null;
-  wind_speed_mps: N;
-  wind_from_deg: N;
-  wind_sigma_mps: N;
-  position_sigma_m: N;
-  gps_ok: boolean | null;
-}
+export type Estimate = Lenient<Wire.EstimateView>;
 
-export interface Pattern {
-  corners: LatLon[];
-  final_entry: LatLon | null;
-  final_course_deg: N;
-  final_approach_height_m: N;
-  target_reachable: boolean | null;
-  reach_ratio: N;
-}
+export type Pattern = Lenient<Wire.PatternView, "corners">;
 
-export interface Guidance {
-  mode: string | null;
-  phase: string | null;
-  target: (LatLon & { alt_msl_m: N }) | null;
+export type Localizer = Lenient<Wire.LocalizerView, "point">;
+
+export type Guidance = Omit<Lenient<Wire.GuidanceView>, "target" | "localizer" | "pattern"> & {
+  target: Position | null;
+  localizer: Localizer | null;
   pattern: Pattern | null;
-  commands: { main_line: N; brake: N } | null;
-}
+};
 
-export interface LandingPrediction extends LatLon {
-  time_to_land_s: N;
-  semi_major_m: N;
-  semi_minor_m: N;
-  /** Direction of the major axis, degrees clockwise from true north. */
-  major_axis_deg: N;
-}
+export type LandingPrediction = Lenient<Wire.TouchdownView, "lat_deg" | "lon_deg">;
 
-export interface Prediction {
+export type Prediction = Omit<Lenient<Wire.PredictionView>, "planned" | "uncontrolled"> & {
   planned: LandingPrediction | null;
   uncontrolled: LandingPrediction | null;
-}
+};
 
-export interface ForecastWind {
-  alt_msl_m: number;
-  speed_mps: number;
-  from_deg: N;
-}
+export type ForecastWind = Lenient<Wire.ForecastRow, "alt_msl_m" | "speed_mps">;
 
-export interface Mission {
-  stage: string | null;
-  cutdown_armed_until_s: N;
-}
+export type Mission = Lenient<Wire.MissionView>;
 
-export interface State {
-  type: "state";
-  time_s: number;
-  wall_ms: N;
+export type State = Omit<
+  Lenient<Wire.StateMsg, "type" | "time_s" | "link" | "forecast_wind" | "mission">,
+  "link" | "vehicle" | "guidance" | "prediction" | "forecast_wind"
+> & {
   link: Link;
   vehicle: Vehicle | null;
-  estimate: Estimate | null;
   guidance: Guidance | null;
   prediction: Prediction | null;
   forecast_wind: ForecastWind[];
-  mission: Mission;
-}
+};
 
-export type Level = "info" | "warning" | "error";
+export type EventMsg = Omit<Lenient<Wire.EventMsg, "type" | "level" | "text">, "source"> & {
+  /** The station's sources, or `page` for what the page itself logs (a command refused, cutdown armed). */
+  source: Wire.EventMsg["source"] | "page" | null;
+};
 
-export interface EventMsg {
-  type: "event";
-  time_s: N;
-  wall_ms: N;
-  level: Level;
-  source: string;
-  text: string;
-}
+export type CommandResult = Lenient<Wire.CommandResultMsg, "type" | "request_id" | "command" | "outcome" | "detail">;
 
-export type Outcome = "accepted" | "denied" | "failed" | "unsupported" | "timed_out" | "in_progress";
+export type Param = Lenient<Wire.ParamView, "name" | "units" | "description" | "choices">;
 
-export interface CommandResult {
-  type: "command_result";
-  request_id: string;
-  command: string;
-  outcome: Outcome;
-  attempts: N;
-  detail: string;
-  /** Value read back from the drone, for parameter writes (assumed field; see README). */
-  value: N;
-}
+export type ParamsMsg = Omit<Lenient<Wire.ParamsMsg, "type" | "complete">, "params"> & { params: Param[] };
 
-export interface Param {
-  name: string;
-  value: N;
-  min: N;
-  max: N;
-  units: string;
-  description: string;
-}
+export type TrackPoint = Lenient<Wire.TrackPoint, "time_s" | "lat_deg" | "lon_deg">;
 
-export interface ParamsMsg {
-  type: "params";
-  params: Param[];
-  complete: boolean;
-  time_s: N;
-}
-
-export interface TrackPoint {
-  time_s: number;
-  lat_deg: number;
-  lon_deg: number;
-  alt_msl_m: N;
-}
-
-export interface History {
-  type: "history";
+export type History = Omit<Lenient<Wire.HistoryMsg, "type">, "track" | "events" | "states"> & {
   track: TrackPoint[];
   events: EventMsg[];
   states: State[];
-}
+};
 
-export interface Hello {
-  type: "hello";
-  session: Session;
-}
+/** `hello` as the page keeps it: the session (the role and name beside it repeat the session's). */
+export type Hello = Pick<Wire.HelloMsg, "type"> & { session: Session };
 
+export type Lagged = Lenient<Wire.LaggedMsg, "type">;
+
+/** Every message of the station, and what the page does not know (a newer station). */
 export type ServerMessage =
   | Hello
   | State
@@ -218,24 +142,19 @@ export type ServerMessage =
   | CommandResult
   | ParamsMsg
   | History
-  | { type: "pong" }
+  | Lagged
+  | Wire.PongMsg
   | { type: "unknown"; raw_type: string };
 
-/** The manual-control message the page sends while the dead-man is held (API.md, client → server). */
-export interface ManualMsg {
-  type: "manual";
-  x: number;
-  y: number;
-  z: number;
-  r: number;
-  buttons: number;
-}
+/** The manual-control message the page sends while the dead-man is held (every stick, always). */
+export type ManualMsg = Required<Extract<Wire.ClientMessage, { type: "manual" }>>;
 
 /**
  * Sent once when a manual stream ends on the operator's side (dead-man released, focus or
  * visibility lost, gamepad gone): the station stops uplinking MANUAL_CONTROL at once instead of
  * waiting out its 0.5 s silence timeout.
  */
-export interface ManualReleaseMsg {
-  type: "manual_release";
-}
+export type ManualReleaseMsg = Extract<Wire.ClientMessage, { type: "manual_release" }>;
+
+/** Every message the page sends on the WebSocket. */
+export type ClientMessage = Wire.ClientMessage;

@@ -4,7 +4,7 @@
 
 import "../styles/common.css";
 import "../styles/live.css";
-import { Api, ApiError } from "../lib/api";
+import { Api, ApiError, type CommandBodies, type CommandPath } from "../lib/api";
 import { CommandTracker, type CommandEntry } from "../lib/commands";
 import { fmt, fmtMissionTime, label } from "../lib/format";
 import { parseParams, parseSession, isObj } from "../lib/parse";
@@ -95,7 +95,7 @@ function build(session: Session): void {
   const localEvent = (level: Level, text: string): void =>
     events.add({ type: "event", time_s: latest?.time_s ?? null, wall_ms: Date.now(), level, source: "page", text });
 
-  const runCommand = (command: string, text: string, path: string, body: unknown): number => {
+  const runCommand = <P extends CommandPath>(command: string, text: string, path: P, body: CommandBodies[P]): number => {
     const id = tracker.begin(command, text, Date.now());
     api.command(path, body).then(
       (rid) => tracker.accepted(id, rid, Date.now()),
@@ -136,6 +136,10 @@ function build(session: Session): void {
           break;
         case "params":
           params.setParams(m.params, m.complete);
+          break;
+        case "lagged":
+          // The station dropped messages for this page: say so rather than show a silent gap.
+          localEvent("warning", `this page fell behind: ${m.missed ?? "some"} events, command results or parameter tables were not received (reload to re-read them)`);
           break;
         default:
           break;

@@ -2,14 +2,16 @@
 // a number), heading, course and localizer. Controls marked `data-command` are disabled for
 // viewers (see role.ts). Nothing is sent unless every field validates.
 
+import type { CommandBodies, CommandPath } from "../lib/api";
 import { h, panel } from "./dom";
 import { all, parseAlt, parseDeg, parseLat, parseLon, parseNumber } from "../lib/inputs";
 import { label } from "../lib/format";
-import type { LatLon, State } from "../lib/types";
+import type { FlightMode, LatLon, State } from "../lib/types";
+import type { LocalizerBody } from "../generated/api";
 import type { PickGroup } from "./pick";
 import type { MapView } from "./map";
 
-export type SendCommand = (command: string, label: string, path: string, body: unknown) => void;
+export type SendCommand = <P extends CommandPath>(command: string, label: string, path: P, body: CommandBodies[P]) => void;
 
 const field = (lbl: string, testid: string, attrs: Record<string, string> = {}): { root: HTMLElement; input: HTMLInputElement } => {
   const input = h("input", { type: "text", inputmode: "decimal", "data-testid": testid, "data-command": true, "aria-label": lbl, ...attrs });
@@ -22,7 +24,7 @@ export class ModeButtons {
   readonly root: HTMLElement;
   private readonly buttons = new Map<string, HTMLButtonElement>();
 
-  constructor(modes: readonly string[], send: SendCommand) {
+  constructor(modes: readonly FlightMode[], send: SendCommand) {
     const row = h("div", { class: "modes", role: "group", "aria-label": "flight mode" });
     for (const m of modes) {
       const b = button(label(m), `mode-${m}`, "mode");
@@ -153,7 +155,7 @@ export class GuidanceInputs {
         lzErr.textContent = c.error;
         return;
       }
-      const body: Record<string, number> = { lat_deg: c.values[0], lon_deg: c.values[1], course_deg: c.values[2] };
+      const body: LocalizerBody = { lat_deg: c.values[0], lon_deg: c.values[1], course_deg: c.values[2] };
       if (gs.input.value.trim() !== "") {
         const g = parseNumber(gs.input.value, "glide slope", 0, 10);
         if (!g.ok) {

@@ -190,9 +190,10 @@ export class MapView {
     }
     // After touchdown the pattern and the predictions are over: the map shows where it is.
     const pat = landed ? null : (g?.pattern ?? null);
-    this.pattern.setLatLngs(pat ? pat.corners.map(ll) : []);
+    // The wire's `[lat, lon]` pairs are Leaflet's own.
+    this.pattern.setLatLngs(pat ? pat.corners : []);
     if (pat?.final_entry && g?.target) {
-      this.final.setLatLngs([ll(pat.final_entry), ll(g.target)]);
+      this.final.setLatLngs([pat.final_entry, ll(g.target)]);
       setText(this.finalText, `final ${fmtDir(pat.final_course_deg)} from ${fmt(pat.final_approach_height_m, "m", 0)}${pat.target_reachable === false ? " · target NOT reachable" : ""}`);
       this.finalText.hidden = false;
     } else {

@@ -33,13 +33,10 @@ mod tests;
 
 pub use dormand_prince::{DormandPrince54, TrialStep};
 pub use rk4::Rk4;
+pub use root::EVENT_TIME_TOLERANCE_S;
 
 use nalgebra::SVector;
 use thiserror::Error;
-
-/// Time tolerance to which an event's time is located, s. Beyond about 10⁶ s the spacing of
-/// `f64` times is coarser than this, and the tolerance widens to a few units of it.
-pub const EVENT_TIME_TOLERANCE_S: f64 = 1e-9;
 
 /// A system of `N` first-order ODEs, `ẏ = f(t, y)`.
 pub trait OdeSystem<const N: usize> {

@@ -5,7 +5,9 @@
 //! superlinearly on the smooth functions an interpolant gives. Should it ever stall, it falls
 //! back to bisection, so the bracket always shrinks to the tolerance.
 
-use super::EVENT_TIME_TOLERANCE_S;
+/// Time tolerance to which an event's time is located, s. Beyond about 10⁶ s the spacing of
+/// `f64` times is coarser than this, and the tolerance widens to a few units of it.
+pub const EVENT_TIME_TOLERANCE_S: f64 = 1e-9;
 
 /// Iterations of regula falsi before the search switches to plain bisection.
 const FALSI_ITERATIONS: usize = 60;

@@ -28,7 +28,10 @@
 //!    limit against aliasing). They give the attitude at any instant between AHRS samples, the
 //!    heading and heading rate the estimate reports, and the attitude's uncertainty.
 //!
-//! 2. **Navigation EKF** (`filter.rs`), thirteen states
+//! 2. **Navigation EKF** (state, prediction and Kalman update in `ekf.rs`; one file per
+//!    measurement: `gps.rs`, `pitot.rs`, `baro.rs`, `sideslip.rs`; the estimate read out in
+//!    `readout.rs`; `filter.rs` advances the angle filters and the EKF together), thirteen
+//!    states
 //!
 //!    ```text
 //!    x = [ p (NED position, m) | a (NED velocity relative to the air, m/s) | ω (turn rate
@@ -129,8 +132,14 @@
 //! time per call.
 
 mod angle;
+mod baro;
 mod config;
+mod ekf;
 mod filter;
+mod gps;
+mod pitot;
+mod readout;
+mod sideslip;
 
 pub use config::{EstimatorConfig, EstimatorConfigError};
 
@@ -141,7 +150,9 @@ use serde::{Deserialize, Serialize};
 use crate::estimate::Estimate;
 use crate::measurement::Measurement;
 use config::Tuning;
-use filter::{MAX_INTERPOLATION_S, NavFilter, Outcome, Timeouts};
+use ekf::Outcome;
+use filter::{NavFilter, Timeouts};
+use pitot::MAX_INTERPOLATION_S;
 
 /// Most measurements held for re-ordering, each with a filter snapshot (about 1.5 kB). At 4 Hz
 /// from three sensors and a 0.6-s window about eight wait at once; the rest is headroom for

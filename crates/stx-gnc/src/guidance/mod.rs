@@ -3,80 +3,24 @@
 //! [`Guidance::update`] runs at the drone's control rate (4 Hz) on the drone and, identically,
 //! in the ground station. The simple modes wrap one control law each (seed §5.1–5.2); spiral
 //! landing is the state machine of [`spiral`] (seed §5.3). Every phase change is an event with a
-//! reason, kept for the operator's log.
+//! reason, kept for the operator's log. What guidance is configured with ([`GuidanceConfig`])
+//! and what the operator asked it to fly ([`Plan`]) have files of their own, which the spiral
+//! reads without depending on this module's [`Guidance`].
 
+mod config;
+mod plan;
 pub mod spiral;
 
-use nalgebra::Vector3;
+pub use config::GuidanceConfig;
+pub use plan::Plan;
+pub use spiral::{FinalLaw, SpiralConfig, SpiralStatus};
+
 use serde::{Deserialize, Serialize};
 use stx_dynamics::state::Controls;
 
-use crate::control::{self, ControlGains, GlidePath, LawPhase, Localizer};
+use crate::control::{self, ControlGains, LawPhase};
 use crate::estimate::Estimate;
 use crate::mission::{FlightMode, GuidancePhase};
-use crate::performance::GlidePerformance;
-pub use spiral::{FinalLaw, SpiralConfig, SpiralStatus};
-
-/// Everything guidance is configured with.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Default)]
-#[serde(deny_unknown_fields, default)]
-pub struct GuidanceConfig {
-    /// Control-law gains and limits.
-    pub gains: ControlGains,
-    /// How the parafoil flies, for planning.
-    pub performance: GlidePerformance,
-    /// Spiral-landing settings.
-    pub spiral: SpiralConfig,
-}
-
-/// What the operator asked to fly: targets of every mode.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct Plan {
-    /// Landing target on the ground, local NED, m.
-    pub target_ned_m: Vector3<f64>,
-    /// Course of the final approach, rad; `None` lands into the wind.
-    pub approach_course_rad: Option<f64>,
-    /// Heading held in heading mode, rad.
-    pub heading_rad: f64,
-    /// Course held in course mode, rad.
-    pub course_rad: f64,
-    /// Line followed in localizer mode.
-    pub localizer: Localizer,
-    /// Glide slope (sink over ground speed) followed down the localizer to its point, if any.
-    pub localizer_glide_slope: Option<f64>,
-}
-
-impl Plan {
-    /// The glide path localizer mode flies when the plan has a glide slope: down the localizer
-    /// to its point, ending with the lowest hanging body — `hang_height_m` below the drone — on
-    /// the target's ground. Aimed with the drone, the stack touched down the hang height's glide
-    /// short of the point (13 m on `vertical`). Guidance flies it, and the tuner measures the
-    /// vertical law's error against it.
-    pub fn localizer_glide_path(&self, hang_height_m: f64) -> Option<GlidePath> {
-        self.localizer_glide_slope.map(|slope| GlidePath {
-            line: self.localizer,
-            aim_height_m: -self.target_ned_m.z + hang_height_m,
-            slope,
-        })
-    }
-}
-
-impl Default for Plan {
-    fn default() -> Self {
-        Self {
-            target_ned_m: Vector3::zeros(),
-            approach_course_rad: None,
-            heading_rad: 0.0,
-            course_rad: 0.0,
-            localizer: Localizer {
-                point_ne_m: [0.0, 0.0],
-                course_rad: 0.0,
-            },
-            localizer_glide_slope: None,
-        }
-    }
-}
 
 /// A change of guidance phase, with why.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

@@ -13,6 +13,7 @@ use super::units::{
 
 /// GNSS fix type (GPS_FIX_TYPE).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(rename_all = "snake_case")]
 pub enum GpsFix {
     NoGps,

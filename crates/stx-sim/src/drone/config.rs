@@ -14,9 +14,9 @@ use stx_dynamics::wind::WindConfig;
 use stx_gnc::estimator::EstimatorConfig;
 use stx_gnc::geo::LocalFrame;
 use stx_gnc::mission::{FlightMode, FlightStage};
-use stx_gnc::params::{OnboardSettings, ParamError};
-use thiserror::Error;
+use stx_gnc::params::OnboardSettings;
 
+pub use crate::drone::config_error::MissionError;
 use crate::drone::failures::FailureConfig;
 use crate::scenario::LocalizerSpec;
 use crate::sensors::SensorConfig;
@@ -36,40 +36,6 @@ pub const BUILTIN: &[(&str, &str)] = &[
         include_str!("../../../../config/scenarios/rehearsal.toml"),
     ),
 ];
-
-/// Why a mission scenario was refused.
-#[derive(Debug, Error)]
-pub enum MissionError {
-    /// No built-in mission has this name.
-    #[error("unknown mission scenario `{name}`; built-in missions: {known}")]
-    Unknown { name: String, known: String },
-    /// Not valid TOML for a mission (unknown or missing field, wrong type).
-    #[error("mission scenario `{name}` is not valid: {source}")]
-    Parse {
-        name: String,
-        #[source]
-        source: toml::de::Error,
-    },
-    /// A field breaks a rule.
-    #[error("mission field `{field}` = {value} breaks the rule: {rule}")]
-    Invalid {
-        field: String,
-        value: String,
-        rule: &'static str,
-    },
-    /// The wind description is invalid.
-    #[error("mission wind is invalid: {0}")]
-    Wind(#[from] stx_dynamics::wind::WindError),
-    /// The sensor description is invalid.
-    #[error("mission sensors are invalid: {0}")]
-    Sensors(#[from] crate::sensors::SensorConfigError),
-    /// The estimator description is invalid.
-    #[error("mission estimator is invalid: {0}")]
-    Estimator(#[from] stx_gnc::estimator::EstimatorConfigError),
-    /// An onboard setting (a parameter) is out of its range or contradicts another.
-    #[error("mission onboard settings are invalid: {0}")]
-    Onboard(#[from] ParamError),
-}
 
 fn invalid(field: &str, value: impl ToString, rule: &'static str) -> MissionError {
     MissionError::Invalid {

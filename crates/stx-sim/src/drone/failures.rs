@@ -22,7 +22,7 @@ use rand_chacha::ChaCha8Rng;
 use serde::Deserialize;
 use stx_dynamics::state::Controls;
 
-use crate::drone::config::MissionError;
+use crate::drone::config_error::MissionError;
 
 /// One of the three servos.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]

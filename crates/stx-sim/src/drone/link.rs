@@ -117,6 +117,8 @@ pub struct LinkedDrone {
     status: VehicleStatus,
     events: VecDeque<DroneEvent>,
     counters: LinkCounters,
+    /// `time_boot_ms` of the latest ATTITUDE handed to the endpoint.
+    last_attitude_ms: Option<u32>,
 }
 
 impl LinkedDrone {
@@ -143,6 +145,7 @@ impl LinkedDrone {
             status,
             events: VecDeque::new(),
             counters: LinkCounters::default(),
+            last_attitude_ms: None,
         };
         linked.forward_outputs(link_now);
         Ok(linked)
@@ -179,6 +182,11 @@ impl LinkedDrone {
         let result = self.drone.step();
         self.forward_outputs(link_now);
         result
+    }
+
+    /// `time_boot_ms` of the latest ATTITUDE sent: the stamp a station shows the frame by.
+    pub fn last_attitude_time_boot_ms(&self) -> Option<u32> {
+        self.last_attitude_ms
     }
 
     /// Whether the drone has landed.
@@ -277,7 +285,12 @@ impl LinkedDrone {
         let time_s = self.drone.time_s();
         while let Some(output) = self.drone.poll_output() {
             match output {
-                Output::Telemetry(t) => self.endpoint.send_telemetry(link_now, &t),
+                Output::Telemetry(t) => {
+                    if let Telemetry::Attitude(a) = &t {
+                        self.last_attitude_ms = Some(a.time_boot_ms);
+                    }
+                    self.endpoint.send_telemetry(link_now, &t);
+                }
                 Output::Text { severity, text } => {
                     self.endpoint.send_status_text(link_now, severity, &text);
                     self.event(DroneEvent::Text {

@@ -7,9 +7,9 @@
 //! sends goes in through methods ([`Drone::handle_command`], [`Drone::set_param`],
 //! [`Drone::handle_plan`], [`Drone::set_sticks`], [`Drone::link_changed`]) and everything the
 //! drone sends comes out of [`Drone::poll_output`]. The same seed and the same calls give the
-//! same flight, bit for bit. `stx drone` (crate `stx`) is the thin tokio adapter that puts a
-//! [`stx_link::endpoint::VehicleEndpoint`] and a socket around it and paces it in real or
-//! accelerated time.
+//! same flight, bit for bit. [`link::LinkedDrone`] puts it behind a
+//! [`stx_link::endpoint::VehicleEndpoint`]; the runner (`crate::runner`, feature `runner`) is
+//! the thin tokio adapter that adds a socket and paces it in real or accelerated time.
 //!
 //! How the parts fit, one control period:
 //!
@@ -24,13 +24,19 @@
 //!                                   └──────────────▶ telemetry (Streams, builders) ──▶ outputs
 //! ```
 //!
-//! - [`config`]: the mission scenario file, validated before anything runs;
+//! - [`config`]: the mission scenario file, validated before anything runs ([`config_error`]
+//!   says why one is refused), and [`overrides`], what the command line changes in it;
 //! - [`mission`]: the physics of each stage (balloon, round chute, 14-DOF parafoil);
 //! - [`onboard`]: the drone's software;
-//! - [`telemetry`]: what is sent when, and the battery model;
+//! - [`commands`]: what the station asks of the drone (commands, parameters, plans, sticks);
+//! - [`outputs`]: what it sends each control period, scheduled and built by [`telemetry`]
+//!   (which also models the battery);
+//! - [`stages`]: stage and guidance-phase changes, recorded and told to the operator;
+//! - [`summary`]: the mission in figures ([`MissionSummary`]);
 //! - [`failures`]: link drops, packet loss, GPS loss and a stuck servo, for rehearsals;
 //! - [`link`]: [`link::LinkedDrone`], the drone behind its MAVLink endpoint (still sans-io):
-//!   what `stx drone` drives over a socket and the tests drive against a ground endpoint.
+//!   what the runner (`crate::runner`, feature `runner`) drives over a socket and the tests
+//!   drive against a ground endpoint.
 //!
 //! The estimator runs from launch so the station sees an onboard estimate all along; it is
 //! restarted when the parafoil deploys, so that guidance starts from a filter that has only
@@ -43,11 +49,17 @@
 //! the wind forecast loaded before launch (the mission's mean wind) — where to look if the
 //! parafoil never opened.
 
+mod commands;
 pub mod config;
+pub mod config_error;
 pub mod failures;
 pub mod link;
 pub mod mission;
 pub mod onboard;
+mod outputs;
+pub mod overrides;
+mod stages;
+pub mod summary;
 pub mod telemetry;
 
 use std::collections::VecDeque;
@@ -62,26 +74,22 @@ use stx_gnc::estimate::Estimate;
 use stx_gnc::estimator::Estimator;
 use stx_gnc::geo::LocalFrame;
 use stx_gnc::guidance::PhaseEvent;
-use stx_gnc::measurement::{AirDataSample, AttitudeSample, Measurement};
+use stx_gnc::measurement::{AirDataSample, AttitudeSample};
 use stx_gnc::mission::{FlightMode, FlightStage};
-use stx_gnc::params::ParamError;
-use stx_gnc::predict::{PredictorConfig, predict};
-use stx_link::command::{Command, CommandResult};
-use stx_link::manual::Sticks;
 use stx_link::param::{ParamSpec, ParamTableError};
-use stx_link::plan::PlanItem;
-use stx_link::telemetry::{
-    GuidanceStatus, PredictedLanding, Severity, SystemState, SystemStatus, Telemetry, VehicleStatus,
-};
+use stx_link::telemetry::{Severity, SystemState, Telemetry, VehicleStatus};
 
 use crate::closed_loop::{NavigationError, phase_name};
 use crate::guided::CONTROL_PERIOD_S;
 use crate::sensors::{DeliveryQueue, SensorSuite};
-pub use config::{MissionConfig, MissionError};
+pub use config::MissionConfig;
+pub use config_error::MissionError;
 use failures::{LinkFaults, Servo, ServoFault};
-use mission::{MissionPhysics, PhysicsError, StageEvent};
+use mission::{MissionPhysics, PhysicsError};
 use onboard::{HardwareRequest, Onboard, mode_name};
-use telemetry::{Battery, Streams, msg};
+pub use overrides::{FailureFlags, MissionOverrides};
+pub use summary::{BalloonEnd, Landing, MissionSummary, StageStart, stage_name};
+use telemetry::{Battery, Streams};
 
 /// Most outputs kept for a caller that does not drain them; older ones are dropped and
 /// counted ([`Drone::outputs_dropped`]).
@@ -89,20 +97,6 @@ pub const MAX_QUEUED_OUTPUTS: usize = 20_000;
 
 /// Shortest time between two guidance-phase texts, s of mission time.
 pub const PHASE_TEXT_INTERVAL_S: f64 = 2.0;
-
-/// SYS_STATUS sensor bits (MAV_SYS_STATUS_SENSOR): magnetometer (the AHRS's heading),
-/// absolute and differential pressure, GPS, motor outputs (the servos), AHRS, battery.
-mod sensor_bits {
-    pub const MAG: u32 = 4;
-    pub const ABSOLUTE_PRESSURE: u32 = 8;
-    pub const DIFFERENTIAL_PRESSURE: u32 = 16;
-    pub const GPS: u32 = 32;
-    pub const SERVOS: u32 = 32_768;
-    pub const AHRS: u32 = 2_097_152;
-    pub const BATTERY: u32 = 33_554_432;
-    pub const ALL: u32 =
-        MAG | ABSOLUTE_PRESSURE | DIFFERENTIAL_PRESSURE | GPS | SERVOS | AHRS | BATTERY;
-}
 
 /// Why the drone cannot be built or go on.
 #[derive(Debug, thiserror::Error)]
@@ -131,76 +125,6 @@ pub enum Output {
     Telemetry(Telemetry),
     /// A text for the operator's log (STATUSTEXT, split by the link when long).
     Text { severity: Severity, text: String },
-}
-
-/// Where and how the mission ended.
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
-pub struct Landing {
-    /// Mission time of ground contact, s.
-    pub time_s: f64,
-    /// Where (north, east of the launch site), m.
-    pub position_ne_m: [f64; 2],
-    /// Distance from the landing target, m, if there is one.
-    pub miss_m: Option<f64>,
-    /// Vertical speed at contact, m/s.
-    pub vertical_speed_mps: f64,
-    /// Stage it landed from (parafoil, or round chute if the parafoil never deployed).
-    pub under_parafoil: bool,
-    /// Where, latitude, degrees.
-    pub lat_deg: f64,
-    /// Where, longitude, degrees.
-    pub lon_deg: f64,
-}
-
-/// How the balloon stage ended.
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum BalloonEnd {
-    /// It burst by itself.
-    Burst,
-    /// It was cut away (operator's command or `MIS_CUTDOWN_M`).
-    Cutdown,
-}
-
-/// A stage and when it began.
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
-pub struct StageStart {
-    /// The stage (snake case).
-    pub stage: String,
-    /// Mission time it began, s.
-    pub start_s: f64,
-}
-
-/// A mission in figures, from the simulator's truth: what a run is judged by and what
-/// `stx drone --summary-json` prints.
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
-pub struct MissionSummary {
-    /// Mission name.
-    pub mission: String,
-    /// Seed flown.
-    pub seed: u64,
-    /// Mission time reached, s.
-    pub mission_time_s: f64,
-    /// Every stage entered, in order.
-    pub stages: Vec<StageStart>,
-    /// How the balloon stage ended, when, and how high (m MSL).
-    pub balloon_end: Option<(BalloonEnd, f64, f64)>,
-    /// Highest altitude reached, m MSL.
-    pub max_altitude_msl_m: f64,
-    /// Fastest fall (under the round chute in a whole mission), m/s.
-    pub peak_descent_mps: f64,
-    /// When and how high above the site the parafoil deployed, s and m.
-    pub deployment: Option<(f64, f64)>,
-    /// The landing target, latitude and longitude, degrees.
-    pub target_lat_lon_deg: Option<[f64; 2]>,
-    /// Where and how it landed.
-    pub landing: Option<Landing>,
-    /// Guidance phases entered, with their mission time.
-    pub phases: Vec<StageStart>,
-    /// Status texts sent.
-    pub texts: u64,
-    /// Outputs dropped because nobody drained them.
-    pub outputs_dropped: u64,
 }
 
 /// The simulated drone.
@@ -500,93 +424,6 @@ impl Drone {
         }
     }
 
-    /// Whether `name` may take `value` now (range, kind, the rules between parameters, the
-    /// servo travel), without changing anything: the link's table asks this before it takes a
-    /// set from the station or echoes it.
-    pub fn check_param(&self, name: &str, value: f32) -> Result<(), ParamError> {
-        self.onboard.check_param(name, value).map(drop)
-    }
-
-    /// Sets a parameter from the station (checked against the shared catalog); effective at
-    /// the next period. On refusal nothing changes and the reason goes to the operator's log.
-    pub fn set_param(&mut self, name: &str, value: f32) -> Result<(), ParamError> {
-        match self.onboard.set_param(name, value) {
-            Ok(()) => {
-                self.physics.settle_s = self.onboard.settings().mission.settle_s;
-                self.say(Severity::Info, format!("parameter {name} = {value}"));
-                Ok(())
-            }
-            Err(e) => {
-                self.say(Severity::Warning, format!("parameter refused: {e}"));
-                Err(e)
-            }
-        }
-    }
-
-    /// The sticks as the link's receiver has them (`None` when stale): call before every
-    /// [`step`](Self::step) and whenever they change.
-    pub fn set_sticks(&mut self, sticks: Option<Sticks>) {
-        self.onboard.set_sticks(self.time_s(), sticks);
-        self.drain_onboard_texts();
-    }
-
-    /// An uploaded plan.
-    pub fn handle_plan(&mut self, items: &[PlanItem]) {
-        self.onboard.handle_plan(self.time_s(), items);
-        self.drain_onboard_texts();
-    }
-
-    /// The plan held, as mission items.
-    pub fn plan_items(&self) -> Vec<PlanItem> {
-        self.onboard.plan_items()
-    }
-
-    /// The station's heartbeats stopped (`false`) or came back (`true`). Nothing changes in
-    /// flight: the drone keeps flying its plan; when the link returns it says what it did.
-    pub fn link_changed(&mut self, connected: bool) {
-        let now = self.time_s();
-        if !connected {
-            self.link_lost_at_s.get_or_insert(now);
-        } else if let Some(lost) = self.link_lost_at_s.take() {
-            let stage = self.stage();
-            self.say(
-                Severity::Notice,
-                format!(
-                    "link back after {:.0} s: {}, {}, {:.0} m",
-                    now - lost,
-                    stage_name(stage),
-                    mode_name(self.onboard.mode()),
-                    self.estimate.map_or(f64::NAN, |e| e.height_m()),
-                ),
-            );
-        }
-    }
-
-    /// Executes an operator command; every command gets a result (COMMAND_ACK), refusals
-    /// with a reason in the log.
-    pub fn handle_command(&mut self, command: &Command) -> CommandResult {
-        let result = match *command {
-            Command::Cutdown => match self.physics.cutdown() {
-                Ok(event) => {
-                    self.stage_event(event);
-                    CommandResult::Accepted
-                }
-                Err(why) => {
-                    self.say(Severity::Warning, format!("cutdown refused: {why}"));
-                    CommandResult::Denied
-                }
-            },
-            Command::RequestMessage { message_id } => self.streams.request(message_id),
-            Command::SetMessageInterval {
-                message_id,
-                interval_us,
-            } => self.streams.set_interval(message_id, interval_us),
-            _ => self.onboard.handle_command(self.time_s(), command),
-        };
-        self.drain_onboard_texts();
-        result
-    }
-
     /// Flies one control period: sensors, estimator, onboard software, telemetry, physics.
     pub fn step(&mut self) -> Result<(), DroneError> {
         let t = self.time_s();
@@ -685,314 +522,4 @@ impl Drone {
         }
         Ok(())
     }
-
-    /// Tells the operator of a guidance phase change, with its reason. Changes closer than
-    /// [`PHASE_TEXT_INTERVAL_S`] to the last one told are counted and told with the next, so a
-    /// guidance that hesitates between phases cannot flood the link (the heartbeat carries
-    /// the phase in any case).
-    fn announce_phase(&mut self, event: &PhaseEvent) {
-        let now = event.time_s;
-        if self
-            .last_phase_text_s
-            .is_some_and(|last| now - last < PHASE_TEXT_INTERVAL_S)
-        {
-            self.phase_texts_held += 1;
-            return;
-        }
-        let held = std::mem::take(&mut self.phase_texts_held);
-        let more = if held > 0 {
-            format!(" (+{held} changes in the last {PHASE_TEXT_INTERVAL_S:.0} s)")
-        } else {
-            String::new()
-        };
-        self.last_phase_text_s = Some(now);
-        self.say(
-            Severity::Info,
-            format!("phase {}: {}{more}", phase_name(event.to), event.reason),
-        );
-    }
-
-    fn stage_event(&mut self, event: StageEvent) {
-        let now = self.time_s();
-        let stage = self.stage();
-        if self.stage_log.last().map(|s| s.0) != Some(stage) {
-            self.stage_log.push((stage, now));
-        }
-        let (severity, text) = match event {
-            StageEvent::Launched => (
-                Severity::Notice,
-                format!(
-                    "launched: ascending at {:.1} m/s on average ({:.1} m/s now) to burst at {:.0} m",
-                    self.config.balloon.mean_ascent_rate_mps,
-                    self.physics.balloon().launch_rate_mps(),
-                    self.physics.burst_altitude_msl_m()
-                ),
-            ),
-            StageEvent::Burst { altitude_msl_m } => {
-                self.balloon_end = Some((BalloonEnd::Burst, now, altitude_msl_m));
-                (
-                    Severity::Notice,
-                    format!("balloon burst at {altitude_msl_m:.0} m MSL: round chute"),
-                )
-            }
-            StageEvent::CutDown { altitude_msl_m } => {
-                self.balloon_end = Some((BalloonEnd::Cutdown, now, altitude_msl_m));
-                (
-                    Severity::Notice,
-                    format!("cutdown at {altitude_msl_m:.0} m MSL: balloon released, round chute"),
-                )
-            }
-            StageEvent::Deployed {
-                height_m,
-                heading_rad,
-            } => {
-                self.deployment = Some((now, height_m));
-                // Guidance starts from a filter that has only seen the parafoil fly.
-                if let Ok(e) = Estimator::new(self.config.estimator.clone()) {
-                    self.estimator = e;
-                    self.estimate = None;
-                }
-                (
-                    Severity::Notice,
-                    format!(
-                        "round chute released at {height_m:.0} m: parafoil deploying, heading {:.0}°",
-                        heading_rad.to_degrees().rem_euclid(360.0)
-                    ),
-                )
-            }
-            StageEvent::Flying => (
-                Severity::Notice,
-                format!("parafoil flying: {}", mode_name(self.onboard.mode())),
-            ),
-            StageEvent::Landed(t) => {
-                let target = self.target_ned_m();
-                let miss =
-                    target.map(|p| (t.position_ne_m[0] - p.x).hypot(t.position_ne_m[1] - p.y));
-                let (lat_deg, lon_deg, _) = self.frame.to_geodetic(&Vector3::new(
-                    t.position_ne_m[0],
-                    t.position_ne_m[1],
-                    0.0,
-                ));
-                self.landing = Some(Landing {
-                    time_s: t.time_s,
-                    position_ne_m: t.position_ne_m,
-                    miss_m: miss,
-                    vertical_speed_mps: t.vertical_speed_mps,
-                    under_parafoil: self.physics.parafoil().is_some(),
-                    lat_deg,
-                    lon_deg,
-                });
-                let from_target = miss
-                    .map(|m| format!(", {m:.0} m from the target"))
-                    .unwrap_or_default();
-                (
-                    Severity::Notice,
-                    format!(
-                        "landed at {:.0} m N {:.0} m E{from_target}, {:.1} m/s down",
-                        t.position_ne_m[0], t.position_ne_m[1], t.vertical_speed_mps
-                    ),
-                )
-            }
-        };
-        self.say(severity, text);
-    }
-
-    /// Raw sensor telemetry, as each measurement reaches the drone's computer.
-    fn raw_telemetry(&mut self, arrival_s: f64, m: &Measurement) {
-        match m {
-            Measurement::Gps(fix) => {
-                self.last_gps_arrival_s = Some(arrival_s);
-                if self.streams.due(msg::GPS_RAW_INT, arrival_s) {
-                    self.send(Telemetry::GpsRaw(telemetry::gps_raw(&self.frame, fix)));
-                }
-            }
-            Measurement::Attitude(a) => {
-                if self.streams.due(msg::ATTITUDE, arrival_s) {
-                    let att = telemetry::attitude(a, self.last_attitude.as_ref());
-                    self.send(Telemetry::Attitude(att));
-                }
-                self.last_attitude = Some(*a);
-            }
-            Measurement::AirData(a) => {
-                self.last_air = Some(*a);
-                if self.streams.due(msg::SCALED_PRESSURE, arrival_s) {
-                    self.send(Telemetry::AirData(telemetry::air_data(a)));
-                }
-            }
-        }
-    }
-
-    fn periodic_telemetry(&mut self, t: f64, stage: FlightStage) {
-        let travel = self.physics.vehicle().main_line_travel_m;
-        let est = self.estimate;
-        // Messages asked for while the sensor-driven ones had nothing new.
-        if self.streams.take_request(msg::ATTITUDE)
-            && let Some(a) = self.last_attitude
-        {
-            self.send(Telemetry::Attitude(telemetry::attitude(&a, None)));
-        }
-        if self.streams.take_request(msg::SCALED_PRESSURE)
-            && let Some(a) = self.last_air
-        {
-            self.send(Telemetry::AirData(telemetry::air_data(&a)));
-        }
-        let gps_silent = self.last_gps_arrival_s.is_none_or(|a| t - a > 1.0);
-        let whole_second = (t - t.floor()) < 1e-6;
-        if gps_silent && (whole_second || self.streams.take_request(msg::GPS_RAW_INT)) {
-            self.send(Telemetry::GpsRaw(telemetry::gps_no_fix(t)));
-        }
-        if let Some(e) = &est {
-            if self.streams.due(msg::GLOBAL_POSITION_INT, t) {
-                self.send(Telemetry::Position(telemetry::position(&self.frame, e)));
-            }
-            if self.streams.due(msg::VFR_HUD, t) {
-                self.send(Telemetry::Hud(telemetry::hud(&self.frame, e)));
-            }
-            if self.streams.due(msg::WIND_COV, t) {
-                self.send(Telemetry::Wind(telemetry::wind(&self.frame, e)));
-            }
-            if self.streams.due(msg::NAV_CONTROLLER_OUTPUT, t) {
-                let g = self.guidance_status(e);
-                self.send(Telemetry::Guidance(g));
-            }
-            if self.streams.due(msg::POSITION_TARGET_GLOBAL_INT, t)
-                && let Some(p) = self.predict(stage, e)
-            {
-                self.send(Telemetry::PredictedLanding(p));
-            }
-        }
-        if self.streams.due(msg::SERVO_OUTPUT_RAW, t) {
-            // Where the servos are (lagging their commands, or stuck), not where they were sent.
-            let a = telemetry::actuators(t, &self.physics.servo_positions(), travel);
-            self.send(Telemetry::Actuators(a));
-        }
-        if self.streams.due(msg::SYS_STATUS, t) {
-            let s = self.system_status(t);
-            self.send(Telemetry::System(s));
-        }
-        if self.streams.due(msg::BATTERY_STATUS, t) {
-            self.send(Telemetry::Battery(self.battery.status()));
-        }
-    }
-
-    fn system_status(&self, t: f64) -> SystemStatus {
-        let mut health = sensor_bits::ALL;
-        if self.last_gps_arrival_s.is_none_or(|a| t - a > 1.0) {
-            health &= !sensor_bits::GPS;
-        }
-        let est = self.estimate.as_ref();
-        if !est.is_some_and(|e| e.attitude_ok) {
-            health &= !(sensor_bits::AHRS | sensor_bits::MAG);
-        }
-        if !est.is_some_and(|e| e.air_data_ok) {
-            health &= !(sensor_bits::ABSOLUTE_PRESSURE | sensor_bits::DIFFERENTIAL_PRESSURE);
-        }
-        if self.servo_fault.active_at(t) {
-            health &= !sensor_bits::SERVOS;
-        }
-        SystemStatus {
-            battery_voltage_v: Some(self.battery.voltage_v()),
-            battery_current_a: Some(self.battery.current_a()),
-            battery_remaining_pct: Some(self.battery.remaining_pct()),
-            load_pct: 0.0,
-            comm_drop_rate_pct: 0.0,
-            comm_errors: 0,
-            sensors_present: sensor_bits::ALL,
-            sensors_enabled: sensor_bits::ALL,
-            sensors_health: health,
-        }
-    }
-
-    /// NAV_CONTROLLER_OUTPUT: what guidance is after, per mode.
-    fn guidance_status(&self, e: &Estimate) -> GuidanceStatus {
-        let g = self.onboard.guidance();
-        let plan = g.plan();
-        let to_target = plan.target_ned_m - e.position_ned_m;
-        let bearing = to_target
-            .y
-            .atan2(to_target.x)
-            .to_degrees()
-            .rem_euclid(360.0);
-        let position = [e.position_ned_m.x, e.position_ned_m.y];
-        let (desired_heading_deg, xtrack_error_m, alt_error_m) = match g.mode() {
-            FlightMode::Heading => (plan.heading_rad.to_degrees(), 0.0, 0.0),
-            FlightMode::Course => (plan.course_rad.to_degrees(), 0.0, 0.0),
-            FlightMode::Localizer => (
-                plan.localizer.course_rad.to_degrees(),
-                plan.localizer.cross_track_m(position),
-                0.0,
-            ),
-            FlightMode::SpiralLanding => {
-                let s = g.spiral_status();
-                (bearing, 0.0, s.final_approach_height_m - s.height_m)
-            }
-            FlightMode::Uncontrolled | FlightMode::Manual => (e.heading_rad.to_degrees(), 0.0, 0.0),
-        };
-        GuidanceStatus {
-            desired_roll_deg: 0.0,
-            desired_heading_deg: desired_heading_deg.rem_euclid(360.0).round(),
-            bearing_to_target_deg: bearing.round(),
-            distance_to_target_m: if self.onboard.has_target() {
-                to_target.x.hypot(to_target.y).round().min(65_535.0)
-            } else {
-                0.0
-            },
-            alt_error_m: if alt_error_m.is_finite() {
-                alt_error_m
-            } else {
-                0.0
-            },
-            xtrack_error_m,
-        }
-    }
-
-    /// The predicted landing point (see the module documentation).
-    fn predict(&mut self, stage: FlightStage, e: &Estimate) -> Option<PredictedLanding> {
-        let ne = match stage {
-            FlightStage::PreLaunch | FlightStage::Ascent | FlightStage::RoundChute => {
-                self.physics
-                    .forecast_round_chute_landing(&e.position_ned_m, self.forecast.as_ref())?
-                    .0
-            }
-            FlightStage::ParafoilDeploy | FlightStage::Parafoil => {
-                let g = self.onboard.guidance();
-                let p = predict(
-                    e,
-                    g,
-                    &g.config().performance,
-                    &StandardAtmosphere,
-                    self.frame.alt_msl_m,
-                    &PredictorConfig::default(),
-                );
-                let manual = g.mode() == FlightMode::Manual;
-                if manual || g.mode() == FlightMode::Uncontrolled || stage != FlightStage::Parafoil
-                {
-                    p.uncontrolled.position_ne_m
-                } else {
-                    p.planned.position_ne_m
-                }
-            }
-            FlightStage::Landed => return None,
-        };
-        if !(ne[0].is_finite() && ne[1].is_finite()) {
-            return None;
-        }
-        self.prediction = Some(ne);
-        let (lat_deg, lon_deg, alt_msl_m) =
-            self.frame.to_geodetic(&Vector3::new(ne[0], ne[1], 0.0));
-        Some(PredictedLanding {
-            time_boot_ms: telemetry::boot_ms(e.time_s),
-            lat_deg,
-            lon_deg,
-            alt_msl_m,
-        })
-    }
-}
-
-/// Snake-case name of a stage, as the operator reads it.
-pub fn stage_name(stage: FlightStage) -> String {
-    serde_json::to_value(stage)
-        .ok()
-        .and_then(|v| v.as_str().map(String::from))
-        .unwrap_or_else(|| format!("{stage:?}"))
 }

@@ -1,406 +1,234 @@
-//! Operators' requests and their outcomes: request ids, what goes on the link, the answers
-//! that come back (COMMAND_ACK, PARAM_VALUE, MISSION_ACK) turned into `command_result`s, the
-//! parameter table, and the cutdown's arm-then-confirm.
+//! Each operator's request through its whole life, on the mission clock:
+//!
+//! 1. opened: recorded `in_progress`, its link action queued in the [`Outbox`];
+//! 2. the link driver reports the action applied (`sent`), refused (`failed`: e.g. the same
+//!    command is still waiting for its answer) or not applied in time (`timed_out`). A plan
+//!    upload that meets another plan transfer (the station's own read of the drone's plan) is
+//!    offered again every [`UPLOAD_RETRY_S`], [`UPLOAD_TRIES`] times in all, then `failed`;
+//! 3. the drone's answer (COMMAND_ACK, PARAM_VALUE, MISSION_ACK), or the link's own give-up
+//!    after its retries, settles it; IN_PROGRESS acknowledgements keep it open;
+//! 4. with no answer by its deadline, well past the link's own retries, it times out: nothing
+//!    stays `in_progress` for ever because an answer was lost.
+//!
+//! Every step that settles a request yields its `command_result`; an answer from the drone
+//! that comes after the station gave up still corrects it (the drone's word is the truth).
 
 use std::collections::{BTreeMap, HashMap};
 
-use nalgebra::Vector3;
-use stx_gnc::control::Localizer;
-use stx_gnc::geo::LocalFrame;
-use stx_gnc::mission::FlightMode;
-use stx_gnc::plan_upload::PlanPoint;
-use stx_link::command::{Command, CommandEvent, CommandOutcome, CommandResult, RequestId};
-use stx_link::param::{ParamEvent, ParamValue};
-use stx_link::plan::{PlanEvent, PlanItem};
+use stx_link::command::{CommandEvent, CommandOutcome, CommandResult, RequestId};
+use stx_link::param::ParamEvent;
+use stx_link::plan::PlanEvent;
 
+use super::actions::{APPLY_WITHIN_S, ActionError, ActionId, LinkOp, Outbox, Purpose};
+use super::requests::{Payload, PlanChange};
 use crate::messages::{CommandResultMsg, Outcome};
 
-/// An operator's request, checked.
-#[derive(Debug, Clone, PartialEq)]
-pub enum CommandRequest {
-    /// Select a mode.
-    Mode(FlightMode),
-    /// Heading for heading mode, degrees.
-    Heading { heading_deg: f64 },
-    /// Course for course mode, degrees.
-    Course { course_deg: f64 },
-    /// Localizer through a point with a course and optional glide slope (sink over ground
-    /// speed).
-    Localizer {
-        lat_deg: f64,
-        lon_deg: f64,
-        course_deg: f64,
-        glide_slope: Option<f64>,
-    },
-    /// Landing target.
-    Target {
-        lat_deg: f64,
-        lon_deg: f64,
-        alt_msl_m: f64,
-        approach_course_deg: Option<f64>,
-    },
-    /// A guidance plan (waypoints and a landing).
-    Plan(Vec<PlanItem>),
-    /// Set a parameter.
-    ParamSet { name: String, value: f64 },
-}
+/// Seconds an upload that met another plan transfer waits before it is offered again …
+pub const UPLOAD_RETRY_S: f64 = 0.25;
+/// … and how many times in all it is offered (a plan read is over within a few round trips).
+pub const UPLOAD_TRIES: u32 = 40;
+/// Seconds after sending by which the drone's answer to a command or a parameter write must
+/// have come; an IN_PROGRESS acknowledgement starts it again. The link itself gives up after
+/// 4 transmissions 1 s apart (`stx_link` defaults): this only catches an answer that was lost.
+pub const ANSWER_WITHIN_S: f64 = 30.0;
+/// For a plan upload, this much more per item: the link re-sends each item up to 5 times
+/// 1.5 s apart before it gives up, and progress starts its count again.
+pub const ANSWER_PER_PLAN_ITEM_S: f64 = 8.0;
 
-/// What the daemon must do on the link.
-#[derive(Debug, Clone, PartialEq)]
-pub enum LinkAction {
-    /// Send a command (retried by the link until acknowledged).
-    Command {
-        request_id: RequestId,
-        command: Command,
-    },
-    /// Set a parameter (retried until echoed).
-    ParamSet { name: String, value: f32 },
-    /// Upload a plan.
-    PlanUpload(Vec<PlanItem>),
-    /// Read the plan the drone holds (the station's own initiative, no request id).
-    PlanDownload,
-}
-
-/// A refusal of a request, as the HTTP layer answers it.
-#[derive(Debug, Clone, PartialEq)]
-pub struct ApiError {
-    /// HTTP status.
-    pub status: u16,
-    /// Machine-readable kind.
-    pub error: &'static str,
-    /// For people.
-    pub reason: String,
-}
-
-impl ApiError {
-    /// 400 with a reason naming the field.
-    pub fn bad_request(reason: impl Into<String>) -> Self {
-        Self {
-            status: 400,
-            error: "bad_request",
-            reason: reason.into(),
-        }
-    }
-}
-
-/// An armed cutdown, as `POST /api/cutdown/arm` answers it.
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
-pub struct CutdownArm {
-    /// The id to confirm with.
-    pub arm_id: String,
-    /// Seconds left to confirm.
-    pub expires_in_s: f64,
-}
-
-/// A plan change the guidance replica adopts once the drone accepts it.
-#[derive(Debug, Clone, PartialEq)]
-pub(crate) enum PlanChange {
-    Target {
-        target_ned_m: Vector3<f64>,
-        approach_course_rad: Option<f64>,
-    },
-    Heading(f64),
-    Course(f64),
-    Localizer {
-        line: Localizer,
-        glide_slope: Option<f64>,
-    },
-    /// An uploaded plan, applied with the drone's own mapping (`stx_gnc::plan_upload`).
-    Upload(Vec<PlanPoint>),
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Stage {
+    /// Its action is with the link driver.
+    Sending(ActionId),
+    /// The link took it; the drone's answer is due by `deadline_s`.
+    Answering { deadline_s: f64 },
+    /// The link was busy with another plan transfer: offered again at `at_s`.
+    Retrying { at_s: f64 },
+    /// Settled.
+    Done,
 }
 
 #[derive(Debug, Clone)]
 struct Record {
     result: CommandResultMsg,
-    plan_change: Option<PlanChange>,
+    op: LinkOp,
+    /// What the replica adopts once the drone accepts (taken then).
+    change: Option<PlanChange>,
+    stage: Stage,
+    /// Times its action was handed to the link driver.
+    tries: u32,
 }
 
-#[derive(Debug, Clone)]
-struct Armed {
-    arm_id: String,
-    until_s: f64,
-    by: String,
+fn answer_within_s(op: &LinkOp) -> f64 {
+    match op {
+        LinkOp::PlanUpload(items) => ANSWER_WITHIN_S + ANSWER_PER_PLAN_ITEM_S * items.len() as f64,
+        _ => ANSWER_WITHIN_S,
+    }
 }
 
-/// Parameter metadata the station knows (the wire only carries names and values).
-#[derive(Debug, Clone, Default)]
-pub(crate) struct Table {
-    pub values: BTreeMap<String, ParamValue>,
-    pub complete: bool,
+/// `r12` → 12.
+fn number(request_id: &str) -> Option<u64> {
+    request_id.strip_prefix('r')?.parse().ok()
 }
 
-/// Every request and the parameter table.
-#[derive(Debug)]
+/// Every request, by number (its link request id too).
+#[derive(Debug, Default)]
 pub(crate) struct Commands {
-    next: u64,
-    records: HashMap<String, Record>,
-    by_link_id: HashMap<u64, String>,
-    param_sets: HashMap<String, String>,
-    plan_request: Option<(String, Option<PlanChange>)>,
-    pub table: Table,
-    armed: Option<Armed>,
-    window_s: f64,
-    next_arm: u64,
-}
-
-fn check_finite(name: &str, v: f64) -> Result<f64, super::ApiError> {
-    if v.is_finite() {
-        Ok(v)
-    } else {
-        Err(ApiError::bad_request(format!(
-            "{name} must be a finite number"
-        )))
-    }
-}
-
-fn check_lat_lon(lat: f64, lon: f64) -> Result<(), super::ApiError> {
-    if !(lat.is_finite() && lat.abs() <= 90.0) {
-        return Err(ApiError::bad_request("lat_deg must be within ±90°"));
-    }
-    if !(lon.is_finite() && lon.abs() <= 180.0) {
-        return Err(ApiError::bad_request("lon_deg must be within ±180°"));
-    }
-    Ok(())
-}
-
-fn mode_name(mode: FlightMode) -> String {
-    serde_json::to_value(mode)
-        .ok()
-        .and_then(|v| v.as_str().map(String::from))
-        .unwrap_or_else(|| format!("{mode:?}"))
+    last: u64,
+    records: BTreeMap<u64, Record>,
+    /// Parameter writes the link took, by name.
+    param_sets: HashMap<String, u64>,
+    /// The plan upload the link took.
+    plan_upload: Option<u64>,
 }
 
 impl Commands {
-    pub fn new(window_s: f64) -> Self {
-        Self {
-            next: 1,
-            records: HashMap::new(),
-            by_link_id: HashMap::new(),
-            param_sets: HashMap::new(),
-            plan_request: None,
-            table: Table::default(),
-            armed: None,
-            window_s,
-            next_arm: 1,
-        }
-    }
-
-    fn new_id(&mut self) -> (String, RequestId) {
-        let n = self.next;
-        self.next += 1;
-        (format!("r{n}"), RequestId(n))
-    }
-
-    fn record(&mut self, id: &str, command: &str, plan_change: Option<PlanChange>) {
+    /// Records a request for `command` and queues its link action; its id.
+    pub fn open(
+        &mut self,
+        now_s: f64,
+        outbox: &mut Outbox,
+        command: &'static str,
+        payload: Payload,
+        change: Option<PlanChange>,
+    ) -> String {
+        self.last += 1;
+        let n = self.last;
+        let op = match payload {
+            Payload::Command(command) => LinkOp::Command {
+                request_id: RequestId(n),
+                command,
+            },
+            Payload::ParamSet { name, value } => LinkOp::ParamSet { name, value },
+            Payload::Plan(items) => LinkOp::PlanUpload(items),
+        };
+        let action = outbox.issue(now_s, op.clone(), Purpose::Request(n), APPLY_WITHIN_S);
+        let request_id = format!("r{n}");
         self.records.insert(
-            id.to_string(),
+            n,
             Record {
                 result: CommandResultMsg {
                     kind: "command_result",
-                    request_id: id.to_string(),
+                    request_id: request_id.clone(),
                     command: command.to_string(),
                     outcome: Outcome::InProgress,
                     attempts: 0,
-                    detail: "sent".into(),
+                    detail: "queued for the link".into(),
                     value: None,
                 },
-                plan_change,
+                op,
+                change,
+                stage: Stage::Sending(action),
+                tries: 1,
             },
         );
+        request_id
     }
 
-    /// Checks a request and turns it into a link action; returns the request id, the action
-    /// and a sentence for the log.
-    pub fn request(
+    /// The link driver applied request `n`'s `action`, or did not: its result if that
+    /// settles it (or reopens one the station had given up on).
+    pub fn on_applied(
         &mut self,
-        _now_s: f64,
-        frame: &LocalFrame,
-        request: CommandRequest,
-    ) -> Result<(String, LinkAction, String), ApiError> {
-        let (command, change, name, text) = match request {
-            CommandRequest::ParamSet { name, value } => {
-                let value = check_finite("value", value)?;
-                if name.is_empty() || name.len() > 16 || !name.is_ascii() {
-                    return Err(ApiError::bad_request(
-                        "parameter names are 1–16 ASCII characters",
-                    ));
-                }
-                // The drone would refuse it too, but saying so here spares a round trip
-                // over a slow radio and names the range.
-                if let Some(def) = stx_gnc::params::find(&name) {
-                    def.check(value)
-                        .map_err(|e| ApiError::bad_request(e.to_string()))?;
-                }
-                if !self.table.values.is_empty() && !self.table.values.contains_key(&name) {
-                    return Err(ApiError {
-                        status: 404,
-                        error: "not_found",
-                        reason: format!("the drone has no parameter `{name}`"),
-                    });
-                }
-                let (id, _) = self.new_id();
-                self.record(&id, "set_param", None);
-                self.param_sets.insert(name.clone(), id.clone());
-                let text = format!("set parameter {name} = {value}");
-                return Ok((
-                    id,
-                    LinkAction::ParamSet {
-                        name,
-                        value: value as f32,
-                    },
-                    text,
-                ));
-            }
-            CommandRequest::Plan(items) => {
-                if items.is_empty() {
-                    return Err(ApiError::bad_request("items must not be empty"));
-                }
-                if items.len() > usize::from(stx_link::plan::MAX_PLAN_ITEMS) {
-                    return Err(ApiError::bad_request(format!(
-                        "items: at most {} items",
-                        stx_link::plan::MAX_PLAN_ITEMS
-                    )));
-                }
-                for item in &items {
-                    let (lat, lon, alt, approach) = match *item {
-                        PlanItem::Waypoint {
-                            lat_deg,
-                            lon_deg,
-                            alt_msl_m,
-                        } => (lat_deg, lon_deg, alt_msl_m, None),
-                        PlanItem::Land {
-                            lat_deg,
-                            lon_deg,
-                            alt_msl_m,
-                            approach_heading_deg,
-                        } => (lat_deg, lon_deg, alt_msl_m, approach_heading_deg),
-                    };
-                    check_lat_lon(lat, lon)?;
-                    check_finite("alt_msl_m", alt)?;
-                    if let Some(a) = approach {
-                        check_finite("approach_course_deg", a)?;
-                    }
-                }
-                let change = Some(PlanChange::Upload(
-                    items.iter().map(|i| i.to_local(frame)).collect(),
-                ));
-                let (id, _) = self.new_id();
-                self.record(&id, "set_plan", None);
-                let text = format!("upload a plan of {} items", items.len());
-                self.plan_request = Some((id.clone(), change));
-                return Ok((id, LinkAction::PlanUpload(items), text));
-            }
-            CommandRequest::Mode(mode) => (
-                Command::SetMode(mode),
-                None,
-                "set_mode",
-                format!("mode → {}", mode_name(mode)),
-            ),
-            CommandRequest::Heading { heading_deg } => {
-                let h = check_finite("heading_deg", heading_deg)?.rem_euclid(360.0);
-                (
-                    Command::HoldHeading { heading_deg: h },
-                    Some(PlanChange::Heading(h.to_radians())),
-                    "set_heading",
-                    format!("heading → {h:.0}°"),
-                )
-            }
-            CommandRequest::Course { course_deg } => {
-                let c = check_finite("course_deg", course_deg)?.rem_euclid(360.0);
-                (
-                    Command::HoldCourse { course_deg: c },
-                    Some(PlanChange::Course(c.to_radians())),
-                    "set_course",
-                    format!("course → {c:.0}°"),
-                )
-            }
-            CommandRequest::Localizer {
-                lat_deg,
-                lon_deg,
-                course_deg,
-                glide_slope,
-            } => {
-                check_lat_lon(lat_deg, lon_deg)?;
-                let c = check_finite("course_deg", course_deg)?.rem_euclid(360.0);
-                if let Some(s) = glide_slope
-                    && !(s > 0.0 && s < 10.0)
-                {
-                    return Err(ApiError::bad_request("glide_slope must be in (0, 10)"));
-                }
-                let p = frame.to_ned(lat_deg, lon_deg, frame.alt_msl_m);
-                (
-                    Command::SetLocalizer {
-                        lat_deg,
-                        lon_deg,
-                        course_deg: c,
-                        glide_slope_deg: glide_slope.map(|s| s.atan().to_degrees()),
-                    },
-                    Some(PlanChange::Localizer {
-                        line: Localizer {
-                            point_ne_m: [p.x, p.y],
-                            course_rad: c.to_radians(),
-                        },
-                        glide_slope,
-                    }),
-                    "set_localizer",
-                    format!("localizer → {c:.0}° through {lat_deg:.5}, {lon_deg:.5}"),
-                )
-            }
-            CommandRequest::Target {
-                lat_deg,
-                lon_deg,
-                alt_msl_m,
-                approach_course_deg,
-            } => {
-                check_lat_lon(lat_deg, lon_deg)?;
-                check_finite("alt_msl_m", alt_msl_m)?;
-                if let Some(a) = approach_course_deg {
-                    check_finite("approach_course_deg", a)?;
-                }
-                (
-                    Command::SetLandingTarget {
-                        lat_deg,
-                        lon_deg,
-                        alt_msl_m,
-                        approach_heading_deg: approach_course_deg.map(|a| a.rem_euclid(360.0)),
-                    },
-                    Some(PlanChange::Target {
-                        target_ned_m: frame.to_ned(lat_deg, lon_deg, alt_msl_m),
-                        approach_course_rad: approach_course_deg.map(f64::to_radians),
-                    }),
-                    "set_target",
-                    format!(
-                        "landing target → {lat_deg:.5}, {lon_deg:.5}, approach {}",
-                        approach_course_deg
-                            .map_or("into the wind".to_string(), |a| format!("{a:.0}°"))
-                    ),
-                )
+        now_s: f64,
+        n: u64,
+        action: ActionId,
+        result: Result<(), ActionError>,
+    ) -> Option<CommandResultMsg> {
+        let r = self.records.get_mut(&n)?;
+        let late = match r.stage {
+            Stage::Sending(current) if current == action => false,
+            // Settled as not sent, and the outcome came after all.
+            Stage::Done => true,
+            _ => {
+                tracing::warn!(
+                    ?action,
+                    request = n,
+                    "outcome of an action the request no longer waits for"
+                );
+                return None;
             }
         };
-        let (id, link_id) = self.new_id();
-        self.record(&id, name, change);
-        self.by_link_id.insert(link_id.0, id.clone());
-        Ok((
-            id,
-            LinkAction::Command {
-                request_id: link_id,
-                command,
-            },
-            text,
-        ))
+        match result {
+            Ok(()) => {
+                r.stage = Stage::Answering {
+                    deadline_s: now_s + answer_within_s(&r.op),
+                };
+                match &r.op {
+                    LinkOp::ParamSet { name, .. } => {
+                        self.param_sets.insert(name.clone(), n);
+                    }
+                    LinkOp::PlanUpload(_) => self.plan_upload = Some(n),
+                    _ => {}
+                }
+                if late {
+                    // Reported not sent, and sent after all: say so, and wait for the answer.
+                    r.result.outcome = Outcome::InProgress;
+                    r.result.detail = "sent late, after it was reported not sent".into();
+                    return Some(r.result.clone());
+                }
+                r.result.detail = "sent".into();
+                None
+            }
+            // Settled already; this changes nothing.
+            Err(_) if late => None,
+            Err(ActionError::Busy(reason))
+                if matches!(r.op, LinkOp::PlanUpload(_)) && r.tries < UPLOAD_TRIES =>
+            {
+                r.stage = Stage::Retrying {
+                    at_s: now_s + UPLOAD_RETRY_S,
+                };
+                r.result.detail = format!("waiting: {reason}");
+                None
+            }
+            Err(e) => {
+                r.stage = Stage::Done;
+                r.result.outcome = match e {
+                    ActionError::Expired => Outcome::TimedOut,
+                    ActionError::Busy(_) | ActionError::Refused(_) => Outcome::Failed,
+                };
+                r.result.detail = match e {
+                    ActionError::Busy(reason) if r.tries > 1 => {
+                        format!("{reason} (tried {} times)", r.tries)
+                    }
+                    e => e.to_string(),
+                };
+                Some(r.result.clone())
+            }
+        }
     }
 
-    /// A command could not even be queued on the link (another of the same kind is waiting).
-    pub fn refuse(&mut self, id: &str, reason: String) -> Option<CommandResultMsg> {
-        let r = self.records.get_mut(id)?;
-        r.result.outcome = Outcome::Failed;
-        r.result.detail = reason;
-        Some(r.result.clone())
+    /// Runs the timers at `now_s`: busy uploads offered again, answers overdue; the results
+    /// this settles.
+    pub fn handle_timeout(&mut self, now_s: f64, outbox: &mut Outbox) -> Vec<CommandResultMsg> {
+        let mut settled = Vec::new();
+        for (n, r) in &mut self.records {
+            match r.stage {
+                Stage::Retrying { at_s } if now_s >= at_s => {
+                    r.tries += 1;
+                    let action =
+                        outbox.issue(now_s, r.op.clone(), Purpose::Request(*n), APPLY_WITHIN_S);
+                    r.stage = Stage::Sending(action);
+                }
+                Stage::Answering { deadline_s } if now_s > deadline_s => {
+                    r.stage = Stage::Done;
+                    r.result.outcome = Outcome::TimedOut;
+                    r.result.detail = format!(
+                        "sent, but no answer from the drone within {:.0} s",
+                        answer_within_s(&r.op)
+                    );
+                    settled.push(r.result.clone());
+                }
+                _ => {}
+            }
+        }
+        settled
     }
 
-    pub fn on_command_event(&mut self, _now_s: f64, e: &CommandEvent) -> Option<CommandResultMsg> {
-        let id = self.by_link_id.get(&e.request_id.0)?.clone();
-        let r = self.records.get_mut(&id)?;
+    /// COMMAND_ACKs as the link reports them.
+    pub fn on_command_event(&mut self, now_s: f64, e: &CommandEvent) -> Option<CommandResultMsg> {
+        let r = self.records.get_mut(&e.request_id.0)?;
+        if !matches!(r.op, LinkOp::Command { .. }) {
+            return None;
+        }
         r.result.attempts = u32::from(e.attempts);
         let (outcome, detail) = match e.outcome {
             CommandOutcome::Accepted => (Outcome::Accepted, "acknowledged by the drone".into()),
@@ -423,82 +251,62 @@ impl Commands {
         };
         r.result.outcome = outcome;
         r.result.detail = detail;
-        if outcome != Outcome::InProgress {
-            self.by_link_id.remove(&e.request_id.0);
-        }
+        r.stage = if outcome == Outcome::InProgress {
+            Stage::Answering {
+                deadline_s: now_s + ANSWER_WITHIN_S,
+            }
+        } else {
+            Stage::Done
+        };
         Some(r.result.clone())
     }
 
-    /// Parameter events: finished writes as results, and whether the table changed.
-    pub fn on_param_event(&mut self, e: &ParamEvent) -> (Vec<CommandResultMsg>, bool) {
-        let mut results = Vec::new();
-        let mut changed = false;
-        let store = |table: &mut Table, p: &ParamValue| {
-            table.values.insert(p.name.clone(), p.clone());
-            if table.values.len() >= usize::from(p.count) {
-                table.complete = true;
-            }
-        };
-        match e {
-            ParamEvent::ListComplete { params } => {
-                for p in params {
-                    store(&mut self.table, p);
-                }
-                self.table.complete = true;
-                changed = true;
-            }
-            ParamEvent::ListFailed { received, .. } => {
-                for p in received {
-                    store(&mut self.table, p);
-                }
-                changed = true;
-            }
-            ParamEvent::ReadDone { param } | ParamEvent::Value { param } => {
-                store(&mut self.table, param);
-                changed = true;
-            }
-            ParamEvent::ReadFailed { .. } => {}
+    /// Finished parameter writes as results.
+    pub fn on_param_event(&mut self, e: &ParamEvent) -> Option<CommandResultMsg> {
+        let (name, outcome, detail, attempts, value) = match e {
             ParamEvent::SetDone {
                 name,
                 requested,
                 actual,
                 accepted,
             } => {
-                if let Some(p) = self.table.values.get_mut(name) {
-                    p.value = *actual;
-                    changed = true;
-                }
-                if let Some(id) = self.param_sets.remove(name)
-                    && let Some(r) = self.records.get_mut(&id)
-                {
-                    r.result.attempts = r.result.attempts.max(1);
-                    r.result.value = Some(f64::from(*actual));
-                    if *accepted {
-                        r.result.outcome = Outcome::Accepted;
-                        r.result.detail = format!("{name} = {actual} read back from the drone");
-                    } else {
-                        r.result.outcome = Outcome::Denied;
-                        r.result.detail = format!(
+                let (outcome, detail) = if *accepted {
+                    (
+                        Outcome::Accepted,
+                        format!("{name} = {actual} read back from the drone"),
+                    )
+                } else {
+                    (
+                        Outcome::Denied,
+                        format!(
                             "the drone kept {name} = {actual} (asked {requested}: out of range)"
-                        );
-                    }
-                    results.push(r.result.clone());
-                }
+                        ),
+                    )
+                };
+                (name, outcome, detail, None, Some(f64::from(*actual)))
             }
-            ParamEvent::SetFailed { name, attempts, .. } => {
-                if let Some(id) = self.param_sets.remove(name)
-                    && let Some(r) = self.records.get_mut(&id)
-                {
-                    r.result.attempts = u32::from(*attempts);
-                    r.result.outcome = Outcome::TimedOut;
-                    r.result.detail = format!("no PARAM_VALUE after {attempts} attempts");
-                    results.push(r.result.clone());
-                }
-            }
+            ParamEvent::SetFailed { name, attempts, .. } => (
+                name,
+                Outcome::TimedOut,
+                format!("no PARAM_VALUE after {attempts} attempts"),
+                Some(u32::from(*attempts)),
+                None,
+            ),
+            _ => return None,
+        };
+        let n = self.param_sets.remove(name)?;
+        let r = self.records.get_mut(&n)?;
+        r.result.attempts = attempts.unwrap_or(r.result.attempts.max(1));
+        if value.is_some() {
+            r.result.value = value;
         }
-        (results, changed)
+        r.result.outcome = outcome;
+        r.result.detail = detail;
+        r.stage = Stage::Done;
+        Some(r.result.clone())
     }
 
+    /// The end of a plan upload as a result.
     pub fn on_plan_event(&mut self, e: &PlanEvent) -> Option<CommandResultMsg> {
         let (outcome, detail) = match e {
             PlanEvent::UploadDone { items } => (
@@ -515,97 +323,44 @@ impl Commands {
             ),
             PlanEvent::DownloadDone { .. } | PlanEvent::DownloadFailed { .. } => return None,
         };
-        let (id, change) = self.plan_request.take()?;
-        let r = self.records.get_mut(&id)?;
+        let n = self.plan_upload.take()?;
+        let r = self.records.get_mut(&n)?;
         r.result.outcome = outcome;
         r.result.detail = detail;
         r.result.attempts = r.result.attempts.max(1);
-        if outcome == Outcome::Accepted {
-            r.plan_change = change;
-        }
+        r.stage = Stage::Done;
         Some(r.result.clone())
     }
 
     /// The plan change of an accepted request, once.
-    pub fn take_accepted_plan(&mut self, id: &str) -> Option<PlanChange> {
-        self.records.get_mut(id)?.plan_change.take()
+    pub fn take_accepted_change(&mut self, request_id: &str) -> Option<PlanChange> {
+        let r = self.records.get_mut(&number(request_id)?)?;
+        if r.result.outcome != Outcome::Accepted {
+            return None;
+        }
+        r.change.take()
     }
 
-    pub fn result(&self, id: &str) -> Option<CommandResultMsg> {
-        self.records.get(id).map(|r| r.result.clone())
+    pub fn result(&self, request_id: &str) -> Option<CommandResultMsg> {
+        let n = number(request_id)?;
+        self.records.get(&n).map(|r| r.result.clone())
     }
 
+    /// Requests not settled, by id, with their command.
     pub fn pending(&self) -> HashMap<String, String> {
         self.records
-            .iter()
-            .filter(|(_, r)| r.result.outcome == Outcome::InProgress)
-            .map(|(id, r)| (id.clone(), r.result.command.clone()))
+            .values()
+            .filter(|r| r.result.outcome == Outcome::InProgress)
+            .map(|r| (r.result.request_id.clone(), r.result.command.clone()))
             .collect()
     }
 
-    pub fn arm_cutdown(&mut self, now_s: f64, who: &str) -> CutdownArm {
-        // Unpredictable enough that a stale page cannot confirm someone else's arming.
-        let n = self.next_arm;
-        self.next_arm += 1;
-        let salt = (now_s.to_bits() ^ 0x9E37_79B9_7F4A_7C15).rotate_left((n % 63) as u32);
-        let arm_id = format!("arm-{n}-{salt:016x}");
-        self.armed = Some(Armed {
-            arm_id: arm_id.clone(),
-            until_s: now_s + self.window_s,
-            by: who.to_string(),
-        });
-        CutdownArm {
-            arm_id,
-            expires_in_s: self.window_s,
-        }
-    }
-
-    pub fn confirm_cutdown(
-        &mut self,
-        now_s: f64,
-        who: &str,
-        arm_id: &str,
-    ) -> Result<(String, LinkAction), ApiError> {
-        let not_armed = |reason: &str| ApiError {
-            status: 409,
-            error: "not_armed",
-            reason: reason.to_string(),
-        };
-        let Some(armed) = self.armed.take() else {
-            return Err(not_armed("the cutdown is not armed: arm it first"));
-        };
-        if now_s > armed.until_s {
-            return Err(not_armed("the arming expired: arm it again"));
-        }
-        if armed.arm_id != arm_id {
-            self.armed = Some(armed);
-            return Err(not_armed("that is not the current arming"));
-        }
-        if armed.by != who {
-            tracing::warn!(armed_by = %armed.by, confirmed_by = who, "cutdown confirmed by another operator");
-        }
-        let (id, link_id) = self.new_id();
-        self.record(&id, "cutdown", None);
-        self.by_link_id.insert(link_id.0, id.clone());
-        Ok((
-            id,
-            LinkAction::Command {
-                request_id: link_id,
-                command: Command::Cutdown,
-            },
-        ))
-    }
-
-    /// Drops an arming whose window has passed; the sentence for the log.
-    pub fn expire_cutdown(&mut self, now_s: f64) -> Option<String> {
-        if self.armed.as_ref().is_some_and(|a| now_s > a.until_s) {
-            let a = self.armed.take()?;
-            return Some(format!("cutdown armed by {} expired unconfirmed", a.by));
-        }
-        None
-    }
-
-    pub fn armed_until(&self) -> Option<f64> {
-        self.armed.as_ref().map(|a| a.until_s)
+    /// An operator's plan upload waits to be taken by the link (possibly for another plan
+    /// transfer to end).
+    pub fn upload_waiting(&self) -> bool {
+        self.records.values().any(|r| {
+            matches!(r.op, LinkOp::PlanUpload(_))
+                && matches!(r.stage, Stage::Sending(_) | Stage::Retrying { .. })
+        })
     }
 }

@@ -25,7 +25,8 @@ use stx_gnc::plan_upload::{LineChange, apply};
 use stx_link::plan::PlanItem;
 use stx_link::telemetry::GuidanceStatus;
 
-use super::{LinkAction, StationCore};
+use super::StationCore;
+use super::actions::{APPLY_WITHIN_S, ActionId, LinkOp, Purpose};
 use crate::messages::Level;
 
 /// Where the replica's landing target comes from.
@@ -71,8 +72,8 @@ pub(crate) struct PlanSync {
     wanted: bool,
     /// Not before this mission time, s.
     not_before_s: f64,
-    /// Mission time the running download was asked, s.
-    in_flight_since_s: Option<f64>,
+    /// The running download's link action and the mission time it was asked, s.
+    in_flight: Option<(ActionId, f64)>,
     /// Downloads failed in a row.
     failures: u32,
     /// Mission time of the last download asked because of a telemetry mismatch, s.
@@ -122,36 +123,43 @@ impl StationCore {
         s.not_before_s = s.not_before_s.min(now_s);
     }
 
-    /// What the daemon must do on the link on the station's own initiative (the plan
-    /// download); each action once.
-    pub fn take_link_actions(&mut self, now_s: f64) -> Vec<LinkAction> {
+    /// Queues the download when it is due (not while an operator's upload waits for the
+    /// link: the operator goes first).
+    pub(crate) fn schedule_plan_download(&mut self, now_s: f64, upload_waiting: bool) {
         let s = &mut self.sync;
-        if let Some(since) = s.in_flight_since_s
+        if let Some((_, since)) = s.in_flight
             && now_s - since > DOWNLOAD_LOST_S
         {
-            s.in_flight_since_s = None;
+            s.in_flight = None;
         }
-        if s.wanted && s.in_flight_since_s.is_none() && now_s >= s.not_before_s {
+        if s.wanted && s.in_flight.is_none() && now_s >= s.not_before_s && !upload_waiting {
             s.wanted = false;
-            s.in_flight_since_s = Some(now_s);
-            return vec![LinkAction::PlanDownload];
+            let id = self.outbox.issue(
+                now_s,
+                LinkOp::PlanDownload,
+                Purpose::PlanDownload,
+                APPLY_WITHIN_S,
+            );
+            self.sync.in_flight = Some((id, now_s));
         }
-        Vec::new()
     }
 
-    /// The link could not start the download (another plan transfer is running): try again
+    /// The link did not start download `id` (another plan transfer is running): try again
     /// shortly.
-    pub fn plan_download_refused(&mut self, now_s: f64, reason: &str) {
-        tracing::debug!(reason, "plan download postponed");
+    pub(crate) fn plan_download_refused(&mut self, now_s: f64, id: ActionId, reason: &str) {
         let s = &mut self.sync;
-        s.in_flight_since_s = None;
+        if s.in_flight.is_none_or(|(running, _)| running != id) {
+            return;
+        }
+        tracing::debug!(reason, "plan download postponed");
+        s.in_flight = None;
         s.wanted = true;
         s.not_before_s = now_s + 1.0;
     }
 
     pub(crate) fn on_plan_download_failed(&mut self, now_s: f64, reason: &str) {
         let s = &mut self.sync;
-        s.in_flight_since_s = None;
+        s.in_flight = None;
         s.failures += 1;
         let delay = (FIRST_RETRY_S * 2_f64.powi(s.failures as i32 - 1)).min(MAX_RETRY_S);
         s.wanted = true;
@@ -175,7 +183,7 @@ impl StationCore {
         let points: Vec<_> = items.iter().map(|i| i.to_local(&self.frame)).collect();
         let update = apply(self.guidance.plan(), &points);
         let s = &mut self.sync;
-        s.in_flight_since_s = None;
+        s.in_flight = None;
         s.failures = 0;
         s.downloaded = true;
         let was = (s.target, s.line_known);

@@ -250,7 +250,7 @@ impl StationCore {
             forecast_wind: self.config.forecast_wind.clone(),
             mission: MissionView {
                 stage: self.latest.status.map(|(s, _)| snake(s.stage)),
-                cutdown_armed_until_s: self.commands.armed_until(),
+                cutdown_armed_until_s: self.cutdown.armed_until(),
             },
         }
     }
@@ -258,8 +258,7 @@ impl StationCore {
     /// The parameter table as the dashboard shows it.
     pub fn params_msg(&self, now_s: f64) -> ParamsMsg {
         let params = self
-            .commands
-            .table
+            .params
             .values
             .values()
             .map(|p| {
@@ -283,7 +282,7 @@ impl StationCore {
         ParamsMsg {
             kind: "params",
             params,
-            complete: self.commands.table.complete,
+            complete: self.params.complete,
             time_s: now_s,
         }
     }

@@ -1,5 +1,6 @@
-//! Test fixtures: a station on loopback, a scripted drone on the other end of the real
-//! MAVLink link, a small HTTP client and WebSocket helpers.
+//! Test fixtures: a station on loopback, a scripted drone or the simulated one (the runner of
+//! `stx drone`) on the other end of the real MAVLink link, a small HTTP client and WebSocket
+//! helpers.
 
 #![allow(dead_code)] // each test file uses a different part
 
@@ -319,9 +320,10 @@ pub async fn ws_send(ws: &mut Ws, value: Value) {
 }
 
 /// The real simulated drone (`stx_sim`'s onboard software, physics and link) flying `config`
-/// over loopback UDP to the station, stepped `speed` times faster than real time.
+/// over loopback UDP to the station, `speed` times faster than real time: the runner of
+/// `stx drone` (`stx_sim::runner`), with heartbeats every 200 ms.
 pub struct SimDrone {
-    actions: mpsc::Sender<Action<stx_sim::drone::link::LinkedDrone>>,
+    handle: stx_sim::runner::FlightHandle,
 }
 
 pub async fn sim_drone(
@@ -329,41 +331,16 @@ pub async fn sim_drone(
     config: &stx_sim::drone::config::MissionConfig,
     speed: f64,
 ) -> SimDrone {
-    use stx_sim::drone::Drone;
-    use stx_sim::drone::link::LinkedDrone;
-    let drone = Drone::new(config, stx_dynamics::vehicle::Vehicle::straplex()).expect("drone");
-    let linked =
-        LinkedDrone::new(drone, fast_link(LinkConfig::vehicle()), Duration::ZERO).expect("link");
-    let transport = Transport::open_str(&format!("udpout:{station_link}"))
-        .await
-        .expect("drone socket");
-    let (actions_tx, actions_rx) = mpsc::channel::<Action<LinkedDrone>>(64);
-    let (events_tx, mut events_rx) = mpsc::channel(1024);
-    tokio::spawn(drive(
-        transport,
-        linked,
-        actions_rx,
-        events_tx,
-        DriveOptions::default(),
-    ));
-    tokio::spawn(async move { while events_rx.recv().await.is_some() {} });
-    let steps = actions_tx.clone();
-    let period = Duration::from_secs_f64(stx_sim::guided::CONTROL_PERIOD_S / speed);
-    tokio::spawn(async move {
-        let mut ticker = tokio::time::interval(period);
-        loop {
-            ticker.tick().await;
-            let step: Action<LinkedDrone> = Box::new(|d, now| {
-                let _ = d.step(now);
-            });
-            if steps.send(step).await.is_err() {
-                break;
-            }
-        }
-    });
-    SimDrone {
-        actions: actions_tx,
-    }
+    use stx_sim::runner::{Flight, FlyOptions, Speed};
+    let mut options = FlyOptions::new(&format!("udpout:{station_link}"), config.clone());
+    options.link = fast_link(LinkConfig::vehicle());
+    options.speed = Speed::Times(speed);
+    // On the ground it keeps answering until the test ends.
+    options.linger = None;
+    let flight = Flight::start(options).await.expect("drone on the air");
+    let handle = flight.handle();
+    tokio::spawn(flight.run(std::future::pending(), ()));
+    SimDrone { handle }
 }
 
 impl SimDrone {
@@ -372,11 +349,6 @@ impl SimDrone {
         &self,
         f: impl FnOnce(&stx_sim::drone::link::LinkedDrone) -> T + Send + 'static,
     ) -> T {
-        let (tx, rx) = oneshot::channel();
-        let ask: Action<stx_sim::drone::link::LinkedDrone> = Box::new(move |d, _| {
-            let _ = tx.send(f(d));
-        });
-        let _ = self.actions.send(ask).await;
-        rx.await.expect("the drone answers")
+        self.handle.query(f).await.expect("the drone answers")
     }
 }

@@ -1,0 +1,249 @@
+//! The final approach and the flare: the final line through the target, into the wind; how
+//! much height there is beyond what full brakes can take off before the flare; the brakes set
+//! by the chosen [`FinalLaw`]; S-turns across the line while far too high; full brakes below
+//! the flare height.
+
+use stx_dynamics::rotation::wrap_pi;
+use stx_dynamics::state::Controls;
+
+use super::config::{FinalLaw, SpiralConfig};
+use super::energy::Energy;
+use super::pattern::WindFrame;
+use crate::control::{self, GlidePath, Localizer};
+use crate::estimate::Estimate;
+use crate::guidance::config::GuidanceConfig;
+use crate::performance::GlidePerformance;
+
+/// Height above the steepest glide on final at which S-turns start, m.
+const S_TURN_EXCESS_M: f64 = 10.0;
+/// S-turns swing this far either side of the final line, m.
+const S_TURN_HALF_WIDTH_M: f64 = 40.0;
+/// Course offset of an S-turn leg from the final course, rad (100°: slightly back downwind).
+const S_TURN_ANGLE_RAD: f64 = 1.7453;
+
+/// The final approach's geometry and energy at one update.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct FinalGeometry {
+    /// Course of the final approach (upwind), rad.
+    pub(super) course_rad: f64,
+    /// The final-approach line, through the target.
+    pub(super) line: Localizer,
+    /// Measured wind along the pattern's axis: the final's headwind, m/s.
+    headwind_mps: f64,
+    /// Glide over the ground with full brakes into that headwind (≥ 0).
+    flare_glide: f64,
+    /// Distance left along the final to the aim point (the flare's start), m.
+    to_go_before_flare: f64,
+    /// Height of the lowest body above the flare height, m.
+    pub(super) height_to_flare: f64,
+    /// Height beyond what full brakes can take off before the flare, the way across to the
+    /// line included, m (−∞ when full brakes hold the stack still over the ground).
+    pub(super) excess_m: f64,
+}
+
+impl FinalGeometry {
+    /// The final for the pattern's axis in `frame`, the vehicle at `position` (north, east, m)
+    /// and `height` m above the target's ground.
+    pub(super) fn assess(
+        sc: &SpiralConfig,
+        perf: &GlidePerformance,
+        density: f64,
+        frame: &WindFrame,
+        energy: &Energy,
+        position: [f64; 2],
+        height: f64,
+    ) -> Self {
+        let w_along_measured = energy.wind_along_mps;
+        // The final approach's energy: how far to go before the flare, and how much height there
+        // is beyond what even full brakes can take off in that distance.
+        let final_course = wrap_pi(frame.downwind_rad + std::f64::consts::PI);
+        let final_line = Localizer {
+            point_ne_m: frame.target_ne,
+            course_rad: final_course,
+        };
+        let flare_glide = perf.ground_glide(1.0, w_along_measured, density).max(0.0);
+        let to_go_before_flare =
+            -final_line.along_track_m(position) - flare_glide * sc.flare_height_m + sc.aim_beyond_m;
+        let height_to_flare = height - sc.hang_height_m - sc.flare_height_m;
+        // The way across to the line, if not on it yet, is flown too (brakes released).
+        let across_m = final_line.cross_track_m(position).abs();
+        let across_height_m = energy.s0 * across_m / energy.g_cross;
+        let final_excess_m = if flare_glide > 1e-3 {
+            height_to_flare - across_height_m - to_go_before_flare.max(0.0) / flare_glide
+        } else {
+            // Full brakes hold the stack still over the ground or back: no height is too much.
+            f64::NEG_INFINITY
+        };
+        Self {
+            course_rad: final_course,
+            line: final_line,
+            headwind_mps: w_along_measured,
+            flare_glide,
+            to_go_before_flare,
+            height_to_flare,
+            excess_m: final_excess_m,
+        }
+    }
+}
+
+/// What the final approach remembers between updates.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct FinalApproach {
+    /// The last brake set, held to the ground when not flaring.
+    last_brake: f64,
+    /// Side the S-turns swing to.
+    weave_right: bool,
+    /// Slope of the glide path on this final approach (seed's GS0), fixed at the turn onto
+    /// it, with [`FinalLaw::GlideSlope`].
+    slope: Option<f64>,
+}
+
+impl Default for FinalApproach {
+    fn default() -> Self {
+        Self {
+            last_brake: 0.0,
+            weave_right: true,
+            slope: None,
+        }
+    }
+}
+
+impl FinalApproach {
+    /// Commands on the final approach for the estimate `est` at `position` (north, east, m),
+    /// the target's ground `ground_m` high.
+    pub(super) fn fly(
+        &mut self,
+        config: &GuidanceConfig,
+        geometry: &FinalGeometry,
+        est: &Estimate,
+        position: [f64; 2],
+        ground_m: f64,
+        density: f64,
+    ) -> Controls {
+        let sc = &config.spiral;
+        let perf = &config.performance;
+        let gains = &config.gains;
+        let FinalGeometry {
+            course_rad: final_course,
+            line: final_line,
+            headwind_mps: w_along_measured,
+            flare_glide,
+            to_go_before_flare,
+            height_to_flare,
+            excess_m: final_excess_m,
+        } = *geometry;
+        let target_ne = final_line.point_ne_m;
+        let brake = if height_to_flare <= 0.0 || to_go_before_flare <= 0.0 {
+            if sc.flare { 1.0 } else { self.last_brake }
+        } else {
+            match sc.final_law {
+                // The brake whose glide over the ground ends the descent on the aim
+                // point, recomputed every update (a closed loop on the predicted
+                // touchdown). The aim is the flare's start: the flare's own glide, at
+                // full brake, carries the stack the rest of the way. Planned for the
+                // wind as measured: planned for the decisions' headwind margin, the
+                // final kept height in hand and spent it late, which saved the odd
+                // final caught by a strengthening wind but cost more elsewhere (the
+                // Monte Carlo comparison is in GNC_NOTES.md).
+                FinalLaw::GlideInversion => perf.brake_for_ground_glide(
+                    to_go_before_flare / height_to_flare,
+                    w_along_measured,
+                    density,
+                ),
+                // The seed's vertical law (eqs. 5.12–5.17): a straight glide path
+                // through the aim point, its slope GS0 the geometry at the turn onto
+                // the final, flown about the brake that holds GS0 in the wind planned
+                // with (the performance model's feed-forward).
+                FinalLaw::GlideSlope => {
+                    let slope = *self
+                        .slope
+                        .get_or_insert((height_to_flare / to_go_before_flare).clamp(0.05, 20.0));
+                    let aim_ne = [
+                        target_ne[0]
+                            + (sc.aim_beyond_m - flare_glide * sc.flare_height_m)
+                                * final_course.cos(),
+                        target_ne[1]
+                            + (sc.aim_beyond_m - flare_glide * sc.flare_height_m)
+                                * final_course.sin(),
+                    ];
+                    let path = GlidePath {
+                        line: Localizer {
+                            point_ne_m: aim_ne,
+                            course_rad: final_course,
+                        },
+                        aim_height_m: ground_m + sc.hang_height_m + sc.flare_height_m,
+                        slope,
+                    };
+                    let trim = perf.brake_for_ground_glide(1.0 / slope, w_along_measured, density);
+                    control::vertical_about(
+                        gains,
+                        &path,
+                        position,
+                        est.height_m(),
+                        [est.velocity_ned_mps.x, est.velocity_ned_mps.y],
+                        est.sink_rate_mps,
+                        trim,
+                    )
+                    .brake
+                }
+            }
+        };
+        // Horizontal: the final line; while far too high for even full brakes to
+        // bring it down in time, S-turns across the line burn the height.
+        self.last_brake = brake;
+        let weave = final_excess_m > S_TURN_EXCESS_M;
+        let main_line_m = if weave {
+            let ct = final_line.cross_track_m(position);
+            if ct > S_TURN_HALF_WIDTH_M {
+                self.weave_right = false;
+            } else if ct < -S_TURN_HALF_WIDTH_M {
+                self.weave_right = true;
+            }
+            let offset = if self.weave_right { 1.0 } else { -1.0 } * S_TURN_ANGLE_RAD;
+            control::course(
+                gains,
+                est.course_rad,
+                est.heading_rate_rad_s,
+                final_course + offset,
+            )
+        } else {
+            follow(config, &final_line, est, position)
+        };
+        Controls {
+            main_line_m,
+            brake_right: brake,
+            brake_left: brake,
+        }
+    }
+
+    /// The flare: full brakes, still on the final line.
+    pub(super) fn flare(
+        config: &GuidanceConfig,
+        geometry: &FinalGeometry,
+        est: &Estimate,
+        position: [f64; 2],
+    ) -> Controls {
+        Controls {
+            main_line_m: follow(config, &geometry.line, est, position),
+            brake_right: 1.0,
+            brake_left: 1.0,
+        }
+    }
+
+    /// Forgets the glide slope of a final approach that has ended.
+    pub(super) fn end(&mut self) {
+        self.slope = None;
+    }
+}
+
+/// The main line that follows `line` (localizer control).
+fn follow(config: &GuidanceConfig, line: &Localizer, est: &Estimate, position: [f64; 2]) -> f64 {
+    control::localizer(
+        &config.gains,
+        line,
+        position,
+        est.course_rad,
+        est.heading_rate_rad_s,
+    )
+    .main_line_m
+}

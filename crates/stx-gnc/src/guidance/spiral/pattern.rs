@@ -1,0 +1,268 @@
+//! The pattern's geometry: its axis (downwind, turned only when the phase machine allows), the
+//! wind frame centred on the target, the corners, the branches scaled with the wind, and the
+//! line each branch is flown on.
+
+use stx_dynamics::rotation::wrap_pi;
+
+use super::config::SpiralConfig;
+use super::wind::WindNow;
+use crate::control::Localizer;
+use crate::mission::GuidancePhase;
+
+/// The branches in flying order.
+pub(super) const BRANCHES: [GuidancePhase; 4] = [
+    GuidancePhase::Branch1,
+    GuidancePhase::Branch2,
+    GuidancePhase::Branch3,
+    GuidancePhase::Branch4,
+];
+
+/// Largest turn of the pattern's axis at the start of a loop, rad (45°).
+const LOOP_REORIENT_MAX_RAD: f64 = std::f64::consts::FRAC_PI_4;
+/// Largest turn of the final-approach course when turning final, rad (20°).
+const FINAL_REORIENT_MAX_RAD: f64 = 0.3491;
+
+pub(super) fn branch_index(phase: GuidancePhase) -> Option<usize> {
+    BRANCHES.iter().position(|b| *b == phase)
+}
+
+/// Corners in wind coordinates (x downwind, y right), start of each branch.
+/// `ax` is the half-length along the wind, `ay` the half-width across it.
+pub(super) fn corner_xy(branch: usize, ax: f64, ay: f64) -> [f64; 2] {
+    match branch % 4 {
+        0 => [-ax, -ay],
+        1 => [ax, -ay],
+        2 => [ax, ay],
+        _ => [-ax, ay],
+    }
+}
+
+/// The pattern's axis and half-length, held between the moments they may follow the wind.
+#[derive(Debug, Clone, Copy, Default)]
+pub(super) struct Axis {
+    /// Direction of the pattern's x axis (downwind), rad from north.
+    downwind_rad: Option<f64>,
+    /// Half-length of the pattern along the wind, m.
+    half_length_m: Option<f64>,
+}
+
+impl Axis {
+    /// The pattern's downwind direction for this update, rad, and whether the axis (and the
+    /// half-length with it) is held. `reorient` says the phase machine lets the axis follow
+    /// the wind at this update (the start of a loop, the turn onto the final); in the
+    /// approximation and on the way to the best reachable point it always may. `rel` is the
+    /// vehicle's place from the target (north, east), m.
+    pub(super) fn orient(
+        &mut self,
+        phase: GuidancePhase,
+        reorient: bool,
+        approach_course_rad: Option<f64>,
+        wind: &WindNow,
+        sc: &SpiralConfig,
+        rel: [f64; 2],
+    ) -> (f64, bool) {
+        let wind_speed = wind.speed_mps;
+        let wind = wind.ne_mps;
+        // The pattern's axis: downwind, unless the operator fixed the approach course; in calm
+        // air it stays where it was (first: the final approach is flown towards the target
+        // from where the vehicle is).
+        let free = matches!(
+            phase,
+            GuidancePhase::Approximation | GuidancePhase::BestReachable
+        );
+        let frozen = !(reorient || free);
+        // A turn of the axis at a loop's start or onto the final is limited: the vehicle is
+        // placed for the axis it had, and a light wind's direction is barely known.
+        let largest_turn = match phase {
+            _ if free => std::f64::consts::PI,
+            GuidancePhase::FinalApproach => FINAL_REORIENT_MAX_RAD,
+            _ => LOOP_REORIENT_MAX_RAD,
+        };
+        let downwind = match (approach_course_rad, self.downwind_rad) {
+            (Some(course), _) => wrap_pi(course + std::f64::consts::PI),
+            (None, Some(previous)) if frozen || wind_speed < sc.calm_wind_mps => previous,
+            (None, Some(previous)) => {
+                let turn = wrap_pi(wind[1].atan2(wind[0]) - previous);
+                wrap_pi(previous + turn.clamp(-largest_turn, largest_turn))
+            }
+            (None, None) if wind_speed >= sc.calm_wind_mps => wind[1].atan2(wind[0]),
+            (None, None) => rel[1].atan2(rel[0]),
+        };
+        self.downwind_rad = Some(downwind);
+        (downwind, frozen)
+    }
+
+    /// The pattern's half-length along the wind, m (see [the spiral](super): "branches scaled
+    /// with the wind"); held, like the axis, while `frozen`. `wind_along_mps` is the measured
+    /// wind along the axis, `v0` the airspeed with the brakes released, `turn_distance_m` a
+    /// corner's turn radius.
+    pub(super) fn half_length(
+        &mut self,
+        frozen: bool,
+        sc: &SpiralConfig,
+        wind_along_mps: f64,
+        v0: f64,
+        turn_distance_m: f64,
+    ) -> f64 {
+        let ay = sc.half_size_m;
+        // The branches scaled with the wind (seed §5.3): the legs along the wind are shortened
+        // in proportion to the upwind leg's ground speed, `ax = a·(V − w)/V`, so the upwind leg
+        // takes as long as in still air and the pattern shrinks to a weave across the wind as
+        // the wind nears the airspeed (at least a turn's length, or the corners overlap). Held,
+        // like the axis, from the start of a loop to its end.
+        let ax = match self.half_length_m {
+            Some(held) if frozen => held,
+            _ if !sc.wind_scaled_branches => ay,
+            _ => {
+                let w = wind_along_mps.clamp(0.0, v0);
+                (ay * (v0 - w) / v0.max(1e-3)).max(turn_distance_m.min(ay))
+            }
+        };
+        self.half_length_m = Some(ax);
+        ax
+    }
+}
+
+/// The wind frame of one update: centred on the target, `x` downwind, `y` to its right.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct WindFrame {
+    /// The target (north, east), m.
+    pub(super) target_ne: [f64; 2],
+    /// Direction of `x`, rad from north.
+    pub(super) downwind_rad: f64,
+    sin: f64,
+    cos: f64,
+}
+
+impl WindFrame {
+    pub(super) fn new(target_ne: [f64; 2], downwind_rad: f64) -> Self {
+        let (sin, cos) = downwind_rad.sin_cos();
+        Self {
+            target_ne,
+            downwind_rad,
+            sin,
+            cos,
+        }
+    }
+
+    /// A vector's component along `x` (downwind).
+    pub(super) fn along(&self, ne: [f64; 2]) -> f64 {
+        ne[0] * self.cos + ne[1] * self.sin
+    }
+
+    /// A vector (north, east) in the frame's axes.
+    pub(super) fn to_wind(self, ne: [f64; 2]) -> [f64; 2] {
+        [self.along(ne), -ne[0] * self.sin + ne[1] * self.cos]
+    }
+
+    /// A point of the frame (x, y) as north, east, m.
+    pub(super) fn to_ne(self, xy: [f64; 2]) -> [f64; 2] {
+        [
+            self.target_ne[0] + xy[0] * self.cos - xy[1] * self.sin,
+            self.target_ne[1] + xy[0] * self.sin + xy[1] * self.cos,
+        ]
+    }
+}
+
+/// The pattern as it stands at one update.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Pattern {
+    pub(super) frame: WindFrame,
+    /// Half-length along the wind, m.
+    pub(super) ax: f64,
+    /// Half-width across the wind, m.
+    pub(super) ay: f64,
+    /// Lateral place of the downwind leg (Branch1), m: `−ay`, or where the phase machine moved
+    /// it.
+    pub(super) downwind_y: f64,
+}
+
+impl Pattern {
+    /// The start corner of branch `k`, (x, y), m.
+    pub(super) fn corner(&self, k: usize) -> [f64; 2] {
+        corner_xy(k, self.ax, self.ay)
+    }
+
+    /// The line branch `k` is flown on; with `base_x_m`, Branch2 is the base leg across from
+    /// the downwind leg to the final-approach line at that `x`.
+    pub(super) fn branch_line(&self, k: usize, base_x_m: Option<f64>) -> Localizer {
+        let downwind_y = self.downwind_y;
+        let mut start = self.corner(k);
+        let mut course = self.frame.downwind_rad + std::f64::consts::FRAC_PI_2 * k as f64;
+        match (k, base_x_m) {
+            (0, _) => start[1] = downwind_y,
+            (1, Some(x_base)) => {
+                // The base leg: across from the downwind leg towards the final line.
+                start = [x_base, downwind_y];
+                if downwind_y > 0.0 {
+                    course += std::f64::consts::PI;
+                }
+            }
+            _ => {}
+        }
+        Localizer {
+            point_ne_m: self.frame.to_ne(start),
+            course_rad: wrap_pi(course),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::guidance::spiral::{Spiral, corner_turn_rate_rad_s};
+    use crate::guidance::{GuidanceConfig, Plan};
+    use crate::pointmass::PointMass;
+    use nalgebra::Vector3;
+
+    /// The branches along the wind shrink as the wind grows (seed §5.3, "scaling the branches
+    /// length"): the upwind leg takes as long as in still air, down to a turn's length.
+    #[test]
+    fn the_legs_along_the_wind_shrink_with_the_wind_so_the_upwind_leg_keeps_its_duration() {
+        let config = GuidanceConfig::default();
+        let plan = Plan::default();
+        let perf = &config.performance;
+        let v0 = perf.horizontal_airspeed(0.0, 1.2);
+        let half_length = |speed: f64| {
+            let mut spiral = Spiral::new();
+            spiral.force_phase(GuidancePhase::Approximation);
+            let wind = Vector3::new(-speed, 0.0, 0.0);
+            let mut est =
+                PointMass::new(0.0, Vector3::new(300.0, 0.0, -600.0), 0.0).estimate(&wind);
+            est.wind_sigma_mps = Vector3::new(0.1, 0.1, 0.0);
+            spiral.update(&config, &plan, &est, 1.2);
+            let c = spiral.status().corners_ne_m;
+            // Branch1 runs from corner 0 to corner 1 along the wind.
+            0.5 * (c[1][0] - c[0][0]).hypot(c[1][1] - c[0][1])
+        };
+        let a = config.spiral.half_size_m;
+        assert!((half_length(0.0) - a).abs() < 1e-9);
+        for speed in [1.0, 2.0] {
+            let ax = half_length(speed);
+            assert!(
+                (ax - a * (v0 - speed) / v0).abs() < 1e-6,
+                "{speed} m/s: half-length {ax}"
+            );
+            // The upwind leg's duration is the still-air one.
+            assert!((2.0 * ax / (v0 - speed) - 2.0 * a / v0).abs() < 1e-6);
+        }
+        // Near the airspeed: a turn's length, not less.
+        let turn = spiral_turn_distance(&config);
+        assert!((half_length(0.95 * v0) - turn).abs() < 1e-6);
+        // Without the scaling, the square of any wind.
+        let mut fixed = config;
+        fixed.spiral.wind_scaled_branches = false;
+        let mut spiral = Spiral::new();
+        spiral.force_phase(GuidancePhase::Approximation);
+        let est = PointMass::new(0.0, Vector3::new(300.0, 0.0, -600.0), 0.0)
+            .estimate(&Vector3::new(-3.0, 0.0, 0.0));
+        spiral.update(&fixed, &plan, &est, 1.2);
+        let c = spiral.status().corners_ne_m;
+        assert!((0.5 * (c[1][0] - c[0][0]).hypot(c[1][1] - c[0][1]) - a).abs() < 1e-9);
+    }
+
+    fn spiral_turn_distance(config: &GuidanceConfig) -> f64 {
+        let rate = corner_turn_rate_rad_s(&config.gains, &config.performance);
+        config.performance.turn_radius_m(rate, 0.0, 1.2)
+    }
+}

@@ -1,0 +1,84 @@
+//! What each phase flies: the line to the entry corner, the branch lines, the final approach
+//! and the flare, the heading to the best reachable point.
+
+use stx_dynamics::state::Controls;
+
+use super::final_approach::FinalApproach;
+use super::pattern::branch_index;
+use super::phases::PhaseMachine;
+use super::situation::Situation;
+use crate::control::{self, Localizer};
+use crate::estimate::Estimate;
+use crate::guidance::config::GuidanceConfig;
+use crate::mission::GuidancePhase;
+
+/// Servo commands for the phase `machine` is in (after this update's decision), in situation
+/// `s`; `final_approach` keeps the final's memory.
+pub(super) fn steer(
+    machine: &PhaseMachine,
+    final_approach: &mut FinalApproach,
+    config: &GuidanceConfig,
+    s: &Situation,
+    est: &Estimate,
+    density: f64,
+) -> Controls {
+    let gains = &config.gains;
+    let position = s.position;
+    let horizontal = |line: &Localizer| {
+        control::localizer(
+            gains,
+            line,
+            position,
+            est.course_rad,
+            est.heading_rate_rad_s,
+        )
+        .main_line_m
+    };
+    let branch_line = |k: usize| s.pattern.branch_line(k, machine.base_x_m);
+    match machine.phase {
+        GuidancePhase::Idle | GuidancePhase::Landed => Controls::default(),
+        GuidancePhase::Approximation => {
+            let k = branch_index(machine.entry_branch).unwrap_or(0);
+            let corner = s.pattern.frame.to_ne(s.pattern.corner(k));
+            let from = machine.approach_from_ne_m.unwrap_or(position);
+            let line = if (corner[0] - from[0]).hypot(corner[1] - from[1]) > 1.0 {
+                Localizer::through(from, corner)
+            } else {
+                branch_line(k)
+            };
+            Controls {
+                main_line_m: horizontal(&line),
+                ..Controls::default()
+            }
+        }
+        GuidancePhase::Branch1
+        | GuidancePhase::Branch2
+        | GuidancePhase::Branch3
+        | GuidancePhase::Branch4 => {
+            let k = branch_index(machine.phase).unwrap_or(0);
+            Controls {
+                main_line_m: horizontal(&branch_line(k)),
+                ..Controls::default()
+            }
+        }
+        GuidancePhase::FinalApproach => final_approach.fly(
+            config,
+            &s.final_approach,
+            est,
+            position,
+            s.ground_m,
+            density,
+        ),
+        GuidancePhase::Flare => FinalApproach::flare(config, &s.final_approach, est, position),
+        GuidancePhase::BestReachable => Controls {
+            main_line_m: control::heading(
+                gains,
+                est.heading_rad,
+                est.heading_rate_rad_s,
+                s.reach
+                    .heading_rad(s.lowest_body_height, s.final_approach.course_rad),
+            ),
+            ..Controls::default()
+        },
+    }
+}

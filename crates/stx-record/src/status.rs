@@ -1,0 +1,186 @@
+//! What the file adapter tells its caller: bytes and messages written, messages lost, and
+//! the last problem — polled by the station for its dashboard, and logged once per kind of
+//! problem per interval so a full disk does not flood the log.
+
+use std::collections::HashMap;
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicU32, AtomicU64, Ordering};
+use std::sync::{Mutex, PoisonError};
+use std::time::{Duration, Instant};
+
+use serde::Serialize;
+
+/// Kinds of trouble a recorder meets.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum IssueKind {
+    /// The writer thread fell behind and its queue was full: messages dropped.
+    QueueFull,
+    /// The writer thread has stopped: messages dropped.
+    Stopped,
+    /// A recording file (or its directory) could not be created.
+    Create,
+    /// Writing to the file failed (e.g. the disk is full); the file is given up.
+    Write,
+    /// Syncing a finished file to disk failed.
+    Sync,
+    /// A message could not be encoded as JSON.
+    Encode,
+    /// The writer core refused a message.
+    Core,
+}
+
+/// The last problem of one kind.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+pub struct RecorderIssue {
+    /// Its kind.
+    pub kind: IssueKind,
+    /// What happened, last time.
+    pub message: String,
+    /// How many times problems of this kind happened since the recorder started.
+    pub occurrences: u64,
+}
+
+/// A snapshot of a recorder's state.
+#[derive(Debug, Clone, Default, PartialEq, Eq, Serialize)]
+pub struct RecorderStatus {
+    /// Bytes written to recording files, B.
+    pub bytes_written: u64,
+    /// Messages in chunks written to files.
+    pub messages_written: u64,
+    /// Messages dropped: queue full, writer stopped, or their chunk could not be written.
+    pub messages_lost: u64,
+    /// Files opened.
+    pub files_started: u32,
+    /// The file being written, if one is open.
+    pub current_file: Option<PathBuf>,
+    /// The most recent problem, if any.
+    pub last_error: Option<RecorderIssue>,
+}
+
+#[derive(Default)]
+struct Issues {
+    current_file: Option<PathBuf>,
+    last: Option<RecorderIssue>,
+    occurrences: HashMap<IssueKind, u64>,
+    /// When each kind was last logged, and how many were not logged since.
+    logged: HashMap<IssueKind, (Instant, u64)>,
+}
+
+/// Counters shared by the caller's handles and the writer thread.
+pub(crate) struct Shared {
+    bytes_written: AtomicU64,
+    messages_written: AtomicU64,
+    messages_lost: AtomicU64,
+    files_started: AtomicU32,
+    issues: Mutex<Issues>,
+    log_every: Duration,
+}
+
+impl Shared {
+    pub(crate) fn new(log_every: Duration) -> Self {
+        Self {
+            bytes_written: AtomicU64::new(0),
+            messages_written: AtomicU64::new(0),
+            messages_lost: AtomicU64::new(0),
+            files_started: AtomicU32::new(0),
+            issues: Mutex::new(Issues::default()),
+            log_every,
+        }
+    }
+
+    pub(crate) fn written(&self, bytes: u64, messages: u64) {
+        self.bytes_written.fetch_add(bytes, Ordering::Relaxed);
+        self.messages_written.fetch_add(messages, Ordering::Relaxed);
+    }
+
+    pub(crate) fn lost(&self, messages: u64) {
+        self.messages_lost.fetch_add(messages, Ordering::Relaxed);
+    }
+
+    pub(crate) fn file_opened(&self, path: PathBuf) {
+        self.files_started.fetch_add(1, Ordering::Relaxed);
+        tracing::info!(file = %path.display(), "recording to a new file");
+        self.issues().current_file = Some(path);
+    }
+
+    pub(crate) fn file_closed(&self) {
+        self.issues().current_file = None;
+    }
+
+    /// Notes a problem; logs it unless one of its kind was logged within `log_every`.
+    pub(crate) fn report(&self, kind: IssueKind, message: String) {
+        let now = Instant::now();
+        let mut issues = self.issues();
+        let occurrences = {
+            let n = issues.occurrences.entry(kind).or_insert(0);
+            *n += 1;
+            *n
+        };
+        let due = match issues.logged.get_mut(&kind) {
+            Some((at, quiet)) if now.duration_since(*at) < self.log_every => {
+                *quiet += 1;
+                None
+            }
+            Some((at, quiet)) => {
+                let silenced = *quiet;
+                *at = now;
+                *quiet = 0;
+                Some(silenced)
+            }
+            None => {
+                issues.logged.insert(kind, (now, 0));
+                Some(0)
+            }
+        };
+        if let Some(silenced) = due {
+            tracing::warn!(
+                ?kind,
+                occurrences,
+                not_logged_since_last = silenced,
+                "recording: {message}"
+            );
+        }
+        issues.last = Some(RecorderIssue {
+            kind,
+            message,
+            occurrences,
+        });
+    }
+
+    pub(crate) fn snapshot(&self) -> RecorderStatus {
+        let issues = self.issues();
+        RecorderStatus {
+            bytes_written: self.bytes_written.load(Ordering::Relaxed),
+            messages_written: self.messages_written.load(Ordering::Relaxed),
+            messages_lost: self.messages_lost.load(Ordering::Relaxed),
+            files_started: self.files_started.load(Ordering::Relaxed),
+            current_file: issues.current_file.clone(),
+            last_error: issues.last.clone(),
+        }
+    }
+
+    fn issues(&self) -> std::sync::MutexGuard<'_, Issues> {
+        self.issues.lock().unwrap_or_else(PoisonError::into_inner)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_problem_is_counted_and_the_last_kept() {
+        let shared = Shared::new(Duration::from_secs(3600));
+        for i in 0..5 {
+            shared.report(IssueKind::Write, format!("disk full {i}"));
+        }
+        shared.report(IssueKind::QueueFull, "queue full".into());
+        shared.report(IssueKind::Write, "disk full again".into());
+        let status = shared.snapshot();
+        let last = status.last_error.unwrap();
+        assert_eq!(last.kind, IssueKind::Write);
+        assert_eq!(last.occurrences, 6);
+        assert_eq!(last.message, "disk full again");
+    }
+}

@@ -1,0 +1,282 @@
+//! The file adapter: recording to a directory, and what happens when the disk will not take
+//! the data — the caller is never held up, and every message is counted written or lost.
+
+use std::io::{self, Cursor};
+use std::path::PathBuf;
+use std::sync::mpsc;
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, SystemTime};
+
+use stx_record::file::recordings_dir;
+use stx_record::{
+    ChannelId, CoreOptions, Directory, IssueKind, Recorder, RecorderConfig, RecorderCore,
+    Recording, RecordingInfo, Storage, StorageFile, foxglove, recover,
+};
+
+const T0: u64 = 1_767_225_600_000_000_000;
+
+fn new_core() -> (RecorderCore, ChannelId) {
+    let info = RecordingInfo::new("0.1.0", "straplex-1", "adapter test");
+    let mut core = RecorderCore::new(CoreOptions::default(), info, Duration::ZERO).unwrap();
+    let ch = core
+        .add_channel(Duration::ZERO, foxglove::log_channel("/events").unwrap())
+        .unwrap();
+    (core, ch)
+}
+
+fn log(i: u64) -> foxglove::Log {
+    foxglove::Log {
+        timestamp: foxglove::Timestamp::from_nanos(T0 + i),
+        level: foxglove::LogLevel::Info,
+        message: format!("event {i}"),
+        name: "test".into(),
+        file: String::new(),
+        line: 0,
+    }
+}
+
+fn quick() -> RecorderConfig {
+    RecorderConfig {
+        retry_after: Duration::ZERO,
+        ..RecorderConfig::default()
+    }
+}
+
+#[test]
+fn records_to_the_state_directory_and_reads_back() {
+    let state = tempfile::tempdir().unwrap();
+    let dir = recordings_dir(state.path());
+    assert_eq!(dir, state.path().join("recordings"));
+    // 2026-01-01T00:00:00Z.
+    let started = SystemTime::UNIX_EPOCH + Duration::from_secs(1_767_225_600);
+    let storage = Directory::new(&dir, started);
+    assert_eq!(storage.file_name(1), "stx-20260101T000000Z-001.mcap");
+    let (core, ch) = new_core();
+    let recorder = Recorder::spawn(core, storage, RecorderConfig::default()).unwrap();
+    let handle = recorder.handle();
+    for i in 0..500 {
+        assert!(handle.write_json(ch, T0 + i, &log(i)));
+    }
+    assert!(handle.flush(Duration::from_secs(10)), "flush answered");
+    let mid = handle.status();
+    assert_eq!(mid.messages_written, 500, "{mid:?}");
+    let path = mid.current_file.clone().unwrap();
+    assert_eq!(path, dir.join("stx-20260101T000000Z-001.mcap"));
+    let status = recorder.finish();
+    assert_eq!(
+        (
+            status.messages_written,
+            status.messages_lost,
+            status.files_started
+        ),
+        (500, 0, 1)
+    );
+    assert_eq!(status.current_file, None);
+    assert_eq!(status.last_error, None);
+    assert_eq!(
+        status.bytes_written,
+        std::fs::metadata(&path).unwrap().len()
+    );
+    let mut rec = Recording::open(&path).unwrap();
+    assert_eq!(rec.message_count(), 500);
+    let first = rec.messages().unwrap().next().unwrap().unwrap();
+    let back: foxglove::Log = serde_json::from_slice(&first.data).unwrap();
+    assert_eq!(back, log(0));
+    // A second run in the same second does not overwrite the first.
+    let (core, _) = new_core();
+    let again = Recorder::spawn(core, Directory::new(&dir, started), quick()).unwrap();
+    let second = again.status().current_file;
+    let status = again.finish();
+    assert_eq!(status.files_started, 1);
+    assert_ne!(second, Some(path));
+}
+
+#[test]
+fn an_unwritable_directory_loses_messages_counts_them_and_says_why() {
+    let tmp = tempfile::tempdir().unwrap();
+    // A directory inside a regular file can never be made (even by root).
+    let file = tmp.path().join("not-a-directory");
+    std::fs::write(&file, b"x").unwrap();
+    let storage = Directory::new(file.join("recordings"), SystemTime::now());
+    let (core, ch) = new_core();
+    let recorder = Recorder::spawn(core, storage, quick()).unwrap();
+    let handle = recorder.handle();
+    for i in 0..300 {
+        handle.write_json(ch, T0 + i, &log(i));
+    }
+    let status = recorder.finish();
+    assert_eq!(status.messages_written, 0);
+    assert_eq!(status.messages_lost, 300, "{status:?}");
+    assert_eq!(status.files_started, 0);
+    let issue = status.last_error.unwrap();
+    assert_eq!(issue.kind, IssueKind::Create);
+    assert!(issue.message.contains("cannot create"), "{}", issue.message);
+}
+
+/// Files in memory that refuse writes past `capacity` bytes in all, like a disk filling up.
+#[derive(Clone)]
+struct SmallDisk {
+    files: Arc<Mutex<Vec<Vec<u8>>>>,
+    used: Arc<Mutex<u64>>,
+    capacity: u64,
+}
+
+struct SmallDiskFile {
+    disk: SmallDisk,
+    index: usize,
+}
+
+impl Storage for SmallDisk {
+    fn create(&mut self, part: u32) -> io::Result<(PathBuf, Box<dyn StorageFile>)> {
+        let mut files = self.files.lock().unwrap();
+        files.push(Vec::new());
+        let file = SmallDiskFile {
+            disk: self.clone(),
+            index: files.len() - 1,
+        };
+        Ok((PathBuf::from(format!("mem-{part}")), Box::new(file)))
+    }
+}
+
+impl StorageFile for SmallDiskFile {
+    fn write_all(&mut self, data: &[u8]) -> io::Result<()> {
+        let mut used = self.disk.used.lock().unwrap();
+        let room = self.disk.capacity.saturating_sub(*used) as usize;
+        let n = room.min(data.len());
+        self.disk.files.lock().unwrap()[self.index].extend_from_slice(&data[..n]);
+        *used += n as u64;
+        if n < data.len() {
+            return Err(io::Error::new(io::ErrorKind::StorageFull, "no space left"));
+        }
+        Ok(())
+    }
+
+    fn sync(&mut self) -> io::Result<()> {
+        Ok(())
+    }
+}
+
+#[test]
+fn a_full_disk_loses_messages_counts_them_and_what_was_written_recovers() {
+    let disk = SmallDisk {
+        files: Arc::default(),
+        used: Arc::default(),
+        capacity: 20_000,
+    };
+    let (core, ch) = new_core();
+    let recorder = Recorder::spawn(core, disk.clone(), quick()).unwrap();
+    let handle = recorder.handle();
+    let n = 3000;
+    for i in 0..n {
+        handle.write_json(ch, T0 + i, &log(i));
+        if i % 100 == 99 {
+            // Close a chunk now and then, as a second passing would.
+            handle.flush(Duration::from_secs(10));
+        }
+    }
+    let status = recorder.finish();
+    assert_eq!(
+        status.messages_written + status.messages_lost,
+        n,
+        "{status:?}"
+    );
+    assert!(
+        status.messages_lost > 0 && status.messages_written > 0,
+        "{status:?}"
+    );
+    let kinds: Vec<_> = status.last_error.iter().map(|i| i.kind).collect();
+    assert_eq!(kinds, [IssueKind::Write]);
+    // The disk was tried again after the error (retry_after is zero here).
+    let files = disk.files.lock().unwrap().clone();
+    assert!(files.len() > 1, "{} files", files.len());
+    // What reached the disk is readable, and holds at least the messages counted written
+    // (a chunk whose write failed after its last byte, in its message indexes, is counted
+    // lost but reads whole; so may be the head of a chunk cut by the full disk).
+    let recovered: u64 = files
+        .iter()
+        .filter(|f| !f.is_empty())
+        .map(|f| {
+            let mut out = Cursor::new(Vec::new());
+            recover(&f[..], &mut out).unwrap().messages
+        })
+        .sum();
+    assert!(
+        (status.messages_written..=n).contains(&recovered),
+        "{recovered} recovered, {status:?}"
+    );
+}
+
+/// A disk that takes nothing until the test lets it.
+struct StalledDisk {
+    gate: Arc<Mutex<mpsc::Receiver<()>>>,
+}
+
+struct StalledFile {
+    gate: Arc<Mutex<mpsc::Receiver<()>>>,
+    open: bool,
+}
+
+impl Storage for StalledDisk {
+    fn create(&mut self, part: u32) -> io::Result<(PathBuf, Box<dyn StorageFile>)> {
+        let file = StalledFile {
+            gate: self.gate.clone(),
+            open: false,
+        };
+        Ok((PathBuf::from(format!("stalled-{part}")), Box::new(file)))
+    }
+}
+
+impl StorageFile for StalledFile {
+    fn write_all(&mut self, _data: &[u8]) -> io::Result<()> {
+        if !self.open {
+            // Blocks until the test sends (or drops the sender).
+            let _ = self.gate.lock().unwrap().recv();
+            self.open = true;
+        }
+        Ok(())
+    }
+
+    fn sync(&mut self) -> io::Result<()> {
+        Ok(())
+    }
+}
+
+#[test]
+fn a_stalled_disk_never_holds_up_the_caller() {
+    let (open_tx, open_rx) = mpsc::channel();
+    let storage = StalledDisk {
+        gate: Arc::new(Mutex::new(open_rx)),
+    };
+    let (core, ch) = new_core();
+    let config = RecorderConfig {
+        queue_capacity: 8,
+        ..RecorderConfig::default()
+    };
+    let recorder = Recorder::spawn(core, storage, config).unwrap();
+    let handle = recorder.handle();
+    // The writer thread is stuck on the file's first bytes; the caller sends 10 000 messages
+    // from another thread, which must finish regardless.
+    let (done_tx, done_rx) = mpsc::channel();
+    let producer = handle.clone();
+    std::thread::spawn(move || {
+        let queued = (0..10_000u64)
+            .filter(|i| producer.write_json(ch, T0 + i, &log(*i)))
+            .count();
+        done_tx.send(queued).unwrap();
+    });
+    let queued = done_rx
+        .recv_timeout(Duration::from_secs(60))
+        .expect("the caller was held up by a stalled disk");
+    assert_eq!(queued, 8, "exactly the queue's capacity got in");
+    let status = handle.status();
+    assert_eq!(status.messages_lost, 9_992);
+    assert_eq!(status.last_error.unwrap().kind, IssueKind::QueueFull);
+    // The disk comes back: the queued messages are written, nothing else is lost.
+    open_tx.send(()).unwrap();
+    let status = recorder.finish();
+    assert_eq!(
+        (status.messages_written, status.messages_lost),
+        (8, 9_992),
+        "{status:?}"
+    );
+}

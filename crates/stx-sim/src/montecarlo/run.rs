@@ -1,0 +1,346 @@
+//! One run of a campaign: its conditions drawn from `(seed, index)`, its wind, its flight from
+//! the steady-glide template, and what it gave.
+
+use std::f64::consts::PI;
+use std::sync::Arc;
+
+use nalgebra::Vector3;
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use serde::Serialize;
+use stx_dynamics::atmosphere::StandardAtmosphere;
+use stx_dynamics::integrate::{Hooks, IntegrateError, Rk4, integrate};
+use stx_dynamics::model::{Environment, ParafoilModel};
+use stx_dynamics::rotation::wrap_pi;
+use stx_dynamics::state::{Pose, StateVector, idx};
+use stx_dynamics::vehicle::Vehicle;
+use stx_dynamics::wind::{
+    ProfileRow, Turbulence, TurbulenceParams, WindComposite, WindField, WindProfile,
+};
+use stx_gnc::guidance::{Guidance, PhaseEvent, Plan};
+use stx_gnc::mission::{FlightMode, GuidancePhase};
+
+use super::config::MonteCarloConfig;
+use crate::closed_loop::{GuidedFlight, Navigator};
+use crate::guided::{CONTROL_PERIOD_S, STEP_S};
+
+/// The conditions of one run.
+#[derive(Debug, Clone, Serialize)]
+pub struct RunConditions {
+    /// Release point relative to the target (north, east), m.
+    pub release_ne_m: [f64; 2],
+    /// Heading at release, degrees.
+    pub heading_deg: f64,
+    /// Mean wind speed, m/s.
+    pub wind_speed_mps: f64,
+    /// Direction it blows from at the ground, degrees.
+    pub wind_from_deg: f64,
+    /// Seed of this run's turbulence and sensors.
+    pub seed: u64,
+}
+
+/// What one run gave.
+#[derive(Debug, Clone, Serialize)]
+pub struct RunResult {
+    /// Index in the campaign.
+    pub index: usize,
+    /// Its conditions.
+    pub conditions: RunConditions,
+    /// Distance from the target to where the stack touched down, m.
+    pub miss_m: f64,
+    /// Canopy heading at touchdown minus the upwind direction, degrees.
+    pub heading_vs_upwind_deg: f64,
+    /// The mean wind where the stack touched down (gusts left out) was below
+    /// [`CALM_WIND_MPS`]: there is no upwind to land into.
+    pub calm: bool,
+    /// Vertical speed of the first body to touch, m/s.
+    pub touchdown_vertical_speed_mps: f64,
+    /// RMS of the horizontal wind-estimate error from 30 s after release on, m/s.
+    pub wind_estimate_rmse_mps: f64,
+    /// Guidance found the target out of reach at some point.
+    pub unreachable: bool,
+    /// The best reachable point (north, east, m) guidance announced when it first called the
+    /// target out of reach.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub best_reachable_ne_m: Option<[f64; 2]>,
+    /// Distance from that point to where the stack touched down, m.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub from_best_reachable_m: Option<f64>,
+    /// The best reachable point guidance announced last (it announces it again when it moves
+    /// as the wind estimate firms up), north and east, m.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub last_best_reachable_ne_m: Option<[f64; 2]>,
+    /// Distance from that point to the touchdown, m.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub from_last_best_reachable_m: Option<f64>,
+    /// Flight time, s.
+    pub flight_time_s: f64,
+    /// Touchdown point relative to the target along the upwind direction (positive: beyond
+    /// the target, i.e. long) and across it (positive right), m.
+    pub long_short_m: f64,
+    /// See `long_short_m`.
+    pub left_right_m: f64,
+    /// Guidance phase changes with their reasons (kept only when one run is replayed).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub events: Vec<PhaseEvent>,
+    /// The flight every second (kept only when one run is replayed).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub track: Vec<TrackPoint>,
+}
+
+/// One second of a replayed run: truth and what guidance saw.
+#[derive(Debug, Clone, Serialize)]
+pub struct TrackPoint {
+    /// Time, s.
+    pub time_s: f64,
+    /// True canopy position (north, east, height above the target), m.
+    pub position_neh_m: [f64; 3],
+    /// Estimated wind (north, east), m/s.
+    pub wind_estimate_ne_mps: [f64; 2],
+    /// True wind at the canopy (north, east), m/s.
+    pub wind_ne_mps: [f64; 2],
+    /// Guidance phase.
+    pub phase: GuidancePhase,
+    /// Final-approach height the spiral plans with, m.
+    pub final_approach_height_m: f64,
+    /// Symmetric brake commanded, 0…1.
+    pub brake: f64,
+}
+
+/// Below this mean surface wind, m/s (about 1 kn), the air counts as calm: weather reports
+/// (METAR) give a wind under 1 kn as calm, with no direction. Below it the gusts of a run outweigh its mean
+/// wind and turn the instantaneous wind through any direction in seconds, so "upwind" at
+/// touchdown is not something guidance could have known a final approach earlier.
+pub const CALM_WIND_MPS: f64 = 0.5;
+
+/// A steady glide (after the seed's initial conditions settle in still air), heading north at
+/// the origin: the template every run's release state is rotated and moved from.
+pub fn steady_glide_state(vehicle: &Vehicle) -> Result<StateVector, IntegrateError> {
+    let mut model = ParafoilModel::new(
+        vehicle.clone(),
+        Environment {
+            atmosphere: Arc::new(StandardAtmosphere),
+            wind: Arc::new(stx_dynamics::wind::Calm),
+            ground_altitude_msl_m: 0.0,
+        },
+    );
+    let pose = Pose {
+        position_ned_m: [0.0, 0.0, -1000.0],
+        canopy_euler_deg: [0.0, 6.5, 0.0],
+        canopy_velocity_mps: [3.3, 0.0, 1.0],
+        line_pitch_deg: -9.0,
+        drone_euler_deg: [0.0, 20.0, 0.0],
+        capsule_angles_deg: [0.0, -7.0],
+        transponder_angles_deg: [0.0, 5.0],
+        ..Default::default()
+    };
+    let outcome = integrate(
+        &mut Rk4::new(0.02),
+        &mut model,
+        0.0,
+        &pose.to_state(),
+        40.0,
+        Hooks::default(),
+    )?;
+    let mut x = outcome.state;
+    x[idx::POSITION] = 0.0;
+    x[idx::POSITION + 1] = 0.0;
+    x[idx::POSITION + 2] = 0.0;
+    x[idx::CANOPY_EULER + 2] = 0.0;
+    Ok(x)
+}
+
+/// Draws the conditions of run `index`.
+pub fn conditions(config: &MonteCarloConfig, index: usize) -> RunConditions {
+    let seed = config
+        .seed
+        .wrapping_mul(0x9E37_79B9_7F4A_7C15)
+        .wrapping_add(index as u64);
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let radius = config.release_radius_m * rng.random::<f64>().sqrt();
+    let bearing = 2.0 * PI * rng.random::<f64>();
+    RunConditions {
+        release_ne_m: [radius * bearing.cos(), radius * bearing.sin()],
+        heading_deg: 360.0 * rng.random::<f64>() - 180.0,
+        wind_speed_mps: config.wind_max_mps * rng.random::<f64>(),
+        wind_from_deg: 360.0 * rng.random::<f64>(),
+        seed: rng.random::<u64>(),
+    }
+}
+
+/// The wind of a run: the mean speed sheared over height (±20 % about the mean from the
+/// ground to the release height, veering up to ±20°) plus Dryden turbulence of 10 % of the
+/// mean speed (at least 0.1 m/s).
+pub fn wind_field(
+    c: &RunConditions,
+    altitude_m: f64,
+) -> Result<WindComposite, stx_dynamics::wind::WindError> {
+    let mut rng = ChaCha8Rng::seed_from_u64(c.seed ^ 0x005E_ED0F_517D);
+    let shear = 0.4 * rng.random::<f64>() - 0.2;
+    let veer_deg = 40.0 * rng.random::<f64>() - 20.0;
+    let rows = (0..=4)
+        .map(|k| {
+            let f = k as f64 / 4.0;
+            ProfileRow {
+                altitude_m: f * (altitude_m + 100.0),
+                speed_mps: c.wind_speed_mps * (1.0 - shear + 2.0 * shear * f),
+                from_deg: (c.wind_from_deg + veer_deg * f).rem_euclid(360.0),
+            }
+        })
+        .collect();
+    let sigma = (0.1 * c.wind_speed_mps).max(0.1);
+    let turbulence = Turbulence::new(TurbulenceParams {
+        sigma_horizontal_mps: sigma,
+        sigma_vertical_mps: 0.5 * sigma,
+        length_scale_horizontal_m: 200.0,
+        length_scale_vertical_m: 50.0,
+        reference_airspeed_mps: 6.7,
+        seed: c.seed,
+        components: 24,
+    })?;
+    Ok(WindComposite {
+        mean: Box::new(WindProfile::new(rows)?),
+        turbulence: Some(turbulence),
+    })
+}
+
+/// Flies run `index` with navigation from `navigator(&conditions)`.
+pub fn run_one<N: Navigator>(
+    config: &MonteCarloConfig,
+    vehicle: &Vehicle,
+    template: &StateVector,
+    index: usize,
+    navigator: impl Fn(&RunConditions) -> Result<N, String>,
+) -> Result<RunResult, String> {
+    let c = conditions(config, index);
+    let composite = Arc::new(wind_field(&c, config.altitude_m).map_err(|e| e.to_string())?);
+    let wind: Arc<dyn WindField> = composite.clone();
+    let model = ParafoilModel::new(
+        vehicle.clone(),
+        Environment {
+            atmosphere: Arc::new(StandardAtmosphere),
+            wind: wind.clone(),
+            ground_altitude_msl_m: stx_gnc::geo::LocalFrame::default().alt_msl_m,
+        },
+    );
+    let mut x = *template;
+    x[idx::POSITION] = c.release_ne_m[0];
+    x[idx::POSITION + 1] = c.release_ne_m[1];
+    x[idx::POSITION + 2] = -config.altitude_m;
+    x[idx::CANOPY_EULER + 2] = c.heading_deg.to_radians();
+    let mut guidance_config = config.guidance;
+    guidance_config.spiral.flare = config.flare;
+    let mut guidance = Guidance::new(guidance_config);
+    guidance.set_plan(
+        Plan {
+            target_ned_m: Vector3::zeros(),
+            ..Plan::default()
+        },
+        0.0,
+    );
+    guidance.set_mode(FlightMode::SpiralLanding, 0.0);
+    let mut flight = GuidedFlight::new(
+        model,
+        x,
+        0.0,
+        guidance,
+        navigator(&c)?,
+        STEP_S,
+        CONTROL_PERIOD_S,
+    );
+    let mut wind_error_sq = 0.0;
+    let mut wind_samples = 0usize;
+    let replay = config.only_run == Some(index);
+    let mut track = Vec::new();
+    let mut next_track_s = 0.0;
+    let touchdown = loop {
+        if let Some(t) = flight.advance().map_err(|e| e.to_string())? {
+            break t;
+        }
+        if replay
+            && let Some(est) = flight.estimate
+            && est.time_s >= next_track_s
+        {
+            next_track_s += 1.0;
+            let p = Vector3::new(
+                flight.state[idx::POSITION],
+                flight.state[idx::POSITION + 1],
+                flight.state[idx::POSITION + 2],
+            );
+            let truth = wind.wind_ned_mps(est.time_s, &p);
+            track.push(TrackPoint {
+                time_s: est.time_s,
+                position_neh_m: [p.x, p.y, -p.z],
+                wind_estimate_ne_mps: [est.wind_ned_mps.x, est.wind_ned_mps.y],
+                wind_ne_mps: [truth.x, truth.y],
+                phase: flight.guidance.phase(),
+                final_approach_height_m: flight.guidance.spiral_status().final_approach_height_m,
+                brake: flight.model.controls().brake_left,
+            });
+        }
+        if let Some(est) = flight.estimate
+            && est.time_s >= 30.0
+        {
+            let truth = wind.wind_ned_mps(est.time_s, &est.position_ned_m);
+            let (dn, de) = (est.wind_ned_mps.x - truth.x, est.wind_ned_mps.y - truth.y);
+            wind_error_sq += dn * dn + de * de;
+            wind_samples += 1;
+        }
+        if flight.time_s > 4.0 * config.altitude_m {
+            return Err(format!(
+                "run {index} still flying after {} s",
+                flight.time_s
+            ));
+        }
+    };
+    let heading_vs_upwind = if touchdown.upwind_rad.is_finite() {
+        wrap_pi(touchdown.heading_rad - touchdown.upwind_rad).to_degrees()
+    } else {
+        0.0
+    };
+    let mean_wind_at_touchdown = composite.mean.wind_ned_mps(
+        touchdown.time_s,
+        &Vector3::new(touchdown.position_ne_m[0], touchdown.position_ne_m[1], 0.0),
+    );
+    let first_announced = flight.best_reachable_announced.first().map(|(_, ne)| *ne);
+    let last_announced = flight.best_reachable_announced.last().map(|(_, ne)| *ne);
+    let from_touchdown =
+        |b: [f64; 2]| (touchdown.position_ne_m[0] - b[0]).hypot(touchdown.position_ne_m[1] - b[1]);
+    Ok(RunResult {
+        index,
+        miss_m: touchdown.position_ne_m[0].hypot(touchdown.position_ne_m[1]),
+        heading_vs_upwind_deg: heading_vs_upwind,
+        calm: mean_wind_at_touchdown.x.hypot(mean_wind_at_touchdown.y) < CALM_WIND_MPS,
+        touchdown_vertical_speed_mps: touchdown.vertical_speed_mps,
+        wind_estimate_rmse_mps: if wind_samples > 0 {
+            (wind_error_sq / wind_samples as f64).sqrt()
+        } else {
+            0.0
+        },
+        unreachable: !flight.best_reachable_announced.is_empty(),
+        best_reachable_ne_m: first_announced,
+        from_best_reachable_m: first_announced.map(from_touchdown),
+        last_best_reachable_ne_m: last_announced,
+        from_last_best_reachable_m: last_announced.map(from_touchdown),
+        flight_time_s: touchdown.time_s,
+        long_short_m: if touchdown.upwind_rad.is_finite() {
+            touchdown.position_ne_m[0] * touchdown.upwind_rad.cos()
+                + touchdown.position_ne_m[1] * touchdown.upwind_rad.sin()
+        } else {
+            0.0
+        },
+        left_right_m: if touchdown.upwind_rad.is_finite() {
+            -touchdown.position_ne_m[0] * touchdown.upwind_rad.sin()
+                + touchdown.position_ne_m[1] * touchdown.upwind_rad.cos()
+        } else {
+            0.0
+        },
+        conditions: c,
+        events: if replay {
+            std::mem::take(&mut flight.events)
+        } else {
+            Vec::new()
+        },
+        track,
+    })
+}

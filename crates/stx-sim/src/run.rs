@@ -1,0 +1,33 @@
+//! A finished flight of a scenario ([`Run`]: its samples and summary), open or closed loop,
+//! and why one failed ([`RunError`]).
+
+use serde::Serialize;
+use stx_dynamics::integrate::IntegrateError;
+use stx_dynamics::output::Sample;
+use thiserror::Error;
+
+use crate::scenario::ScenarioError;
+use crate::summary::Summary;
+
+/// Why a run failed.
+#[derive(Debug, Error)]
+pub enum RunError {
+    /// The scenario is invalid.
+    #[error(transparent)]
+    Scenario(#[from] ScenarioError),
+    /// The integrator could not follow the solution.
+    #[error("integration failed")]
+    Integrate(#[from] IntegrateError),
+    /// Navigation could not be set up.
+    #[error(transparent)]
+    Navigation(#[from] crate::closed_loop::NavigationError),
+}
+
+/// A finished run.
+#[derive(Debug, Clone, Serialize)]
+pub struct Run {
+    /// Recorded samples at the scenario's output interval (and the last instant).
+    pub samples: Vec<Sample>,
+    /// The summary.
+    pub summary: Summary,
+}

@@ -1,0 +1,220 @@
+//! The API's contract: one JSON Schema (draft 7) of every message, both ways, derived from the
+//! Rust types the daemon serialises ([`crate::messages`], [`crate::replies`]) and parses
+//! ([`crate::requests`]). It is committed as `web/src/generated/api.schema.json` (written by
+//! `cargo run -p stx-station --example api_schema`; a test fails while the file is stale), the
+//! dashboard's TypeScript types are generated from it, and the browser test validates every
+//! message the daemon sends against it. `API.md` explains it for people.
+//!
+//! What the station sends is described as it serialises it (every field present, `null` when
+//! empty, nothing else); what it reads, as it parses it (optional fields may be left out,
+//! unknown fields are refused).
+
+use schemars::generate::{Contract, SchemaSettings};
+use schemars::transform::RecursiveTransform;
+use schemars::{JsonSchema, Schema, SchemaGenerator};
+use serde_json::{Map, Value, json};
+use thiserror::Error;
+
+use crate::core::CutdownArm;
+use crate::messages::{CommandResultMsg, ErrorBody, EventMsg, ParamsMsg, Session, StateMsg};
+use crate::replies::{
+    ClientsBody, CommandAccepted, EventsBody, HelloMsg, HistoryMsg, LaggedMsg, PongMsg, TrackBody,
+};
+use crate::requests::{
+    ClientMessage, ConfirmBody, CourseBody, HeadingBody, LocalizerBody, ModeBody, ParamBody,
+    PlanBody, TargetBody,
+};
+
+/// Where the schema is committed, from the workspace root.
+pub const SCHEMA_PATH: &str = "web/src/generated/api.schema.json";
+
+// Only its schema is used: the daemon serialises each message on its own.
+/// Every message the station sends on the WebSocket, told apart by `type`.
+#[derive(JsonSchema)]
+#[schemars(untagged)]
+pub enum ServerMessage {
+    /// First on connecting.
+    Hello(HelloMsg),
+    /// At 4 Hz.
+    State(Box<StateMsg>),
+    /// As they happen.
+    Event(EventMsg),
+    /// Each step of a command.
+    CommandResult(CommandResultMsg),
+    /// When the parameter table changes.
+    Params(ParamsMsg),
+    /// Once, after connecting.
+    History(HistoryMsg),
+    /// When the page fell behind.
+    Lagged(LaggedMsg),
+    /// The answer to `ping`.
+    Pong(PongMsg),
+}
+
+/// Why the contract could not be assembled (a bug in the types, caught by the tests).
+#[derive(Debug, Error)]
+pub enum ContractError {
+    /// A type described differently as sent and as read.
+    #[error("`{0}` is both sent and read, and the two descriptions differ")]
+    Conflict(String),
+}
+
+/// Every object the station sends lists all its fields: nothing else may appear.
+fn closed_objects(schema: &mut Schema) {
+    if schema.get("properties").is_some() && schema.get("additionalProperties").is_none() {
+        schema.insert("additionalProperties".into(), Value::Bool(false));
+    }
+}
+
+fn generator(contract: Contract) -> SchemaGenerator {
+    let settings = SchemaSettings::draft07().with(|s| s.contract = contract);
+    match settings.contract {
+        // What the station reads is closed where serde refuses unknown fields
+        // (`deny_unknown_fields`), and only there.
+        Contract::Deserialize => settings.into_generator(),
+        _ => settings
+            .with_transform(RecursiveTransform(closed_objects))
+            .into_generator(),
+    }
+}
+
+/// The whole contract: a schema whose `definitions` name every message.
+pub fn schema() -> Result<Value, ContractError> {
+    let mut sent = generator(Contract::Serialize);
+    let mut read = generator(Contract::Deserialize);
+    // The root names each message once: what the station sends, then what it reads.
+    let messages = [
+        sent.subschema_for::<ServerMessage>(),
+        sent.subschema_for::<Session>(),
+        sent.subschema_for::<ParamsMsg>(),
+        sent.subschema_for::<EventsBody>(),
+        sent.subschema_for::<TrackBody>(),
+        sent.subschema_for::<ClientsBody>(),
+        sent.subschema_for::<CommandAccepted>(),
+        sent.subschema_for::<CutdownArm>(),
+        sent.subschema_for::<ErrorBody>(),
+        read.subschema_for::<ClientMessage>(),
+        read.subschema_for::<ModeBody>(),
+        read.subschema_for::<HeadingBody>(),
+        read.subschema_for::<CourseBody>(),
+        read.subschema_for::<LocalizerBody>(),
+        read.subschema_for::<TargetBody>(),
+        read.subschema_for::<PlanBody>(),
+        read.subschema_for::<ParamBody>(),
+        read.subschema_for::<ConfirmBody>(),
+    ];
+    let mut definitions: Map<String, Value> = sent.take_definitions(true);
+    // A type both sent and read must be described the same way both times.
+    for (name, schema) in read.take_definitions(true) {
+        match definitions.get(&name) {
+            Some(other) if *other != schema => return Err(ContractError::Conflict(name)),
+            _ => {
+                definitions.insert(name, schema);
+            }
+        }
+    }
+    Ok(json!({
+        "$schema": "http://json-schema.org/draft-07/schema#",
+        "title": "stx station API",
+        "description": "Every message of the stx station's HTTP and WebSocket API (crates/stx-station/API.md), generated from the daemon's Rust types by `cargo run -p stx-station --example api_schema`: do not edit. The root is any one of them: on the WebSocket ServerMessage (station to page) and ClientMessage (page to station); over REST the bodies the station answers (Session, StateMsg, ParamsMsg, EventsBody, TrackBody, ClientsBody, CommandResultMsg, CommandAccepted, CutdownArm, ErrorBody) and the bodies of the commands (*Body).",
+        "anyOf": messages,
+        "definitions": definitions,
+    }))
+}
+
+/// The schema as committed: pretty JSON, one trailing newline.
+pub fn schema_text() -> Result<String, ContractError> {
+    let value = schema()?;
+    let mut text = serde_json::to_string_pretty(&value).unwrap_or_default();
+    text.push('\n');
+    Ok(text)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_committed_schema_is_the_one_the_types_give() {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../..")
+            .join(SCHEMA_PATH);
+        let committed = std::fs::read_to_string(&path).unwrap_or_default();
+        let fresh = schema_text().expect("the contract assembles");
+        assert!(
+            committed == fresh,
+            "{} is stale: run `cargo run -p stx-station --example api_schema`, then \
+             `npm run gen:api` in web/, and commit both",
+            path.display()
+        );
+    }
+
+    /// `API.md` is the people's reference: it must name every message of the contract, show
+    /// every WebSocket message's `type`, and name no message the contract does not have.
+    #[test]
+    fn api_md_agrees_with_the_contract() {
+        let doc_path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("API.md");
+        let doc = std::fs::read_to_string(&doc_path).expect("API.md is readable");
+        let schema = schema().expect("the contract assembles");
+        let definitions = schema["definitions"].as_object().expect("definitions");
+        let name_of = |r: &Value| {
+            r["$ref"]
+                .as_str()
+                .and_then(|r| r.strip_prefix("#/definitions/"))
+                .map(str::to_string)
+        };
+        let messages: Vec<String> = schema["anyOf"]
+            .as_array()
+            .expect("the root lists the messages")
+            .iter()
+            .filter_map(name_of)
+            .collect();
+        assert!(messages.len() > 10, "{messages:?}");
+        for name in &messages {
+            assert!(
+                doc.contains(&format!("`{name}`")),
+                "API.md does not name `{name}`"
+            );
+        }
+        // The `type` of each WebSocket message, either way.
+        let server = definitions["ServerMessage"]["anyOf"]
+            .as_array()
+            .expect("a union");
+        let client = definitions["ClientMessage"]["oneOf"]
+            .as_array()
+            .expect("a union");
+        let types: Vec<String> = server
+            .iter()
+            .filter_map(|m| name_of(&m["allOf"][0]))
+            .map(|name| &definitions[&name])
+            .chain(client)
+            .filter_map(|m| {
+                m["properties"]["type"]["const"]
+                    .as_str()
+                    .map(str::to_string)
+            })
+            .collect();
+        assert_eq!(types.len(), server.len() + client.len(), "{types:?}");
+        for t in &types {
+            assert!(
+                doc.contains(&format!(r#""type":"{t}""#)),
+                "API.md shows no `{t}` message"
+            );
+        }
+        // Every message API.md names by its schema name exists.
+        // (A text between two backticks that is one such word can only be a name in backticks.)
+        for name in doc.split('`') {
+            let looks_like_one = name.chars().next().is_some_and(|c| c.is_ascii_uppercase())
+                && name.chars().all(|c| c.is_ascii_alphanumeric())
+                && ["Msg", "Body", "View", "Message"]
+                    .iter()
+                    .any(|e| name.ends_with(e));
+            if looks_like_one {
+                assert!(
+                    definitions.contains_key(name),
+                    "API.md names `{name}`, which the contract does not have"
+                );
+            }
+        }
+    }
+}

@@ -1,0 +1,298 @@
+//! Navigation on the station: the drone's telemetry feeds the station's own estimator (the
+//! same code as onboard) with the GPS, AHRS and pitot measurements, on the drone's clock so
+//! radio delays and accelerated rehearsals do not distort it; each tick runs the guidance
+//! replica on the new estimate and keeps the track and the plots' history; landing
+//! predictions run as detached jobs, off the telemetry path.
+
+use nalgebra::Vector3;
+use stx_dynamics::atmosphere::{Atmosphere, StandardAtmosphere};
+use stx_gnc::estimate::Estimate;
+use stx_gnc::estimator::{Estimator, EstimatorConfig};
+use stx_gnc::guidance::{Guidance, Plan};
+use stx_gnc::measurement::{AirDataSample, AttitudeSample, GpsFix, Measurement};
+use stx_gnc::mission::FlightMode;
+use stx_gnc::predict::{LandingPrediction, PredictorConfig, predict};
+use stx_link::telemetry::Telemetry;
+
+use super::StationCore;
+use crate::messages::{Level, StateMsg, TrackPoint};
+
+/// States kept for the plots of a newly connected page: 5 minutes at 1 Hz.
+const MAX_HISTORY: usize = 300;
+/// Seconds between track points.
+const TRACK_PERIOD_S: f64 = 1.0;
+
+/// Seconds the drone's clock may step back before the station takes it for a reboot.
+const REBOOT_STEP_BACK_S: f64 = 5.0;
+
+pub(crate) fn new_estimator() -> Estimator {
+    match Estimator::new(EstimatorConfig::default()) {
+        Ok(e) => e,
+        // The default configuration is validated by the estimator's own tests.
+        Err(e) => panic!("default estimator configuration is invalid: {e}"),
+    }
+}
+
+/// Everything a landing prediction needs, detached from the station so it can run on another
+/// thread while telemetry keeps flowing.
+pub struct PredictionJob {
+    estimate: Estimate,
+    guidance: Guidance,
+    performance: stx_gnc::performance::GlidePerformance,
+    ground_altitude_msl_m: f64,
+    config: PredictorConfig,
+    /// When the sensor data behind the estimate arrived (mission time, s).
+    data_s: Option<f64>,
+}
+
+/// A finished [`PredictionJob`].
+pub struct Predicted {
+    prediction: LandingPrediction,
+    data_s: Option<f64>,
+}
+
+impl PredictionJob {
+    /// Flies the plan and the uncontrolled glide from the estimate (milliseconds).
+    pub fn run(&self) -> Predicted {
+        Predicted {
+            prediction: predict(
+                &self.estimate,
+                &self.guidance,
+                &self.performance,
+                &StandardAtmosphere,
+                self.ground_altitude_msl_m,
+                &self.config,
+            ),
+            data_s: self.data_s,
+        }
+    }
+}
+
+impl StationCore {
+    /// Advances the drone's clock with a message's time stamp; a clock that steps far back
+    /// means the drone restarted, and navigation starts over.
+    fn observe_drone_clock(&mut self, now_s: f64, time_boot_ms: u32) -> f64 {
+        let t = f64::from(time_boot_ms) / 1000.0;
+        match self.drone_time_s {
+            Some(last) if last - t > REBOOT_STEP_BACK_S => {
+                self.estimator = new_estimator();
+                self.estimate = None;
+                self.log(
+                    now_s,
+                    Level::Warning,
+                    "vehicle",
+                    format!("the drone's clock went back from {last:.1} s to {t:.1} s: it restarted; navigation starts over"),
+                );
+                self.drone_time_s = Some(t);
+                self.guided_at_s = None;
+                self.want_plan_download(now_s);
+            }
+            Some(last) => self.drone_time_s = Some(last.max(t)),
+            None => self.drone_time_s = Some(t),
+        }
+        t
+    }
+
+    pub(crate) fn on_telemetry(&mut self, now_s: f64, telemetry: Telemetry) {
+        self.latest.any_s = Some(now_s);
+        match telemetry {
+            Telemetry::Status(s) => {
+                let previous = self.latest.status.map(|(p, _)| p);
+                self.latest.status = Some((s, now_s));
+                if previous.map(|p| p.mode) != Some(s.mode) {
+                    let at = self.drone_time_s.unwrap_or(0.0);
+                    self.guidance.set_mode(s.mode, at);
+                }
+                if let Some(p) = previous
+                    && p.stage != s.stage
+                {
+                    self.log(
+                        now_s,
+                        Level::Info,
+                        "vehicle",
+                        format!("stage: {:?} → {:?}", p.stage, s.stage),
+                    );
+                }
+            }
+            Telemetry::GpsRaw(g) => {
+                self.latest.gps = Some((g, now_s));
+                self.latest.sensors_s = Some(now_s);
+                // GPS_RAW_INT's time may be the receiver's (Unix) clock: it is stamped with
+                // the drone's clock of the burst it came in.
+                if let Some(t) = self.drone_time_s
+                    && let Some(m) = self.gps_measurement(t, now_s, &g)
+                {
+                    self.estimator.handle(t, &m);
+                }
+            }
+            Telemetry::Position(p) => {
+                self.observe_drone_clock(now_s, p.time_boot_ms);
+                self.latest.position = Some((p, now_s));
+            }
+            Telemetry::Attitude(a) => {
+                let t = self.observe_drone_clock(now_s, a.time_boot_ms);
+                self.latest.attitude = Some((a, now_s));
+                self.latest.sensors_s = Some(now_s);
+                let m = Measurement::Attitude(AttitudeSample {
+                    time_s: t,
+                    roll_rad: a.roll_rad,
+                    pitch_rad: a.pitch_rad,
+                    yaw_rad: a.yaw_rad,
+                });
+                self.estimator.handle(self.drone_time_s.unwrap_or(t), &m);
+            }
+            Telemetry::AirData(a) => {
+                let t = self.observe_drone_clock(now_s, a.time_boot_ms);
+                self.latest.air = Some((a, now_s));
+                self.latest.sensors_s = Some(now_s);
+                let m = Measurement::AirData(AirDataSample {
+                    time_s: t,
+                    differential_pressure_pa: a.diff_pressure_pa,
+                    static_pressure_pa: a.abs_pressure_pa,
+                    temperature_k: a.temperature_c + 273.15,
+                });
+                self.estimator.handle(self.drone_time_s.unwrap_or(t), &m);
+            }
+            Telemetry::Actuators(a) => self.latest.actuators = Some((a, now_s)),
+            Telemetry::System(s) => self.latest.system = Some((s, now_s)),
+            Telemetry::Battery(b) => self.latest.battery = Some((b, now_s)),
+            Telemetry::Wind(w) => self.latest.wind = Some((w, now_s)),
+            Telemetry::Guidance(g) => {
+                self.latest.guidance = Some((g, now_s));
+                self.on_guidance_status(now_s, g);
+            }
+            Telemetry::PredictedLanding(p) => {
+                self.observe_drone_clock(now_s, p.time_boot_ms);
+                self.latest.predicted_landing = Some((p, now_s));
+            }
+            // VFR_HUD repeats GLOBAL_POSITION_INT and the air data; STATUSTEXT arrives as
+            // `GroundEvent::StatusText`.
+            Telemetry::Hud(_) | Telemetry::StatusText(_) => {}
+        }
+    }
+
+    /// A GPS measurement for the estimator. GPS_RAW_INT carries no vertical velocity: the
+    /// drone's own estimate (GLOBAL_POSITION_INT) stands in for it when it is recent.
+    fn gps_measurement(
+        &self,
+        drone_s: f64,
+        now_s: f64,
+        g: &stx_link::telemetry::GpsRaw,
+    ) -> Option<Measurement> {
+        use stx_link::telemetry::GpsFix as Fix;
+        if !matches!(
+            g.fix,
+            Fix::Fix3d | Fix::Dgps | Fix::RtkFloat | Fix::RtkFixed | Fix::Static | Fix::Ppp
+        ) {
+            return None;
+        }
+        let position = self.frame.to_ned(g.lat_deg, g.lon_deg, g.alt_msl_m);
+        let speed = g.ground_speed_mps?;
+        let course = g.course_deg.unwrap_or(0.0).to_radians();
+        let down = self
+            .latest
+            .position
+            .filter(|(_, t)| now_s - t < 1.0)
+            .map_or(0.0, |(p, _)| p.v_down_mps);
+        Some(Measurement::Gps(GpsFix {
+            time_s: drone_s,
+            position_ned_m: position,
+            velocity_ned_mps: Vector3::new(speed * course.cos(), speed * course.sin(), down),
+            horizontal_accuracy_m: g.h_acc_m.unwrap_or(2.5),
+            vertical_accuracy_m: g.v_acc_m.unwrap_or(5.0),
+            speed_accuracy_mps: 0.3,
+        }))
+    }
+
+    /// Runs navigation, the guidance replica and the core's timers
+    /// ([`StationCore::handle_timeout`]) and returns the `state` message for `now_s`.
+    /// The landing prediction is not run here (it flies the plan in fast time, too slow for the
+    /// telemetry path): see [`StationCore::prediction_job`].
+    pub fn tick(&mut self, now_s: f64) -> StateMsg {
+        let est = self.drone_time_s.map(|t| self.estimator.estimate(t));
+        let usable = est.filter(|e| e.position_sigma_m.iter().all(|s| s.is_finite()));
+        if let Some(est) = usable {
+            let mode = self.guidance.mode();
+            if !self.plan_known_for(mode) {
+                // Flying towards a target the drone may not have would draw and log a
+                // pattern that does not exist.
+                self.replica_command = stx_dynamics::state::Controls::default();
+            } else if self.guided_at_s.is_none_or(|t| est.time_s > t) {
+                // Only new navigation data move guidance on: a stale link does not make
+                // the replica fly on by itself.
+                self.guided_at_s = Some(est.time_s);
+                let density = StandardAtmosphere
+                    .air_at(self.frame.alt_msl_m - est.position_ned_m.z)
+                    .density_kg_per_m3;
+                self.replica_command = self.guidance.update(&est, density).controls;
+            }
+            for e in self.guidance.drain_events() {
+                self.log(
+                    now_s,
+                    Level::Info,
+                    "guidance",
+                    format!("{:?} → {:?}: {}", e.from, e.to, e.reason),
+                );
+            }
+            // One point per second of flight, also when a rehearsal runs faster than real time.
+            if est.time_s >= self.next_track_s {
+                self.next_track_s = est.time_s + TRACK_PERIOD_S;
+                let (lat, lon, alt) = self.frame.to_geodetic(&est.position_ned_m);
+                self.track.push(TrackPoint {
+                    time_s: now_s,
+                    lat_deg: lat,
+                    lon_deg: lon,
+                    alt_msl_m: alt,
+                });
+            }
+            self.estimate = Some(est);
+        } else {
+            self.estimate = None;
+        }
+        self.handle_timeout(now_s);
+        let state = self.state_msg_now(now_s);
+        if now_s >= self.next_history_s {
+            self.next_history_s = now_s + 1.0;
+            if self.history.len() >= MAX_HISTORY {
+                self.history.pop_front();
+            }
+            self.history.push_back(state.clone());
+        }
+        state
+    }
+
+    /// A landing prediction from the current estimate and plan, to be run away from the
+    /// telemetry path; `None` until navigation has a solution.
+    pub fn prediction_job(&self) -> Option<PredictionJob> {
+        let estimate = self.estimate?;
+        Some(PredictionJob {
+            data_s: self.latest.sensors_s,
+            estimate,
+            guidance: self.guidance.clone(),
+            performance: self.config.guidance.performance,
+            ground_altitude_msl_m: self.frame.alt_msl_m,
+            config: PredictorConfig {
+                hang_height_m: self.config.guidance.spiral.hang_height_m,
+                ..PredictorConfig::default()
+            },
+        })
+    }
+
+    /// Takes the result of a [`PredictionJob`].
+    pub fn set_prediction(&mut self, predicted: Predicted) {
+        self.prediction = Some(predicted.prediction);
+        self.prediction_data_s = predicted.data_s;
+    }
+
+    /// The plan the guidance replica flies.
+    pub fn replica_plan(&self) -> &Plan {
+        self.guidance.plan()
+    }
+
+    /// The mode the drone reports (uncontrolled before the first heartbeat).
+    pub fn vehicle_mode(&self) -> FlightMode {
+        self.latest
+            .status
+            .map_or(FlightMode::Uncontrolled, |(s, _)| s.mode)
+    }
+}

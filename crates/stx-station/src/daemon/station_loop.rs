@@ -1,0 +1,201 @@
+//! The station loop: moves messages between the link driver, the core and the pages, and
+//! owns no logic of its own.
+//!
+//! - the link driver's reports (endpoint events, action outcomes, link statistics, socket
+//!   events) go to the core's entry points;
+//! - after each turn, the core's timers run and its link actions are queued for the driver,
+//!   and what the core has for the pages is broadcast. Actions wait in the loop's own queue
+//!   until the driver has room (`reserve`), so neither side can block the other and none is
+//!   dropped;
+//! - `state` follows each burst of telemetry within [`COALESCE`], and the 4 Hz timer fills
+//!   the gaps so pages see the link go stale when nothing arrives;
+//! - landing predictions run on a blocking thread once a second.
+
+use std::collections::VecDeque;
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use stx_link::endpoint::GroundEvent;
+use stx_link_tokio::{Action, DriverEvent};
+use tokio::sync::{mpsc, watch};
+
+use crate::core::{LinkAction, Outbound};
+use crate::http::Shared;
+use crate::link::{LinkReport, StationLink};
+
+/// The state message period: 4 Hz, the drone's rate.
+pub const STATE_PERIOD: Duration = Duration::from_millis(250);
+/// Link statistics are sampled this often.
+const STATS_PERIOD: Duration = Duration::from_millis(500);
+/// The core's timers (retries, deadlines, silent sticks) run at least this often.
+const TIMER_PERIOD: Duration = Duration::from_millis(100);
+/// Telemetry frames arriving within this window of the first one are answered with one
+/// `state` message: the drone sends its sensors in bursts, and one message per burst keeps
+/// pages current without flooding them.
+const COALESCE: Duration = Duration::from_millis(1);
+/// Landing predictions run this often, off the station loop.
+const PREDICTION_PERIOD: Duration = Duration::from_secs(1);
+
+/// The station loop's inputs and outputs.
+pub(super) struct StationLoop {
+    pub shared: Arc<Shared>,
+    pub actions: mpsc::Sender<Action<StationLink>>,
+    pub events: mpsc::Receiver<DriverEvent<LinkReport>>,
+    pub stop: watch::Receiver<bool>,
+}
+
+/// The closure that applies the core's `action` in the link driver, on the mission clock of
+/// `started` (the driver's own clock starts later).
+fn apply(started: Instant, action: LinkAction) -> Action<StationLink> {
+    Box::new(move |link: &mut StationLink, now| {
+        link.apply(now, started.elapsed().as_secs_f64(), action);
+    })
+}
+
+pub(super) async fn station_loop(mut io: StationLoop) {
+    let shared = io.shared.clone();
+    let mut state_timer = tokio::time::interval(STATE_PERIOD);
+    let mut stats_timer = tokio::time::interval(STATS_PERIOD);
+    let mut core_timer = tokio::time::interval(TIMER_PERIOD);
+    let mut prediction_timer = tokio::time::interval(PREDICTION_PERIOD);
+    let (prediction_tx, mut prediction_rx) = mpsc::channel(1);
+    let mut predicting = false;
+    let mut burst_deadline: Option<tokio::time::Instant> = None;
+    let mut last_state = tokio::time::Instant::now();
+    // For the driver, oldest first, until it has room.
+    let mut outgoing: VecDeque<Action<StationLink>> = VecDeque::new();
+    // The driver stopped (it panicked): actions are dropped here, and the core reports each
+    // request as not sent at its deadline.
+    let mut driver_gone = false;
+    loop {
+        let burst_due = async {
+            match burst_deadline {
+                Some(deadline) => tokio::time::sleep_until(deadline).await,
+                None => std::future::pending().await,
+            }
+        };
+        tokio::select! {
+            event = io.events.recv() => {
+                let Some(event) = event else { break };
+                if on_driver_event(&shared, event) && burst_deadline.is_none() {
+                    burst_deadline = Some(tokio::time::Instant::now() + COALESCE);
+                }
+            }
+            permit = io.actions.reserve(), if !outgoing.is_empty() && !driver_gone => {
+                match permit {
+                    Ok(permit) => {
+                        if let Some(action) = outgoing.pop_front() {
+                            permit.send(action);
+                        }
+                    }
+                    Err(_) => {
+                        tracing::error!("the link driver stopped: nothing more goes to the drone");
+                        driver_gone = true;
+                    }
+                }
+            }
+            () = shared.link_due.notified() => {}
+            () = burst_due => {
+                burst_deadline = None;
+                last_state = tokio::time::Instant::now();
+                publish_state(&shared);
+            }
+            Some(prediction) = prediction_rx.recv() => {
+                predicting = false;
+                shared.core().set_prediction(prediction);
+            }
+            _ = prediction_timer.tick() => {
+                let job = if predicting { None } else { shared.core().prediction_job() };
+                if let Some(job) = job {
+                    predicting = true;
+                    let tx = prediction_tx.clone();
+                    tokio::task::spawn_blocking(move || {
+                        let _ = tx.blocking_send(job.run());
+                    });
+                }
+            }
+            _ = stats_timer.tick() => {
+                outgoing.push_back(Box::new(|link: &mut StationLink, now| link.sample_stats(now)));
+            }
+            _ = core_timer.tick() => {}
+            _ = state_timer.tick() => {
+                if last_state.elapsed() >= STATE_PERIOD {
+                    last_state = tokio::time::Instant::now();
+                    publish_state(&shared);
+                }
+            }
+            _ = io.stop.changed() => break,
+        }
+        let now = shared.now_s();
+        let (actions, outbound) = {
+            let mut core = shared.core();
+            (core.take_link_actions(now), core.drain_outbound())
+        };
+        outgoing.extend(actions.into_iter().map(|a| apply(shared.started, a)));
+        if driver_gone {
+            outgoing.clear();
+        }
+        send_outbound(&shared, outbound);
+    }
+}
+
+/// Hands one report of the link driver to the core; true if it was telemetry (a `state` is
+/// due).
+fn on_driver_event(shared: &Shared, event: DriverEvent<LinkReport>) -> bool {
+    let now = shared.now_s();
+    let mut core = shared.core();
+    match event {
+        DriverEvent::Endpoint(LinkReport::Event(e)) => {
+            let telemetry = matches!(e, GroundEvent::Telemetry { .. });
+            core.on_link_event(now, e);
+            telemetry
+        }
+        DriverEvent::Endpoint(LinkReport::Outcome { id, result }) => {
+            core.on_action_outcome(now, id, result);
+            false
+        }
+        DriverEvent::Endpoint(LinkReport::Stats(stats)) => {
+            core.set_link_stats(now, stats);
+            false
+        }
+        DriverEvent::Io { path, event } => {
+            core.on_io_event(now, path, event);
+            false
+        }
+    }
+}
+
+/// Ticks the core and sends what it queued, then the fresh `state`.
+fn publish_state(shared: &Shared) {
+    let now = shared.now_s();
+    let (state, outbound) = {
+        let mut core = shared.core();
+        let state = core.tick(now);
+        (state, core.drain_outbound())
+    };
+    send_outbound(shared, outbound);
+    if let Ok(text) = serde_json::to_string(&state) {
+        // Latest wins: a page that is behind gets the newest state, never a queue of old ones.
+        shared.states.send_modify(|frame| {
+            frame.seq += 1;
+            frame.text = text.into();
+        });
+    }
+}
+
+fn send_outbound(shared: &Shared, outbound: Vec<Outbound>) {
+    for o in outbound {
+        let text = match o {
+            Outbound::Event(e) => serde_json::to_string(&e),
+            Outbound::CommandResult(r) => serde_json::to_string(&r),
+            Outbound::Params(p) => serde_json::to_string(&p),
+        };
+        if let Ok(text) = text {
+            shared
+                .broadcast_total
+                .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+            // No page connected is not an error.
+            let _ = shared.broadcast.send(text.into());
+        }
+    }
+}

@@ -1,0 +1,115 @@
+//! Who is calling: the token from `Authorization: Bearer …` or `?token=` (the WebSocket and
+//! Google Earth cannot set headers), its name and role from the station config; and the
+//! percent-encoding of tokens in URLs.
+
+use axum::extract::FromRequestParts;
+use axum::http::request::Parts;
+use axum::http::{StatusCode, header};
+
+use super::shared::{AppState, HttpError, error};
+use crate::config::Role;
+
+/// The authenticated caller.
+pub struct Caller {
+    /// Name from the station config.
+    pub name: String,
+    /// Role.
+    pub role: Role,
+}
+
+impl Caller {
+    pub(crate) fn operator(&self) -> Result<(), HttpError> {
+        match self.role {
+            Role::Operator => Ok(()),
+            Role::Viewer => Err(error(
+                StatusCode::FORBIDDEN,
+                "forbidden",
+                "viewers cannot command: operator role required",
+            )),
+        }
+    }
+}
+
+fn token_from(parts: &Parts) -> Option<String> {
+    if let Some(value) = parts.headers.get(header::AUTHORIZATION)
+        && let Ok(text) = value.to_str()
+        && let Some(token) = text.strip_prefix("Bearer ")
+    {
+        return Some(token.trim().to_string());
+    }
+    parts.uri.query().and_then(|q| {
+        q.split('&').find_map(|pair| {
+            let (k, v) = pair.split_once('=')?;
+            (k == "token").then(|| percent_decode(v))
+        })
+    })
+}
+
+pub(crate) fn percent_encode(s: &str) -> String {
+    let mut out = String::with_capacity(s.len());
+    for b in s.bytes() {
+        if b.is_ascii_alphanumeric() || b"-._~".contains(&b) {
+            out.push(char::from(b));
+        } else {
+            out.push_str(&format!("%{b:02X}"));
+        }
+    }
+    out
+}
+
+fn percent_decode(s: &str) -> String {
+    let bytes = s.as_bytes();
+    let mut out = Vec::with_capacity(bytes.len());
+    let mut i = 0;
+    while i < bytes.len() {
+        match bytes[i] {
+            b'%' if i + 2 < bytes.len() => {
+                let hex = std::str::from_utf8(&bytes[i + 1..i + 3]).ok();
+                match hex.and_then(|h| u8::from_str_radix(h, 16).ok()) {
+                    Some(b) => {
+                        out.push(b);
+                        i += 3;
+                    }
+                    None => {
+                        out.push(b'%');
+                        i += 1;
+                    }
+                }
+            }
+            b'+' => {
+                out.push(b' ');
+                i += 1;
+            }
+            b => {
+                out.push(b);
+                i += 1;
+            }
+        }
+    }
+    String::from_utf8_lossy(&out).into_owned()
+}
+
+impl FromRequestParts<AppState> for Caller {
+    type Rejection = HttpError;
+
+    async fn from_request_parts(parts: &mut Parts, state: &AppState) -> Result<Self, HttpError> {
+        let Some(token) = token_from(parts) else {
+            return Err(error(
+                StatusCode::UNAUTHORIZED,
+                "unauthorized",
+                "a token is needed: Authorization: Bearer <token> or ?token=",
+            ));
+        };
+        match state.config.authenticate(&token) {
+            Some((name, role)) => Ok(Caller {
+                name: name.to_string(),
+                role,
+            }),
+            None => Err(error(
+                StatusCode::UNAUTHORIZED,
+                "unauthorized",
+                "unknown token",
+            )),
+        }
+    }
+}

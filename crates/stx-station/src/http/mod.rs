@@ -1,0 +1,65 @@
+//! The HTTP side (axum): the REST endpoints and the WebSocket of `API.md`, the KML feed,
+//! offline tiles and the built dashboard.
+//!
+//! - `shared`: what every handler shares ([`Shared`]) and the `{error, reason}` answers;
+//! - `auth`: tokens, names and roles;
+//! - `rest`: the reading endpoints; `commands`: the commanding ones (operators only);
+//! - `ws`: the WebSocket (state, events, command results; operators' sticks);
+//! - `kml`: the Google Earth feed.
+//!
+//! Handlers only lock the core for a moment, build their answer, and wake the daemon when they
+//! gave the core something for the link ([`Shared::link_due`]); nothing here waits on the
+//! radio. Every page's counts are in `GET /api/clients`.
+
+mod auth;
+mod commands;
+mod kml;
+mod rest;
+mod shared;
+mod ws;
+
+use axum::Router;
+use axum::routing::{any, get, post};
+use tower_http::services::{ServeDir, ServeFile};
+
+pub use auth::Caller;
+pub use shared::{ClientCounters, HttpError, Shared, StateFrame};
+
+use crate::requests::{CourseBody, HeadingBody, LocalizerBody, ModeBody, PlanBody, TargetBody};
+use commands::{arm_cutdown, command, confirm_cutdown, set_param};
+use rest::{api_not_found, clients, command_result, events, params, session, state_now, track};
+
+/// The router of the whole station.
+pub fn router(state: std::sync::Arc<Shared>) -> Router {
+    let web_dir = state.config.web_dir.clone();
+    let index = web_dir.join("index.html");
+    let mut app = Router::new()
+        .route("/api/session", get(session))
+        .route("/api/state", get(state_now))
+        .route("/api/params", get(params))
+        .route("/api/params/{name}", post(set_param))
+        .route("/api/events", get(events))
+        .route("/api/track", get(track))
+        .route("/api/commands/{id}", get(command_result))
+        .route("/api/commands/mode", post(command::<ModeBody>))
+        .route("/api/commands/heading", post(command::<HeadingBody>))
+        .route("/api/commands/course", post(command::<CourseBody>))
+        .route("/api/commands/localizer", post(command::<LocalizerBody>))
+        .route("/api/commands/target", post(command::<TargetBody>))
+        .route("/api/commands/plan", post(command::<PlanBody>))
+        .route("/api/cutdown/arm", post(arm_cutdown))
+        .route("/api/cutdown/confirm", post(confirm_cutdown))
+        .route("/api/clients", get(clients))
+        .route("/api/ws", get(ws::websocket))
+        // An API path that does not exist is an API error, never the dashboard's page.
+        .route("/api", any(api_not_found))
+        .route("/api/", any(api_not_found))
+        .route("/api/{*rest}", any(api_not_found))
+        .route("/kml", get(kml::kml_link))
+        .route("/kml/live", get(kml::kml_live));
+    if let Some(tiles) = &state.config.tiles_dir {
+        app = app.nest_service("/tiles", ServeDir::new(tiles));
+    }
+    app.fallback_service(ServeDir::new(web_dir).fallback(ServeFile::new(index)))
+        .with_state(state)
+}

@@ -1,0 +1,156 @@
+//! What every handler shares: the core behind its lock, the mission clock, the channels that
+//! feed the pages, each page's counters, and the `{error, reason}` answer of every refusal.
+
+use std::collections::BTreeMap;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::{Arc, Mutex};
+use std::time::Instant;
+
+use axum::Json;
+use axum::extract::rejection::JsonRejection;
+use axum::extract::ws::Utf8Bytes;
+use axum::http::StatusCode;
+use axum::response::{IntoResponse, Response};
+use tokio::sync::{Notify, broadcast, watch};
+
+use crate::config::{Role, StationConfig};
+use crate::core::{ApiError, StationCore};
+use crate::messages::ErrorBody;
+use crate::replies::ClientView;
+
+/// State shared by every handler.
+pub struct Shared {
+    /// The station.
+    pub core: Mutex<StationCore>,
+    /// Configuration (immutable).
+    pub config: StationConfig,
+    /// Mission clock origin.
+    pub started: Instant,
+    /// Woken when a handler gave the core something for the link (a request, sticks): the
+    /// daemon then takes the core's link actions at once instead of at its next tick.
+    pub link_due: Notify,
+    /// Events, command results and parameter tables for every WebSocket, pre-serialised
+    /// (shared bytes: one copy for all pages); kept until every page has read them, up to
+    /// the backlog.
+    pub broadcast: broadcast::Sender<Utf8Bytes>,
+    /// The newest `state` message, pre-serialised, with its sequence number.
+    pub states: watch::Sender<StateFrame>,
+    /// Connected pages and what each was sent or missed.
+    pub clients: Mutex<BTreeMap<u64, Arc<ClientCounters>>>,
+    /// The next page's id.
+    pub next_client: AtomicU64,
+    /// Messages put on [`Shared::broadcast`] so far (to tell how far behind a page is).
+    pub broadcast_total: AtomicU64,
+}
+
+/// The newest `state`, numbered so a page can count the ones it skipped.
+#[derive(Debug, Clone, Default)]
+pub struct StateFrame {
+    /// 1 for the first state published, then +1 each.
+    pub seq: u64,
+    /// The message.
+    pub text: Utf8Bytes,
+}
+
+/// One page's WebSocket, as `GET /api/clients` shows it.
+#[derive(Debug, Default)]
+pub struct ClientCounters {
+    /// Token name.
+    pub name: String,
+    /// Role.
+    pub role: Option<Role>,
+    /// Mission time it connected, s.
+    pub connected_s: f64,
+    /// [`Shared::broadcast_total`] when it subscribed.
+    pub base: u64,
+    /// `state` messages sent.
+    pub states_sent: AtomicU64,
+    /// `state` messages skipped because the page was behind (a newer one was sent instead).
+    pub states_coalesced: AtomicU64,
+    /// Events, command results and parameter tables sent.
+    pub messages_sent: AtomicU64,
+    /// Events, command results and parameter tables it missed by falling more than the
+    /// backlog behind (each time announced to it with `lagged`).
+    pub messages_missed: AtomicU64,
+    /// Times it fell that far behind.
+    pub lag_episodes: AtomicU64,
+}
+
+impl ClientCounters {
+    pub(crate) fn view(&self, id: u64, total: u64) -> ClientView {
+        let n = |c: &AtomicU64| c.load(Ordering::Relaxed);
+        let done = self.base + n(&self.messages_sent) + n(&self.messages_missed);
+        ClientView {
+            id,
+            name: self.name.clone(),
+            role: self.role,
+            connected_s: self.connected_s,
+            states_sent: n(&self.states_sent),
+            states_coalesced: n(&self.states_coalesced),
+            messages_sent: n(&self.messages_sent),
+            messages_missed: n(&self.messages_missed),
+            messages_behind: total.saturating_sub(done),
+            lag_episodes: n(&self.lag_episodes),
+        }
+    }
+}
+
+impl Shared {
+    /// Seconds on the mission clock.
+    pub fn now_s(&self) -> f64 {
+        self.started.elapsed().as_secs_f64()
+    }
+
+    /// The core, for a moment.
+    pub fn core(&self) -> std::sync::MutexGuard<'_, StationCore> {
+        // A panic while holding the lock would be a bug in the core; keep serving.
+        self.core.lock().unwrap_or_else(|e| e.into_inner())
+    }
+}
+
+pub(crate) type AppState = Arc<Shared>;
+
+/// An error answered as `{error, reason}`.
+pub struct HttpError(StatusCode, ErrorBody);
+
+impl IntoResponse for HttpError {
+    fn into_response(self) -> Response {
+        (self.0, Json(self.1)).into_response()
+    }
+}
+
+impl From<ApiError> for HttpError {
+    fn from(e: ApiError) -> Self {
+        HttpError(
+            StatusCode::from_u16(e.status).unwrap_or(StatusCode::BAD_REQUEST),
+            ErrorBody {
+                error: e.error,
+                reason: e.reason,
+            },
+        )
+    }
+}
+
+pub(crate) fn error(
+    status: StatusCode,
+    kind: &'static str,
+    reason: impl Into<String>,
+) -> HttpError {
+    HttpError(
+        status,
+        ErrorBody {
+            error: kind,
+            reason: reason.into(),
+        },
+    )
+}
+
+pub(crate) fn json_body<T>(body: Result<Json<T>, JsonRejection>) -> Result<T, HttpError> {
+    body.map(|Json(v)| v).map_err(|e| {
+        error(
+            StatusCode::BAD_REQUEST,
+            "bad_request",
+            format!("malformed request body: {}", e.body_text()),
+        )
+    })
+}

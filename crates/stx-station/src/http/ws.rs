@@ -1,0 +1,198 @@
+//! The WebSocket of `API.md`. Each page is fed from two sources: `state` messages through a
+//! `watch` channel (latest wins: a page that falls behind skips to the newest state, counted
+//! as coalesced), and events, command results and parameter tables through a broadcast
+//! backlog of [`crate::daemon::RELIABLE_BACKLOG`] messages, never skipped silently: a page
+//! that falls further behind gets a `lagged` message with the number it missed, and re-reads
+//! the event log. Operators' sticks come in on it.
+
+use std::sync::Arc;
+use std::sync::atomic::Ordering;
+
+use axum::extract::State;
+use axum::extract::ws::{Message, WebSocket, WebSocketUpgrade};
+use axum::response::Response;
+use stx_link::manual::Sticks;
+use tokio::sync::broadcast;
+
+use super::auth::Caller;
+use super::rest::session_of;
+use super::shared::{AppState, ClientCounters, Shared};
+use crate::config::Role;
+use crate::messages::{EventMsg, Level};
+use crate::replies::{HelloMsg, HistoryMsg, LaggedMsg, PongMsg};
+use crate::requests::ClientMessage;
+
+pub(crate) async fn websocket(
+    State(state): State<AppState>,
+    caller: Caller,
+    upgrade: WebSocketUpgrade,
+) -> Response {
+    upgrade.on_upgrade(move |socket| serve_socket(state, caller, socket))
+}
+
+async fn serve_socket(state: AppState, caller: Caller, mut socket: WebSocket) {
+    let mut updates = state.broadcast.subscribe();
+    let base = state.broadcast_total.load(Ordering::Relaxed);
+    let mut states = state.states.subscribe();
+    let mut last_seq = states.borrow_and_update().seq;
+    let id = state.next_client.fetch_add(1, Ordering::Relaxed) + 1;
+    let counters = Arc::new(ClientCounters {
+        name: caller.name.clone(),
+        role: Some(caller.role),
+        connected_s: state.now_s(),
+        base,
+        ..ClientCounters::default()
+    });
+    state
+        .clients
+        .lock()
+        .unwrap_or_else(|e| e.into_inner())
+        .insert(id, counters.clone());
+    let greeting = {
+        let now = state.now_s();
+        let core = state.core();
+        let hello = HelloMsg {
+            kind: "hello",
+            session: session_of(&state, &caller),
+            role: caller.role,
+            name: caller.name.clone(),
+        };
+        let mut events = core.events_since(f64::NEG_INFINITY);
+        let history = HistoryMsg {
+            kind: "history",
+            track: core.track(1.0),
+            events: events.split_off(events.len().saturating_sub(500)),
+            states: core.history(),
+        };
+        let state_msg = core.state_msg_now(now);
+        [
+            serde_json::to_string(&hello).unwrap_or_default(),
+            serde_json::to_string(&state_msg).unwrap_or_default(),
+            serde_json::to_string(&history).unwrap_or_default(),
+        ]
+    };
+    let mut open = true;
+    for text in greeting {
+        if socket.send(Message::Text(text.into())).await.is_err() {
+            open = false;
+            break;
+        }
+    }
+    while open {
+        tokio::select! {
+            // Events and command results before states: they are what must not be lost.
+            biased;
+            update = updates.recv() => match update {
+                Ok(text) => {
+                    counters.messages_sent.fetch_add(1, Ordering::Relaxed);
+                    open = socket.send(Message::Text(text)).await.is_ok();
+                }
+                Err(broadcast::error::RecvError::Lagged(missed)) => {
+                    counters.messages_missed.fetch_add(missed, Ordering::Relaxed);
+                    let episodes = counters.lag_episodes.fetch_add(1, Ordering::Relaxed) + 1;
+                    tracing::warn!(client = id, name = %caller.name, missed, episodes,
+                        "a page fell behind: it is told what it missed");
+                    let notice = LaggedMsg {
+                        kind: "lagged",
+                        missed,
+                        missed_total: counters.messages_missed.load(Ordering::Relaxed),
+                        time_s: state.now_s(),
+                        refetch: "/api/events",
+                    };
+                    let text = serde_json::to_string(&notice).unwrap_or_default();
+                    open = socket.send(Message::Text(text.into())).await.is_ok();
+                }
+                Err(broadcast::error::RecvError::Closed) => break,
+            },
+            changed = states.changed() => {
+                if changed.is_err() {
+                    break;
+                }
+                let frame = states.borrow_and_update().clone();
+                let skipped = frame.seq.saturating_sub(last_seq + 1);
+                if skipped > 0 {
+                    counters.states_coalesced.fetch_add(skipped, Ordering::Relaxed);
+                }
+                last_seq = frame.seq;
+                counters.states_sent.fetch_add(1, Ordering::Relaxed);
+                open = socket.send(Message::Text(frame.text)).await.is_ok();
+            }
+            incoming = socket.recv() => match incoming {
+                Some(Ok(Message::Text(text))) => {
+                    handle_client(&state, &caller, &mut socket, text.as_str()).await;
+                }
+                Some(Ok(Message::Close(_))) | None | Some(Err(_)) => break,
+                Some(Ok(_)) => {}
+            },
+        }
+    }
+    state
+        .clients
+        .lock()
+        .unwrap_or_else(|e| e.into_inner())
+        .remove(&id);
+}
+
+/// The `event` a page gets back when its message is refused (to that page only, not logged).
+fn refusal(state: &Shared, text: &str) -> Message {
+    let now = state.now_s();
+    let reply = EventMsg {
+        kind: "event",
+        time_s: now,
+        wall_ms: state.core().wall_ms(now),
+        level: Level::Error,
+        source: "station",
+        text: text.to_string(),
+    };
+    Message::Text(serde_json::to_string(&reply).unwrap_or_default().into())
+}
+
+async fn handle_client(state: &Shared, caller: &Caller, socket: &mut WebSocket, text: &str) {
+    let message = serde_json::from_str::<ClientMessage>(text);
+    if matches!(
+        message,
+        Ok(ClientMessage::Manual { .. } | ClientMessage::ManualRelease)
+    ) && caller.role != Role::Operator
+    {
+        let reply = refusal(
+            state,
+            "viewers cannot fly the drone: operator role required",
+        );
+        let _ = socket.send(reply).await;
+        return;
+    }
+    match message {
+        Ok(ClientMessage::ManualRelease) => {
+            let now = state.now_s();
+            state.core().manual_release(now);
+            state.link_due.notify_one();
+        }
+        Ok(ClientMessage::Ping) => {
+            let pong = serde_json::to_string(&PongMsg { kind: "pong" }).unwrap_or_default();
+            let _ = socket.send(Message::Text(pong.into())).await;
+        }
+        Ok(ClientMessage::Manual {
+            x,
+            y,
+            z,
+            r,
+            buttons,
+        }) => {
+            let now = state.now_s();
+            // The core clamps each axis.
+            let sticks = Sticks {
+                x,
+                y,
+                z,
+                r,
+                buttons,
+            };
+            state.core().manual_hold(now, sticks);
+            state.link_due.notify_one();
+        }
+        Err(e) => {
+            let reply = refusal(state, &format!("malformed message refused: {e}"));
+            let _ = socket.send(reply).await;
+        }
+    }
+}

@@ -1,0 +1,257 @@
+//! The ground endpoint as the station's link driver runs it: [`StationLink`] applies the
+//! core's [`LinkAction`]s to the endpoint, synchronously, and reports each one's outcome as a
+//! [`LinkReport`] through the same queue as the endpoint's own events, so an outcome can be
+//! delayed by backpressure but never dropped. Sans-io like the endpoint it wraps: the tokio
+//! driver (`stx_link_tokio::drive_paths`) moves its bytes, and tests drive it by hand.
+
+use std::collections::VecDeque;
+use std::time::Duration;
+
+use stx_link::endpoint::{GroundEndpoint, GroundEvent, LinkStats};
+use stx_link::param::ParamRequestError;
+use stx_link::plan::PlanRequestError;
+use stx_link::sansio::SansIo;
+
+use crate::core::{ActionError, ActionId, LinkAction, LinkOp};
+
+/// What the station link reports, in the order it happened.
+#[derive(Debug, Clone, PartialEq)]
+pub enum LinkReport {
+    /// An event of the ground endpoint.
+    Event(GroundEvent),
+    /// What became of a link action (for [`crate::core::StationCore::on_action_outcome`]).
+    Outcome {
+        id: ActionId,
+        result: Result<(), ActionError>,
+    },
+    /// The link statistics, sampled on request ([`StationLink::sample_stats`]).
+    Stats(LinkStats),
+}
+
+/// The ground endpoint with the reports of what was done to it.
+#[derive(Debug)]
+pub struct StationLink {
+    endpoint: GroundEndpoint,
+    reports: VecDeque<LinkReport>,
+}
+
+impl StationLink {
+    /// Wraps `endpoint`.
+    pub fn new(endpoint: GroundEndpoint) -> Self {
+        Self {
+            endpoint,
+            reports: VecDeque::new(),
+        }
+    }
+
+    /// The endpoint.
+    pub fn endpoint(&self) -> &GroundEndpoint {
+        &self.endpoint
+    }
+
+    /// Applies `action` at link time `now`, unless the mission time `now_s` is past its
+    /// deadline (the core has told the operator it was not sent); its outcome is queued.
+    pub fn apply(&mut self, now: Duration, now_s: f64, action: LinkAction) {
+        let LinkAction { id, op, deadline_s } = action;
+        let result = if now_s > deadline_s {
+            Err(ActionError::Expired)
+        } else {
+            self.run(now, op)
+        };
+        if let Err(e) = &result {
+            tracing::debug!(?id, error = %e, "link action not applied");
+        }
+        self.reports.push_back(LinkReport::Outcome { id, result });
+    }
+
+    fn run(&mut self, now: Duration, op: LinkOp) -> Result<(), ActionError> {
+        let ep = &mut self.endpoint;
+        match op {
+            LinkOp::Command {
+                request_id,
+                command,
+            } => ep
+                .send_command(now, request_id, command)
+                // Busy: the same command is still waiting for its acknowledgement.
+                .map_err(|e| ActionError::Busy(e.to_string())),
+            LinkOp::ParamSet { name, value } => {
+                ep.param_set(now, &name, value).map_err(param_error)
+            }
+            LinkOp::PlanUpload(items) => ep.plan_upload(now, items).map_err(plan_error),
+            LinkOp::PlanDownload => ep.plan_download(now).map_err(plan_error),
+            LinkOp::ParamList => ep.param_list(now).map_err(param_error),
+            LinkOp::ManualHold(sticks) => {
+                ep.manual_hold(now, sticks);
+                Ok(())
+            }
+            LinkOp::ManualRelease => {
+                ep.manual_release();
+                Ok(())
+            }
+        }
+    }
+
+    /// Queues the link statistics at `now` as a report.
+    pub fn sample_stats(&mut self, now: Duration) {
+        let stats = self.endpoint.link_stats(now);
+        self.reports.push_back(LinkReport::Stats(stats));
+    }
+}
+
+fn param_error(e: ParamRequestError) -> ActionError {
+    match e {
+        ParamRequestError::Busy { .. } | ParamRequestError::ListInProgress => {
+            ActionError::Busy(e.to_string())
+        }
+        ParamRequestError::BadName { .. } => ActionError::Refused(e.to_string()),
+    }
+}
+
+fn plan_error(e: PlanRequestError) -> ActionError {
+    match e {
+        PlanRequestError::Busy => ActionError::Busy(e.to_string()),
+        PlanRequestError::TooLong { .. } => ActionError::Refused(e.to_string()),
+    }
+}
+
+impl SansIo for StationLink {
+    type Event = LinkReport;
+
+    fn handle_bytes_on(&mut self, path: usize, now: Duration, bytes: &[u8]) {
+        self.endpoint.handle_bytes_on(path, now, bytes);
+    }
+
+    fn handle_datagram_on(&mut self, path: usize, now: Duration, datagram: &[u8]) -> bool {
+        self.endpoint.handle_datagram_on(path, now, datagram)
+    }
+
+    fn handle_timeout(&mut self, now: Duration) {
+        self.endpoint.handle_timeout(now);
+    }
+
+    fn poll_timeout(&self) -> Option<Duration> {
+        self.endpoint.poll_timeout()
+    }
+
+    fn poll_transmit(&mut self, now: Duration) -> Option<Vec<u8>> {
+        self.endpoint.poll_transmit(now)
+    }
+
+    /// Reports of actions first: the endpoint's events queued before an action were polled
+    /// before it was applied, so this keeps the order things happened in.
+    fn poll_event(&mut self) -> Option<LinkReport> {
+        self.reports
+            .pop_front()
+            .or_else(|| self.endpoint.poll_event().map(LinkReport::Event))
+    }
+
+    fn handle_stream_end_on(&mut self, path: usize, now: Duration) {
+        self.endpoint.handle_stream_end_on(path, now);
+    }
+
+    fn transmit_path(&self, now: Duration) -> usize {
+        self.endpoint.transmit_path(now)
+    }
+
+    fn signing_timestamp_mark(&self) -> Option<u64> {
+        self.endpoint.signing_timestamp_mark()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use stx_link::command::{Command, RequestId};
+    use stx_link::endpoint::GroundConfig;
+    use stx_link::plan::PlanItem;
+
+    fn link() -> StationLink {
+        StationLink::new(GroundEndpoint::new(GroundConfig::default(), Duration::ZERO))
+    }
+
+    fn action(id: u64, op: LinkOp, deadline_s: f64) -> LinkAction {
+        LinkAction {
+            id: ActionId(id),
+            op,
+            deadline_s,
+        }
+    }
+
+    fn outcomes(link: &mut StationLink) -> Vec<(ActionId, Result<(), ActionError>)> {
+        std::iter::from_fn(|| link.poll_event())
+            .filter_map(|r| match r {
+                LinkReport::Outcome { id, result } => Some((id, result)),
+                _ => None,
+            })
+            .collect()
+    }
+
+    fn land() -> Vec<PlanItem> {
+        vec![PlanItem::Land {
+            lat_deg: 38.5,
+            lon_deg: -7.9,
+            alt_msl_m: 245.0,
+            approach_heading_deg: None,
+        }]
+    }
+
+    #[test]
+    fn every_action_reports_its_outcome_in_order() {
+        let mut link = link();
+        let now = Duration::from_secs(1);
+        link.apply(now, 1.0, action(1, LinkOp::PlanDownload, 6.0));
+        link.apply(now, 1.0, action(2, LinkOp::PlanUpload(land()), 6.0));
+        let mode = LinkOp::Command {
+            request_id: RequestId(7),
+            command: Command::SetMode(stx_gnc::mission::FlightMode::Heading),
+        };
+        link.apply(now, 1.0, action(3, mode.clone(), 6.0));
+        link.apply(now, 1.0, action(4, mode, 6.0));
+        link.apply(now, 1.0, action(5, LinkOp::ManualRelease, 6.0));
+        let got = outcomes(&mut link);
+        let ids: Vec<u64> = got.iter().map(|(id, _)| id.0).collect();
+        assert_eq!(ids, [1, 2, 3, 4, 5]);
+        assert_eq!(got[0].1, Ok(()));
+        assert!(
+            matches!(&got[1].1, Err(ActionError::Busy(r)) if r.contains("plan transfer")),
+            "an upload during the download is busy: {:?}",
+            got[1].1
+        );
+        assert_eq!(got[2].1, Ok(()));
+        assert!(
+            matches!(&got[3].1, Err(ActionError::Busy(r)) if r.contains("in flight")),
+            "the same command twice: {:?}",
+            got[3].1
+        );
+        assert_eq!(got[4].1, Ok(()));
+    }
+
+    #[test]
+    fn an_action_past_its_deadline_is_not_applied() {
+        let mut link = link();
+        link.apply(
+            Duration::from_secs(9),
+            9.0,
+            action(1, LinkOp::PlanDownload, 6.0),
+        );
+        assert!(matches!(
+            outcomes(&mut link)[..],
+            [(ActionId(1), Err(ActionError::Expired))]
+        ));
+        // Not started: a download is possible now.
+        link.apply(
+            Duration::from_secs(9),
+            9.0,
+            action(2, LinkOp::PlanDownload, 14.0),
+        );
+        assert_eq!(outcomes(&mut link), [(ActionId(2), Ok(()))]);
+    }
+
+    #[test]
+    fn stats_are_reported_on_request() {
+        let mut link = link();
+        link.sample_stats(Duration::from_secs(1));
+        assert!(matches!(link.poll_event(), Some(LinkReport::Stats(_))));
+        assert!(link.poll_event().is_none());
+    }
+}
