@@ -1,5 +1,6 @@
-//! [`drive`] runs a sans-io endpoint over a [`Transport`]: it reads, feeds bytes and timeouts
-//! to the endpoint, writes what it transmits, runs the application's closures on it (the only
+//! [`drive`] runs a sans-io endpoint over a [`Transport`]: it reads, feeds bytes (each UDP
+//! datagram whole, passing the endpoint's verdict on it back to the transport, which moves
+//! its peer only on a datagram from the expected system) and timeouts to the endpoint, writes what it transmits, runs the application's closures on it (the only
 //! way to touch the endpoint while it is driven) and forwards its events; [`drive_paths`] does
 //! the same over several radios to one peer (see `stx_link::paths`).
 //!
@@ -134,7 +135,15 @@ pub async fn drive_paths<E: SansIo>(
             (path, n) = recv_any(&mut transports, &mut bufs) => {
                 if n > 0 {
                     let bytes = bufs.get(path).and_then(|b| b.get(..n)).unwrap_or(&[]);
-                    endpoint.handle_bytes_on(path, start.elapsed(), bytes);
+                    match transports.get_mut(path) {
+                        // Only the endpoint can tell a frame from its peer: its verdict decides
+                        // whether the datagram's source becomes the transport's peer.
+                        Some(t) if t.is_datagram() => {
+                            let from_peer = endpoint.handle_datagram_on(path, start.elapsed(), bytes);
+                            t.datagram_verdict(from_peer);
+                        }
+                        _ => endpoint.handle_bytes_on(path, start.elapsed(), bytes),
+                    }
                 }
                 if transports.get_mut(path).is_some_and(Transport::take_stream_ended) {
                     endpoint.handle_stream_end_on(path, start.elapsed());

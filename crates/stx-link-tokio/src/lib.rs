@@ -5,6 +5,8 @@
 //!
 //! - [`transport`]: [`Transport`], an open `udpin:`/`udpout:`/`tcp:`/`tcpin:`/`serial:`
 //!   address (`stx_link::address`), with every I/O error counted and reported rate-limited;
+//!   a `udpin:` transport's peer moves only to the source of a datagram its endpoint
+//!   accepted a frame in from the expected system (`udp_peer.rs`);
 //! - [`mod@drive`]: [`drive()`] / [`drive_paths`] run any [`SansIo`](stx_link::sansio::SansIo)
 //!   endpoint over one transport or several radios, persisting the signing timestamp before
 //!   frames signed under it leave.
@@ -14,6 +16,7 @@
 
 pub mod drive;
 pub mod transport;
+mod udp_peer;
 
 pub use drive::{Action, DriveOptions, DriverEvent, connect_and_drive, drive, drive_paths};
 pub use transport::{

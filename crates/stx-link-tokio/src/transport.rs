@@ -1,10 +1,13 @@
 //! Thin tokio adapters that move bytes between a socket (or serial port) and a sans-io
 //! endpoint, so the protocol logic of `stx-link` stays free of I/O and clocks.
 //!
-//! [`Transport`] is an open socket for an [`Address`]. UDP-in answers whoever sent the last
-//! datagram; frames sent before any peer was heard are queued (up to
-//! [`MAX_QUEUED_WITHOUT_PEER`]) and flushed when one is, with an [`IoEvent`] for the queueing
-//! and for any overflow. TCP server accepts one client at a time and accepts the next when it
+//! [`Transport`] is an open socket for an [`Address`]. UDP-in answers the address that last
+//! sent a datagram carrying a frame accepted from the expected system (the driver hands each
+//! datagram to the endpoint and its verdict to [`Transport::datagram_verdict`]; see
+//! `udp_peer.rs`), so garbage cannot divert the uplink; other datagrams are counted in
+//! [`IoStats::ignored_datagrams`] and reported rate-limited. Frames sent before any peer was
+//! heard are queued (up to [`MAX_QUEUED_WITHOUT_PEER`]) and flushed when one is, with an
+//! [`IoEvent`] for the queueing and for any overflow. TCP server accepts one client at a time and accepts the next when it
 //! leaves; TCP client and serial reopen after [`REOPEN_DELAY`]. No I/O error is swallowed:
 //! each is counted in [`IoStats`]; they are reported (a `tracing` warning and an [`IoEvent`])
 //! rate-limited, because a link without a peer fails every frame — the first failure at once,
@@ -21,6 +24,8 @@ use stx_link::sansio::{IoEvent, IoStats};
 use tokio::io::{AsyncRead, AsyncReadExt, AsyncWrite, AsyncWriteExt};
 use tokio::net::{TcpListener, TcpStream, UdpSocket};
 use tokio::time::Instant;
+
+use crate::udp_peer::{UdpPeer, Verdict};
 
 /// Frames kept for a UDP-in peer not yet heard from.
 pub const MAX_QUEUED_WITHOUT_PEER: usize = 256;
@@ -55,8 +60,7 @@ impl<T: AsyncRead + AsyncWrite + Unpin + Send> ByteStream for T {}
 enum Kind {
     Udp {
         socket: UdpSocket,
-        peer: Option<SocketAddr>,
-        fixed: bool,
+        peer: UdpPeer,
         queue: VecDeque<Vec<u8>>,
     },
     TcpServer {
@@ -121,6 +125,8 @@ pub struct Transport {
     pub(crate) events: VecDeque<IoEvent>,
     recv_reports: ErrorReports,
     send_reports: ErrorReports,
+    /// Datagrams ignored as peer candidates (not failures, but reported the same way).
+    ignored_reports: ErrorReports,
     /// A stream connection ended since the driver last asked.
     stream_ended: bool,
 }
@@ -180,8 +186,7 @@ impl Transport {
         let kind = match &address {
             Address::UdpIn(a) => Kind::Udp {
                 socket: UdpSocket::bind(a).await.map_err(err)?,
-                peer: None,
-                fixed: false,
+                peer: UdpPeer::learned(),
                 queue: VecDeque::new(),
             },
             Address::UdpOut(a) => {
@@ -192,8 +197,7 @@ impl Transport {
                 };
                 Kind::Udp {
                     socket: UdpSocket::bind(local).await.map_err(err)?,
-                    peer: Some(*a),
-                    fixed: true,
+                    peer: UdpPeer::fixed(*a),
                     queue: VecDeque::new(),
                 }
             }
@@ -249,6 +253,7 @@ impl Transport {
             events: VecDeque::new(),
             recv_reports: ErrorReports::default(),
             send_reports: ErrorReports::default(),
+            ignored_reports: ErrorReports::default(),
             stream_ended: false,
         }
     }
@@ -260,6 +265,52 @@ impl Transport {
             (Address::UdpIn(_), local) => Some(Address::UdpIn(local)),
             (Address::TcpServer(_), local) => Some(Address::TcpServer(local)),
             _ => None,
+        }
+    }
+
+    /// Whether bytes arrive as datagrams (UDP): each [`recv`](Self::recv) then returns one
+    /// whole datagram, to be fed with `SansIo::handle_datagram_on` and answered with
+    /// [`datagram_verdict`](Self::datagram_verdict).
+    pub fn is_datagram(&self) -> bool {
+        matches!(self.kind, Kind::Udp { .. })
+    }
+
+    /// The endpoint's verdict on the datagram [`recv`](Self::recv) last returned:
+    /// `from_expected` when it carried a frame accepted from the expected peer system. On
+    /// UDP-in, such a datagram from a new address makes that address the peer (logged once, and
+    /// an [`IoEvent::PeerChanged`]); any other datagram from an address that is not the peer
+    /// is ignored as a peer candidate, counted in [`IoStats::ignored_datagrams`] and reported
+    /// at most once per [`IO_ERROR_REPORT_INTERVAL`]. Nothing on other transports.
+    pub fn datagram_verdict(&mut self, from_expected: bool) {
+        let Kind::Udp { peer, .. } = &mut self.kind else {
+            return;
+        };
+        let previous = peer.get();
+        match peer.verdict(from_expected) {
+            Verdict::Kept => {}
+            Verdict::Adopted(from) => {
+                match previous {
+                    Some(previous) => tracing::info!(%from, %previous, "udp peer moved"),
+                    None => tracing::info!(%from, "udp peer"),
+                }
+                self.events.push_back(IoEvent::PeerChanged { peer: from });
+            }
+            Verdict::Ignored(from) => {
+                self.stats.ignored_datagrams += 1;
+                if let Some(since_last_report) = self.ignored_reports.failed(Instant::now()) {
+                    let peer = previous.map_or_else(|| "none yet".to_string(), |p| p.to_string());
+                    tracing::warn!(
+                        address = %self.address,
+                        %from,
+                        %peer,
+                        since_last_report,
+                        total = self.stats.ignored_datagrams,
+                        "udp datagrams ignored: no frame accepted from the expected system, the \
+                         peer stays (reported at most every {} s)",
+                        IO_ERROR_REPORT_INTERVAL.as_secs()
+                    );
+                }
+            }
         }
     }
 
@@ -362,18 +413,9 @@ impl Transport {
 
     async fn recv_inner(&mut self, buf: &mut [u8]) -> usize {
         match &mut self.kind {
-            Kind::Udp {
-                socket,
-                peer,
-                fixed,
-                ..
-            } => match socket.recv_from(buf).await {
+            Kind::Udp { socket, peer, .. } => match socket.recv_from(buf).await {
                 Ok((n, from)) => {
-                    if !*fixed && *peer != Some(from) {
-                        *peer = Some(from);
-                        tracing::info!(%from, "udp peer");
-                        self.events.push_back(IoEvent::PeerChanged { peer: from });
-                    }
+                    peer.received_from(from);
                     self.stats.rx_bytes += n as u64;
                     n
                 }
@@ -484,45 +526,43 @@ impl Transport {
         let result = match &mut self.kind {
             Kind::Udp {
                 socket,
-                peer: Some(peer),
+                peer,
                 queue,
-                ..
-            } => {
-                let peer = *peer;
-                let mut r = Ok(());
-                // Flush what was queued before the peer was known, in order.
-                while let Some(q) = queue.pop_front() {
-                    if let Err(e) = socket.send_to(&q, peer).await {
-                        r = Err(e);
-                        break;
+            } => match peer.get() {
+                Some(peer) => {
+                    let mut r = Ok(());
+                    // Flush what was queued before the peer was known, in order.
+                    while let Some(q) = queue.pop_front() {
+                        if let Err(e) = socket.send_to(&q, peer).await {
+                            r = Err(e);
+                            break;
+                        }
+                        self.stats.tx_bytes += q.len() as u64;
                     }
-                    self.stats.tx_bytes += q.len() as u64;
+                    match r {
+                        Ok(()) => socket
+                            .send_to(frame, peer)
+                            .await
+                            .map(|n| self.stats.tx_bytes += n as u64),
+                        Err(e) => Err(e),
+                    }
                 }
-                match r {
-                    Ok(()) => socket
-                        .send_to(frame, peer)
-                        .await
-                        .map(|n| self.stats.tx_bytes += n as u64),
-                    Err(e) => Err(e),
+                None => {
+                    if queue.len() >= MAX_QUEUED_WITHOUT_PEER {
+                        queue.pop_front();
+                        self.stats.dropped_without_peer += 1;
+                        self.events.push_back(IoEvent::DroppedWithoutPeer {
+                            dropped_total: self.stats.dropped_without_peer,
+                        });
+                    }
+                    queue.push_back(frame.to_vec());
+                    self.stats.queued_without_peer += 1;
+                    let queued = queue.len();
+                    tracing::debug!(queued, "udpin: no peer yet, frame queued");
+                    self.events.push_back(IoEvent::QueuedWithoutPeer { queued });
+                    Ok(())
                 }
-            }
-            Kind::Udp {
-                peer: None, queue, ..
-            } => {
-                if queue.len() >= MAX_QUEUED_WITHOUT_PEER {
-                    queue.pop_front();
-                    self.stats.dropped_without_peer += 1;
-                    self.events.push_back(IoEvent::DroppedWithoutPeer {
-                        dropped_total: self.stats.dropped_without_peer,
-                    });
-                }
-                queue.push_back(frame.to_vec());
-                self.stats.queued_without_peer += 1;
-                let queued = queue.len();
-                tracing::debug!(queued, "udpin: no peer yet, frame queued");
-                self.events.push_back(IoEvent::QueuedWithoutPeer { queued });
-                Ok(())
-            }
+            },
             Kind::TcpServer {
                 conn: Some(stream), ..
             } => stream

@@ -44,8 +44,10 @@
 //!   accounting (`senders.rs`).
 //! - [`paths`]: one link over several radios: copies dropped, sends on the radio that works,
 //!   each radio's loss counted with the endpoint's per-sender accounting.
-//! - [`sansio`]: the [`sansio::SansIo`] trait both endpoints implement for an I/O adapter,
-//!   and the [`sansio::IoEvent`]s and [`sansio::IoStats`] adapters report;
+//! - [`sansio`]: the [`sansio::SansIo`] trait both endpoints implement for an I/O adapter
+//!   (including the verdict on each UDP datagram that decides whether its source may become
+//!   the peer: only a frame accepted from the expected system vouches for it), and the
+//!   [`sansio::IoEvent`]s and [`sansio::IoStats`] adapters report;
 //!   [`address`]: the link address strings such as `udpin:0.0.0.0:14550`. The adapter itself
 //!   (sockets, serial ports, the driver loop) is the `stx-link-tokio` crate: this one has no
 //!   tokio, so the station core and the drone's onboard logic stay pure.

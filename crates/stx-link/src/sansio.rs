@@ -2,6 +2,12 @@
 //! an I/O adapter drives (bytes and `now` in; frames, timers and events out), and the
 //! [`IoEvent`]s and [`IoStats`] an adapter reports back. Nothing here does I/O: the tokio
 //! adapter is the `stx-link-tokio` crate, and tests drive endpoints by hand.
+//!
+//! Datagram transports (UDP) feed each datagram whole with
+//! [`SansIo::handle_datagram_on`], whose answer says whether it carried a frame accepted from
+//! the expected peer system: a datagram's source address is anyone's to forge, and only the
+//! endpoint can tell a frame from its peer, so a `udpin:` adapter moves its peer only on that
+//! verdict.
 
 use std::net::SocketAddr;
 use std::path::PathBuf;
@@ -22,7 +28,8 @@ pub enum IoEvent {
     QueuedWithoutPeer { queued: usize },
     /// UDP-in: the queue was full and its oldest frame was dropped.
     DroppedWithoutPeer { dropped_total: u64 },
-    /// UDP-in: replies now go to this address.
+    /// UDP-in: replies now go to this address (the source of a datagram that carried a frame
+    /// accepted from the expected peer system; see [`SansIo::handle_datagram_on`]).
     PeerChanged { peer: SocketAddr },
     /// TCP / serial: connected (peer address, or the port path).
     Connected { peer: String },
@@ -49,6 +56,11 @@ pub struct IoStats {
     pub dropped_without_peer: u64,
     /// Connections (re)established.
     pub connects: u64,
+    /// UDP: datagrams from an address other than the peer's that carried no frame accepted
+    /// from the expected peer system (garbage, frames from other systems, unsigned or badly
+    /// signed frames with signing on): their source was not taken as the peer.
+    #[serde(default)]
+    pub ignored_datagrams: u64,
 }
 
 /// The sans-io surface an I/O adapter needs; implemented by both endpoints.
@@ -57,6 +69,12 @@ pub trait SansIo: Send + 'static {
     type Event: Send + 'static;
     /// Feeds bytes received on radio `path` (0 with one transport).
     fn handle_bytes_on(&mut self, path: usize, now: Duration, bytes: &[u8]);
+    /// Feeds one whole datagram (UDP) received on radio `path`: frames never span datagrams.
+    /// Returns whether it carried a frame accepted from the expected peer system (CRC checked
+    /// and, with signing on, correctly signed): only such a datagram may move a UDP-in
+    /// transport's peer to its source, so that garbage or frames from other systems cannot
+    /// divert the uplink.
+    fn handle_datagram_on(&mut self, path: usize, now: Duration, datagram: &[u8]) -> bool;
     /// Runs timers.
     fn handle_timeout(&mut self, now: Duration);
     /// Next timer.
@@ -81,6 +99,9 @@ macro_rules! impl_sans_io {
             type Event = $ev;
             fn handle_bytes_on(&mut self, path: usize, now: Duration, bytes: &[u8]) {
                 <$ty>::handle_bytes_on(self, path, now, bytes)
+            }
+            fn handle_datagram_on(&mut self, path: usize, now: Duration, datagram: &[u8]) -> bool {
+                <$ty>::handle_datagram_on(self, path, now, datagram)
             }
             fn handle_timeout(&mut self, now: Duration) {
                 <$ty>::handle_timeout(self, now)

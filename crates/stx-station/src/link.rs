@@ -121,6 +121,10 @@ impl SansIo for StationLink {
         self.endpoint.handle_bytes_on(path, now, bytes);
     }
 
+    fn handle_datagram_on(&mut self, path: usize, now: Duration, datagram: &[u8]) -> bool {
+        self.endpoint.handle_datagram_on(path, now, datagram)
+    }
+
     fn handle_timeout(&mut self, now: Duration) {
         self.endpoint.handle_timeout(now);
     }

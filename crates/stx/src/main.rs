@@ -10,6 +10,7 @@ mod bench_memory;
 mod bench_station;
 mod drone;
 mod inputs;
+mod logging;
 mod montecarlo;
 mod record;
 mod serve;
@@ -27,6 +28,10 @@ use clap::{Parser, Subcommand};
     about = "Ground station and simulator for STRAPLEX parafoil landings"
 )]
 struct Cli {
+    /// How log lines (on stderr) are written: `text` (coloured only on a terminal) or `json`
+    /// (one object per line, for log collectors).
+    #[arg(long, global = true, value_enum, default_value_t = logging::LogFormat::Text)]
+    log_format: logging::LogFormat,
     #[command(subcommand)]
     command: Command,
 }
@@ -64,14 +69,8 @@ impl std::fmt::Display for BadInput {
 impl std::error::Error for BadInput {}
 
 fn main() -> ExitCode {
-    tracing_subscriber::fmt()
-        .with_env_filter(
-            tracing_subscriber::EnvFilter::try_from_default_env()
-                .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new("info")),
-        )
-        .with_writer(std::io::stderr)
-        .init();
     let cli = Cli::parse();
+    logging::init(cli.log_format);
     let result = match cli.command {
         Command::Sim(args) => sim::run(args),
         Command::Bench(args) => bench::run(args),

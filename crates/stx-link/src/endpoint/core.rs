@@ -198,16 +198,46 @@ impl LinkCore {
     /// Decodes `bytes` received on `path`, returning the frames for the endpoint to
     /// dispatch.
     pub(super) fn ingest(&mut self, path: usize, now: Duration, bytes: &[u8]) -> Vec<Frame> {
+        if !self.push(path, bytes) {
+            return Vec::new();
+        }
+        self.drain_decoder(path, now, |_| false).0
+    }
+
+    /// Decodes one whole datagram received on `path`. MAVLink over UDP never splits a frame
+    /// across datagrams, so a candidate left incomplete at the datagram's end is dropped as
+    /// truncated rather than completed by the next datagram, which may come from another
+    /// sender: every frame returned lies wholly in this datagram. Also returns whether any
+    /// frame passed `from_peer` (copies already delivered over another radio included: they
+    /// show this radio reaches the peer as well as a first copy does).
+    pub(super) fn ingest_datagram(
+        &mut self,
+        path: usize,
+        now: Duration,
+        datagram: &[u8],
+        from_peer: impl Fn(&Frame) -> bool,
+    ) -> (Vec<Frame>, bool) {
+        if !self.push(path, datagram) {
+            return (Vec::new(), false);
+        }
+        if let Some(p) = self.paths.get_mut(path) {
+            p.decoder.finish();
+        }
+        self.drain_decoder(path, now, from_peer)
+    }
+
+    /// Appends `bytes` to `path`'s decoder; `false` (and a warning) if there is no such path.
+    fn push(&mut self, path: usize, bytes: &[u8]) -> bool {
         let Some(p) = self.paths.get_mut(path) else {
             tracing::warn!(
                 path,
                 paths = self.paths.len(),
                 "bytes on a path that does not exist dropped"
             );
-            return Vec::new();
+            return false;
         };
         p.decoder.push(bytes);
-        self.drain_decoder(path, now)
+        true
     }
 
     /// The connection carrying `path`'s byte stream ended: what is buffered can no longer
@@ -217,17 +247,25 @@ impl LinkCore {
             return Vec::new();
         };
         p.decoder.finish();
-        self.drain_decoder(path, now)
+        self.drain_decoder(path, now, |_| false).0
     }
 
-    fn drain_decoder(&mut self, path: usize, now: Duration) -> Vec<Frame> {
+    /// The frames `path`'s decoder has ready, and whether any of them passed `from_peer`.
+    fn drain_decoder(
+        &mut self,
+        path: usize,
+        now: Duration,
+        from_peer: impl Fn(&Frame) -> bool,
+    ) -> (Vec<Frame>, bool) {
         let mut frames = Vec::new();
+        let mut peer_heard = false;
         let several = self.paths.len() > 1;
         while let Some(p) = self.paths.get_mut(path)
             && let Some(r) = p.decoder.poll(now)
         {
             match r {
                 Ok(frame) => {
+                    peer_heard |= from_peer(&frame);
                     if several {
                         p.heard(now, &frame.header);
                         if self.copies.is_copy(now, &frame.header) {
@@ -244,7 +282,7 @@ impl LinkCore {
                 }
             }
         }
-        frames
+        (frames, peer_heard)
     }
 
     fn account(&mut self, now: Duration, h: &FrameHeader, msg: &MavMessage) {
@@ -266,6 +304,11 @@ impl LinkCore {
         {
             self.arrivals.pop_front();
         }
+    }
+
+    /// The (system, component) of the peer whose heartbeats we track, once one was heard.
+    pub(super) fn peer(&self) -> Option<(u8, u8)> {
+        self.peer
     }
 
     /// A heartbeat from the peer we track.

@@ -55,7 +55,7 @@ impl Default for GroundConfig {
 pub enum GroundEvent {
     /// Link state, dropped frames, signing timestamp to persist.
     Link(LinkEvent),
-    /// A telemetry item from the drone.
+    /// A telemetry item from the drone (its system; any component).
     Telemetry {
         from: (u8, u8),
         telemetry: Telemetry,
@@ -72,7 +72,8 @@ pub enum GroundEvent {
     Param(ParamEvent),
     /// Outcome of a plan transfer.
     Plan(PlanEvent),
-    /// Any other message from anyone (for recording and other tools).
+    /// Any other message from the drone, and every message from another system (for
+    /// recording and other tools).
     Other(Box<Frame>),
 }
 
@@ -116,6 +117,22 @@ impl GroundEndpoint {
         }
     }
 
+    /// Feeds one whole datagram (UDP) received on radio `path`; returns whether it carried a
+    /// frame accepted from the drone's system (CRC checked and, with signing on, correctly
+    /// signed), the only kind of datagram whose source a UDP-in transport may take as the
+    /// drone's address. A frame left incomplete at the datagram's end is dropped as
+    /// truncated, so a datagram cannot finish a frame that another one began.
+    pub fn handle_datagram_on(&mut self, path: usize, now: Duration, datagram: &[u8]) -> bool {
+        let drone = self.vehicle.0;
+        let (frames, from_drone) = self
+            .core
+            .ingest_datagram(path, now, datagram, |f| f.header.system_id == drone);
+        for frame in frames {
+            self.dispatch(now, frame);
+        }
+        from_drone
+    }
+
     /// The stream connection (TCP, serial) ended: a frame cut off by it is counted as
     /// truncated and any frame behind it still delivered.
     pub fn handle_stream_end(&mut self, now: Duration) {
@@ -142,18 +159,23 @@ impl GroundEndpoint {
 
     fn dispatch(&mut self, now: Duration, frame: Frame) {
         let from = (frame.header.system_id, frame.header.component_id);
-        let msg = &frame.message;
-        if from.0 == self.vehicle.0 {
-            if let MavMessage::HEARTBEAT(h) = msg
-                && h.mavtype != mc::MavType::MAV_TYPE_GCS
-            {
-                self.core.peer_heartbeat(now, from);
-            }
-            let our = self.core.config.system_id;
-            self.commands.handle_message(now, from.0, our, msg);
-            self.params.handle_message(now, from.0, msg);
-            self.plan.handle_message(now, from.0, msg);
+        // Another system's frames (another vehicle, a ground station, someone on the network
+        // forging them) are passed on as they are, never read as the drone's telemetry or
+        // texts.
+        if from.0 != self.vehicle.0 {
+            self.events.push_back(GroundEvent::Other(Box::new(frame)));
+            return;
         }
+        let msg = &frame.message;
+        if let MavMessage::HEARTBEAT(h) = msg
+            && h.mavtype != mc::MavType::MAV_TYPE_GCS
+        {
+            self.core.peer_heartbeat(now, from);
+        }
+        let our = self.core.config.system_id;
+        self.commands.handle_message(now, from.0, our, msg);
+        self.params.handle_message(now, from.0, msg);
+        self.plan.handle_message(now, from.0, msg);
         match Telemetry::from_mavlink(msg) {
             Some(telemetry) => {
                 if let Telemetry::StatusText(chunk) = &telemetry
@@ -178,7 +200,7 @@ impl GroundEndpoint {
                         | MavMessage::MISSION_COUNT(_)
                         | MavMessage::MISSION_ACK(_)
                 );
-                if !protocol || from.0 != self.vehicle.0 {
+                if !protocol {
                     self.events.push_back(GroundEvent::Other(Box::new(frame)));
                 }
             }

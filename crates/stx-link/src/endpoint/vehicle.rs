@@ -142,6 +142,39 @@ impl VehicleEndpoint {
         self.handle_bytes_on_with(path, now, bytes, &mut RangeOnly);
     }
 
+    /// Feeds one whole datagram (UDP) received on radio `path`; returns whether it carried a
+    /// frame accepted (CRC checked and, with signing on, correctly signed) from the ground
+    /// station this vehicle serves — the only kind of datagram whose source a UDP-in
+    /// transport may take as the station's address. That station is the one whose heartbeats
+    /// the vehicle tracks, or any that announces itself with a ground-station heartbeat (as
+    /// the vehicle then serves it); before any has, a frame from any other system counts, so
+    /// a tool that commands before its first heartbeat is answered. A frame left incomplete
+    /// at the datagram's end is dropped as truncated.
+    pub fn handle_datagram_on_with(
+        &mut self,
+        path: usize,
+        now: Duration,
+        datagram: &[u8],
+        validator: &mut impl ParamValidator,
+    ) -> bool {
+        let (tracked, own) = (self.core.peer(), self.core.config.system_id);
+        let (frames, from_station) =
+            self.core
+                .ingest_datagram(path, now, datagram, |f| match (tracked, &f.message) {
+                    (_, MavMessage::HEARTBEAT(h)) if h.mavtype == mc::MavType::MAV_TYPE_GCS => true,
+                    (Some((system, _)), _) => f.header.system_id == system,
+                    (None, _) => f.header.system_id != own,
+                });
+        self.dispatch(now, frames, validator);
+        from_station
+    }
+
+    /// [`handle_datagram_on_with`](Self::handle_datagram_on_with) with parameter sets checked
+    /// against the table's ranges only.
+    pub fn handle_datagram_on(&mut self, path: usize, now: Duration, datagram: &[u8]) -> bool {
+        self.handle_datagram_on_with(path, now, datagram, &mut RangeOnly)
+    }
+
     /// [`handle_stream_end`](Self::handle_stream_end) for radio `path`.
     pub fn handle_stream_end_on(&mut self, path: usize, now: Duration) {
         self.handle_stream_end_on_with(path, now, &mut RangeOnly);

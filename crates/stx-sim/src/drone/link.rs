@@ -212,6 +212,24 @@ impl LinkedDrone {
         self.process(link_now);
     }
 
+    /// One whole datagram received on radio `path` (UDP); returns whether it carried a frame
+    /// accepted from the ground station (see `VehicleEndpoint::handle_datagram_on_with`). A
+    /// datagram the fault model drops carried nothing.
+    pub fn handle_datagram_on(&mut self, path: usize, link_now: Duration, datagram: &[u8]) -> bool {
+        if self.faults.drops_datagram(self.drone.time_s()) {
+            return false;
+        }
+        let drone = &self.drone;
+        let from_station = self.endpoint.handle_datagram_on_with(
+            path,
+            link_now,
+            datagram,
+            &mut |name: &str, value: f32| drone.check_param(name, value).map_err(|e| e.to_string()),
+        );
+        self.process(link_now);
+        from_station
+    }
+
     /// The stream connection carrying the link ended (TCP, serial).
     pub fn handle_stream_end(&mut self, link_now: Duration) {
         self.handle_stream_end_on(0, link_now);
@@ -392,6 +410,10 @@ impl SansIo for LinkedDrone {
 
     fn handle_bytes_on(&mut self, path: usize, now: Duration, bytes: &[u8]) {
         LinkedDrone::handle_bytes_on(self, path, now, bytes);
+    }
+
+    fn handle_datagram_on(&mut self, path: usize, now: Duration, datagram: &[u8]) -> bool {
+        LinkedDrone::handle_datagram_on(self, path, now, datagram)
     }
 
     fn handle_timeout(&mut self, now: Duration) {
