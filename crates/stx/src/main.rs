@@ -71,6 +71,9 @@ impl std::error::Error for BadInput {}
 fn main() -> ExitCode {
     let cli = Cli::parse();
     logging::init(cli.log_format);
+    if cli.command.is_offline_report() {
+        default_sigpipe();
+    }
     let result = match cli.command {
         Command::Sim(args) => sim::run(args),
         Command::Bench(args) => bench::run(args),
@@ -92,5 +95,30 @@ fn main() -> ExitCode {
                 ExitCode::from(1)
             }
         }
+    }
+}
+
+impl Command {
+    /// Commands that only compute and print (no sockets): they may end quietly when their
+    /// reader goes away, as `stx analyze | head` expects.
+    fn is_offline_report(&self) -> bool {
+        matches!(
+            self,
+            Command::Sim(_)
+                | Command::Montecarlo(_)
+                | Command::Analyze(_)
+                | Command::Tune(_)
+                | Command::Record(_)
+        )
+    }
+}
+
+/// Rust ignores SIGPIPE, so a `println!` into a closed pipe panics. A report command gets the
+/// default disposition back (ended by the signal, as `cat` would be). The daemon, the drone and
+/// the benches keep it ignored: their sockets must see EPIPE as an error, not end the process.
+fn default_sigpipe() {
+    // SAFETY: called once at start-up, before any thread is spawned; SIG_DFL is a valid handler.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
     }
 }
