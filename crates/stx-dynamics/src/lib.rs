@@ -9,7 +9,10 @@
 //! - [`model`] evaluates the equations of motion `M [Ẋ; F_C] = N`: the state derivative and
 //!   the four line tensions, for a state, the control inputs and the environment;
 //! - [`integrate`] advances any [`integrate::OdeSystem`] in time (fixed-step RK4, adaptive
-//!   Dormand–Prince 5(4)) and finds events such as ground contact between steps.
+//!   Dormand–Prince 5(4)) and finds events such as ground contact between steps;
+//! - [`state`] lays out the 31 states and the controls, [`rotation`] holds the frames' rotation matrices and Euler
+//!   kinematics in the seed's conventions, and [`output`] turns a state into what a run
+//!   reports (per-body positions, velocities, angles, tensions, air data, servos).
 //!
 //! Nothing here does I/O beyond parsing a string, knows about wall-clock time or draws
 //! randomness it was not given a seed for: callers own time and files.
