@@ -9,8 +9,11 @@ use std::process::{Command, Stdio};
 
 #[test]
 fn a_report_into_a_closed_pipe_ends_without_a_panic() {
+    let out_dir = std::env::temp_dir().join(format!("stx-cli-pipe-{}", std::process::id()));
     let mut child = Command::new(env!("CARGO_BIN_EXE_stx"))
         .arg("analyze")
+        .arg("--out-dir")
+        .arg(&out_dir)
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
@@ -28,6 +31,7 @@ fn a_report_into_a_closed_pipe_ends_without_a_panic() {
         .read_to_string(&mut stderr)
         .expect("stderr is read");
     let status = child.wait().expect("stx ends");
+    let _ = std::fs::remove_dir_all(&out_dir);
     assert!(!stderr.contains("panicked"), "no panic: {stderr}");
     assert!(
         status.success() || status.signal() == Some(libc_sigpipe()),
