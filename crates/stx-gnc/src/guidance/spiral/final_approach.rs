@@ -20,6 +20,15 @@ const S_TURN_EXCESS_M: f64 = 10.0;
 const S_TURN_HALF_WIDTH_M: f64 = 40.0;
 /// Course offset of an S-turn leg from the final course, rad (100°: slightly back downwind).
 const S_TURN_ANGLE_RAD: f64 = 1.7453;
+/// Time constant of the learned glide correction on final, s: long against gusts and the
+/// brakes' own transient (≈ 2 s), short against a final of a minute or more.
+const GLIDE_LEARN_TIME_S: f64 = 8.0;
+/// The learned correction stays within this of the polar's glide over the ground.
+const GLIDE_CORRECTION_LIMIT: f64 = 0.4;
+/// Heading rate above which the glide is not learned (turning, not gliding), rad/s.
+const GLIDE_LEARN_MAX_TURN_RAD_S: f64 = 0.1;
+/// Sink rate below which the measured glide is not learned (a flare, a thermal), m/s.
+const GLIDE_LEARN_MIN_SINK_MPS: f64 = 1.0;
 
 /// The final approach's geometry and energy at one update.
 #[derive(Debug, Clone, Copy)]
@@ -96,6 +105,11 @@ pub(super) struct FinalApproach {
     /// Slope of the glide path on this final approach (seed's GS0), fixed at the turn onto
     /// it, with [`FinalLaw::GlideSlope`].
     slope: Option<f64>,
+    /// Glide over the ground flown on this final minus what the polar gives for the brake and
+    /// headwind flown (low-passed), added to the polar's glide when choosing the brake.
+    glide_correction: f64,
+    /// Estimate time of the last update on final, s.
+    last_time_s: Option<f64>,
 }
 
 impl Default for FinalApproach {
@@ -104,6 +118,8 @@ impl Default for FinalApproach {
             last_brake: 0.0,
             weave_right: true,
             slope: None,
+            glide_correction: 0.0,
+            last_time_s: None,
         }
     }
 }
@@ -133,6 +149,14 @@ impl FinalApproach {
             excess_m: final_excess_m,
         } = *geometry;
         let target_ne = final_line.point_ne_m;
+        self.learn_glide(
+            perf,
+            est,
+            final_course,
+            w_along_measured,
+            density,
+            final_excess_m,
+        );
         let brake = if height_to_flare <= 0.0 || to_go_before_flare <= 0.0 {
             if sc.flare { 1.0 } else { self.last_brake }
         } else {
@@ -145,8 +169,13 @@ impl FinalApproach {
                 // final kept height in hand and spent it late, which saved the odd
                 // final caught by a strengthening wind but cost more elsewhere (the
                 // Monte Carlo comparison is in GNC_NOTES.md).
+                //
+                // The polar's glide is corrected by what this final has flown
+                // (`learn_glide`): a closed loop on the polar alone held the brakes on
+                // while the stack sank faster than the polar says (gusts, the brakes'
+                // working) and fell 20–40 m short into strong headwinds.
                 FinalLaw::GlideInversion => perf.brake_for_ground_glide(
-                    to_go_before_flare / height_to_flare,
+                    to_go_before_flare / height_to_flare - self.glide_correction,
                     w_along_measured,
                     density,
                 ),
@@ -230,9 +259,43 @@ impl FinalApproach {
         }
     }
 
-    /// Forgets the glide slope of a final approach that has ended.
+    /// Forgets the glide slope and what was learned of a final approach that has ended.
     pub(super) fn end(&mut self) {
         self.slope = None;
+        self.glide_correction = 0.0;
+        self.last_time_s = None;
+    }
+
+    /// Learns how far the glide over the ground flown along the final differs from the
+    /// polar's for the brake held and the headwind measured: only in straight flight along
+    /// the line (not in S-turns or turns, where the glide along the line is not the glide).
+    fn learn_glide(
+        &mut self,
+        perf: &GlidePerformance,
+        est: &Estimate,
+        final_course: f64,
+        headwind_mps: f64,
+        density: f64,
+        excess_m: f64,
+    ) {
+        let dt = match self.last_time_s.replace(est.time_s) {
+            Some(t) => (est.time_s - t).max(0.0),
+            None => return,
+        };
+        let straight = est.heading_rate_rad_s.abs() < GLIDE_LEARN_MAX_TURN_RAD_S
+            && excess_m <= S_TURN_EXCESS_M
+            && est.sink_rate_mps > GLIDE_LEARN_MIN_SINK_MPS;
+        if !straight || dt <= 0.0 {
+            return;
+        }
+        let along_mps = est.velocity_ned_mps.x * final_course.cos()
+            + est.velocity_ned_mps.y * final_course.sin();
+        let flown = along_mps / est.sink_rate_mps;
+        let polar = perf.ground_glide(self.last_brake, headwind_mps, density);
+        let gain = (dt / GLIDE_LEARN_TIME_S).min(1.0);
+        self.glide_correction = (self.glide_correction
+            + gain * (flown - polar - self.glide_correction))
+            .clamp(-GLIDE_CORRECTION_LIMIT, GLIDE_CORRECTION_LIMIT);
     }
 }
 
@@ -246,4 +309,57 @@ fn follow(config: &GuidanceConfig, line: &Localizer, est: &Estimate, position: [
         est.heading_rate_rad_s,
     )
     .main_line_m
+}
+
+#[cfg(test)]
+mod tests {
+    use nalgebra::Vector3;
+
+    use super::*;
+    use crate::pointmass::{Conditions, PointMass};
+
+    /// A point mass flown straight up the final (north, into a 3.5 m/s north wind) at a fixed
+    /// brake for 60 s; what the final approach learned of its glide.
+    fn learned(sink_scale: f64, turning: bool) -> f64 {
+        let perf = GlidePerformance::default();
+        let wind = Vector3::new(-3.5, 0.0, 0.0);
+        let air = Conditions {
+            sink_scale,
+            ..Conditions::nominal(wind, perf.reference_density_kg_per_m3)
+        };
+        let mut stack = PointMass::new(0.0, Vector3::new(-200.0, 0.0, -400.0), 0.0);
+        let mut fa = FinalApproach {
+            last_brake: 0.8,
+            ..FinalApproach::default()
+        };
+        let controls = Controls {
+            main_line_m: if turning { 0.02 } else { 0.0 },
+            brake_right: 0.8,
+            brake_left: 0.8,
+        };
+        for _ in 0..600 {
+            stack.step(&perf, &controls, &air, 0.1);
+            let est = stack.estimate(&wind);
+            fa.learn_glide(&perf, &est, 0.0, 3.5, air.density_kg_per_m3, 0.0);
+        }
+        fa.glide_correction
+    }
+
+    #[test]
+    fn the_final_learns_the_glide_it_flies_and_only_in_straight_flight() {
+        // As the polar says: nothing to correct.
+        assert!(learned(1.0, false).abs() < 0.02, "{}", learned(1.0, false));
+        // Sinking 15 % faster than the polar: the glide over the ground is 13 % shorter.
+        let perf = GlidePerformance::default();
+        let polar = perf.ground_glide(0.8, 3.5, perf.reference_density_kg_per_m3);
+        let want = polar / 1.15 - polar;
+        let got = learned(1.15, false);
+        assert!(
+            (got - want).abs() < 0.02,
+            "learned {got:.3}, flown − polar {want:.3}"
+        );
+        // Turning, the glide along the line is not the glide: nothing learned but in the
+        // second the turn takes to build up.
+        assert!(learned(1.15, true).abs() < 0.01, "{}", learned(1.15, true));
+    }
 }
