@@ -591,3 +591,42 @@ fn the_same_seed_flies_the_same_mission() {
     fly(&mut c, &mut log, |_| false);
     assert_ne!(a.landing(), c.landing(), "another seed, other sensor noise");
 }
+
+/// Regression (issue 17 item 2): MAVProxy announced "fence breach" on connecting, because
+/// SYS_STATUS left the health bit of the geofence (which the drone does not have) clear. A
+/// subsystem not present is reported healthy; a present one is unhealthy only when it fails.
+#[test]
+fn sys_status_reports_absent_subsystems_healthy_and_present_ones_as_they_are() {
+    const GEOFENCE: u32 = 0x10_0000; // MAV_SYS_STATUS_GEOFENCE
+    const GPS: u32 = 0x20; // MAV_SYS_STATUS_SENSOR_GPS
+    let config = mission("rehearsal");
+    let mut d = drone(&config);
+    let mut log = Log::default();
+    fly(&mut d, &mut log, |d| d.time_s() > 10.0);
+    let statuses: Vec<_> = log
+        .telemetry
+        .iter()
+        .filter_map(|(_, m)| match m {
+            Telemetry::System(s) => Some(*s),
+            _ => None,
+        })
+        .collect();
+    assert!(!statuses.is_empty(), "SYS_STATUS is sent");
+    for s in &statuses {
+        assert_eq!(s.sensors_present & GEOFENCE, 0, "no geofence on board");
+        assert_eq!(s.sensors_health & GEOFENCE, GEOFENCE, "absent: healthy");
+        assert_eq!(
+            s.sensors_health | s.sensors_present,
+            u32::MAX,
+            "every absent bit healthy"
+        );
+        assert_eq!(
+            s.sensors_enabled & !s.sensors_present,
+            0,
+            "nothing absent is enabled"
+        );
+    }
+    let last = statuses.last().expect("one");
+    assert_eq!(last.sensors_present & GPS, GPS);
+    assert_eq!(last.sensors_health & GPS, GPS, "GPS fixes arrive: healthy");
+}

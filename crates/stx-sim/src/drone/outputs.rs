@@ -130,7 +130,10 @@ impl Drone {
             comm_errors: 0,
             sensors_present: sensor_bits::ALL,
             sensors_enabled: sensor_bits::ALL,
-            sensors_health: health,
+            // A subsystem the drone does not have is reported healthy, as ArduPilot and PX4
+            // do: ground stations read a clear health bit as a fault whatever `present`
+            // says (MAVProxy announced "fence breach" for the geofence the drone lacks).
+            sensors_health: health | !sensor_bits::ALL,
         }
     }
 

@@ -1,0 +1,176 @@
+//! `stx drone` against MAVProxy 1.8.75 (from PyPI), a ground station nobody here wrote, driven
+//! through its command line as an operator would: it sees the vehicle, fetches the parameters,
+//! sets one and reads it back, changes the mode, and reads the health of what the drone
+//! reports — with no false alarm on the way.
+//!
+//! Regression (issue 17 item 2): connecting MAVProxy announced "fence breach" at once, because
+//! SYS_STATUS left the health bit of a geofence the drone does not have clear.
+//!
+//! Python: `$STX_PYTHON` or `.venv/bin/python` at the workspace root, with MAVProxy installed
+//! (`tests/run-all` does both).
+
+use std::io::{BufRead, BufReader, Write};
+use std::net::UdpSocket;
+use std::path::{Path, PathBuf};
+use std::process::{Child, ChildStdin, Command, Stdio};
+use std::sync::mpsc::{self, Receiver};
+use std::time::{Duration, Instant};
+
+fn python() -> PathBuf {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let p = std::env::var_os("STX_PYTHON")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| root.join(".venv/bin/python"));
+    assert!(
+        p.exists(),
+        "MAVProxy peer: no Python at {} (set STX_PYTHON or run tests/run-all once)",
+        p.display()
+    );
+    p
+}
+
+/// Kills the process when the test ends, passed or not.
+struct Killed(Child);
+
+impl Drop for Killed {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
+/// MAVProxy's console: lines in, everything it printed kept.
+struct Console {
+    stdin: ChildStdin,
+    lines: Receiver<String>,
+    seen: Vec<String>,
+}
+
+impl Console {
+    fn send(&mut self, command: &str) {
+        writeln!(self.stdin, "{command}").expect("MAVProxy reads its console");
+        self.stdin.flush().expect("flush");
+    }
+
+    /// Waits up to `secs` for a line that `pred` accepts; returns it.
+    fn wait_for(&mut self, secs: u64, what: &str, pred: impl Fn(&str) -> bool) -> String {
+        let deadline = Instant::now() + Duration::from_secs(secs);
+        while Instant::now() < deadline {
+            if let Ok(line) = self.lines.recv_timeout(Duration::from_millis(100)) {
+                self.seen.push(line.clone());
+                if pred(&line) {
+                    return line;
+                }
+            }
+        }
+        panic!(
+            "MAVProxy did not show {what} in {secs} s; it printed:\n{}",
+            self.seen.join("\n")
+        );
+    }
+
+    /// Reads what it prints for `secs` seconds.
+    fn drain(&mut self, secs: u64) {
+        let deadline = Instant::now() + Duration::from_secs(secs);
+        while Instant::now() < deadline {
+            if let Ok(line) = self.lines.recv_timeout(Duration::from_millis(100)) {
+                self.seen.push(line);
+            }
+        }
+    }
+}
+
+#[test]
+fn mavproxy_fetches_sets_parameters_changes_mode_and_raises_no_false_alarm() {
+    let port = UdpSocket::bind("127.0.0.1:0")
+        .and_then(|s| s.local_addr())
+        .expect("a free port")
+        .port();
+    let work = std::env::temp_dir().join(format!("stx-mavproxy-{}", std::process::id()));
+    std::fs::create_dir_all(&work).expect("work dir");
+    let mut mavproxy = Command::new(python())
+        .args(["-m", "MAVProxy.mavproxy"])
+        .arg(format!("--master=udpin:127.0.0.1:{port}"))
+        .args(["--nowait", "--show-errors"])
+        .current_dir(&work)
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::null())
+        .spawn()
+        .expect("MAVProxy starts (is it installed in the venv?)");
+    let stdin = mavproxy.stdin.take().expect("stdin");
+    let stdout = mavproxy.stdout.take().expect("stdout");
+    let _mavproxy = Killed(mavproxy);
+    let (tx, lines) = mpsc::channel();
+    std::thread::spawn(move || {
+        for line in BufReader::new(stdout).lines() {
+            let Ok(line) = line else { break };
+            if tx.send(line).is_err() {
+                break;
+            }
+        }
+    });
+    let _drone = Killed(
+        Command::new(env!("CARGO_BIN_EXE_stx"))
+            .args(["drone", "--scenario", "rehearsal", "--speed", "1"])
+            .arg("--connect")
+            .arg(format!("udpout:127.0.0.1:{port}"))
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .expect("stx drone starts"),
+    );
+    let mut c = Console {
+        stdin,
+        lines,
+        seen: Vec::new(),
+    };
+
+    c.wait_for(30, "the vehicle online", |l| l.contains("online system 1"));
+    c.send("param fetch");
+    let received = c.wait_for(60, "the parameters received", |l| {
+        l.contains("Received") && l.contains("parameters")
+    });
+    let count: usize = received
+        .split_whitespace()
+        .find_map(|w| w.parse().ok())
+        .unwrap_or(0);
+    assert!(count >= 20, "{received}");
+
+    c.send("param set SP_FLARE_H 7");
+    c.drain(2);
+    c.send("param show SP_FLARE_H");
+    c.wait_for(10, "SP_FLARE_H read back as 7", |l| {
+        let mut words = l
+            .split_whitespace()
+            .skip_while(|w| !w.ends_with("SP_FLARE_H"));
+        words.nth(1).and_then(|v| v.parse::<f64>().ok()) == Some(7.0)
+    });
+
+    // Heading mode (custom mode 2) through COMMAND_LONG DO_SET_MODE: MAVProxy has no names for
+    // a parafoil's modes, so the operator gives the number.
+    c.send("long DO_SET_MODE 1 2");
+    c.wait_for(10, "the mode change accepted", |l| {
+        l.contains("DO_SET_MODE") && l.contains("ACCEPTED")
+    });
+
+    c.send("status SYS_STATUS");
+    let status = c.wait_for(10, "SYS_STATUS", |l| {
+        l.contains("onboard_control_sensors_health")
+    });
+    c.drain(3);
+    let alarms: Vec<&String> = c
+        .seen
+        .iter()
+        .filter(|l| {
+            let l = l.to_lowercase();
+            l.contains("breach") || l.contains("unhealthy") || l.contains("failsafe")
+        })
+        .collect();
+    assert!(
+        alarms.is_empty(),
+        "false alarms: {alarms:?}\nSYS_STATUS: {status}\nall:\n{}",
+        c.seen.join("\n")
+    );
+    let _ = std::fs::remove_dir_all(&work);
+}
