@@ -1,6 +1,7 @@
 //! `stx drone` against MAVProxy 1.8.75 (from PyPI), a ground station nobody here wrote, driven
 //! through its command line as an operator would: it sees the vehicle, fetches the parameters,
-//! sets one and reads it back, changes the mode, and reads the health of what the drone
+//! sets one and reads it back, has a fraction refused with the reason where only whole numbers
+//! go, changes the mode, and reads the health of what the drone
 //! reports — with no false alarm on the way.
 //!
 //! Regression (issue 17 item 2): connecting MAVProxy announced "fence breach" at once, because
@@ -145,6 +146,12 @@ fn mavproxy_fetches_sets_parameters_changes_mode_and_raises_no_false_alarm() {
             .split_whitespace()
             .skip_while(|w| !w.ends_with("SP_FLARE_H"));
         words.nth(1).and_then(|v| v.parse::<f64>().ok()) == Some(7.0)
+    });
+
+    // A choice takes whole numbers: a fraction is refused, and the drone says why.
+    c.send("param set FS_GPS_ACTION 1.05");
+    c.wait_for(10, "the refusal of 1.05 explained", |l| {
+        l.contains("FS_GPS_ACTION") && l.contains("whole numbers")
     });
 
     // Heading mode (custom mode 2) through COMMAND_LONG DO_SET_MODE: MAVProxy has no names for

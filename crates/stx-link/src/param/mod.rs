@@ -13,7 +13,9 @@
 //!   set, before the echo, so the only PARAM_VALUE a set produces is the value in force: a
 //!   station never sees a value that is put back a moment later.
 //!
-//! Every value travels as `MAV_PARAM_TYPE_REAL32`.
+//! Values travel as `MAV_PARAM_TYPE_REAL32`, those of parameters of whole numbers (choices,
+//! flags: [`ParamSpec::whole`]) as `INT32` cast to the float field (ArduPilot's encoding), and a
+//! set of a fraction to one of those is refused like any other refused set.
 //!
 //! ## Files
 //! - `value.rs`: [`ParamValue`] and the name rules both sides share.

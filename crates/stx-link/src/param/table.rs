@@ -24,10 +24,14 @@ pub struct ParamSpec {
     pub max: f32,
     /// What it does, with its unit.
     pub description: String,
+    /// Whole numbers only (a choice, a flag): advertised as `MAV_PARAM_TYPE_INT32`, and a set
+    /// with a fraction is refused.
+    #[serde(default)]
+    pub integer: bool,
 }
 
 impl ParamSpec {
-    /// A parameter definition.
+    /// A parameter definition taking any number in its range.
     pub fn new(name: &str, default: f32, min: f32, max: f32, description: &str) -> Self {
         Self {
             name: name.to_string(),
@@ -35,6 +39,15 @@ impl ParamSpec {
             min,
             max,
             description: description.to_string(),
+            integer: false,
+        }
+    }
+
+    /// The same definition, taking whole numbers only.
+    pub fn whole(self) -> Self {
+        Self {
+            integer: true,
+            ..self
         }
     }
 }
@@ -70,6 +83,9 @@ pub enum ParamTableError {
         min: f32,
         max: f32,
     },
+    /// Set of a fraction to a parameter that takes whole numbers only.
+    #[error("{name} = {value} refused: it takes whole numbers only")]
+    NotWhole { name: String, value: f32 },
     /// Set refused by the application's validator.
     #[error("{name} = {value} refused: {reason}")]
     Refused {
@@ -171,6 +187,7 @@ impl ParamTable {
                 });
             }
             if !(s.min.is_finite() && s.max.is_finite() && s.min <= s.default && s.default <= s.max)
+                || (s.integer && s.default.fract() != 0.0)
             {
                 return Err(ParamTableError::BadDefault {
                     name: s.name.clone(),
@@ -219,6 +236,14 @@ impl ParamTable {
         })
     }
 
+    /// The PARAM_VALUE announcing the parameter at `index`, typed as its spec says.
+    fn announce(&mut self, index: usize) {
+        let integer = self.specs.get(index).is_some_and(|s| s.integer);
+        if let Some(v) = self.value_at(index) {
+            self.transmit.push_back(param_value_msg(&v, integer));
+        }
+    }
+
     /// Sets a value locally (from the application, which has checked it), announcing it to
     /// the station. Only the table's range is checked.
     pub fn set(&mut self, name: &str, value: f32) -> Result<(), ParamTableError> {
@@ -242,6 +267,12 @@ impl ParamTable {
                 value,
                 min: spec.min,
                 max: spec.max,
+            });
+        }
+        if spec.integer && value.fract() != 0.0 {
+            return Err(ParamTableError::NotWhole {
+                name: name.to_string(),
+                value,
             });
         }
         Ok(i)
@@ -273,9 +304,7 @@ impl ParamTable {
                 });
             }
         }
-        if let Some(v) = self.value_at(i) {
-            self.transmit.push_back(param_value_msg(&v));
-        }
+        self.announce(i);
         Ok(())
     }
 
@@ -299,9 +328,7 @@ impl ParamTable {
         match msg {
             MavMessage::PARAM_REQUEST_LIST(r) if for_us(r.target_system, r.target_component) => {
                 for i in 0..self.specs.len() {
-                    if let Some(v) = self.value_at(i) {
-                        self.transmit.push_back(param_value_msg(&v));
-                    }
+                    self.announce(i);
                 }
                 true
             }
@@ -314,8 +341,8 @@ impl ParamTable {
                     let name = name_from_wire(&r.param_id);
                     self.specs.iter().position(|s| s.name == name)
                 };
-                match index.and_then(|i| self.value_at(i)) {
-                    Some(v) => self.transmit.push_back(param_value_msg(&v)),
+                match index.filter(|&i| i < self.specs.len()) {
+                    Some(i) => self.announce(i),
                     None => {
                         self.stats.unknown_requests += 1;
                         tracing::debug!(index = r.param_index, name = %name_from_wire(&r.param_id), "read of unknown parameter");
@@ -340,7 +367,7 @@ impl ParamTable {
                         if let Some(i) = self.specs.iter().position(|sp| sp.name == name)
                             && let Some(v) = self.value_at(i)
                         {
-                            self.transmit.push_back(param_value_msg(&v));
+                            self.announce(i);
                             self.refusals.push_back(ParamRefusal {
                                 name: name.clone(),
                                 value: s.param_value,
@@ -385,6 +412,8 @@ impl ParamTable {
 
 #[cfg(test)]
 mod tests {
+    use mavlink::dialects::common::MavParamType;
+
     use super::*;
 
     #[test]
@@ -412,5 +441,92 @@ mod tests {
             ),
             Err(ParamTableError::Duplicate { .. })
         ));
+        assert!(matches!(
+            ParamTable::new(1, 1, vec![ParamSpec::new("A", 0.5, 0.0, 1.0, "").whole()]),
+            Err(ParamTableError::BadDefault { .. })
+        ));
+    }
+
+    fn answers(t: &mut ParamTable) -> Vec<(String, f32, MavParamType)> {
+        std::iter::from_fn(|| t.poll_transmit())
+            .filter_map(|m| match m {
+                MavMessage::PARAM_VALUE(v) => {
+                    Some((name_from_wire(&v.param_id), v.param_value, v.param_type))
+                }
+                _ => None,
+            })
+            .collect()
+    }
+
+    fn set(name: &str, value: f32) -> MavMessage {
+        MavMessage::PARAM_SET(mavlink::dialects::common::PARAM_SET_DATA {
+            param_value: value,
+            target_system: 1,
+            target_component: 1,
+            param_id: super::super::value::name_to_wire(name),
+            param_type: MavParamType::MAV_PARAM_TYPE_REAL32,
+        })
+    }
+
+    /// Regression (issue 17 item 3): a parameter of whole numbers was advertised as REAL32,
+    /// so a generic ground station offered a float editor, and its write of 1.05 was answered
+    /// with the old value and no word why.
+    #[test]
+    fn whole_numbers_are_advertised_as_int32_and_a_fraction_is_refused_with_a_reason() {
+        let mut t = ParamTable::new(
+            1,
+            1,
+            vec![
+                ParamSpec::new("FS_GPS_ACTION", 1.0, 0.0, 2.0, "choice").whole(),
+                ParamSpec::new("SP_FLARE_H", 6.0, 0.0, 30.0, "m"),
+            ],
+        )
+        .expect("table");
+        t.handle_message(&MavMessage::PARAM_REQUEST_LIST(
+            mavlink::dialects::common::PARAM_REQUEST_LIST_DATA {
+                target_system: 1,
+                target_component: 1,
+            },
+        ));
+        assert_eq!(
+            answers(&mut t),
+            vec![
+                (
+                    "FS_GPS_ACTION".into(),
+                    1.0,
+                    MavParamType::MAV_PARAM_TYPE_INT32
+                ),
+                (
+                    "SP_FLARE_H".into(),
+                    6.0,
+                    MavParamType::MAV_PARAM_TYPE_REAL32
+                ),
+            ]
+        );
+        t.handle_message(&set("FS_GPS_ACTION", 1.05));
+        assert_eq!(
+            answers(&mut t),
+            vec![(
+                "FS_GPS_ACTION".into(),
+                1.0,
+                MavParamType::MAV_PARAM_TYPE_INT32
+            )],
+            "the value in force answers"
+        );
+        let (_, text) = t.poll_text().expect("a text says why");
+        assert!(text.contains("whole numbers"), "{text}");
+        assert_eq!(t.poll_refusal().map(|r| r.in_force), Some(1.0));
+        t.handle_message(&set("FS_GPS_ACTION", 2.0));
+        assert_eq!(
+            answers(&mut t),
+            vec![(
+                "FS_GPS_ACTION".into(),
+                2.0,
+                MavParamType::MAV_PARAM_TYPE_INT32
+            )]
+        );
+        // A fraction is fine where fractions are.
+        t.handle_message(&set("SP_FLARE_H", 6.5));
+        assert_eq!(t.get("SP_FLARE_H"), Some(6.5));
     }
 }

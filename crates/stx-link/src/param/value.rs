@@ -1,6 +1,6 @@
 //! A parameter as it travels: its name (1..=16 ASCII bytes, checked alike by both sides and
 //! refused with [`ParamRequestError::BadName`]), its value as [`ParamValue`] and the
-//! PARAM_VALUE that carries it, always as `MAV_PARAM_TYPE_REAL32`.
+//! PARAM_VALUE that carries it, as `MAV_PARAM_TYPE_REAL32` or, for whole numbers, `INT32`.
 
 use mavlink::dialects::common as mc;
 use mavlink::dialects::common::MavMessage;
@@ -36,13 +36,20 @@ pub(super) fn name_from_wire(id: &mavlink::types::CharArray<16>) -> String {
     String::from_utf8_lossy(raw.get(..end).unwrap_or(&[])).into_owned()
 }
 
-pub(super) fn param_value_msg(p: &ParamValue) -> MavMessage {
+/// The PARAM_VALUE carrying `p`: `REAL32`, or `INT32` for a parameter of whole numbers,
+/// its value then cast to the float field as ArduPilot does ("C-cast" encoding), which
+/// MAVProxy and pymavlink read as the number it is for a vehicle that is not PX4.
+pub(super) fn param_value_msg(p: &ParamValue, integer: bool) -> MavMessage {
     MavMessage::PARAM_VALUE(mc::PARAM_VALUE_DATA {
         param_value: p.value,
         param_count: p.count,
         param_index: p.index,
         param_id: name_to_wire(&p.name),
-        param_type: mc::MavParamType::MAV_PARAM_TYPE_REAL32,
+        param_type: if integer {
+            mc::MavParamType::MAV_PARAM_TYPE_INT32
+        } else {
+            mc::MavParamType::MAV_PARAM_TYPE_REAL32
+        },
     })
 }
 

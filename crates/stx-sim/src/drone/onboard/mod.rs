@@ -73,7 +73,7 @@ use stx_gnc::estimate::Estimate;
 use stx_gnc::geo::LocalFrame;
 use stx_gnc::guidance::{Guidance, Plan};
 use stx_gnc::mission::{FlightMode, FlightStage, GuidancePhase};
-use stx_gnc::params::{CATALOG, OnboardSettings, ParamError};
+use stx_gnc::params::{CATALOG, OnboardSettings, ParamError, ParamKind};
 use stx_link::manual::Sticks;
 use stx_link::param::ParamSpec;
 use stx_link::telemetry::Severity;
@@ -103,6 +103,7 @@ pub fn param_specs(settings: &OnboardSettings, main_line_travel_m: f64) -> Vec<P
                 min: p.min as f32,
                 max: max as f32,
                 description: format!("{}{units}", p.description),
+                integer: !matches!(p.kind, ParamKind::Real),
             }
         })
         .collect()
