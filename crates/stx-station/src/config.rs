@@ -8,6 +8,7 @@ use std::collections::HashMap;
 use std::ffi::OsString;
 use std::net::SocketAddr;
 use std::path::PathBuf;
+use subtle::ConstantTimeEq;
 
 use serde::{Deserialize, Serialize};
 use stx_gnc::geo::LocalFrame;
@@ -339,16 +340,9 @@ impl StationConfig {
     pub fn authenticate(&self, token: &str) -> Option<(&str, Role)> {
         self.tokens
             .iter()
-            .find(|t| constant_time_eq(t.token.as_bytes(), token.as_bytes()))
+            .find(|t| bool::from(t.token.as_bytes().ct_eq(token.as_bytes())))
             .map(|t| (t.name.as_str(), t.role))
     }
-}
-
-fn constant_time_eq(a: &[u8], b: &[u8]) -> bool {
-    if a.len() != b.len() {
-        return false;
-    }
-    a.iter().zip(b).fold(0_u8, |acc, (x, y)| acc | (x ^ y)) == 0
 }
 
 #[cfg(test)]

@@ -14,7 +14,8 @@
 //!   reads (parameter ranges, units and meanings come from the onboard catalogue,
 //!   `stx_gnc::params`, shared with the drone); [`contract`]: all of them as one JSON Schema,
 //!   the contract the dashboard's TypeScript types are generated from; [`kml`]: the Google
-//!   Earth feed.
+//!   Earth feed; [`limits`]: requests per token, wrong tokens per address and pages at once,
+//!   as token buckets on the station's clock.
 //!
 //! With the default feature `daemon`, the adapters:
 //! - `http`: the axum routes (auth, REST, WebSocket, KML, static files);
@@ -28,6 +29,7 @@ pub mod daemon;
 #[cfg(feature = "daemon")]
 pub mod http;
 pub mod kml;
+pub mod limits;
 pub mod link;
 pub mod messages;
 pub mod replies;

@@ -518,7 +518,7 @@ pub struct TrackPoint {
 #[derive(Debug, Clone, Serialize, JsonSchema)]
 pub struct ErrorBody {
     /// Machine-readable kind.
-    #[schemars(extend("enum" = ["unauthorized", "forbidden", "bad_request", "not_found", "not_armed"]))]
+    #[schemars(extend("enum" = ["unauthorized", "forbidden", "bad_request", "not_found", "not_armed", "too_many_requests"]))]
     pub error: &'static str,
     /// For people: what is wrong.
     pub reason: String,

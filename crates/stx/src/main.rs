@@ -15,6 +15,7 @@ mod montecarlo;
 mod record;
 mod serve;
 mod sim;
+mod token;
 mod tune;
 
 use std::process::ExitCode;
@@ -54,6 +55,8 @@ enum Command {
     Drone(drone::DroneArgs),
     /// Flight recordings (MCAP): `stx record recover FILE` repairs a cut one.
     Record(record::RecordArgs),
+    /// Station tokens: `stx token new` prints a strong random one as a `[[tokens]]` entry.
+    Token(token::TokenArgs),
 }
 
 /// An error that is the user's input, not the program's failure (exit code 2).
@@ -83,6 +86,7 @@ fn main() -> ExitCode {
         Command::Tune(args) => tune::run(args),
         Command::Drone(args) => drone::run(args),
         Command::Record(args) => record::run(args),
+        Command::Token(args) => token::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -109,6 +113,7 @@ impl Command {
                 | Command::Analyze(_)
                 | Command::Tune(_)
                 | Command::Record(_)
+                | Command::Token(_)
         )
     }
 }

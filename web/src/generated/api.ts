@@ -1134,7 +1134,7 @@ export interface ErrorBody {
   /**
    * Machine-readable kind.
    */
-  error: "unauthorized" | "forbidden" | "bad_request" | "not_found" | "not_armed";
+  error: "unauthorized" | "forbidden" | "bad_request" | "not_found" | "not_armed" | "too_many_requests";
   /**
    * For people: what is wrong.
    */

@@ -185,6 +185,7 @@ pub async fn run(
         broadcast: broadcast_tx,
         states: watch::channel(StateFrame::default()).0,
         clients: Mutex::new(Default::default()),
+        limits: Mutex::new(Default::default()),
         next_client: Default::default(),
         broadcast_total: Default::default(),
     });
@@ -222,9 +223,12 @@ async fn serve(
     stop: impl Future<Output = ()> + Send + 'static,
 ) -> std::io::Result<()> {
     let Some(tls) = tls else {
-        return axum::serve(listener, router(shared))
-            .with_graceful_shutdown(stop)
-            .await;
+        return axum::serve(
+            listener,
+            router(shared).into_make_service_with_connect_info::<SocketAddr>(),
+        )
+        .with_graceful_shutdown(stop)
+        .await;
     };
     let handle = axum_server::Handle::new();
     let stopper = handle.clone();
@@ -235,6 +239,6 @@ async fn serve(
     let server = axum_server::from_tcp_rustls(listener.into_std()?, tls)?;
     server
         .handle(handle)
-        .serve(router(shared).into_make_service())
+        .serve(router(shared).into_make_service_with_connect_info::<SocketAddr>())
         .await
 }

@@ -2,12 +2,15 @@
 //! Google Earth cannot set headers), its name and role from the station config; and the
 //! percent-encoding of tokens in URLs.
 
-use axum::extract::FromRequestParts;
+use std::net::SocketAddr;
+
+use axum::extract::{ConnectInfo, FromRequestParts};
 use axum::http::request::Parts;
 use axum::http::{StatusCode, header};
 
 use super::shared::{AppState, HttpError, error};
 use crate::config::Role;
+use crate::limits::Verdict;
 
 /// The authenticated caller.
 pub struct Caller {
@@ -93,6 +96,21 @@ impl FromRequestParts<AppState> for Caller {
     type Rejection = HttpError;
 
     async fn from_request_parts(parts: &mut Parts, state: &AppState) -> Result<Self, HttpError> {
+        let address = parts
+            .extensions
+            .get::<ConnectInfo<SocketAddr>>()
+            .map(|c| c.0.ip());
+        let now = state.now_s();
+        // An address that has sent too many wrong tokens is not heard until its bucket
+        // refills, whatever it sends (so a guesser cannot tell a right guess from the wait).
+        if let Some(ip) = address
+            && let Err(retry) = state.limits().may_try(now, ip)
+        {
+            return Err(HttpError::too_many(
+                "too many wrong tokens from this address",
+                retry,
+            ));
+        }
         let Some(token) = token_from(parts) else {
             return Err(error(
                 StatusCode::UNAUTHORIZED,
@@ -101,15 +119,41 @@ impl FromRequestParts<AppState> for Caller {
             ));
         };
         match state.config.authenticate(&token) {
-            Some((name, role)) => Ok(Caller {
-                name: name.to_string(),
-                role,
-            }),
-            None => Err(error(
-                StatusCode::UNAUTHORIZED,
-                "unauthorized",
-                "unknown token",
-            )),
+            Some((name, role)) => match state.limits().requests.take(now, &name.to_string()) {
+                Verdict::Allowed => Ok(Caller {
+                    name: name.to_string(),
+                    role,
+                }),
+                Verdict::Refused { retry, first } => {
+                    if first {
+                        tracing::warn!(token = name, address = ?address, "too many requests: slowed");
+                    }
+                    Err(HttpError::too_many(
+                        "too many requests with this token",
+                        retry,
+                    ))
+                }
+            },
+            None => {
+                if let Some(ip) = address
+                    && let Verdict::Refused { retry, first } =
+                        state.limits().bad_tokens.take(now, &ip)
+                {
+                    if first {
+                        tracing::warn!(%ip, "wrong tokens: address locked out for {} s", retry.0);
+                    }
+                    return Err(HttpError::too_many(
+                        "too many wrong tokens from this address",
+                        retry,
+                    ));
+                }
+                tracing::info!(address = ?address, "request with an unknown token");
+                Err(error(
+                    StatusCode::UNAUTHORIZED,
+                    "unauthorized",
+                    "unknown token",
+                ))
+            }
         }
     }
 }

@@ -15,6 +15,7 @@ use tokio::sync::{Notify, broadcast, watch};
 
 use crate::config::{Role, StationConfig};
 use crate::core::{ApiError, StationCore};
+use crate::limits::{Limits, RetryAfter};
 use crate::messages::ErrorBody;
 use crate::replies::ClientView;
 
@@ -41,6 +42,8 @@ pub struct Shared {
     pub next_client: AtomicU64,
     /// Messages put on [`Shared::broadcast`] so far (to tell how far behind a page is).
     pub broadcast_total: AtomicU64,
+    /// Requests per token and wrong tokens per address ([`crate::limits`]).
+    pub limits: Mutex<Limits>,
 }
 
 /// The newest `state`, numbered so a page can count the ones it skipped.
@@ -101,6 +104,11 @@ impl Shared {
         self.started.elapsed().as_secs_f64()
     }
 
+    /// The request limits, for a moment.
+    pub fn limits(&self) -> std::sync::MutexGuard<'_, Limits> {
+        self.limits.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
     /// The core, for a moment.
     pub fn core(&self) -> std::sync::MutexGuard<'_, StationCore> {
         // A panic while holding the lock would be a bug in the core; keep serving.
@@ -111,11 +119,26 @@ impl Shared {
 pub(crate) type AppState = Arc<Shared>;
 
 /// An error answered as `{error, reason}`.
-pub struct HttpError(StatusCode, ErrorBody);
+pub struct HttpError(StatusCode, ErrorBody, Option<RetryAfter>);
 
 impl IntoResponse for HttpError {
     fn into_response(self) -> Response {
-        (self.0, Json(self.1)).into_response()
+        let mut response = (self.0, Json(self.1)).into_response();
+        if let Some(RetryAfter(s)) = self.2 {
+            response
+                .headers_mut()
+                .insert(axum::http::header::RETRY_AFTER, s.into());
+        }
+        response
+    }
+}
+
+impl HttpError {
+    /// 429 Too Many Requests, with `Retry-After`.
+    pub(crate) fn too_many(reason: impl Into<String>, retry: RetryAfter) -> Self {
+        let mut e = error(StatusCode::TOO_MANY_REQUESTS, "too_many_requests", reason);
+        e.2 = Some(retry);
+        e
     }
 }
 
@@ -127,6 +150,7 @@ impl From<ApiError> for HttpError {
                 error: e.error,
                 reason: e.reason,
             },
+            None,
         )
     }
 }
@@ -142,6 +166,7 @@ pub(crate) fn error(
             error: kind,
             reason: reason.into(),
         },
+        None,
     )
 }
 

@@ -10,14 +10,15 @@ use std::sync::atomic::Ordering;
 
 use axum::extract::State;
 use axum::extract::ws::{Message, WebSocket, WebSocketUpgrade};
-use axum::response::Response;
+use axum::response::{IntoResponse, Response};
 use stx_link::manual::Sticks;
 use tokio::sync::broadcast;
 
 use super::auth::Caller;
 use super::rest::session_of;
-use super::shared::{AppState, ClientCounters, Shared};
+use super::shared::{AppState, ClientCounters, HttpError, Shared};
 use crate::config::Role;
+use crate::limits::{MAX_WEBSOCKETS, RetryAfter};
 use crate::messages::{EventMsg, Level};
 use crate::replies::{HelloMsg, HistoryMsg, LaggedMsg, PongMsg};
 use crate::requests::ClientMessage;
@@ -27,6 +28,22 @@ pub(crate) async fn websocket(
     caller: Caller,
     upgrade: WebSocketUpgrade,
 ) -> Response {
+    let pages = state
+        .clients
+        .lock()
+        .unwrap_or_else(|e| e.into_inner())
+        .len();
+    if pages >= MAX_WEBSOCKETS {
+        tracing::warn!(
+            pages,
+            "WebSocket refused: the station serves {MAX_WEBSOCKETS} pages at most"
+        );
+        return HttpError::too_many(
+            format!("the station serves {MAX_WEBSOCKETS} pages at once"),
+            RetryAfter(5),
+        )
+        .into_response();
+    }
     upgrade.on_upgrade(move |socket| serve_socket(state, caller, socket))
 }
 
