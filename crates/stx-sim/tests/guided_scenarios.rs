@@ -199,7 +199,6 @@ fn the_monte_carlo_gives_the_same_result_for_the_same_seed_on_any_thread_count()
 /// announced last.
 #[test]
 fn a_too_strong_wind_with_the_estimator_in_the_loop_is_called_and_flown_to_the_best_point() {
-    let sensors = SensorConfig::default();
     let config = MonteCarloConfig {
         runs: 30,
         seed: 3,
@@ -208,15 +207,7 @@ fn a_too_strong_wind_with_the_estimator_in_the_loop_is_called_and_flown_to_the_b
         only_run: Some(17),
         ..MonteCarloConfig::default()
     };
-    let report = run_all(
-        &config,
-        |c| {
-            SensedNavigation::new(&sensors, EstimatorConfig::default(), c.seed)
-                .map_err(|e| e.to_string())
-        },
-        |_| {},
-    )
-    .expect("runs");
+    let report = fly_sensed(&config);
     let run = &report.results[0];
     assert!(run.conditions.wind_speed_mps > 9.0);
     assert!(run.unreachable, "{:?}", run.events);
@@ -242,7 +233,6 @@ fn a_too_strong_wind_with_the_estimator_in_the_loop_is_called_and_flown_to_the_b
 /// short. Now the final learns the glide it flies and releases the brakes in time.
 #[test]
 fn finals_into_a_strong_headwind_no_longer_fall_short() {
-    let sensors = SensorConfig::default();
     for (index, before_m) in [(171, 38.5), (254, 33.7), (260, 30.1)] {
         let config = MonteCarloConfig {
             runs: 1000,
@@ -251,15 +241,7 @@ fn finals_into_a_strong_headwind_no_longer_fall_short() {
             only_run: Some(index),
             ..MonteCarloConfig::default()
         };
-        let report = run_all(
-            &config,
-            |c| {
-                SensedNavigation::new(&sensors, EstimatorConfig::default(), c.seed)
-                    .map_err(|e| e.to_string())
-            },
-            |_| {},
-        )
-        .expect("runs");
+        let report = fly_sensed(&config);
         let run = &report.results[0];
         assert!(run.conditions.wind_speed_mps > 3.3, "a strong wind");
         assert!(
@@ -269,4 +251,18 @@ fn finals_into_a_strong_headwind_no_longer_fall_short() {
             run.long_short_m
         );
     }
+}
+
+/// The campaign `config` flown with the default sensors and estimator.
+fn fly_sensed(config: &MonteCarloConfig) -> stx_sim::montecarlo::MonteCarloReport {
+    let sensors = SensorConfig::default();
+    run_all(
+        config,
+        |c| {
+            SensedNavigation::new(&sensors, EstimatorConfig::default(), c.seed)
+                .map_err(|e| e.to_string())
+        },
+        |_| {},
+    )
+    .expect("runs")
 }
