@@ -15,7 +15,8 @@
 //!   `stx_gnc::params`, shared with the drone); [`contract`]: all of them as one JSON Schema,
 //!   the contract the dashboard's TypeScript types are generated from; [`kml`]: the Google
 //!   Earth feed; [`limits`]: requests per token, wrong tokens per address and pages at once,
-//!   as token buckets on the station's clock.
+//!   as token buckets on the station's clock; [`recording`]: what a flight's MCAP recording
+//!   holds, under which topics.
 //!
 //! With the default feature `daemon`, the adapters:
 //! - `http`: the axum routes (auth, REST, WebSocket, KML, static files);
@@ -32,5 +33,6 @@ pub mod kml;
 pub mod limits;
 pub mod link;
 pub mod messages;
+pub mod recording;
 pub mod replies;
 pub mod requests;
