@@ -22,7 +22,8 @@
 
 import { spawn } from "node:child_process";
 import { createSocket } from "node:dgram";
-import { mkdir, readFile } from "node:fs/promises";
+import { mkdir, mkdtemp, readFile, readdir } from "node:fs/promises";
+import { tmpdir } from "node:os";
 import { createRequire } from "node:module";
 import { dirname, join, resolve } from "node:path";
 import { fileURLToPath, pathToFileURL } from "node:url";
@@ -185,8 +186,10 @@ function run(args, label) {
   logs.push(io);
   return io;
 }
+/** Each station of the test records its run here (not in the user's state directory). */
+const recordDir = await mkdtemp(join(tmpdir(), "stx-browser-recordings-"));
 async function startStation(args) {
-  const io = run(["serve", "--listen", "127.0.0.1:0", ...args], "stx serve");
+  const io = run(["serve", "--listen", "127.0.0.1:0", "--record-dir", recordDir, ...args], "stx serve");
   for (let i = 0; i < 100 && !/open (http:\/\/\S+)\/\?token=/.test(io.out); i++) await sleep(100);
   const found = /open (http:\/\/\S+)\/\?token=/.exec(io.out);
   if (!found) throw new Error(`stx serve did not start:\n${io.out}\n${io.err}`);
@@ -387,6 +390,10 @@ async function rehearsal() {
   check("telemetry updates the page (altitude falls)", alt1 !== alt2 && parseFloat(alt2) < parseFloat(alt1), `${alt1} → ${alt2}; heading ${att1}`);
   check("the drone's stage is shown", /parafoil/i.test(await text(page, "hdr-stage")), await text(page, "hdr-stage"));
   check("the link is fresh", (await page.evaluate(() => document.body.dataset.freshness)) === "fresh");
+  await page.waitForFunction(() => /^REC [0-9.]+ MB/.test(document.querySelector('[data-testid="recording-state"]')?.textContent ?? ""), null, { timeout: 5000 }).catch(() => {});
+  const rec = { text: await text(page, "recording-state"), state: await attr(page, "recording-state", "data-state") };
+  const files = (await readdir(recordDir)).filter((f) => f.endsWith(".mcap"));
+  check("the page shows the station recording, and the file is there", rec.state === "on" && /^REC [0-9.]+ MB/.test(rec.text) && files.length >= 1, `${rec.state}: ${rec.text}; files ${files.join(", ")}`);
   const tiles = { state: await attr(page, "map-tiles-status", "data-state"), text: await text(page, "map-tiles-status") };
   check("no tile source configured: the map says so (grid only)", tiles.state === "none" && /no tiles configured/.test(tiles.text), `${tiles.state}: ${tiles.text}`);
   const windDir = await page.locator('[data-testid="wind-chart"] [data-testid="wind-forecast-dir"]').count();

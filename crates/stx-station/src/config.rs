@@ -16,6 +16,8 @@ use stx_gnc::guidance::GuidanceConfig;
 use stx_link::signing::{KeyText, SIGNING_KEY_ENV, SigningKey};
 use thiserror::Error;
 
+use crate::recording::settings::RecordingSettings;
+
 /// Why a station configuration was refused.
 #[derive(Debug, Error)]
 pub enum ConfigError {
@@ -189,6 +191,9 @@ pub struct StationConfig {
     /// Seconds an armed cutdown waits for its confirmation, s.
     #[serde(default = "default_cutdown_window_s")]
     pub cutdown_window_s: f64,
+    /// Flight recordings (`[recording]`): on by default, in the state directory.
+    #[serde(default)]
+    pub recording: RecordingSettings,
 }
 
 fn default_web_dir() -> PathBuf {
@@ -243,6 +248,10 @@ impl StationConfig {
         if self.link.signing_on() && self.link.signing_timestamp_file.is_none() {
             self.link.signing_timestamp_file = stx_link::signing::persist::default_state_dir(&env)
                 .map(|dir| dir.join(SIGNING_TIMESTAMP_FILE_NAME));
+        }
+        if self.recording.enabled && self.recording.dir.is_none() {
+            self.recording.dir = stx_link::signing::persist::default_state_dir(&env)
+                .map(|dir| stx_record::file::recordings_dir(&dir));
         }
         Ok(())
     }
@@ -319,6 +328,9 @@ impl StationConfig {
             if tls.key_path.as_os_str().is_empty() {
                 return invalid("tls.key_path", "a PEM private-key file");
             }
+        }
+        if let Err((field, rule)) = self.recording.check() {
+            return invalid(field, rule);
         }
         if !(self.cutdown_window_s > 0.0 && self.cutdown_window_s <= 60.0) {
             return invalid("cutdown_window_s", "in (0, 60] s");

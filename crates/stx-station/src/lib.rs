@@ -20,7 +20,9 @@
 //!
 //! With the default feature `daemon`, the adapters:
 //! - `http`: the axum routes (auth, REST, WebSocket, KML, static files);
-//! - `daemon`: the tokio wiring of link driver, core and HTTP, with graceful shutdown.
+//! - `daemon`: the tokio wiring of link driver, core and HTTP, with graceful shutdown;
+//! - `recorder`: the run's recording (stx-record's writer thread) fed from the station loop
+//!   and the link driver.
 
 pub mod config;
 pub mod contract;
@@ -33,6 +35,8 @@ pub mod kml;
 pub mod limits;
 pub mod link;
 pub mod messages;
+#[cfg(feature = "daemon")]
+pub mod recorder;
 pub mod recording;
 pub mod replies;
 pub mod requests;

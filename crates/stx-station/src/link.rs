@@ -28,11 +28,29 @@ pub enum LinkReport {
     Stats(LinkStats),
 }
 
+/// Sees every byte the link carries, as it passes: the station's recording of the raw
+/// link. Called on the driver's thread, so it must not block (the recorder queues).
+pub trait FrameTap: Send {
+    /// `bytes` were received on radio `path` (`sent` false: one datagram or one read of a
+    /// stream) or sent on it (`sent` true: one frame).
+    fn frame(&mut self, path: usize, sent: bool, bytes: &[u8]);
+}
+
 /// The ground endpoint with the reports of what was done to it.
-#[derive(Debug)]
 pub struct StationLink {
     endpoint: GroundEndpoint,
     reports: VecDeque<LinkReport>,
+    tap: Option<Box<dyn FrameTap>>,
+}
+
+impl std::fmt::Debug for StationLink {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("StationLink")
+            .field("endpoint", &self.endpoint)
+            .field("reports", &self.reports)
+            .field("tap", &self.tap.is_some())
+            .finish()
+    }
 }
 
 impl StationLink {
@@ -41,7 +59,14 @@ impl StationLink {
         Self {
             endpoint,
             reports: VecDeque::new(),
+            tap: None,
         }
+    }
+
+    /// Shows every byte received and sent to `tap` from now on.
+    pub fn with_tap(mut self, tap: Box<dyn FrameTap>) -> Self {
+        self.tap = Some(tap);
+        self
     }
 
     /// The endpoint.
@@ -118,10 +143,16 @@ impl SansIo for StationLink {
     type Event = LinkReport;
 
     fn handle_bytes_on(&mut self, path: usize, now: Duration, bytes: &[u8]) {
+        if let Some(tap) = &mut self.tap {
+            tap.frame(path, false, bytes);
+        }
         self.endpoint.handle_bytes_on(path, now, bytes);
     }
 
     fn handle_datagram_on(&mut self, path: usize, now: Duration, datagram: &[u8]) -> bool {
+        if let Some(tap) = &mut self.tap {
+            tap.frame(path, false, datagram);
+        }
         self.endpoint.handle_datagram_on(path, now, datagram)
     }
 
@@ -134,7 +165,11 @@ impl SansIo for StationLink {
     }
 
     fn poll_transmit(&mut self, now: Duration) -> Option<Vec<u8>> {
-        self.endpoint.poll_transmit(now)
+        let frame = self.endpoint.poll_transmit(now)?;
+        if let Some(tap) = &mut self.tap {
+            tap.frame(self.endpoint.transmit_path(now), true, &frame);
+        }
+        Some(frame)
     }
 
     /// Reports of actions first: the endpoint's events queued before an action were polled
@@ -245,6 +280,39 @@ mod tests {
             action(2, LinkOp::PlanDownload, 14.0),
         );
         assert_eq!(outcomes(&mut link), [(ActionId(2), Ok(()))]);
+    }
+
+    /// Radio, sent, bytes.
+    type Tapped = (usize, bool, Vec<u8>);
+
+    #[derive(Clone, Default)]
+    struct Seen(std::sync::Arc<std::sync::Mutex<Vec<Tapped>>>);
+
+    impl FrameTap for Seen {
+        fn frame(&mut self, path: usize, sent: bool, bytes: &[u8]) {
+            self.0.lock().unwrap().push((path, sent, bytes.to_vec()));
+        }
+    }
+
+    #[test]
+    fn the_tap_sees_every_byte_received_and_every_frame_sent() {
+        let seen = Seen::default();
+        let mut link = link().with_tap(Box::new(seen.clone()));
+        link.handle_datagram_on(0, Duration::ZERO, b"garbage");
+        link.handle_bytes_on(0, Duration::ZERO, &[0xfd, 1]);
+        // The station's heartbeat is due at once.
+        link.handle_timeout(Duration::from_secs(1));
+        let mut sent = Vec::new();
+        while let Some(f) = link.poll_transmit(Duration::from_secs(1)) {
+            sent.push(f);
+        }
+        assert!(!sent.is_empty(), "a heartbeat goes out");
+        let seen = seen.0.lock().unwrap();
+        assert_eq!(seen[0], (0, false, b"garbage".to_vec()));
+        assert_eq!(seen[1], (0, false, vec![0xfd, 1]));
+        let tapped: Vec<Vec<u8>> = seen[2..].iter().map(|(_, _, b)| b.clone()).collect();
+        assert_eq!(tapped, sent);
+        assert!(seen[2..].iter().all(|(p, s, _)| *p == 0 && *s));
     }
 
     #[test]

@@ -391,6 +391,39 @@ pub struct StateMsg {
     pub forecast_wind: Vec<ForecastRow>,
     /// Mission.
     pub mission: MissionView,
+    /// The station's recording of this run; `null` where no daemon records (tests of the
+    /// core, replays).
+    pub recording: Option<RecordingView>,
+}
+
+/// Whether the station is recording.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum RecordingState {
+    /// Writing a file.
+    On,
+    /// Switched off in the configuration.
+    Off,
+    /// Wanted but nothing is being written (no directory, disk full, unwritable): see
+    /// `problem`.
+    Failing,
+}
+
+/// The station's recording, for the dashboard.
+#[derive(Debug, Clone, Serialize, JsonSchema)]
+pub struct RecordingView {
+    /// Recording, off, or failing.
+    pub state: RecordingState,
+    /// The file being written.
+    pub file: Option<String>,
+    /// Bytes written to recording files, B.
+    pub bytes_written: u64,
+    /// Messages written.
+    pub messages_written: u64,
+    /// Messages that could not be written (queue full, disk full, unwritable).
+    pub messages_lost: u64,
+    /// The last problem, if any.
+    pub problem: Option<String>,
 }
 
 /// Event levels.

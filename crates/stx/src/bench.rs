@@ -56,6 +56,9 @@ enum BenchWhat {
         /// Commands timed.
         #[arg(long, default_value_t = 200)]
         commands: usize,
+        /// Record the run (MCAP) into this directory, as `stx serve` does; default: off.
+        #[arg(long, value_name = "DIR")]
+        record_dir: Option<std::path::PathBuf>,
     },
 }
 
@@ -105,12 +108,14 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
             frames,
             frame_rate_hz,
             commands,
+            record_dir,
         } => {
             let report = crate::bench_station::run(&crate::bench_station::StationBenchOptions {
                 clients,
                 frames,
                 frame_rate_hz,
                 commands,
+                record_dir,
             })?;
             if json {
                 println!("{}", serde_json::to_string_pretty(&report)?);
@@ -132,6 +137,18 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
                 println!(
                     "command → MAVLink bytes, {} commands: p50 {:.2} ms, p99 {:.2} ms, max {:.2} ms ({} lost)",
                     c.commands_sent, c.latency.p50_ms, c.latency.p99_ms, c.latency.max_ms, c.lost
+                );
+                let r = &report.recording;
+                println!(
+                    "recording: {:?}, {} messages ({:.2} MB) written, {} lost{}",
+                    r.state,
+                    r.messages_written,
+                    r.bytes_written as f64 / 1e6,
+                    r.messages_lost,
+                    r.problem
+                        .as_deref()
+                        .map(|p| format!(" (last problem: {p})"))
+                        .unwrap_or_default()
                 );
             }
             Ok(())

@@ -51,6 +51,8 @@ pub struct StationBenchOptions {
     pub frame_rate_hz: f64,
     /// Commands sent.
     pub commands: usize,
+    /// Record the run into this directory (the station's recording on), else not.
+    pub record_dir: Option<std::path::PathBuf>,
 }
 
 /// Latency distribution, ms.
@@ -107,12 +109,18 @@ pub struct CommandReport {
 pub struct StationReport {
     pub telemetry_to_websocket: TelemetryReport,
     pub command_to_mavlink: CommandReport,
+    /// The station's recording at the end (`off` without `--record-dir`).
+    pub recording: stx_station::messages::RecordingView,
 }
 
 /// Starts the station on its own runtime; returns its addresses and the stop switch.
-fn start_station() -> anyhow::Result<(stx_station::daemon::Running, String, oneshot::Sender<()>)> {
+fn start_station(
+    record_dir: Option<std::path::PathBuf>,
+) -> anyhow::Result<(stx_station::daemon::Running, String, oneshot::Sender<()>)> {
     let mut config =
         StationConfig::from_toml_str(DEFAULT_STATION_TOML).context("shipped station config")?;
+    config.recording.enabled = record_dir.is_some();
+    config.recording.dir = record_dir;
     config.listen = "127.0.0.1:0".parse()?;
     config.link.address = "udpin:127.0.0.1:0".into();
     config.web_dir = std::env::temp_dir().join("stx-bench-no-dashboard");
@@ -293,7 +301,8 @@ pub fn run(options: &StationBenchOptions) -> anyhow::Result<StationReport> {
     {
         bail!("clients, frames and frame rate must be positive");
     }
-    let (running, token, stop_station) = start_station()?;
+    let (running, token, stop_station) = start_station(options.record_dir.clone())?;
+    let shared = running.shared.clone();
     let link = running
         .link_local
         .context("the station's link has no local address")?;
@@ -430,6 +439,7 @@ pub fn run(options: &StationBenchOptions) -> anyhow::Result<StationReport> {
                 lost,
                 latency: Latency::of(samples),
             },
+            recording: shared.recording.view(),
         })
     });
     let _ = stop_station.send(());

@@ -48,6 +48,13 @@ pub struct ServeArgs {
     /// writes it).
     #[arg(long, value_name = "FILE", requires = "sim")]
     sim_gains: Option<PathBuf>,
+    /// Record this run (MCAP) into this directory instead of the configuration's
+    /// `recording.dir` (default: `recordings/` in the state directory).
+    #[arg(long, value_name = "DIR", conflicts_with = "no_record")]
+    record_dir: Option<PathBuf>,
+    /// Do not record this run.
+    #[arg(long)]
+    no_record: bool,
 }
 
 /// Reads and validates the station configuration.
@@ -76,6 +83,17 @@ pub fn run(args: ServeArgs) -> anyhow::Result<()> {
     if let Some(link) = args.link.clone() {
         config.link.address = link;
         config.validate().context("--link").map_err(BadInput)?;
+    }
+    if let Some(dir) = args.record_dir.clone() {
+        config.recording.enabled = true;
+        config.recording.dir = Some(dir);
+        config
+            .validate()
+            .context("--record-dir")
+            .map_err(BadInput)?;
+    }
+    if args.no_record {
+        config.recording.enabled = false;
     }
     if !config.web_dir.join("index.html").exists() {
         tracing::warn!(

@@ -52,13 +52,14 @@ fn log_of(args: &[&str], lines: usize) -> String {
     log.join("\n")
 }
 
-const SERVE: [&str; 6] = [
+const SERVE: [&str; 7] = [
     "serve",
     "--sim",
     "--listen",
     "127.0.0.1:0",
     "--link",
     "udpin:127.0.0.1:0",
+    "--no-record",
 ];
 
 #[test]

@@ -86,6 +86,7 @@ fn a_bad_station_config_exits_2_and_names_the_field() {
 fn spawn_serve(args: &[&str]) -> std::process::Child {
     Command::new(env!("CARGO_BIN_EXE_stx"))
         .arg("serve")
+        .arg("--no-record")
         .args(args)
         .stdout(Stdio::piped())
         .stderr(Stdio::null())

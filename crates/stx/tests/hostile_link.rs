@@ -49,6 +49,7 @@ impl Station {
                 "127.0.0.1:0",
                 "--link",
                 "udpin:127.0.0.1:0",
+                "--no-record",
             ])
             .env("RUST_LOG", "info")
             .stdout(Stdio::piped())

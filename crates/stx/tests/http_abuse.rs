@@ -28,6 +28,7 @@ fn serve() -> (Killed, SocketAddr, String) {
             "127.0.0.1:0",
             "--link",
             "udpin:127.0.0.1:0",
+            "--no-record",
         ])
         .stdout(Stdio::piped())
         .stderr(Stdio::null())

@@ -55,6 +55,10 @@ export type GuidancePhase =
  */
 export type FlightStage = "pre_launch" | "ascent" | "round_chute" | "parafoil_deploy" | "parafoil" | "landed";
 /**
+ * Whether the station is recording.
+ */
+export type RecordingState = "on" | "off" | "failing";
+/**
  * GNSS fix type (GPS_FIX_TYPE).
  */
 export type GpsFix = "no_gps" | "no_fix" | "fix2d" | "fix3d" | "dgps" | "rtk_float" | "rtk_fixed" | "static" | "ppp";
@@ -254,6 +258,11 @@ export interface StateMsg {
    * Prediction.
    */
   prediction: PredictionView | null;
+  /**
+   * The station's recording of this run; `null` where no daemon records (tests of the
+   * core, replays).
+   */
+  recording: RecordingView | null;
   /**
    * Mission clock, s.
    */
@@ -634,6 +643,35 @@ export interface TouchdownView {
    * Seconds to touchdown.
    */
   time_to_land_s: number;
+}
+/**
+ * The station's recording, for the dashboard.
+ */
+export interface RecordingView {
+  /**
+   * Bytes written to recording files, B.
+   */
+  bytes_written: number;
+  /**
+   * The file being written.
+   */
+  file: string | null;
+  /**
+   * Messages that could not be written (queue full, disk full, unwritable).
+   */
+  messages_lost: number;
+  /**
+   * Messages written.
+   */
+  messages_written: number;
+  /**
+   * The last problem, if any.
+   */
+  problem: string | null;
+  /**
+   * Recording, off, or failing.
+   */
+  state: RecordingState;
 }
 /**
  * What the drone reports about itself.

@@ -32,6 +32,7 @@ const STATE = {
     uncontrolled: { lat_deg: 38.52, lon_deg: -7.87, time_to_land_s: 190.0, semi_major_m: 80, semi_minor_m: 40, major_axis_deg: 100 }, age_s: 0.6, stale: false },
   forecast_wind: [{ alt_msl_m: 300, speed_mps: 2.0, from_deg: 270 }, { alt_msl_m: 1000, speed_mps: 4, from_deg: 280 }],
   mission: { stage: "parafoil", cutdown_armed_until_s: null },
+  recording: { state: "on", file: "/var/lib/stx/recordings/stx-20261124T100000Z-001.mcap", bytes_written: 1200000, messages_written: 9000, messages_lost: 0, problem: null },
 };
 const SESSION = {
   role: "operator", name: "ops-1",

@@ -24,6 +24,7 @@ import type {
   Link,
   Localizer,
   Mission,
+  Recording,
   N,
   OnboardLanding,
   Outcome,
@@ -317,7 +318,23 @@ export function parseState(v: Obj): Parsed<State> {
     prediction: sub(v, "prediction", parsePrediction),
     forecast_wind: parseForecast(v.forecast_wind),
     mission: m,
+    recording: sub(v, "recording", parseRecording),
   });
+}
+
+const RECORDING_STATES = { on: true, off: true, failing: true } as const satisfies Record<Recording["state"], true>;
+
+function parseRecording(o: Obj): Recording | null {
+  const state = oneOf(o, "state", RECORDING_STATES);
+  if (state === null) return null;
+  return {
+    state,
+    file: str(o, "file"),
+    bytes_written: num(o, "bytes_written"),
+    messages_written: num(o, "messages_written"),
+    messages_lost: num(o, "messages_lost"),
+    problem: str(o, "problem"),
+  };
 }
 
 export function parseEvent(v: Obj): Parsed<EventMsg> {

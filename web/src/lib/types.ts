@@ -99,10 +99,14 @@ export type ForecastWind = Lenient<Wire.ForecastRow, "alt_msl_m" | "speed_mps">;
 
 export type Mission = Lenient<Wire.MissionView>;
 
+/** The station's recording of this run. */
+export type Recording = Lenient<Wire.RecordingView, "state">;
+
 export type State = Omit<
   Lenient<Wire.StateMsg, "type" | "time_s" | "link" | "forecast_wind" | "mission">,
-  "link" | "vehicle" | "guidance" | "prediction" | "forecast_wind"
+  "link" | "vehicle" | "guidance" | "prediction" | "forecast_wind" | "recording"
 > & {
+  recording: Recording | null;
   link: Link;
   vehicle: Vehicle | null;
   guidance: Guidance | null;

@@ -288,7 +288,7 @@ function build(session: Session): void {
     verdict = judgeStaleness({ socketOpen: socket.open, link: latest?.link ?? null, receivedAtMs, nowMs: now });
     document.body.classList.toggle("stale", verdict.stale);
     document.body.dataset.freshness = verdict.freshness;
-    link.update(latest?.link ?? null, verdict, socket.stats, receivedAtMs, now);
+    link.update(latest?.link ?? null, verdict, socket.stats, receivedAtMs, now, latest?.recording ?? null);
     const st = socketStatus;
     const connText = st.kind === "open" ? "CONNECTED" : st.kind === "connecting" ? "CONNECTING…" : `DISCONNECTED — retry in ${Math.max(0, (st.retryAtMs - now) / 1000).toFixed(0)} s`;
     setText(conn, connText);

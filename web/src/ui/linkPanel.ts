@@ -6,7 +6,7 @@ import { h, panel, readout, setText } from "./dom";
 import { fmt } from "../lib/format";
 import { messageAges, type StaleVerdict } from "../lib/staleness";
 import type { MessageStats } from "../lib/parse";
-import type { Link, Radio } from "../lib/types";
+import type { Link, Radio, Recording } from "../lib/types";
 
 export class LinkPanel {
   readonly root: HTMLElement;
@@ -16,6 +16,7 @@ export class LinkPanel {
   private readonly errors: HTMLElement;
   private readonly bad: HTMLElement;
   private readonly state: HTMLElement;
+  private readonly rec: HTMLElement;
   private readonly agesBody: HTMLTableSectionElement;
   private readonly radiosTable: HTMLTableElement;
   private readonly radiosBody: HTMLTableSectionElement;
@@ -27,7 +28,8 @@ export class LinkPanel {
     const e = readout("CRC/parse/sig", "link-errors", "frames refused: CRC errors / parse errors / signature errors");
     const b = readout("Bad msgs", "link-bad-messages", "messages from the station this page could not read");
     const st = readout("Link", "link-state");
-    [this.rate, this.loss, this.age, this.errors, this.bad, this.state] = [r.value, l.value, a.value, e.value, b.value, st.value];
+    const rec = readout("Recording", "recording-state", "the station's MCAP recording of this run");
+    [this.rate, this.loss, this.age, this.errors, this.bad, this.state, this.rec] = [r.value, l.value, a.value, e.value, b.value, st.value, rec.value];
     this.agesBody = h("tbody");
     const details = h("details", { class: "ages", "data-testid": "link-details" },
       h("summary", { "data-testid": "link-details-toggle" }, "Per-message ages"),
@@ -35,10 +37,11 @@ export class LinkPanel {
     this.radiosBody = h("tbody");
     this.radiosTable = h("table", { class: "radios", "data-testid": "link-radios", hidden: true },
       h("thead", {}, h("tr", {}, ...["radio", "rate", "loss", "age", "copies"].map((c) => h("th", {}, c)))), this.radiosBody);
-    this.root = panel("Link", "panel-link", h("div", { class: "ro-grid three" }, st.root, r.root, l.root, a.root, e.root, b.root), this.radiosTable, details);
+    this.root = panel("Link", "panel-link", h("div", { class: "ro-grid three" }, st.root, r.root, l.root, a.root, e.root, b.root, rec.root), this.radiosTable, details);
   }
 
-  update(link: Link | null, verdict: StaleVerdict, stats: MessageStats, receivedAtMs: number | null, nowMs: number): void {
+  update(link: Link | null, verdict: StaleVerdict, stats: MessageStats, receivedAtMs: number | null, nowMs: number, recording: Recording | null = null): void {
+    this.showRecording(recording);
     setText(this.state, verdict.freshness === "fresh" ? "OK" : verdict.freshness === "stale" ? "STALE" : verdict.freshness === "disconnected" ? "DISCONNECTED" : "NO DATA");
     this.state.dataset.state = verdict.freshness;
     setText(this.rate, fmt(link?.rate_hz, "Hz"));
@@ -55,6 +58,22 @@ export class LinkPanel {
     const rows = messageAges(link, receivedAtMs, nowMs).map((m) =>
       h("tr", { class: m.old ? "old" : "", "data-testid": `link-age-${m.name}` }, h("td", {}, m.name), h("td", {}, `${m.age_s.toFixed(1)} s${m.old ? " OLD" : ""}`)));
     this.agesBody.replaceChildren(...rows);
+  }
+
+  /** REC with what was written, OFF, or FAILING with why (the station keeps flying either way). */
+  private showRecording(r: Recording | null): void {
+    if (r === null) {
+      setText(this.rec, "—");
+      delete this.rec.dataset.state;
+      this.rec.title = "";
+      return;
+    }
+    const mb = r.bytes_written === null ? "—" : `${(r.bytes_written / 1e6).toFixed(1)} MB`;
+    const lost = r.messages_lost ? `, ${r.messages_lost} lost` : "";
+    setText(this.rec, r.state === "on" ? `REC ${mb}${lost}` : r.state === "off" ? "OFF" : `FAILING${lost}`);
+    this.rec.dataset.state = r.state;
+    this.rec.classList.toggle("warn", r.state === "failing" || (r.messages_lost ?? 0) > 0);
+    this.rec.title = [r.file, r.problem].filter((x) => x).join("\n");
   }
 
   /** One row per radio, only when there is a choice of radios: which one carries the commands

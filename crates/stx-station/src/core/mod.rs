@@ -79,6 +79,8 @@ pub enum Outbound {
     CommandResult(crate::messages::CommandResultMsg),
     /// A `params` message.
     Params(crate::messages::ParamsMsg),
+    /// An operator's request, accepted: for the recording (pages see its event).
+    Command(crate::recording::station::CommandRecord),
 }
 
 /// The station.

@@ -14,6 +14,7 @@ use super::cutdown::CutdownArm;
 use super::requests::{ApiError, Checked, CommandRequest, Payload, PlanChange, check};
 use super::sync::TargetSource;
 use crate::messages::{CommandResultMsg, Level, Outcome};
+use crate::recording::station::CommandRecord;
 
 impl StationCore {
     /// Checks and records an operator's request and queues its link action; the request id,
@@ -33,6 +34,12 @@ impl StationCore {
         let id = self
             .commands
             .open(now_s, &mut self.outbox, command, payload, change);
+        self.outbound.push(super::Outbound::Command(CommandRecord {
+            time_s: now_s,
+            request_id: id.clone(),
+            by: who.to_owned(),
+            text: text.clone(),
+        }));
         self.log(now_s, Level::Info, "command", format!("{who}: {text}"));
         Ok(id)
     }

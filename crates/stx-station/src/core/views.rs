@@ -252,6 +252,7 @@ impl StationCore {
                 stage: self.latest.status.map(|(s, _)| snake(s.stage)),
                 cutdown_armed_until_s: self.cutdown.armed_until(),
             },
+            recording: None,
         }
     }
 

@@ -24,6 +24,7 @@ use crate::config::StationConfig;
 use crate::core::StationCore;
 use crate::http::{Shared, StateFrame, router};
 use crate::link::StationLink;
+use crate::recorder::Recording;
 
 pub use station_loop::STATE_PERIOD;
 pub use tls::tls_config;
@@ -162,7 +163,15 @@ pub async fn run(
     let http_address = listener.local_addr().map_err(listen_error)?;
     let (transports, link_locals, link_shown) = open_radios(&config).await?;
     let start = Instant::now();
-    let link = ground_link(&config, transports.len())?;
+    let wall_origin_ms = SystemTime::now()
+        .duration_since(UNIX_EPOCH)
+        .map(|d| d.as_millis() as u64)
+        .unwrap_or(0);
+    let recording = Recording::start(&config, start, wall_origin_ms);
+    let mut link = ground_link(&config, transports.len())?;
+    if let Some(tap) = recording.frame_tap() {
+        link = link.with_tap(tap);
+    }
     let (actions_tx, actions_rx) = mpsc::channel::<Action<StationLink>>(1024);
     let (events_tx, events_rx) = mpsc::channel(4096);
     let options = DriveOptions {
@@ -172,10 +181,6 @@ pub async fn run(
         transports, link, actions_rx, events_tx, options,
     ));
 
-    let wall_origin_ms = SystemTime::now()
-        .duration_since(UNIX_EPOCH)
-        .map(|d| d.as_millis() as u64)
-        .unwrap_or(0);
     let (broadcast_tx, _) = broadcast::channel::<Utf8Bytes>(RELIABLE_BACKLOG);
     let shared = Arc::new(Shared {
         core: Mutex::new(StationCore::new(config.clone(), wall_origin_ms)),
@@ -188,6 +193,7 @@ pub async fn run(
         limits: Mutex::new(Default::default()),
         next_client: Default::default(),
         broadcast_total: Default::default(),
+        recording,
     });
     let (stop_tx, stop_rx) = watch::channel(false);
     let station_task = tokio::spawn(station_loop::station_loop(station_loop::StationLoop {
@@ -209,9 +215,15 @@ pub async fn run(
         shutdown.await;
         let _ = stop_tx.send(true);
     };
-    let served = serve(listener, tls, shared, stop).await;
+    let served = serve(listener, tls, shared.clone(), stop).await;
     station_task.abort();
     link_task.abort();
+    // The loop and the driver hold recording handles; the writer drains its queue and closes
+    // the file with its summary.
+    let _ = station_task.await;
+    let _ = link_task.await;
+    let finishing = shared.clone();
+    let _ = tokio::task::spawn_blocking(move || finishing.recording.finish()).await;
     served.map_err(DaemonError::Serve)
 }
 

@@ -168,12 +168,14 @@ fn on_driver_event(shared: &Shared, event: DriverEvent<LinkReport>) -> bool {
 /// Ticks the core and sends what it queued, then the fresh `state`.
 fn publish_state(shared: &Shared) {
     let now = shared.now_s();
-    let (state, outbound) = {
+    let (mut state, outbound) = {
         let mut core = shared.core();
         let state = core.tick(now);
         (state, core.drain_outbound())
     };
     send_outbound(shared, outbound);
+    state.recording = Some(shared.recording.view());
+    shared.recording.state(&state);
     if let Ok(text) = serde_json::to_string(&state) {
         // Latest wins: a page that is behind gets the newest state, never a queue of old ones.
         shared.states.send_modify(|frame| {
@@ -184,11 +186,14 @@ fn publish_state(shared: &Shared) {
 }
 
 fn send_outbound(shared: &Shared, outbound: Vec<Outbound>) {
+    shared.recording.outbound(&outbound);
     for o in outbound {
         let text = match o {
             Outbound::Event(e) => serde_json::to_string(&e),
             Outbound::CommandResult(r) => serde_json::to_string(&r),
             Outbound::Params(p) => serde_json::to_string(&p),
+            // Recorded only: pages see the request's event.
+            Outbound::Command(_) => continue,
         };
         if let Ok(text) = text {
             shared

@@ -68,7 +68,8 @@ pub(crate) async fn session(State(state): State<AppState>, caller: Caller) -> Js
 
 pub(crate) async fn state_now(State(state): State<AppState>, _caller: Caller) -> Response {
     let now = state.now_s();
-    let msg = state.core().state_msg_now(now);
+    let mut msg = state.core().state_msg_now(now);
+    msg.recording = Some(state.recording.view());
     Json(msg).into_response()
 }
 

@@ -44,6 +44,8 @@ pub struct Shared {
     pub broadcast_total: AtomicU64,
     /// Requests per token and wrong tokens per address ([`crate::limits`]).
     pub limits: Mutex<Limits>,
+    /// The run's recording.
+    pub recording: crate::recorder::Recording,
 }
 
 /// The newest `state`, numbered so a page can count the ones it skipped.

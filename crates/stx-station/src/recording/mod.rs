@@ -15,8 +15,8 @@
 //! - [`VEHICLE_GPS`] (`foxglove.LocationFix`, the drone's GPS with its accuracy) and
 //!   [`VEHICLE_ATTITUDE`] (`foxglove.FrameTransform`, body in the local NED frame): for
 //!   Foxglove's map and 3-D panels.
-//! - [`STATE`]: the station's `state` message at 4 Hz (link, vehicle, estimate, guidance phase
-//!   and pattern, prediction, mission) — what the dashboard showed.
+//! - [`STATE`]: the station's `state` message at 2 Hz (link, vehicle, estimate, guidance phase
+//!   and pattern, prediction, mission, the recording itself) — what the dashboard showed.
 //! - [`ESTIMATE_POSITION`], [`PREDICTED_LANDING`] (`foxglove.LocationFix`): the station's
 //!   estimate and predicted landing, with covariance, for the map.
 //! - [`EVENTS`] (`stx.EventMsg`) and [`LOG`] (`foxglove.Log`): the event log.
@@ -24,6 +24,9 @@
 //! - [`PARAMS`]: the drone's parameter table each time it changes.
 //! - [`CONFIG`]: the station's configuration at start, without secrets (token names and roles
 //!   only, never a token or the signing key).
+
+pub mod settings;
+pub mod station;
 
 /// The link's raw bytes, both directions.
 pub const FRAMES: &str = "/mavlink/frames";

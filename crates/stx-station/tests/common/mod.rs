@@ -53,6 +53,8 @@ pub fn config(edit: impl FnOnce(&mut StationConfig)) -> StationConfig {
     c.listen = "127.0.0.1:0".parse().expect("address");
     c.link.address = "udpin:127.0.0.1:0".into();
     c.web_dir = std::env::temp_dir().join("stx-station-test-no-web");
+    // Tests that record say where.
+    c.recording.enabled = false;
     edit(&mut c);
     c.validate().expect("valid test config");
     c

@@ -1,0 +1,260 @@
+//! The daemon's recording (an adapter: a thread and files): starts stx-record's writer thread on the station's channels
+//! (`crate::recording`), and feeds it what the station loop and the link driver see. Never
+//! blocks the station: a message the writer cannot take is dropped and counted, and the
+//! dashboard's `state.recording` says so.
+
+use std::sync::Mutex;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::time::{Duration, Instant, SystemTime};
+
+use stx_record::frame::mavlink_frame_channel;
+use stx_record::{
+    ChannelId, CoreOptions, Direction, Directory, MavlinkFrame, Recorder, RecorderConfig,
+    RecorderCore, RecorderHandle, RecordingInfo,
+};
+
+use crate::config::StationConfig;
+use crate::core::Outbound;
+use crate::link::FrameTap;
+use crate::messages::{RecordingState, RecordingView, StateMsg};
+use crate::recording::FRAMES;
+use crate::recording::station::{StationChannels, wall_ns};
+
+/// The station's recording, or why there is none.
+pub enum Recording {
+    /// `recording.enabled = false`.
+    Off,
+    /// Wanted, but it could not start (no directory known, the writer thread).
+    Unavailable(String),
+    /// Recording.
+    On(Box<StationRecorder>),
+}
+
+/// A running recording and the channels it writes.
+pub struct StationRecorder {
+    recorder: Mutex<Option<Recorder>>,
+    handle: RecorderHandle,
+    channels: StationChannels,
+    frames: ChannelId,
+    started: Instant,
+    wall_origin_ms: u64,
+    ground_alt_msl_m: f64,
+    /// Unix ms of the last `state` recorded.
+    last_state_ms: AtomicU64,
+}
+
+/// `state` is recorded at most this often, ms: 2 Hz shows the debrief what the dashboard
+/// showed, and the raw frames hold everything at the drone's own rates for a re-run.
+pub const STATE_RECORD_PERIOD_MS: u64 = 500;
+
+impl Recording {
+    /// Starts recording `config`'s run (mission time 0 at `started`, Unix ms
+    /// `wall_origin_ms`), as its `[recording]` says.
+    pub fn start(config: &StationConfig, started: Instant, wall_origin_ms: u64) -> Self {
+        let settings = &config.recording;
+        if !settings.enabled {
+            return Self::Off;
+        }
+        let Some(dir) = settings.dir.clone() else {
+            let why = "no recording directory: set recording.dir, --record-dir or a state \
+                       directory ($STATE_DIRECTORY, $XDG_STATE_HOME or $HOME)";
+            tracing::error!("{why}; the station runs without recording");
+            return Self::Unavailable(why.into());
+        };
+        match StationRecorder::spawn(config, dir.clone(), started, wall_origin_ms) {
+            Ok(r) => {
+                tracing::info!(dir = %dir.display(), "recording");
+                let (ch, payload) = r.channels.config(config);
+                let t = r.now_ns();
+                r.handle.write(ch, t, t, payload);
+                Self::On(Box::new(r))
+            }
+            Err(why) => {
+                tracing::error!("recording not started: {why}; the station runs without it");
+                Self::Unavailable(why)
+            }
+        }
+    }
+
+    fn on(&self) -> Option<&StationRecorder> {
+        match self {
+            Self::On(r) => Some(r),
+            _ => None,
+        }
+    }
+
+    /// Records a `state` message.
+    pub fn state(&self, state: &StateMsg) {
+        if let Some(r) = self.on() {
+            let last = r.last_state_ms.load(Ordering::Relaxed);
+            if last != 0 && state.wall_ms < last.saturating_add(STATE_RECORD_PERIOD_MS) {
+                return;
+            }
+            r.last_state_ms.store(state.wall_ms, Ordering::Relaxed);
+            let t = wall_ns(state.wall_ms);
+            for (ch, payload) in r.channels.state(state, r.ground_alt_msl_m) {
+                r.handle.write(ch, t, t, payload);
+            }
+        }
+    }
+
+    /// Records what the core sent the pages (and the requests it accepted).
+    pub fn outbound(&self, outbound: &[Outbound]) {
+        let Some(r) = self.on() else { return };
+        let now = r.now_ns();
+        for o in outbound {
+            let records = match o {
+                Outbound::Event(e) => r.channels.event(e),
+                Outbound::CommandResult(c) => vec![r.channels.command_result(c)],
+                Outbound::Params(p) => vec![r.channels.params(p)],
+                Outbound::Command(c) => vec![r.channels.command(c)],
+            };
+            for (ch, payload) in records {
+                r.handle.write(ch, now, now, payload);
+            }
+        }
+    }
+
+    /// The tap that records the link's bytes, if recording.
+    pub fn frame_tap(&self) -> Option<Box<dyn FrameTap>> {
+        self.on().map(|r| {
+            Box::new(Tap {
+                handle: r.handle.clone(),
+                frames: r.frames,
+                started: r.started,
+                wall_origin_ms: r.wall_origin_ms,
+            }) as Box<dyn FrameTap>
+        })
+    }
+
+    /// What the dashboard shows.
+    pub fn view(&self) -> RecordingView {
+        match self {
+            Self::Off => RecordingView {
+                state: RecordingState::Off,
+                file: None,
+                bytes_written: 0,
+                messages_written: 0,
+                messages_lost: 0,
+                problem: None,
+            },
+            Self::Unavailable(why) => RecordingView {
+                state: RecordingState::Failing,
+                file: None,
+                bytes_written: 0,
+                messages_written: 0,
+                messages_lost: 0,
+                problem: Some(why.clone()),
+            },
+            Self::On(r) => {
+                let s = r.handle.status();
+                RecordingView {
+                    state: if s.current_file.is_some() {
+                        RecordingState::On
+                    } else {
+                        RecordingState::Failing
+                    },
+                    file: s.current_file.map(|p| p.display().to_string()),
+                    bytes_written: s.bytes_written,
+                    messages_written: s.messages_written,
+                    messages_lost: s.messages_lost,
+                    problem: s.last_error.map(|e| e.message),
+                }
+            }
+        }
+    }
+
+    /// Closes the file with its summary (the station is stopping).
+    pub fn finish(&self) {
+        if let Some(r) = self.on()
+            && let Some(recorder) = r.recorder.lock().ok().and_then(|mut g| g.take())
+        {
+            let status = recorder.finish();
+            tracing::info!(
+                bytes = status.bytes_written,
+                messages = status.messages_written,
+                lost = status.messages_lost,
+                "recording finished"
+            );
+        }
+    }
+}
+
+impl StationRecorder {
+    fn spawn(
+        config: &StationConfig,
+        dir: std::path::PathBuf,
+        started: Instant,
+        wall_origin_ms: u64,
+    ) -> Result<Self, String> {
+        let settings = &config.recording;
+        let options = CoreOptions {
+            max_file_bytes: Some(settings.max_file_bytes()),
+            max_file_duration: Some(settings.max_file_duration()),
+            ..CoreOptions::default()
+        };
+        let info = RecordingInfo::new(
+            env!("CARGO_PKG_VERSION"),
+            settings.vehicle.clone(),
+            settings
+                .mission
+                .clone()
+                .unwrap_or_else(|| config.name.clone()),
+        )
+        .with_token_holders(&config.tokens);
+        let mut core =
+            RecorderCore::new(options, info, Duration::ZERO).map_err(|e| e.to_string())?;
+        let channels =
+            StationChannels::register(&mut core, Duration::ZERO).map_err(|e| e.to_string())?;
+        let frames = mavlink_frame_channel(FRAMES)
+            .map_err(|e| e.to_string())
+            .and_then(|spec| {
+                core.add_channel(Duration::ZERO, spec)
+                    .map_err(|e| e.to_string())
+            })?;
+        let storage = Directory::new(dir, SystemTime::now());
+        let recorder = Recorder::spawn(core, storage, RecorderConfig::default())
+            .map_err(|e| format!("the writer thread: {e}"))?;
+        Ok(Self {
+            handle: recorder.handle(),
+            recorder: Mutex::new(Some(recorder)),
+            channels,
+            frames,
+            started,
+            wall_origin_ms,
+            ground_alt_msl_m: config.origin.alt_msl_m,
+            last_state_ms: AtomicU64::new(0),
+        })
+    }
+
+    fn now_ns(&self) -> u64 {
+        now_ns(self.started, self.wall_origin_ms)
+    }
+}
+
+/// Unix time now on the mission clock, ns.
+fn now_ns(started: Instant, wall_origin_ms: u64) -> u64 {
+    wall_ns(wall_origin_ms).saturating_add(started.elapsed().as_nanos() as u64)
+}
+
+/// Records the link's bytes from the driver's thread.
+struct Tap {
+    handle: RecorderHandle,
+    frames: ChannelId,
+    started: Instant,
+    wall_origin_ms: u64,
+}
+
+impl FrameTap for Tap {
+    fn frame(&mut self, path: usize, sent: bool, bytes: &[u8]) {
+        let t = now_ns(self.started, self.wall_origin_ms);
+        let direction = if sent { Direction::Tx } else { Direction::Rx };
+        let radio = u16::try_from(path).unwrap_or(u16::MAX);
+        self.handle.write(
+            self.frames,
+            t,
+            t,
+            MavlinkFrame::encode(direction, radio, t, bytes),
+        );
+    }
+}
