@@ -83,6 +83,7 @@ function restNames(method, path, status) {
   if (method === "POST" && /^\/api\/params\/[^/]+$/.test(path)) return ["ParamBody", "CommandAccepted"];
   if (method === "POST" && path === "/api/cutdown/arm") return [null, "CutdownArm"];
   if (method === "POST" && path === "/api/cutdown/confirm") return ["ConfirmBody", "CommandAccepted"];
+  if (path === "/api/replay") return [method === "POST" ? "ReplayBody" : null, "ReplayView"];
   return [null, null];
 }
 function conformRest(where, method, path, status, request, body) {
@@ -262,7 +263,8 @@ const altitudePlot = (page) => page.evaluate(() => {
 
 try {
   await missionShort();
-  await rehearsal();
+  const rehearsalStation = await rehearsal();
+  await replay(rehearsalStation);
 } catch (e) {
   check("the test ran to the end", false, e instanceof Error ? (e.stack ?? e.message) : String(e));
 } finally {
@@ -351,7 +353,7 @@ async function missionShort() {
 
 // ==================================================================== 2. rehearsal, under the parafoil
 async function rehearsal() {
-  const { base } = await startStation(["--sim", "--sim-scenario", "rehearsal", "--sim-speed", String(speed), "--link", "udpin:127.0.0.1:0"]);
+  const { io: station, base } = await startStation(["--sim", "--sim-scenario", "rehearsal", "--sim-speed", String(speed), "--link", "udpin:127.0.0.1:0"]);
   const api = apiOf(base);
   console.log(`rehearsal: station at ${base}, simulated drone at ${speed}× real time`);
   const vehicle = async () => (await api("/api/state")).body?.vehicle ?? null;
@@ -391,9 +393,9 @@ async function rehearsal() {
   check("the drone's stage is shown", /parafoil/i.test(await text(page, "hdr-stage")), await text(page, "hdr-stage"));
   check("the link is fresh", (await page.evaluate(() => document.body.dataset.freshness)) === "fresh");
   await page.waitForFunction(() => /^REC [0-9.]+ MB/.test(document.querySelector('[data-testid="recording-state"]')?.textContent ?? ""), null, { timeout: 5000 }).catch(() => {});
-  const rec = { text: await text(page, "recording-state"), state: await attr(page, "recording-state", "data-state") };
+  const recShown = { text: await text(page, "recording-state"), state: await attr(page, "recording-state", "data-state") };
   const files = (await readdir(recordDir)).filter((f) => f.endsWith(".mcap"));
-  check("the page shows the station recording, and the file is there", rec.state === "on" && /^REC [0-9.]+ MB/.test(rec.text) && files.length >= 1, `${rec.state}: ${rec.text}; files ${files.join(", ")}`);
+  check("the page shows the station recording, and the file is there", recShown.state === "on" && /^REC [0-9.]+ MB/.test(recShown.text) && files.length >= 1, `${recShown.state}: ${recShown.text}; files ${files.join(", ")}`);
   const tiles = { state: await attr(page, "map-tiles-status", "data-state"), text: await text(page, "map-tiles-status") };
   check("no tile source configured: the map says so (grid only)", tiles.state === "none" && /no tiles configured/.test(tiles.text), `${tiles.state}: ${tiles.text}`);
   const windDir = await page.locator('[data-testid="wind-chart"] [data-testid="wind-forecast-dir"]').count();
@@ -677,6 +679,65 @@ async function rehearsal() {
   check("plain HTTP (not a secure context): the page says so and still gives the point", insecure.secure === false && /plain HTTP/.test(insecure.why) && pointNear(insecure.point), `secure ${insecure.secure}; "${insecure.why}"; point ${insecure.point}`);
   await npage.screenshot({ path: join(out, "recovery-plain-http.png"), fullPage: true });
   await nctx.close();
+  // The station stops next: its pages go first, so their reconnecting is no page error.
+  await ctx.close();
+  return station;
+}
+
+// ==================================================================== 3. the rehearsal, replayed
+async function replay(rehearsalStation) {
+  // The rehearsal's station stops as at the end of a day (SIGINT): its recording is whole.
+  const exited = new Promise((r) => rehearsalStation.proc.once("exit", r));
+  rehearsalStation.proc.kill("SIGINT");
+  await Promise.race([exited, sleep(10000)]);
+  const files = (await readdir(recordDir)).filter((f) => f.endsWith(".mcap")).sort();
+  const file = join(recordDir, files[files.length - 1]);
+  const io = run(["replay", file, "--listen", "127.0.0.1:0", "--speed", "8"], "stx replay");
+  for (let i = 0; i < 100 && !/open (http:\/\/\S+)\/\?token=/.test(io.out); i++) await sleep(100);
+  const base = /open (http:\/\/\S+)\/\?token=/.exec(io.out)?.[1];
+  if (!base) throw new Error(`stx replay did not start:\n${io.out}\n${io.err}`);
+  console.log(`replay: ${file} at ${base}`);
+  const api = apiOf(base);
+  const ctx = await newContext("replay", { viewport: { width: 1440, height: 900 } });
+  const page = await ctx.newPage();
+  watchErrors(page, "replay");
+  await page.goto(`${base}/?token=${OPERATOR}`);
+  await page.waitForFunction(() => !document.querySelector('[data-testid="replay-bar"]')?.hidden, null, { timeout: 15000 }).catch(() => {});
+  const badge = await page.locator('[data-testid="replay-badge"]').isVisible().catch(() => false);
+  await sleep(1000);
+  const enabled = await page.locator('[data-command]').evaluateAll((els) => els.filter((e) => "disabled" in e && !e.disabled).map((e) => e.dataset.testid ?? e.dataset.command ?? e.tagName));
+  const modeDisabled = enabled.length === 0;
+  const refused = await api("/api/commands/mode", OPERATOR, { method: "POST", body: JSON.stringify({ mode: "heading" }) });
+  check("replay: the page says REPLAY, its command controls are off and the station refuses commands", badge && modeDisabled && refused.status === 409 && refused.body?.error === "replay", `badge ${badge}, controls still on: [${enabled.join(", ")}], command → ${refused.status} ${refused.body?.error}`);
+  // It plays: the re-run station estimates the recorded flight.
+  const playing = await until(() => api("/api/state"), (r) => r.body?.estimate && r.body?.replay?.position_ms > 2000, 20000);
+  check("replay: the recorded flight plays through the station (an estimate, the position moves)", !!playing.body?.estimate && playing.body?.replay?.position_ms > 2000, JSON.stringify(playing.body?.replay));
+  // Pause from the page: the position stops.
+  await page.click('[data-testid="replay-toggle"]');
+  await page.waitForFunction(() => document.querySelector('[data-testid="replay-bar"]')?.dataset.paused === "true", null, { timeout: 5000 }).catch(() => {});
+  const p1 = (await api("/api/replay")).body?.position_ms;
+  await sleep(1500);
+  const p2 = (await api("/api/replay")).body?.position_ms;
+  check("replay: pause from the page stops the position", p1 !== undefined && p1 === p2 && (await text(page, "replay-toggle")) === "Play", `${p1} → ${p2} ms while paused`);
+  // Seek from the page's timeline to 5 s, then play at 2×.
+  await page.locator('[data-testid="replay-seek"]').evaluate((el) => {
+    el.value = "5000";
+    el.dispatchEvent(new Event("input"));
+    el.dispatchEvent(new Event("change"));
+  });
+  await page.waitForFunction(() => Number(document.querySelector('[data-testid="replay-bar"]')?.dataset.positionMs) === 5000, null, { timeout: 5000 }).catch(() => {});
+  const sought = (await api("/api/replay")).body;
+  check("replay: a seek on the page's timeline moves the replay there", sought?.position_ms === 5000 && sought?.paused === true, JSON.stringify(sought));
+  await page.selectOption('[data-testid="replay-speed"]', "2");
+  await page.click('[data-testid="replay-toggle"]');
+  const t0 = Date.now();
+  const s0 = (await api("/api/replay")).body;
+  await sleep(2000);
+  const s1 = (await api("/api/replay")).body;
+  const rate = (s1.position_ms - s0.position_ms) / (Date.now() - t0);
+  check("replay: the speed chosen on the page is the replay's (2×)", s1.speed === 2 && s1.paused === false && rate > 1.5 && rate < 2.5, `speed ${s1.speed}, ${rate.toFixed(2)} ms of flight per ms`);
+  await page.screenshot({ path: join(out, "replay.png") });
+  await ctx.close();
 }
 
 check("no page errors", pageErrors.length === 0, pageErrors.slice(0, 5).join(" | "));

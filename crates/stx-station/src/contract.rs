@@ -16,13 +16,15 @@ use serde_json::{Map, Value, json};
 use thiserror::Error;
 
 use crate::core::CutdownArm;
-use crate::messages::{CommandResultMsg, ErrorBody, EventMsg, ParamsMsg, Session, StateMsg};
+use crate::messages::{
+    CommandResultMsg, ErrorBody, EventMsg, ParamsMsg, ReplayView, Session, StateMsg,
+};
 use crate::replies::{
     ClientsBody, CommandAccepted, EventsBody, HelloMsg, HistoryMsg, LaggedMsg, PongMsg, TrackBody,
 };
 use crate::requests::{
     ClientMessage, ConfirmBody, CourseBody, HeadingBody, LocalizerBody, ModeBody, ParamBody,
-    PlanBody, TargetBody,
+    PlanBody, ReplayBody, TargetBody,
 };
 
 /// Where the schema is committed, from the workspace root.
@@ -93,6 +95,7 @@ pub fn schema() -> Result<Value, ContractError> {
         sent.subschema_for::<CommandAccepted>(),
         sent.subschema_for::<CutdownArm>(),
         sent.subschema_for::<ErrorBody>(),
+        sent.subschema_for::<ReplayView>(),
         read.subschema_for::<ClientMessage>(),
         read.subschema_for::<ModeBody>(),
         read.subschema_for::<HeadingBody>(),
@@ -102,6 +105,7 @@ pub fn schema() -> Result<Value, ContractError> {
         read.subschema_for::<PlanBody>(),
         read.subschema_for::<ParamBody>(),
         read.subschema_for::<ConfirmBody>(),
+        read.subschema_for::<ReplayBody>(),
     ];
     let mut definitions: Map<String, Value> = sent.take_definitions(true);
     // A type both sent and read must be described the same way both times.
@@ -116,7 +120,7 @@ pub fn schema() -> Result<Value, ContractError> {
     Ok(json!({
         "$schema": "http://json-schema.org/draft-07/schema#",
         "title": "stx station API",
-        "description": "Every message of the stx station's HTTP and WebSocket API (crates/stx-station/API.md), generated from the daemon's Rust types by `cargo run -p stx-station --example api_schema`: do not edit. The root is any one of them: on the WebSocket ServerMessage (station to page) and ClientMessage (page to station); over REST the bodies the station answers (Session, StateMsg, ParamsMsg, EventsBody, TrackBody, ClientsBody, CommandResultMsg, CommandAccepted, CutdownArm, ErrorBody) and the bodies of the commands (*Body).",
+        "description": "Every message of the stx station's HTTP and WebSocket API (crates/stx-station/API.md), generated from the daemon's Rust types by `cargo run -p stx-station --example api_schema`: do not edit. The root is any one of them: on the WebSocket ServerMessage (station to page) and ClientMessage (page to station); over REST the bodies the station answers (Session, StateMsg, ParamsMsg, EventsBody, TrackBody, ClientsBody, CommandResultMsg, CommandAccepted, CutdownArm, ErrorBody, ReplayView) and the bodies of the commands (*Body).",
         "anyOf": messages,
         "definitions": definitions,
     }))

@@ -16,7 +16,7 @@
 //!   the contract the dashboard's TypeScript types are generated from; [`kml`]: the Google
 //!   Earth feed; [`limits`]: requests per token, wrong tokens per address and pages at once,
 //!   as token buckets on the station's clock; [`recording`]: what a flight's MCAP recording
-//!   holds, under which topics.
+//!   holds, under which topics; [`replay`]: a recording played back through the station.
 //!
 //! With the default feature `daemon`, the adapters:
 //! - `http`: the axum routes (auth, REST, WebSocket, KML, static files);
@@ -38,5 +38,6 @@ pub mod messages;
 #[cfg(feature = "daemon")]
 pub mod recorder;
 pub mod recording;
+pub mod replay;
 pub mod replies;
 pub mod requests;

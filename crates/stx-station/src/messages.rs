@@ -39,6 +39,8 @@ pub struct StationInfo {
     /// Modes the operator may select.
     #[schemars(with = "Vec<FlightMode>")]
     pub modes: Vec<String>,
+    /// The station is replaying a recording (`stx replay`): nothing can be commanded.
+    pub replay: bool,
 }
 
 /// A geodetic position.
@@ -394,6 +396,29 @@ pub struct StateMsg {
     /// The station's recording of this run; `null` where no daemon records (tests of the
     /// core, replays).
     pub recording: Option<RecordingView>,
+    /// The replay this station is showing (`stx replay`); `null` when live.
+    pub replay: Option<ReplayView>,
+}
+
+/// A replay of a recording, for the dashboard's REPLAY bar.
+#[derive(Debug, Clone, Serialize, JsonSchema)]
+pub struct ReplayView {
+    /// The recording.
+    pub file: String,
+    /// Re-run through this station, or as recorded.
+    pub mode: crate::replay::ReplayMode,
+    /// Unix time of the recording's first message, ms.
+    pub start_ms: u64,
+    /// The recording's length, ms.
+    pub duration_ms: u64,
+    /// Where the replay is, ms after the start.
+    pub position_ms: u64,
+    /// × real time.
+    pub speed: f64,
+    /// Paused by request.
+    pub paused: bool,
+    /// At the end of the recording.
+    pub finished: bool,
 }
 
 /// Whether the station is recording.
@@ -551,7 +576,7 @@ pub struct TrackPoint {
 #[derive(Debug, Clone, Serialize, JsonSchema)]
 pub struct ErrorBody {
     /// Machine-readable kind.
-    #[schemars(extend("enum" = ["unauthorized", "forbidden", "bad_request", "not_found", "not_armed", "too_many_requests"]))]
+    #[schemars(extend("enum" = ["unauthorized", "forbidden", "bad_request", "not_found", "not_armed", "too_many_requests", "replay"]))]
     pub error: &'static str,
     /// For people: what is wrong.
     pub reason: String,

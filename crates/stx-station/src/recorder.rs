@@ -43,9 +43,9 @@ pub struct StationRecorder {
     last_state_ms: AtomicU64,
 }
 
-/// `state` is recorded at most this often, ms: 2 Hz shows the debrief what the dashboard
+/// `state` is recorded at most this often, ms: 1 Hz shows the debrief what the dashboard
 /// showed, and the raw frames hold everything at the drone's own rates for a re-run.
-pub const STATE_RECORD_PERIOD_MS: u64 = 500;
+pub const STATE_RECORD_PERIOD_MS: u64 = 1000;
 
 impl Recording {
     /// Starts recording `config`'s run (mission time 0 at `started`, Unix ms

@@ -140,3 +140,16 @@ pub enum ClientMessage {
     /// Answered with `pong`.
     Ping,
 }
+
+/// `POST /api/replay` (only while replaying): any of pause/play, speed and position; what is
+/// left out stays as it is.
+#[derive(Debug, Clone, Default, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct ReplayBody {
+    /// Pause (`true`) or play (`false`).
+    pub paused: Option<bool>,
+    /// × real time, 0.25–64.
+    pub speed: Option<f64>,
+    /// Jump to this many ms after the recording's start.
+    pub position_ms: Option<i64>,
+}

@@ -13,6 +13,7 @@ mod inputs;
 mod logging;
 mod montecarlo;
 mod record;
+mod replay;
 mod serve;
 mod sim;
 mod token;
@@ -55,6 +56,8 @@ enum Command {
     Drone(drone::DroneArgs),
     /// Flight recordings (MCAP): `stx record recover FILE` repairs a cut one.
     Record(record::RecordArgs),
+    /// Play a recording through a station into the dashboard (pause, seek, speed; no commands).
+    Replay(replay::ReplayArgs),
     /// Station tokens: `stx token new` prints a strong random one as a `[[tokens]]` entry.
     Token(token::TokenArgs),
 }
@@ -86,6 +89,7 @@ fn main() -> ExitCode {
         Command::Tune(args) => tune::run(args),
         Command::Drone(args) => drone::run(args),
         Command::Record(args) => record::run(args),
+        Command::Replay(args) => replay::run(args),
         Command::Token(args) => token::run(args),
     };
     match result {

@@ -240,7 +240,7 @@ fn loopback_if_unspecified(address: std::net::SocketAddr) -> std::net::SocketAdd
 }
 
 /// Ctrl-C, or SIGTERM from systemd or a container runtime.
-async fn shutdown_signal() {
+pub(crate) async fn shutdown_signal() {
     let interrupt = tokio::signal::ctrl_c();
     #[cfg(unix)]
     {
@@ -266,7 +266,7 @@ async fn shutdown_signal() {
 /// Writes the start banner to stdout. A station must not stop because nobody reads its
 /// stdout any more (a closed pipe, a supervisor that went away): `println!` would panic on
 /// the broken pipe, so a failed write is only logged.
-fn announce(banner: &str) {
+pub(crate) fn announce(banner: &str) {
     use std::io::Write;
     let mut out = std::io::stdout().lock();
     if let Err(e) = out.write_all(banner.as_bytes()).and_then(|()| out.flush()) {

@@ -1,7 +1,9 @@
 //! The station's recording through the real daemon (`stx serve --sim`): killed with SIGKILL
 //! mid-flight, its file still reads up to about a second before the kill and `stx record
 //! recover` makes it whole; stopped cleanly, the file is whole and holds every channel of a
-//! flight; given a directory it cannot write, the station keeps flying and says so.
+//! flight; given a directory it cannot write, the station keeps flying and says so; `stx
+//! replay` refuses what it cannot play. (Replay itself is driven from a browser:
+//! tests/browser/live.mjs.)
 
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
@@ -209,7 +211,7 @@ fn a_clean_stop_leaves_a_whole_file_with_the_flight_s_channels() {
         s["estimate"].is_object() && s["prediction"].is_object()
     });
     assert_eq!(s["recording"]["state"], "on", "{}", s["recording"]);
-    // A few recorded states (2 Hz) with the prediction in them.
+    // A few recorded states (1 Hz) with the prediction in them.
     std::thread::sleep(Duration::from_secs(3));
     // SIGINT: the station stops, closing the file with its summary.
     let pid = d.child.id().to_string();
@@ -302,5 +304,32 @@ fn an_unwritable_directory_leaves_the_station_flying_and_saying_so() {
     let t0 = s["time_s"].as_f64().expect("time");
     let later = wait_for(&d, 30.0, |s| s["time_s"].as_f64() > Some(t0 + 2.0));
     assert!(later["estimate"].is_object());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn replay_of_what_is_not_a_recording_or_at_a_bad_speed_is_bad_input() {
+    let dir = temp_dir("bad-replay");
+    let not_mcap = dir.join("notes.mcap");
+    std::fs::write(&not_mcap, b"not a recording").expect("file");
+    for args in [
+        vec!["replay".to_string(), not_mcap.display().to_string()],
+        vec!["replay".into(), "/nonexistent/flight.mcap".into()],
+        vec![
+            "replay".into(),
+            not_mcap.display().to_string(),
+            "--speed".into(),
+            "100".into(),
+        ],
+    ] {
+        let out = Command::new(env!("CARGO_BIN_EXE_stx"))
+            .args(&args)
+            .output()
+            .expect("stx runs");
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
+        assert!(stderr.starts_with("error: "), "{args:?}: {stderr}");
+        assert!(!stderr.contains("panicked"), "{stderr}");
+    }
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -2,7 +2,7 @@
 // the daemon's Rust types by `cargo run -p stx-station --example api_schema`): do not edit.
 
 /**
- * Every message of the stx station's HTTP and WebSocket API (crates/stx-station/API.md), generated from the daemon's Rust types by `cargo run -p stx-station --example api_schema`: do not edit. The root is any one of them: on the WebSocket ServerMessage (station to page) and ClientMessage (page to station); over REST the bodies the station answers (Session, StateMsg, ParamsMsg, EventsBody, TrackBody, ClientsBody, CommandResultMsg, CommandAccepted, CutdownArm, ErrorBody) and the bodies of the commands (*Body).
+ * Every message of the stx station's HTTP and WebSocket API (crates/stx-station/API.md), generated from the daemon's Rust types by `cargo run -p stx-station --example api_schema`: do not edit. The root is any one of them: on the WebSocket ServerMessage (station to page) and ClientMessage (page to station); over REST the bodies the station answers (Session, StateMsg, ParamsMsg, EventsBody, TrackBody, ClientsBody, CommandResultMsg, CommandAccepted, CutdownArm, ErrorBody, ReplayView) and the bodies of the commands (*Body).
  */
 export type StxStationAPI =
   | ServerMessage
@@ -14,6 +14,7 @@ export type StxStationAPI =
   | CommandAccepted
   | CutdownArm
   | ErrorBody
+  | ReplayView
   | ClientMessage
   | ModeBody
   | HeadingBody
@@ -22,7 +23,8 @@ export type StxStationAPI =
   | TargetBody
   | PlanBody
   | ParamBody
-  | ConfirmBody;
+  | ConfirmBody
+  | ReplayBody;
 /**
  * Every message the station sends on the WebSocket, told apart by `type`.
  */
@@ -58,6 +60,10 @@ export type FlightStage = "pre_launch" | "ascent" | "round_chute" | "parafoil_de
  * Whether the station is recording.
  */
 export type RecordingState = "on" | "off" | "failing";
+/**
+ * What a replay shows.
+ */
+export type ReplayMode = "rerun" | "recorded";
 /**
  * GNSS fix type (GPS_FIX_TYPE).
  */
@@ -205,6 +211,10 @@ export interface StationInfo {
    */
   origin: LatLonAlt;
   /**
+   * The station is replaying a recording (`stx replay`): nothing can be commanded.
+   */
+  replay: boolean;
+  /**
    * Tile attribution.
    */
   tile_attribution: string;
@@ -263,6 +273,10 @@ export interface StateMsg {
    * core, replays).
    */
   recording: RecordingView | null;
+  /**
+   * The replay this station is showing (`stx replay`); `null` when live.
+   */
+  replay: ReplayView | null;
   /**
    * Mission clock, s.
    */
@@ -672,6 +686,43 @@ export interface RecordingView {
    * Recording, off, or failing.
    */
   state: RecordingState;
+}
+/**
+ * A replay of a recording, for the dashboard's REPLAY bar.
+ */
+export interface ReplayView {
+  /**
+   * The recording's length, ms.
+   */
+  duration_ms: number;
+  /**
+   * The recording.
+   */
+  file: string;
+  /**
+   * At the end of the recording.
+   */
+  finished: boolean;
+  /**
+   * Re-run through this station, or as recorded.
+   */
+  mode: ReplayMode;
+  /**
+   * Paused by request.
+   */
+  paused: boolean;
+  /**
+   * Where the replay is, ms after the start.
+   */
+  position_ms: number;
+  /**
+   * × real time.
+   */
+  speed: number;
+  /**
+   * Unix time of the recording's first message, ms.
+   */
+  start_ms: number;
 }
 /**
  * What the drone reports about itself.
@@ -1172,7 +1223,7 @@ export interface ErrorBody {
   /**
    * Machine-readable kind.
    */
-  error: "unauthorized" | "forbidden" | "bad_request" | "not_found" | "not_armed" | "too_many_requests";
+  error: "unauthorized" | "forbidden" | "bad_request" | "not_found" | "not_armed" | "too_many_requests" | "replay";
   /**
    * For people: what is wrong.
    */
@@ -1273,4 +1324,22 @@ export interface ConfirmBody {
    * The id `POST /api/cutdown/arm` answered.
    */
   arm_id: string;
+}
+/**
+ * `POST /api/replay` (only while replaying): any of pause/play, speed and position; what is
+ * left out stays as it is.
+ */
+export interface ReplayBody {
+  /**
+   * Pause (`true`) or play (`false`).
+   */
+  paused?: boolean | null;
+  /**
+   * Jump to this many ms after the recording's start.
+   */
+  position_ms?: number | null;
+  /**
+   * × real time, 0.25–64.
+   */
+  speed?: number | null;
 }

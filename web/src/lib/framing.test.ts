@@ -24,6 +24,7 @@ function state(stage: FlightStage, extra: Partial<State> = {}): State {
     forecast_wind: [],
     mission: { stage, cutdown_armed_until_s: null },
     recording: null,
+    replay: null,
     ...extra,
   };
 }

@@ -1,6 +1,7 @@
 // Small pure helpers: backoff, token handling, time series, wind interpolation, recovery point,
 // plan body, input validation.
 import { describe, expect, it } from "vitest";
+import { clockText } from "../ui/replayBar";
 import { backoffMs, BACKOFF_MAX_MS, BACKOFF_MIN_MS } from "./backoff";
 import { resolveToken, searchWithoutToken, TOKEN_KEY, withToken } from "./token";
 import { breakWraps, MAX_GAP_S, Series, staleSpans } from "./series";
@@ -198,5 +199,15 @@ describe("plan and inputs", () => {
     const a = all(parseLat("38.5"), parseNumber("7", "n", 0, 10));
     expect(a.ok && a.values).toEqual([38.5, 7]);
     expect(all(parseLat("38.5"), parseLat("x")).ok).toBe(false);
+  });
+});
+
+
+describe("the replay bar's clock", () => {
+  it("shows minutes and seconds, hours when there are", () => {
+    expect(clockText(0)).toBe("0:00");
+    expect(clockText(61_999)).toBe("1:01");
+    expect(clockText(3 * 3600_000 + 5_000)).toBe("3:00:05");
+    expect(clockText(-5)).toBe("0:00");
   });
 });

@@ -33,11 +33,12 @@ const STATE = {
   forecast_wind: [{ alt_msl_m: 300, speed_mps: 2.0, from_deg: 270 }, { alt_msl_m: 1000, speed_mps: 4, from_deg: 280 }],
   mission: { stage: "parafoil", cutdown_armed_until_s: null },
   recording: { state: "on", file: "/var/lib/stx/recordings/stx-20261124T100000Z-001.mcap", bytes_written: 1200000, messages_written: 9000, messages_lost: 0, problem: null },
+  replay: null,
 };
 const SESSION = {
   role: "operator", name: "ops-1",
   station: { name: "STRAPLEX ground", origin: { lat_deg: 38.5333, lon_deg: -7.8889, alt_msl_m: 245 }, tile_url: "/tiles/{z}/{x}/{y}.png", tile_attribution: "©",
-    offline_tiles: true, modes: ["uncontrolled", "manual", "heading", "course", "localizer", "spiral_landing"] },
+    offline_tiles: true, modes: ["uncontrolled", "manual", "heading", "course", "localizer", "spiral_landing"], replay: false },
 };
 const j = (v: unknown): string => JSON.stringify(v);
 const api = contract();

@@ -25,6 +25,7 @@ import type {
   Localizer,
   Mission,
   Recording,
+  Replay,
   N,
   OnboardLanding,
   Outcome,
@@ -130,6 +131,7 @@ function parseStation(o: Obj): Station | null {
     tile_attribution: str(o, "tile_attribution") ?? "",
     offline_tiles: bool(o, "offline_tiles") ?? false,
     modes,
+    replay: bool(o, "replay") ?? false,
   };
 }
 
@@ -319,7 +321,26 @@ export function parseState(v: Obj): Parsed<State> {
     forecast_wind: parseForecast(v.forecast_wind),
     mission: m,
     recording: sub(v, "recording", parseRecording),
+    replay: sub(v, "replay", parseReplay),
   });
+}
+
+const REPLAY_MODES = { rerun: true, recorded: true } as const satisfies Record<Replay["mode"], true>;
+
+function parseReplay(o: Obj): Replay | null {
+  const mode = oneOf(o, "mode", REPLAY_MODES);
+  const file = str(o, "file");
+  if (mode === null || file === null) return null;
+  return {
+    file,
+    mode,
+    start_ms: num(o, "start_ms"),
+    duration_ms: num(o, "duration_ms"),
+    position_ms: num(o, "position_ms"),
+    speed: num(o, "speed"),
+    paused: bool(o, "paused"),
+    finished: bool(o, "finished"),
+  };
 }
 
 const RECORDING_STATES = { on: true, off: true, failing: true } as const satisfies Record<Recording["state"], true>;

@@ -51,7 +51,7 @@ export type Lenient<T, Kept extends keyof T = never> = {
 /** A position the page requires (latitude and longitude in range), with an optional altitude. */
 export type Position = Lenient<Wire.LatLonAlt, "lat_deg" | "lon_deg">;
 
-export type Station = Omit<Lenient<Wire.StationInfo, "name" | "tile_attribution" | "offline_tiles" | "modes">, "origin"> & {
+export type Station = Omit<Lenient<Wire.StationInfo, "name" | "tile_attribution" | "offline_tiles" | "modes" | "replay">, "origin"> & {
   origin: Position;
 };
 
@@ -102,11 +102,15 @@ export type Mission = Lenient<Wire.MissionView>;
 /** The station's recording of this run. */
 export type Recording = Lenient<Wire.RecordingView, "state">;
 
+/** The replay this station shows (`stx replay`). */
+export type Replay = Lenient<Wire.ReplayView, "file" | "mode">;
+
 export type State = Omit<
   Lenient<Wire.StateMsg, "type" | "time_s" | "link" | "forecast_wind" | "mission">,
-  "link" | "vehicle" | "guidance" | "prediction" | "forecast_wind" | "recording"
+  "link" | "vehicle" | "guidance" | "prediction" | "forecast_wind" | "recording" | "replay"
 > & {
   recording: Recording | null;
+  replay: Replay | null;
   link: Link;
   vehicle: Vehicle | null;
   guidance: Guidance | null;

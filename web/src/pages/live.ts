@@ -22,6 +22,7 @@ import { EventLog } from "../ui/eventLog";
 import { Actuators, FlightData } from "../ui/flightData";
 import { JoystickPanel } from "../ui/joystickPanel";
 import { LinkPanel } from "../ui/linkPanel";
+import { ReplayBar } from "../ui/replayBar";
 import { MapView } from "../ui/map";
 import { ParamEditor } from "../ui/paramEditor";
 import { PickGroup } from "../ui/pick";
@@ -86,6 +87,13 @@ function build(session: Session): void {
   const actuators = new Actuators();
   const wind = new WindPanel();
   const link = new LinkPanel();
+  const replayBar = new ReplayBar(async (body) => {
+    try {
+      await api.post("/api/replay", body);
+    } catch (e) {
+      localEvent("warning", `replay: ${e instanceof Error ? e.message : String(e)}`);
+    }
+  });
   const plots = new Plots();
   const view3d = new View3D(station.origin);
   const events = new EventLog();
@@ -209,7 +217,7 @@ function build(session: Session): void {
     { id: "params", label: "Parameters", content: params.root },
   ]);
   const rightCol = h("aside", { class: "col right" }, viewerNote, right.root, commandList.root, cutdown.root);
-  app.replaceChildren(header, banner, h("main", { class: "grid" }, left, centre, rightCol));
+  app.replaceChildren(header, replayBar.root, banner, h("main", { class: "grid" }, left, centre, rightCol));
   map.invalidate();
   plots.layout();
   new ResizeObserver(() => {
@@ -218,12 +226,21 @@ function build(session: Session): void {
     view3d.layout();
   }).observe(centre);
 
+  // Controls made later (parameter rows, plan items read from the drone) follow the role too:
+  // a viewer's, and a replay's, are off from the moment they appear.
+  new MutationObserver((records) => {
+    const added = records.some((r) => Array.from(r.addedNodes).some((n) => n instanceof HTMLElement && (n.matches("[data-command]") || n.querySelector("[data-command]") !== null)));
+    if (added) applyRoleEverywhere();
+  }).observe(app, { childList: true, subtree: true });
+
   // ---- behaviour
   function applyRoleEverywhere(): void {
-    const operator = role === "operator";
+    // A replay has no drone to command: every command control is off, for everyone.
+    const operator = role === "operator" && !station.replay;
     applyRole(document, operator);
     joystick.setRole(operator);
-    setText(roleBadge, `${operator ? "OPERATOR" : "VIEWER"} ${session.name}`);
+    setText(roleBadge, `${station.replay ? "REPLAY" : operator ? "OPERATOR" : "VIEWER"} ${session.name}`);
+    if (station.replay) setText(viewerNote, "Replay of a recording: there is no drone to command; pause, seek and speed are in the bar above.");
     roleBadge.dataset.role = role;
   }
 
@@ -234,6 +251,7 @@ function build(session: Session): void {
 
   function onState(s: State): void {
     latest = s;
+    replayBar.update(s.replay);
     receivedAtMs = Date.now();
     plots.push(s);
     const e = s.estimate;

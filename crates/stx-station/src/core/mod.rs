@@ -168,6 +168,11 @@ impl StationCore {
         &self.config
     }
 
+    /// Unix time of mission time 0, ms.
+    pub fn wall_origin_ms(&self) -> u64 {
+        self.wall_origin_ms
+    }
+
     pub(crate) fn wall_ms(&self, now_s: f64) -> u64 {
         self.wall_origin_ms + (now_s.max(0.0) * 1000.0) as u64
     }

@@ -253,6 +253,7 @@ impl StationCore {
                 cutdown_armed_until_s: self.cutdown.armed_until(),
             },
             recording: None,
+            replay: None,
         }
     }
 

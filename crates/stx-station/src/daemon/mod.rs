@@ -4,6 +4,7 @@
 //! `tls`), all stopped together by one shutdown signal. Nothing here decides anything: the
 //! core does.
 
+mod replay_feed;
 mod station_loop;
 mod tls;
 
@@ -25,7 +26,9 @@ use crate::core::StationCore;
 use crate::http::{Shared, StateFrame, router};
 use crate::link::StationLink;
 use crate::recorder::Recording;
+use crate::replay::ReplayControl;
 
+pub use replay_feed::spawn_replay_feeder;
 pub use station_loop::STATE_PERIOD;
 pub use tls::tls_config;
 
@@ -152,6 +155,28 @@ pub async fn run(
     shutdown: impl Future<Output = ()> + Send + 'static,
     started: impl FnOnce(Running) + Send,
 ) -> Result<(), DaemonError> {
+    run_with(config, None, shutdown, started).await
+}
+
+/// Starts a station that replays a recording under `replay` (its link hears the feeder,
+/// `stx_station::replay::feeder`, started by the caller in `started`; nothing is recorded
+/// and nothing can be commanded); returns when `shutdown` resolves.
+pub async fn run_replay(
+    mut config: StationConfig,
+    replay: Arc<ReplayControl>,
+    shutdown: impl Future<Output = ()> + Send + 'static,
+    started: impl FnOnce(Running) + Send,
+) -> Result<(), DaemonError> {
+    config.recording.enabled = false;
+    run_with(config, Some(replay), shutdown, started).await
+}
+
+async fn run_with(
+    config: StationConfig,
+    replay: Option<Arc<ReplayControl>>,
+    shutdown: impl Future<Output = ()> + Send + 'static,
+    started: impl FnOnce(Running) + Send,
+) -> Result<(), DaemonError> {
     let tls = config.tls.as_ref().map(tls_config).transpose()?;
     let listen_error = |source| DaemonError::Listen {
         address: config.listen,
@@ -194,6 +219,7 @@ pub async fn run(
         next_client: Default::default(),
         broadcast_total: Default::default(),
         recording,
+        replay,
     });
     let (stop_tx, stop_rx) = watch::channel(false);
     let station_task = tokio::spawn(station_loop::station_loop(station_loop::StationLoop {

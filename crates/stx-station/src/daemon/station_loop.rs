@@ -174,8 +174,16 @@ fn publish_state(shared: &Shared) {
         (state, core.drain_outbound())
     };
     send_outbound(shared, outbound);
-    state.recording = Some(shared.recording.view());
-    shared.recording.state(&state);
+    if let Some(replay) = &shared.replay {
+        if replay.mode() == crate::replay::ReplayMode::Recorded {
+            // The recorded states go to the pages (the feeder); this station heard nothing.
+            return;
+        }
+        state.replay = Some(replay.view());
+    } else {
+        state.recording = Some(shared.recording.view());
+        shared.recording.state(&state);
+    }
     if let Ok(text) = serde_json::to_string(&state) {
         // Latest wins: a page that is behind gets the newest state, never a queue of old ones.
         shared.states.send_modify(|frame| {

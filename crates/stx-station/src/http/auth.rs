@@ -18,10 +18,15 @@ pub struct Caller {
     pub name: String,
     /// Role.
     pub role: Role,
+    /// The station is replaying a recording: nobody commands.
+    pub replay: bool,
 }
 
 impl Caller {
     pub(crate) fn operator(&self) -> Result<(), HttpError> {
+        if self.replay {
+            return Err(HttpError::replaying());
+        }
         match self.role {
             Role::Operator => Ok(()),
             Role::Viewer => Err(error(
@@ -123,6 +128,7 @@ impl FromRequestParts<AppState> for Caller {
                 Verdict::Allowed => Ok(Caller {
                     name: name.to_string(),
                     role,
+                    replay: state.replay.is_some(),
                 }),
                 Verdict::Refused { retry, first } => {
                     if first {

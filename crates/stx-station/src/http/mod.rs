@@ -5,7 +5,7 @@
 //! - `auth`: tokens, names and roles;
 //! - `rest`: the reading endpoints; `commands`: the commanding ones (operators only);
 //! - `ws`: the WebSocket (state, events, command results; operators' sticks);
-//! - `kml`: the Google Earth feed.
+//! - `kml`: the Google Earth feed; `replay`: the replay's pause, seek and speed.
 //!
 //! Handlers only lock the core for a moment, build their answer, and wake the daemon when they
 //! gave the core something for the link ([`Shared::link_due`]); nothing here waits on the
@@ -14,6 +14,7 @@
 mod auth;
 mod commands;
 mod kml;
+mod replay;
 mod rest;
 mod shared;
 mod ws;
@@ -50,6 +51,10 @@ pub fn router(state: std::sync::Arc<Shared>) -> Router {
         .route("/api/cutdown/arm", post(arm_cutdown))
         .route("/api/cutdown/confirm", post(confirm_cutdown))
         .route("/api/clients", get(clients))
+        .route(
+            "/api/replay",
+            get(replay::replay_status).post(replay::replay_control),
+        )
         .route("/api/ws", get(ws::websocket))
         // An API path that does not exist is an API error, never the dashboard's page.
         .route("/api", any(api_not_found))

@@ -39,6 +39,7 @@ pub(crate) fn session_of(state: &Shared, caller: &Caller) -> Session {
                         .unwrap_or_default()
                 })
                 .collect(),
+            replay: state.replay.is_some(),
         },
     }
 }
@@ -69,7 +70,8 @@ pub(crate) async fn session(State(state): State<AppState>, caller: Caller) -> Js
 pub(crate) async fn state_now(State(state): State<AppState>, _caller: Caller) -> Response {
     let now = state.now_s();
     let mut msg = state.core().state_msg_now(now);
-    msg.recording = Some(state.recording.view());
+    msg.recording = state.replay.is_none().then(|| state.recording.view());
+    msg.replay = state.replay.as_ref().map(|r| r.view());
     Json(msg).into_response()
 }
 

@@ -46,6 +46,8 @@ pub struct Shared {
     pub limits: Mutex<Limits>,
     /// The run's recording.
     pub recording: crate::recorder::Recording,
+    /// The replay this station shows (`stx replay`); `None` when live.
+    pub replay: Option<Arc<crate::replay::ReplayControl>>,
 }
 
 /// The newest `state`, numbered so a page can count the ones it skipped.
@@ -116,6 +118,13 @@ impl Shared {
         // A panic while holding the lock would be a bug in the core; keep serving.
         self.core.lock().unwrap_or_else(|e| e.into_inner())
     }
+
+    /// Starts the core afresh (a replay jumped: what it had heard no longer holds).
+    pub fn reset_core(&self) {
+        let mut core = self.core();
+        let wall_origin_ms = core.wall_origin_ms();
+        *core = StationCore::new(self.config.clone(), wall_origin_ms);
+    }
 }
 
 pub(crate) type AppState = Arc<Shared>;
@@ -136,6 +145,15 @@ impl IntoResponse for HttpError {
 }
 
 impl HttpError {
+    /// 409: a replay commands nothing.
+    pub(crate) fn replaying() -> Self {
+        error(
+            StatusCode::CONFLICT,
+            "replay",
+            "this station is replaying a recording: there is no drone to command",
+        )
+    }
+
     /// 429 Too Many Requests, with `Retry-After`.
     pub(crate) fn too_many(reason: impl Into<String>, retry: RetryAfter) -> Self {
         let mut e = error(StatusCode::TOO_MANY_REQUESTS, "too_many_requests", reason);

@@ -169,11 +169,15 @@ async fn handle_client(state: &Shared, caller: &Caller, socket: &mut WebSocket, 
     if matches!(
         message,
         Ok(ClientMessage::Manual { .. } | ClientMessage::ManualRelease)
-    ) && caller.role != Role::Operator
+    ) && (caller.role != Role::Operator || caller.replay)
     {
         let reply = refusal(
             state,
-            "viewers cannot fly the drone: operator role required",
+            if caller.replay {
+                "this station is replaying a recording: there is no drone to fly"
+            } else {
+                "viewers cannot fly the drone: operator role required"
+            },
         );
         let _ = socket.send(reply).await;
         return;

@@ -15,7 +15,7 @@
 //! - [`VEHICLE_GPS`] (`foxglove.LocationFix`, the drone's GPS with its accuracy) and
 //!   [`VEHICLE_ATTITUDE`] (`foxglove.FrameTransform`, body in the local NED frame): for
 //!   Foxglove's map and 3-D panels.
-//! - [`STATE`]: the station's `state` message at 2 Hz (link, vehicle, estimate, guidance phase
+//! - [`STATE`]: the station's `state` message at 1 Hz (link, vehicle, estimate, guidance phase
 //!   and pattern, prediction, mission, the recording itself) — what the dashboard showed.
 //! - [`ESTIMATE_POSITION`], [`PREDICTED_LANDING`] (`foxglove.LocationFix`): the station's
 //!   estimate and predicted landing, with covariance, for the map.
