@@ -19,6 +19,7 @@ use crate::link::FrameTap;
 use crate::messages::{RecordingState, RecordingView, StateMsg};
 use crate::recording::FRAMES;
 use crate::recording::station::{StationChannels, wall_ns};
+use crate::recording::telemetry::TelemetryChannels;
 
 /// The station's recording, or why there is none.
 pub enum Recording {
@@ -35,6 +36,7 @@ pub struct StationRecorder {
     recorder: Mutex<Option<Recorder>>,
     handle: RecorderHandle,
     channels: StationChannels,
+    telemetry: TelemetryChannels,
     frames: ChannelId,
     started: Instant,
     wall_origin_ms: u64,
@@ -112,6 +114,15 @@ impl Recording {
             for (ch, payload) in records {
                 r.handle.write(ch, now, now, payload);
             }
+        }
+    }
+
+    /// Records a decoded telemetry message, received now.
+    pub fn telemetry(&self, telemetry: &stx_link::telemetry::Telemetry) {
+        let Some(r) = self.on() else { return };
+        let t = r.now_ns();
+        for (ch, payload) in r.telemetry.records(t, telemetry) {
+            r.handle.write(ch, t, t, payload);
         }
     }
 
@@ -206,6 +217,8 @@ impl StationRecorder {
             RecorderCore::new(options, info, Duration::ZERO).map_err(|e| e.to_string())?;
         let channels =
             StationChannels::register(&mut core, Duration::ZERO).map_err(|e| e.to_string())?;
+        let telemetry =
+            TelemetryChannels::register(&mut core, Duration::ZERO).map_err(|e| e.to_string())?;
         let frames = mavlink_frame_channel(FRAMES)
             .map_err(|e| e.to_string())
             .and_then(|spec| {
@@ -219,6 +232,7 @@ impl StationRecorder {
             handle: recorder.handle(),
             recorder: Mutex::new(Some(recorder)),
             channels,
+            telemetry,
             frames,
             started,
             wall_origin_ms,

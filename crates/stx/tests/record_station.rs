@@ -243,6 +243,11 @@ fn a_clean_stop_leaves_a_whole_file_with_the_flight_s_channels() {
         stx_station::recording::LOG,
         stx_station::recording::PARAMS,
         stx_station::recording::CONFIG,
+        stx_station::recording::VEHICLE_GPS,
+        stx_station::recording::VEHICLE_ATTITUDE,
+        "/telemetry/GPS_RAW_INT",
+        "/telemetry/ATTITUDE",
+        "/telemetry/HEARTBEAT",
     ] {
         assert!(
             rec.channel(topic).is_some_and(|c| c.message_count > 0),

@@ -7,6 +7,7 @@ use serde::{Deserialize, Serialize};
 
 /// The three actuators (SERVO_OUTPUT_RAW).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 pub struct Actuators {
     /// Time, µs (wraps after ~71 min, as on the wire).
     pub time_usec: u32,

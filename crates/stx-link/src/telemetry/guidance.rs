@@ -11,6 +11,7 @@ use super::units::{deg_to_e7, e7_to_deg, nan_to_none, none_to_nan};
 
 /// Onboard wind estimate (WIND_COV).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 pub struct Wind {
     /// Time, µs.
     pub time_usec: u64,
@@ -66,6 +67,7 @@ impl Wind {
 
 /// Guidance state (NAV_CONTROLLER_OUTPUT).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 pub struct GuidanceStatus {
     /// Roll the controller asks for, degrees.
     pub desired_roll_deg: f64,
@@ -112,6 +114,7 @@ impl GuidanceStatus {
 /// The onboard prediction of the touchdown point (POSITION_TARGET_GLOBAL_INT; see the
 /// [module documentation](super)).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 pub struct PredictedLanding {
     /// Time since boot, ms.
     pub time_boot_ms: u32,

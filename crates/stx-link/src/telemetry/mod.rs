@@ -72,6 +72,7 @@ use serde::{Deserialize, Serialize};
 
 /// Every telemetry item the drone sends.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(tag = "kind", rename_all = "snake_case")]
 pub enum Telemetry {
     Status(VehicleStatus),

@@ -60,6 +60,7 @@ impl GpsFix {
 
 /// Raw GNSS receiver output (GPS_RAW_INT).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 pub struct GpsRaw {
     /// Receiver timestamp, µs (Unix epoch or since boot).
     pub time_usec: u64,
@@ -137,6 +138,7 @@ impl GpsRaw {
 
 /// Onboard position and velocity estimate (GLOBAL_POSITION_INT).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 pub struct GlobalPosition {
     /// Time since boot, ms.
     pub time_boot_ms: u32,
@@ -192,6 +194,7 @@ impl GlobalPosition {
 
 /// Attitude from the AHRS (ATTITUDE).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 pub struct Attitude {
     /// Time since boot, ms.
     pub time_boot_ms: u32,
@@ -239,6 +242,7 @@ impl Attitude {
 
 /// Pitot air data (SCALED_PRESSURE).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 pub struct AirData {
     /// Time since boot, ms.
     pub time_boot_ms: u32,
@@ -289,6 +293,7 @@ impl AirData {
 
 /// Head-up display summary (VFR_HUD).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 pub struct Hud {
     /// Airspeed, m/s.
     pub airspeed_mps: f64,

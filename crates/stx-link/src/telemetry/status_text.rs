@@ -8,6 +8,7 @@ use serde::{Deserialize, Serialize};
 
 /// MAVLink severity (MAV_SEVERITY, RFC 5424).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(rename_all = "snake_case")]
 pub enum Severity {
     Emergency,
@@ -56,6 +57,7 @@ pub const STATUSTEXT_LEN: usize = 50;
 /// boundaries (a shorter chunk would mean "last chunk" to the receiver), which may cut a UTF-8
 /// character in two; [`StatusTextAssembler`] joins the bytes before decoding them.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 pub struct StatusText {
     /// Severity.
     pub severity: Severity,

@@ -13,6 +13,7 @@ use super::units::{
 
 /// Onboard system state (HEARTBEAT `system_status`, MAV_STATE).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(rename_all = "snake_case")]
 pub enum SystemState {
     Uninit,
@@ -59,6 +60,7 @@ impl SystemState {
 
 /// Mode, flight stage and guidance phase of the drone (HEARTBEAT).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 pub struct VehicleStatus {
     /// Control mode the operator selected.
     pub mode: FlightMode,
@@ -126,6 +128,7 @@ impl VehicleStatus {
 
 /// Onboard system health and main battery (SYS_STATUS).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 pub struct SystemStatus {
     /// Battery voltage, V (wire: mV; `None` = UINT16_MAX).
     pub battery_voltage_v: Option<f64>,
@@ -196,6 +199,7 @@ impl SystemStatus {
 
 /// One battery (BATTERY_STATUS).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 pub struct BatteryStatus {
     /// Battery id.
     pub id: u8,

@@ -146,7 +146,12 @@ fn on_driver_event(shared: &Shared, event: DriverEvent<LinkReport>) -> bool {
     let mut core = shared.core();
     match event {
         DriverEvent::Endpoint(LinkReport::Event(e)) => {
-            let telemetry = matches!(e, GroundEvent::Telemetry { .. });
+            let telemetry = if let GroundEvent::Telemetry { telemetry, .. } = &e {
+                shared.recording.telemetry(telemetry);
+                true
+            } else {
+                false
+            };
             core.on_link_event(now, e);
             telemetry
         }

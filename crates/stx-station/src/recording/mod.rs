@@ -27,6 +27,7 @@
 
 pub mod settings;
 pub mod station;
+pub mod telemetry;
 
 /// The link's raw bytes, both directions.
 pub const FRAMES: &str = "/mavlink/frames";
