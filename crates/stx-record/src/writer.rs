@@ -361,6 +361,10 @@ impl RecorderCore {
             .disable_seeking(true)
             // No compression threads: the core stays a plain value on its caller's thread.
             .compression_threads(0)
+            // Per-message indexes inside each chunk (16 B a message, uncompressed) would be a
+            // quarter of a flight's file; readers find messages from the chunk indexes, as
+            // for a cut file (`read::scan`), and every MCAP reader handles their absence.
+            .emit_message_indexes(false)
     }
 
     fn start_file(&mut self, now: Duration) -> Result<(), WriteError> {

@@ -138,7 +138,7 @@ fn files_rotate_at_their_size_and_each_is_whole() {
     };
     let (mut core, a, b) = core_with(options);
     let mut written = Vec::new();
-    for i in 0..400u64 {
+    for i in 0..600u64 {
         let ch = if i % 3 == 0 { a } else { b };
         let data = payload(i);
         core.write(ms(i), ch, T0 + i, T0 + i, &data).unwrap();
@@ -162,8 +162,8 @@ fn files_rotate_at_their_size_and_each_is_whole() {
         let meta = mcap::read::metadata(file, &summary.metadata_indexes[0]).unwrap();
         assert_eq!(meta.name, METADATA_NAME);
         assert_eq!(meta.metadata["part"], (n + 1).to_string());
-        // A file's data pass its size by at most one chunk and its message indexes
-        // (16 B a message); the summary follows.
+        // A file's data pass its size by at most one chunk (and its record's framing); the
+        // summary follows.
         let data_end = mcap::read::footer(file).unwrap().summary_start;
         assert!(
             data_end < 10_000 + 2_100 + 1_100,
