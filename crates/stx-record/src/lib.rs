@@ -21,10 +21,12 @@
 //!   `read::scan`) and iterates messages in log-time order from any time through the chunk
 //!   indexes. [`recover()`] ([`recover`](mod@recover)) writes a clean, finished copy of a cut file.
 //!   Both walk cut files with the private `records` module.
+//! - Export. [`export`]: one CSV per channel with units, and the track as KML or GPX.
 //!
 //! No tokio: the core is plain data; the file adapter uses a thread and a std channel.
 
 pub mod channel;
+pub mod export;
 pub mod file;
 pub mod foxglove;
 pub mod frame;

@@ -9,6 +9,7 @@ mod bench;
 mod bench_memory;
 mod bench_station;
 mod drone;
+mod export;
 mod inputs;
 mod logging;
 mod montecarlo;
@@ -56,6 +57,8 @@ enum Command {
     Drone(drone::DroneArgs),
     /// Flight recordings (MCAP): `stx record recover FILE` repairs a cut one.
     Record(record::RecordArgs),
+    /// A recording as CSV (one file per channel), KML or GPX.
+    Export(export::ExportArgs),
     /// Play a recording through a station into the dashboard (pause, seek, speed; no commands).
     Replay(replay::ReplayArgs),
     /// Station tokens: `stx token new` prints a strong random one as a `[[tokens]]` entry.
@@ -89,6 +92,7 @@ fn main() -> ExitCode {
         Command::Tune(args) => tune::run(args),
         Command::Drone(args) => drone::run(args),
         Command::Record(args) => record::run(args),
+        Command::Export(args) => export::run(args),
         Command::Replay(args) => replay::run(args),
         Command::Token(args) => token::run(args),
     };
@@ -117,6 +121,7 @@ impl Command {
                 | Command::Analyze(_)
                 | Command::Tune(_)
                 | Command::Record(_)
+                | Command::Export(_)
                 | Command::Token(_)
         )
     }

@@ -276,6 +276,46 @@ fn a_clean_stop_leaves_a_whole_file_with_the_flight_s_channels() {
         let read = theirs["read"][&*ours.topic].as_u64().unwrap_or(0);
         assert_eq!(read, ours.message_count, "{} messages read", ours.topic);
     }
+    // Exported for spreadsheets, Google Earth and phones.
+    let out = dir.join("export");
+    let exported = Command::new(env!("CARGO_BIN_EXE_stx"))
+        .arg("export")
+        .arg(&file)
+        .arg("--csv")
+        .arg(&out)
+        .arg("--gpx")
+        .arg(dir.join("flight.gpx"))
+        .arg("--kml")
+        .arg(dir.join("flight.kml"))
+        .output()
+        .expect("stx export");
+    assert!(
+        exported.status.success(),
+        "{}",
+        String::from_utf8_lossy(&exported.stderr)
+    );
+    let gps_csv = std::fs::read_to_string(out.join("vehicle_gps.csv")).expect("GPS CSV");
+    assert_eq!(
+        gps_csv.lines().count() as u64,
+        rec.channel(stx_station::recording::VEHICLE_GPS)
+            .expect("gps")
+            .message_count
+            + 1,
+        "a row per fix under the header"
+    );
+    let state_csv = std::fs::read_to_string(out.join("station_state.csv")).expect("state CSV");
+    assert!(
+        state_csv
+            .lines()
+            .next()
+            .is_some_and(|h| h.contains("estimate.alt_msl_m [m]")),
+        "units in the header"
+    );
+    let gpx = std::fs::read_to_string(dir.join("flight.gpx")).expect("GPX");
+    assert!(gpx.matches("<trkpt ").count() > 10, "{gpx}");
+    assert!(
+        std::fs::read_to_string(dir.join("flight.kml")).is_ok_and(|k| k.contains("<LineString>"))
+    );
     // Never a token in the file.
     let bytes = std::fs::read(&file).expect("file");
     for secret in ["operator-token", "viewer-token"] {

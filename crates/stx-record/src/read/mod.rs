@@ -164,6 +164,16 @@ impl<R: Read + Seek> Recording<R> {
         })
     }
 
+    /// The schema (for stx's channels a JSON Schema) of the channel on `topic`.
+    pub fn schema(&self, topic: &str) -> Option<&[u8]> {
+        self.summary
+            .channels
+            .values()
+            .find(|c| c.topic == topic)
+            .and_then(|c| c.schema.as_ref())
+            .map(|s| &s.data[..])
+    }
+
     /// The channels, by id.
     pub fn channels(&self) -> &[ChannelInfo] {
         &self.channels
