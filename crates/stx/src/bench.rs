@@ -96,6 +96,14 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
                     report.page_messages,
                     report.page_bytes as f64 / 1e6
                 );
+                println!(
+                    "{} pages came and went; open file descriptors {} after 1 min, {} at the end; recording {:.1} MB on disk, {} messages lost",
+                    report.pages_come_and_gone,
+                    report.fds_early,
+                    report.fds_after,
+                    report.recording_mb,
+                    report.recording_lost
+                );
             }
             if !report.landed {
                 anyhow::bail!("the simulated drone did not land in time");

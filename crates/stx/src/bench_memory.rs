@@ -9,7 +9,10 @@
 //! dashboard pages are connected over WebSocket the whole time, reading everything. Once the
 //! station sees the drone landed, the daemon's resident set (`VmRSS`) and its peak (`VmHWM`)
 //! are read from `/proc` (sampled every second along the way too); the drone's peak is reported
-//! beside it.
+//! beside it. The daemon records the run (into a directory of its own, removed after: the
+//! recording's size is reported), 20 more pages come and go every five seconds, and the
+//! daemon's open file descriptors are counted a minute in and at the end, so a leak of
+//! either shows.
 
 use std::io::IsTerminal;
 use std::path::PathBuf;
@@ -61,6 +64,59 @@ pub struct MemoryReport {
     pub page_messages: u64,
     /// Bytes the pages received over the run.
     pub page_bytes: u64,
+    /// Pages that connected for a few seconds and left, over the run (beside the `clients`
+    /// that stay).
+    pub pages_come_and_gone: u64,
+    /// The daemon's open file descriptors one minute into the run.
+    pub fds_early: usize,
+    /// … and after the landing.
+    pub fds_after: usize,
+    /// The run's recording on disk after the landing, MB (10⁶ bytes).
+    pub recording_mb: f64,
+    /// Messages the recording could not write.
+    pub recording_lost: u64,
+}
+
+/// Open file descriptors of a process (`/proc/PID/fd`).
+fn open_fds(pid: u32) -> anyhow::Result<usize> {
+    Ok(std::fs::read_dir(format!("/proc/{pid}/fd"))
+        .with_context(|| format!("reading /proc/{pid}/fd (Linux only)"))?
+        .count())
+}
+
+/// Bytes of the files in `dir`.
+fn dir_bytes(dir: &std::path::Path) -> u64 {
+    std::fs::read_dir(dir)
+        .map(|d| {
+            d.filter_map(Result::ok)
+                .filter_map(|e| e.metadata().ok())
+                .map(|m| m.len())
+                .sum()
+        })
+        .unwrap_or(0)
+}
+
+/// Pages that come and go: 20 at a time connect, read for a few seconds and leave, again and
+/// again, as people open and close the dashboard over a day.
+async fn churn(url: String, gone: Arc<AtomicU64>) {
+    loop {
+        let mut pages = Vec::new();
+        for _ in 0..20 {
+            if let Ok((ws, _)) = tokio_tungstenite::connect_async(url.clone()).await {
+                pages.push(ws);
+            }
+        }
+        let read = async {
+            for ws in &mut pages {
+                let _ = tokio::time::timeout(Duration::from_millis(100), ws.next()).await;
+            }
+        };
+        read.await;
+        tokio::time::sleep(Duration::from_secs(3)).await;
+        gone.fetch_add(pages.len() as u64, Ordering::Relaxed);
+        drop(pages);
+        tokio::time::sleep(Duration::from_secs(2)).await;
+    }
 }
 
 /// The built-in `mission`, held on the pad so that launch to landing and the wait before it
@@ -179,6 +235,9 @@ pub fn run(options: &MemoryBenchOptions) -> anyhow::Result<MemoryReport> {
 async fn measure(options: &MemoryBenchOptions) -> anyhow::Result<MemoryReport> {
     let mission = three_hour_mission(options.mission_s)?;
     let exe: PathBuf = std::env::current_exe().context("this program's path")?;
+    // The station records, as it does in the field; into a directory of its own.
+    let record_dir = std::env::temp_dir().join(format!("stx-bench-memory-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&record_dir);
     let mut child = Command::new(&exe)
         .args([
             "serve",
@@ -186,7 +245,9 @@ async fn measure(options: &MemoryBenchOptions) -> anyhow::Result<MemoryReport> {
             "127.0.0.1:0",
             "--link",
             "udpin:127.0.0.1:0",
+            "--record-dir",
         ])
+        .arg(&record_dir)
         .env("RUST_LOG", "warn")
         .stdout(Stdio::piped())
         .stderr(Stdio::null())
@@ -234,6 +295,11 @@ async fn measure(options: &MemoryBenchOptions) -> anyhow::Result<MemoryReport> {
         let url = format!("ws://{address}/api/ws?token={token}");
         tokio::spawn(page(url, messages.clone(), bytes.clone()));
     }
+    let gone = Arc::new(AtomicU64::new(0));
+    let churning = tokio::spawn(churn(
+        format!("ws://{address}/api/ws?token={token}"),
+        gone.clone(),
+    ));
 
     let progress = if std::io::stderr().is_terminal() {
         let bar = ProgressBar::new_spinner();
@@ -247,6 +313,7 @@ async fn measure(options: &MemoryBenchOptions) -> anyhow::Result<MemoryReport> {
     let expected_wall_s = options.mission_s / options.speed;
     let deadline = start + Duration::from_secs_f64(expected_wall_s * 3.0 + 120.0);
     let mut rss_early_mb = None;
+    let mut fds_early = None;
     let mut state = serde_json::Value::Null;
     let landed = loop {
         tokio::time::sleep(Duration::from_secs(1)).await;
@@ -259,6 +326,7 @@ async fn measure(options: &MemoryBenchOptions) -> anyhow::Result<MemoryReport> {
         let (rss, _) = memory_mb(pid)?;
         if rss_early_mb.is_none() && start.elapsed() >= Duration::from_secs(60) {
             rss_early_mb = Some(rss);
+            fds_early = Some(open_fds(pid)?);
         }
         state = get_json(&address, "/api/state", &token)
             .await
@@ -281,10 +349,17 @@ async fn measure(options: &MemoryBenchOptions) -> anyhow::Result<MemoryReport> {
     };
     progress.finish_and_clear();
     let wall_time_s = start.elapsed().as_secs_f64();
+    churning.abort();
+    // The pages that came and went have closed (the station notices within a second).
+    tokio::time::sleep(Duration::from_secs(2)).await;
     let (rss_after_mb, rss_peak_mb) = memory_mb(pid)?;
+    let fds_after = open_fds(pid)?;
+    let recording_mb = dir_bytes(&record_dir) as f64 / 1e6;
+    let recording_lost = state["recording"]["messages_lost"].as_u64().unwrap_or(0);
     let (_, drone_rss_peak_mb) = memory_mb(drone_pid)?;
     drone.kill().await.ok();
     child.kill().await.ok();
+    let _ = std::fs::remove_dir_all(&record_dir);
     Ok(MemoryReport {
         mission_time_s: state["vehicle"]["attitude"]["time_boot_ms"]
             .as_f64()
@@ -299,5 +374,10 @@ async fn measure(options: &MemoryBenchOptions) -> anyhow::Result<MemoryReport> {
         rss_early_mb: rss_early_mb.unwrap_or(rss_after_mb),
         page_messages: messages.load(Ordering::Relaxed),
         page_bytes: bytes.load(Ordering::Relaxed),
+        pages_come_and_gone: gone.load(Ordering::Relaxed),
+        fds_early: fds_early.unwrap_or(fds_after),
+        fds_after,
+        recording_mb,
+        recording_lost,
     })
 }
