@@ -10,6 +10,7 @@ mod bench_memory;
 mod bench_station;
 mod drone;
 mod export;
+mod import;
 mod inputs;
 mod logging;
 mod montecarlo;
@@ -59,6 +60,8 @@ enum Command {
     Record(record::RecordArgs),
     /// A recording as CSV (one file per channel), KML or GPX.
     Export(export::ExportArgs),
+    /// A MAVLink telemetry log (.tlog) as a recording.
+    Import(import::ImportArgs),
     /// Play a recording through a station into the dashboard (pause, seek, speed; no commands).
     Replay(replay::ReplayArgs),
     /// Station tokens: `stx token new` prints a strong random one as a `[[tokens]]` entry.
@@ -93,6 +96,7 @@ fn main() -> ExitCode {
         Command::Drone(args) => drone::run(args),
         Command::Record(args) => record::run(args),
         Command::Export(args) => export::run(args),
+        Command::Import(args) => import::run(args),
         Command::Replay(args) => replay::run(args),
         Command::Token(args) => token::run(args),
     };
@@ -122,6 +126,7 @@ impl Command {
                 | Command::Tune(_)
                 | Command::Record(_)
                 | Command::Export(_)
+                | Command::Import(_)
                 | Command::Token(_)
         )
     }

@@ -28,6 +28,7 @@
 pub mod settings;
 pub mod station;
 pub mod telemetry;
+pub mod tlog;
 
 /// The link's raw bytes, both directions.
 pub const FRAMES: &str = "/mavlink/frames";
