@@ -16,6 +16,7 @@ use stx_gnc::guidance::GuidanceConfig;
 use stx_link::signing::{KeyText, SIGNING_KEY_ENV, SigningKey};
 use thiserror::Error;
 
+use crate::limits::LimitSettings;
 use crate::recording::settings::RecordingSettings;
 
 /// Why a station configuration was refused.
@@ -194,6 +195,10 @@ pub struct StationConfig {
     /// Flight recordings (`[recording]`): on by default, in the state directory.
     #[serde(default)]
     pub recording: RecordingSettings,
+    /// What one caller may ask (`[limits]`: requests per token, wrong tokens per address,
+    /// pages at once); the defaults suit a field laptop.
+    #[serde(default)]
+    pub limits: LimitSettings,
 }
 
 fn default_web_dir() -> PathBuf {
@@ -330,6 +335,9 @@ impl StationConfig {
             }
         }
         if let Err((field, rule)) = self.recording.check() {
+            return invalid(field, rule);
+        }
+        if let Err((field, rule)) = self.limits.check() {
             return invalid(field, rule);
         }
         if !(self.cutdown_window_s > 0.0 && self.cutdown_window_s <= 60.0) {

@@ -12,6 +12,8 @@ use std::collections::HashMap;
 use std::hash::Hash;
 use std::net::IpAddr;
 
+use serde::{Deserialize, Serialize};
+
 /// Most keys a bucket table remembers.
 pub const MAX_KEYS: usize = 4096;
 /// Requests a token may make at once, and per second after that (one token may serve a
@@ -26,6 +28,57 @@ pub const BAD_TOKEN_BURST: f64 = 10.0;
 pub const BAD_TOKEN_PER_S: f64 = 1.0 / 60.0;
 /// Pages (WebSockets) connected at once.
 pub const MAX_WEBSOCKETS: usize = 64;
+
+/// `[limits]` of the station's TOML; every field may be left out (the defaults above).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct LimitSettings {
+    /// Requests a token may make at once, requests.
+    pub token_burst: f64,
+    /// Requests a token may make per second after its burst, requests/s.
+    pub token_per_s: f64,
+    /// Wrong tokens an address may send at once, requests.
+    pub bad_token_burst: f64,
+    /// Wrong tokens an address may send per minute after that, requests/min.
+    pub bad_tokens_per_min: f64,
+    /// Pages (WebSockets) connected at once.
+    pub max_websockets: usize,
+}
+
+impl Default for LimitSettings {
+    fn default() -> Self {
+        Self {
+            token_burst: TOKEN_BURST,
+            token_per_s: TOKEN_PER_S,
+            bad_token_burst: BAD_TOKEN_BURST,
+            bad_tokens_per_min: BAD_TOKEN_PER_S * 60.0,
+            max_websockets: MAX_WEBSOCKETS,
+        }
+    }
+}
+
+impl LimitSettings {
+    /// The first rule broken, as `(field, rule)`.
+    pub fn check(&self) -> Result<(), (&'static str, &'static str)> {
+        let positive = |x: f64| x.is_finite() && x > 0.0;
+        if !(positive(self.token_burst) && self.token_burst >= 1.0) {
+            return Err(("limits.token_burst", "a number of requests ≥ 1"));
+        }
+        if !positive(self.token_per_s) {
+            return Err(("limits.token_per_s", "requests per second > 0"));
+        }
+        if !(positive(self.bad_token_burst) && self.bad_token_burst >= 1.0) {
+            return Err(("limits.bad_token_burst", "a number of requests ≥ 1"));
+        }
+        if !positive(self.bad_tokens_per_min) {
+            return Err(("limits.bad_tokens_per_min", "requests per minute > 0"));
+        }
+        if !(1..=10_000).contains(&self.max_websockets) {
+            return Err(("limits.max_websockets", "from 1 to 10000 pages"));
+        }
+        Ok(())
+    }
+}
 
 /// How long to wait before asking again, s (whole seconds, as `Retry-After` carries it).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -133,9 +186,16 @@ pub struct Limits {
 
 impl Default for Limits {
     fn default() -> Self {
+        Self::new(&LimitSettings::default())
+    }
+}
+
+impl Limits {
+    /// The limits `settings` ask for.
+    pub fn new(settings: &LimitSettings) -> Self {
         Self {
-            requests: Buckets::new(TOKEN_BURST, TOKEN_PER_S),
-            bad_tokens: Buckets::new(BAD_TOKEN_BURST, BAD_TOKEN_PER_S),
+            requests: Buckets::new(settings.token_burst, settings.token_per_s),
+            bad_tokens: Buckets::new(settings.bad_token_burst, settings.bad_tokens_per_min / 60.0),
         }
     }
 }
@@ -198,6 +258,41 @@ mod tests {
         assert!(l.may_try(30.0, guesser).is_err());
         assert_eq!(l.may_try(30.0, operator), Ok(()));
         assert_eq!(l.may_try(61.0, guesser), Ok(()), "one more a minute");
+    }
+
+    #[test]
+    fn the_configured_limits_are_the_ones_in_force_and_checked() {
+        let settings = LimitSettings {
+            token_burst: 2.0,
+            bad_tokens_per_min: 6.0,
+            ..LimitSettings::default()
+        };
+        assert_eq!(settings.check(), Ok(()));
+        let mut l = Limits::new(&settings);
+        let k = "operator".to_string();
+        assert_eq!(l.requests.take(0.0, &k), Verdict::Allowed);
+        assert_eq!(l.requests.take(0.0, &k), Verdict::Allowed);
+        assert!(matches!(l.requests.take(0.0, &k), Verdict::Refused { .. }));
+        let guesser: IpAddr = "10.0.0.66".parse().expect("address");
+        for _ in 0..BAD_TOKEN_BURST as usize + 1 {
+            l.bad_tokens.take(0.0, &guesser);
+        }
+        // Six a minute: one more after ten seconds.
+        assert!(l.may_try(5.0, guesser).is_err());
+        assert_eq!(l.may_try(11.0, guesser), Ok(()));
+        let bad = |edit: fn(&mut LimitSettings)| {
+            let mut s = LimitSettings::default();
+            edit(&mut s);
+            s.check().unwrap_err().0
+        };
+        assert_eq!(bad(|s| s.token_burst = 0.5), "limits.token_burst");
+        assert_eq!(bad(|s| s.token_per_s = f64::NAN), "limits.token_per_s");
+        assert_eq!(
+            bad(|s| s.bad_tokens_per_min = 0.0),
+            "limits.bad_tokens_per_min"
+        );
+        assert_eq!(bad(|s| s.max_websockets = 0), "limits.max_websockets");
+        assert_eq!(LimitSettings::default().check(), Ok(()));
     }
 
     #[test]

@@ -215,7 +215,7 @@ async fn run_with(
         broadcast: broadcast_tx,
         states: watch::channel(StateFrame::default()).0,
         clients: Mutex::new(Default::default()),
-        limits: Mutex::new(Default::default()),
+        limits: Mutex::new(crate::limits::Limits::new(&config.limits)),
         next_client: Default::default(),
         broadcast_total: Default::default(),
         recording,

@@ -18,7 +18,7 @@ use super::auth::Caller;
 use super::rest::session_of;
 use super::shared::{AppState, ClientCounters, HttpError, Shared};
 use crate::config::Role;
-use crate::limits::{MAX_WEBSOCKETS, RetryAfter};
+use crate::limits::RetryAfter;
 use crate::messages::{EventMsg, Level};
 use crate::replies::{HelloMsg, HistoryMsg, LaggedMsg, PongMsg};
 use crate::requests::ClientMessage;
@@ -33,13 +33,14 @@ pub(crate) async fn websocket(
         .lock()
         .unwrap_or_else(|e| e.into_inner())
         .len();
-    if pages >= MAX_WEBSOCKETS {
+    let max = state.config.limits.max_websockets;
+    if pages >= max {
         tracing::warn!(
             pages,
-            "WebSocket refused: the station serves {MAX_WEBSOCKETS} pages at most"
+            "WebSocket refused: the station serves {max} pages at most"
         );
         return HttpError::too_many(
-            format!("the station serves {MAX_WEBSOCKETS} pages at once"),
+            format!("the station serves {max} pages at once"),
             RetryAfter(5),
         )
         .into_response();
