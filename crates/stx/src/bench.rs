@@ -59,6 +59,10 @@ enum BenchWhat {
         /// Record the run (MCAP) into this directory, as `stx serve` does; default: off.
         #[arg(long, value_name = "DIR")]
         record_dir: Option<std::path::PathBuf>,
+        /// While telemetry is timed, flood the station from other loopback addresses: 1,000
+        /// wrong-token requests and 200 WebSocket connects and disconnects a second.
+        #[arg(long)]
+        abuse: bool,
     },
 }
 
@@ -117,6 +121,7 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
             frame_rate_hz,
             commands,
             record_dir,
+            abuse,
         } => {
             let report = crate::bench_station::run(&crate::bench_station::StationBenchOptions {
                 clients,
@@ -124,6 +129,7 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
                 frame_rate_hz,
                 commands,
                 record_dir,
+                abuse,
             })?;
             if json {
                 println!("{}", serde_json::to_string_pretty(&report)?);
@@ -146,6 +152,19 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
                     "command → MAVLink bytes, {} commands: p50 {:.2} ms, p99 {:.2} ms, max {:.2} ms ({} lost)",
                     c.commands_sent, c.latency.p50_ms, c.latency.p99_ms, c.latency.max_ms, c.lost
                 );
+                if let Some(a) = &report.abuse {
+                    println!(
+                        "flood during it: {} wrong-token requests ({} answered 429, {} 401, {} other), {} WebSockets tried ({} opened and closed); process RSS {:.1} MB before, {:.1} MB after",
+                        a.bad_token_requests,
+                        a.answered_429,
+                        a.answered_401,
+                        a.other,
+                        a.websockets_tried,
+                        a.websockets_opened,
+                        a.rss_before_mb,
+                        a.rss_after_mb
+                    );
+                }
                 let r = &report.recording;
                 println!(
                     "recording: {:?}, {} messages ({:.2} MB) written, {} lost{}",

@@ -173,7 +173,7 @@ mod tempfile_path {
 }
 
 /// `VmRSS` and `VmHWM` of a process, MB.
-fn memory_mb(pid: u32) -> anyhow::Result<(f64, f64)> {
+pub(crate) fn memory_mb(pid: u32) -> anyhow::Result<(f64, f64)> {
     let status = std::fs::read_to_string(format!("/proc/{pid}/status"))
         .with_context(|| format!("reading /proc/{pid}/status (Linux only)"))?;
     let field = |name: &str| -> anyhow::Result<f64> {

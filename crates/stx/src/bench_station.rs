@@ -53,6 +53,8 @@ pub struct StationBenchOptions {
     pub commands: usize,
     /// Record the run into this directory (the station's recording on), else not.
     pub record_dir: Option<std::path::PathBuf>,
+    /// Flood the station from other addresses while telemetry is timed (`bench_abuse`).
+    pub abuse: bool,
 }
 
 /// Latency distribution, ms.
@@ -111,6 +113,8 @@ pub struct StationReport {
     pub command_to_mavlink: CommandReport,
     /// The station's recording at the end (`off` without `--record-dir`).
     pub recording: stx_station::messages::RecordingView,
+    /// The flood during the telemetry window, with `--abuse`.
+    pub abuse: Option<crate::bench_abuse::AbuseReport>,
 }
 
 /// Starts the station on its own runtime; returns its addresses and the stop switch.
@@ -351,10 +355,27 @@ pub fn run(options: &StationBenchOptions) -> anyhow::Result<StationReport> {
         ));
         // The first seconds (link up, plan read back, estimator converging) are not timed.
         tokio::time::sleep(Duration::from_secs(5)).await;
+        let flood = if options.abuse {
+            let viewer = running
+                .shared
+                .config
+                .tokens
+                .iter()
+                .find(|t| t.role == Role::Viewer)
+                .map(|t| t.token.clone())
+                .context("the station config has no viewer token")?;
+            Some(crate::bench_abuse::Flood::start(running.http, viewer)?)
+        } else {
+            None
+        };
         let timed_from = Instant::now();
         let window = Duration::from_secs_f64(options.frames as f64 / options.frame_rate_hz);
         tokio::time::sleep(window).await;
         let timed_to = Instant::now();
+        let abuse = match flood {
+            Some(f) => Some(f.stop().await?),
+            None => None,
+        };
         if landed.load(Ordering::Relaxed) {
             bail!("the drone landed before the telemetry window ended: time fewer frames");
         }
@@ -440,6 +461,7 @@ pub fn run(options: &StationBenchOptions) -> anyhow::Result<StationReport> {
                 latency: Latency::of(samples),
             },
             recording: shared.recording.view(),
+            abuse,
         })
     });
     let _ = stop_station.send(());

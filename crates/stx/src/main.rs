@@ -6,6 +6,7 @@
 
 mod analyze;
 mod bench;
+mod bench_abuse;
 mod bench_memory;
 mod bench_station;
 mod drone;
