@@ -25,8 +25,8 @@ fn temp_dir(name: &str) -> PathBuf {
     dir
 }
 
-/// A recording of 300 events over 3 s (three one-second chunks), and the offset halfway
-/// through its last chunk.
+/// A recording of 400 events over 4 s (one-second chunks), and the offset halfway through
+/// the third chunk, the last one written before `finish`: a cut there leaves two whole chunks.
 fn recording() -> (Vec<u8>, usize) {
     let info = RecordingInfo::new("test", "straplex-1", "cli");
     let mut core = RecorderCore::new(CoreOptions::default(), info, Duration::ZERO).unwrap();
@@ -35,7 +35,7 @@ fn recording() -> (Vec<u8>, usize) {
         .unwrap();
     let mut bytes = Vec::new();
     let mut last_chunk_start = 0;
-    for i in 0..300u64 {
+    for i in 0..400u64 {
         let now = Duration::from_millis(10 * i);
         let payload = format!(r#"{{"i":{i}}}"#);
         core.write(now, ch, T0 + i, T0 + i, payload.as_bytes())
