@@ -20,7 +20,8 @@ use crate::messages::{
     CommandResultMsg, ErrorBody, EventMsg, ParamsMsg, ReplayView, Session, StateMsg,
 };
 use crate::replies::{
-    ClientsBody, CommandAccepted, EventsBody, HelloMsg, HistoryMsg, LaggedMsg, PongMsg, TrackBody,
+    ClientsBody, CommandAccepted, EventsBody, HelloMsg, HistoryMsg, LaggedMsg, PongMsg,
+    RecordingsBody, ReplayOpened, TrackBody,
 };
 use crate::requests::{
     ClientMessage, ConfirmBody, CourseBody, HeadingBody, LocalizerBody, ModeBody, ParamBody,
@@ -96,6 +97,8 @@ pub fn schema() -> Result<Value, ContractError> {
         sent.subschema_for::<CutdownArm>(),
         sent.subschema_for::<ErrorBody>(),
         sent.subschema_for::<ReplayView>(),
+        sent.subschema_for::<RecordingsBody>(),
+        sent.subschema_for::<ReplayOpened>(),
         read.subschema_for::<ClientMessage>(),
         read.subschema_for::<ModeBody>(),
         read.subschema_for::<HeadingBody>(),
@@ -120,7 +123,7 @@ pub fn schema() -> Result<Value, ContractError> {
     Ok(json!({
         "$schema": "http://json-schema.org/draft-07/schema#",
         "title": "stx station API",
-        "description": "Every message of the stx station's HTTP and WebSocket API (crates/stx-station/API.md), generated from the daemon's Rust types by `cargo run -p stx-station --example api_schema`: do not edit. The root is any one of them: on the WebSocket ServerMessage (station to page) and ClientMessage (page to station); over REST the bodies the station answers (Session, StateMsg, ParamsMsg, EventsBody, TrackBody, ClientsBody, CommandResultMsg, CommandAccepted, CutdownArm, ErrorBody, ReplayView) and the bodies of the commands (*Body).",
+        "description": "Every message of the stx station's HTTP and WebSocket API (crates/stx-station/API.md), generated from the daemon's Rust types by `cargo run -p stx-station --example api_schema`: do not edit. The root is any one of them: on the WebSocket ServerMessage (station to page) and ClientMessage (page to station); over REST the bodies the station answers (Session, StateMsg, ParamsMsg, EventsBody, TrackBody, ClientsBody, CommandResultMsg, CommandAccepted, CutdownArm, ErrorBody, ReplayView, RecordingsBody, ReplayOpened) and the bodies of the commands (*Body).",
         "anyOf": messages,
         "definitions": definitions,
     }))

@@ -1,12 +1,14 @@
 //! The API's replies around the station's state (`API.md`): the WebSocket's `hello`,
 //! `history`, `lagged` and `pong`, and the bodies of the REST lists and of a command's `202`.
 //! The state, events, command results and parameters themselves are in [`crate::messages`].
+//! Also the recordings list of `GET /api/recordings` and the answer that opens a replay.
 
 use schemars::JsonSchema;
 use serde::Serialize;
 
 use crate::config::Role;
 use crate::messages::{EventMsg, Session, StateMsg, TrackPoint};
+use crate::recording::summary::RecordingSummary;
 
 /// The WebSocket's first message.
 #[derive(Debug, Clone, Serialize, JsonSchema)]
@@ -122,4 +124,35 @@ pub struct CommandAccepted {
     /// Always `sent`.
     #[schemars(extend("const" = "sent"))]
     pub status: &'static str,
+}
+
+/// The recordings, newest first, and the files that could not be read.
+#[derive(Debug, Clone, PartialEq, Serialize, JsonSchema)]
+pub struct RecordingsBody {
+    /// The recordings directory (`null` when the station has none).
+    pub directory: Option<String>,
+    /// Every readable recording, newest first.
+    pub recordings: Vec<RecordingSummary>,
+    /// Files of the directory that are not readable recordings, with why.
+    pub unreadable: Vec<UnreadableRecording>,
+}
+
+/// A file of the recordings directory that could not be summarised.
+#[derive(Debug, Clone, PartialEq, Serialize, JsonSchema)]
+pub struct UnreadableRecording {
+    /// File name.
+    pub name: String,
+    /// Why.
+    pub reason: String,
+}
+
+/// A replay station the daemon started for a page.
+#[derive(Debug, Clone, PartialEq, Serialize, JsonSchema)]
+pub struct ReplayOpened {
+    /// The recording.
+    pub name: String,
+    /// Port of the replay's dashboard, on the host the page used.
+    pub port: u16,
+    /// `https` with `[tls]`, else `http`.
+    pub scheme: &'static str,
 }

@@ -3,13 +3,11 @@
 //! the page (`POST /api/replay`).
 
 use std::path::PathBuf;
-use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
 
 use anyhow::Context;
 use clap::{Args, ValueEnum};
-use stx_record::Recording;
-use stx_station::replay::{MAX_SPEED, MIN_SPEED, ReplayControl, ReplayMode};
+use stx_station::daemon::{PreparedReplay, serve_replay};
+use stx_station::replay::{MAX_SPEED, MIN_SPEED, ReplayMode};
 
 use crate::BadInput;
 use crate::serve::{announce, load_config, shutdown_signal};
@@ -49,72 +47,34 @@ pub fn run(args: ReplayArgs) -> anyhow::Result<()> {
         ))
         .into());
     }
-    let recording = Recording::open(&args.file)
-        .with_context(|| format!("cannot read the recording {}", args.file.display()))
-        .map_err(BadInput)?;
-    let (start, end) = recording
-        .time_range()
-        .with_context(|| format!("{} holds no messages", args.file.display()))
-        .map_err(BadInput)?;
-    let mut config = load_config(args.config.as_deref())?;
-    if let Some(listen) = args.listen {
-        config.listen = listen;
-    }
-    // The feeder is the only "drone": a fresh loopback port.
-    config.link.address = "udpin:127.0.0.1:0".into();
-    config.link.more_addresses.clear();
     let mode = match args.mode {
         Mode::Rerun => ReplayMode::Rerun,
         Mode::Recorded => ReplayMode::Recorded,
     };
-    let control = Arc::new(
-        ReplayControl::new(
-            args.file.display().to_string(),
-            mode,
-            start,
-            end,
-            args.speed,
-        )
-        .map_err(|e| BadInput(e.into()))?,
-    );
+    let prepared =
+        PreparedReplay::open(&args.file, mode, args.speed).map_err(|e| BadInput(e.into()))?;
+    let mut config = load_config(args.config.as_deref())?;
+    if let Some(listen) = args.listen {
+        config.listen = listen;
+    }
     let runtime = tokio::runtime::Builder::new_multi_thread()
         .enable_all()
         .build()
         .context("starting the async runtime")?;
-    let stop = Arc::new(AtomicBool::new(false));
-    let result = runtime.block_on(async {
+    runtime.block_on(async {
         let operator = config
             .tokens
             .iter()
             .find(|t| t.role == stx_station::config::Role::Operator)
             .map(|t| t.token.clone())
             .unwrap_or_default();
-        let file = args.file.clone();
-        let feeder_stop = stop.clone();
-        let mut recording = Some(recording);
-        stx_station::daemon::run_replay(config, control.clone(), shutdown_signal(), |running| {
+        serve_replay(config, prepared, shutdown_signal(), |running| {
             announce(&format!(
                 "stx replay: open {}://{}/?token={operator}\n",
                 running.scheme, running.http
             ));
-            let (Some(link), Some(recording)) = (running.link_local, recording.take()) else {
-                tracing::error!("the replay station has no link to feed");
-                return;
-            };
-            if let Err(e) = stx_station::daemon::spawn_replay_feeder(
-                recording,
-                file,
-                control.clone(),
-                running.shared.clone(),
-                link,
-                feeder_stop,
-            ) {
-                tracing::error!(error = %e, "the replay could not start");
-            }
         })
         .await
         .context("replay station")
-    });
-    stop.store(true, Ordering::Relaxed);
-    result
+    })
 }

@@ -2,7 +2,7 @@
 // the daemon's Rust types by `cargo run -p stx-station --example api_schema`): do not edit.
 
 /**
- * Every message of the stx station's HTTP and WebSocket API (crates/stx-station/API.md), generated from the daemon's Rust types by `cargo run -p stx-station --example api_schema`: do not edit. The root is any one of them: on the WebSocket ServerMessage (station to page) and ClientMessage (page to station); over REST the bodies the station answers (Session, StateMsg, ParamsMsg, EventsBody, TrackBody, ClientsBody, CommandResultMsg, CommandAccepted, CutdownArm, ErrorBody, ReplayView) and the bodies of the commands (*Body).
+ * Every message of the stx station's HTTP and WebSocket API (crates/stx-station/API.md), generated from the daemon's Rust types by `cargo run -p stx-station --example api_schema`: do not edit. The root is any one of them: on the WebSocket ServerMessage (station to page) and ClientMessage (page to station); over REST the bodies the station answers (Session, StateMsg, ParamsMsg, EventsBody, TrackBody, ClientsBody, CommandResultMsg, CommandAccepted, CutdownArm, ErrorBody, ReplayView, RecordingsBody, ReplayOpened) and the bodies of the commands (*Body).
  */
 export type StxStationAPI =
   | ServerMessage
@@ -15,6 +15,8 @@ export type StxStationAPI =
   | CutdownArm
   | ErrorBody
   | ReplayView
+  | RecordingsBody
+  | ReplayOpened
   | ClientMessage
   | ModeBody
   | HeadingBody
@@ -1228,6 +1230,121 @@ export interface ErrorBody {
    * For people: what is wrong.
    */
   reason: string;
+}
+/**
+ * The recordings, newest first, and the files that could not be read.
+ */
+export interface RecordingsBody {
+  /**
+   * The recordings directory (`null` when the station has none).
+   */
+  directory: string | null;
+  /**
+   * Every readable recording, newest first.
+   */
+  recordings: RecordingSummary[];
+  /**
+   * Files of the directory that are not readable recordings, with why.
+   */
+  unreadable: UnreadableRecording[];
+}
+/**
+ * One past (or current) recording of the station.
+ */
+export interface RecordingSummary {
+  /**
+   * Closed with its index (`true`), or cut short (the station stopped without closing it,
+   * or is still writing it): readable up to its last whole chunk, `stx record recover`
+   * writes a clean copy.
+   */
+  complete: boolean;
+  /**
+   * From the first message to the last, ms.
+   */
+  duration_ms: number;
+  /**
+   * Where the flight landed, when the recording ends landed.
+   */
+  landing: LandingSummary | null;
+  /**
+   * The stage of the flight at the end of the recording (`landed`, `descent`, …).
+   */
+  last_stage: string | null;
+  /**
+   * Messages in it.
+   */
+  messages: number;
+  /**
+   * The mission, as its metadata names it.
+   */
+  mission: string | null;
+  /**
+   * File name in the recordings directory.
+   */
+  name: string;
+  /**
+   * The station is writing this file now.
+   */
+  recording_now: boolean;
+  /**
+   * Size on disk, B.
+   */
+  size_bytes: number;
+  /**
+   * Unix time of the first message, ms (`null` for a recording with no messages).
+   */
+  start_ms: number | null;
+  /**
+   * The vehicle, as its metadata names it.
+   */
+  vehicle: string | null;
+}
+/**
+ * Where a recorded flight came down.
+ */
+export interface LandingSummary {
+  /**
+   * Latitude, degrees (the drone's GPS, else the station's estimate).
+   */
+  lat_deg: number;
+  /**
+   * Longitude, degrees.
+   */
+  lon_deg: number;
+  /**
+   * Horizontal distance to guidance's target, m (`null` without a target).
+   */
+  miss_m: number | null;
+}
+/**
+ * A file of the recordings directory that could not be summarised.
+ */
+export interface UnreadableRecording {
+  /**
+   * File name.
+   */
+  name: string;
+  /**
+   * Why.
+   */
+  reason: string;
+}
+/**
+ * A replay station the daemon started for a page.
+ */
+export interface ReplayOpened {
+  /**
+   * The recording.
+   */
+  name: string;
+  /**
+   * Port of the replay's dashboard, on the host the page used.
+   */
+  port: number;
+  /**
+   * `https` with `[tls]`, else `http`.
+   */
+  scheme: string;
 }
 /**
  * `POST /api/commands/mode`.

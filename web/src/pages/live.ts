@@ -22,6 +22,7 @@ import { EventLog } from "../ui/eventLog";
 import { Actuators, FlightData } from "../ui/flightData";
 import { JoystickPanel } from "../ui/joystickPanel";
 import { LinkPanel } from "../ui/linkPanel";
+import { RecordingsPanel } from "../ui/recordingsPanel";
 import { ReplayBar } from "../ui/replayBar";
 import { MapView } from "../ui/map";
 import { ParamEditor } from "../ui/paramEditor";
@@ -97,6 +98,7 @@ function build(session: Session): void {
   const plots = new Plots();
   const view3d = new View3D(station.origin);
   const events = new EventLog();
+  const recordings = new RecordingsPanel(api, token);
   const commandList = new CommandList();
   const tracker = new CommandTracker((e) => onCommand(e));
 
@@ -207,6 +209,7 @@ function build(session: Session): void {
     { id: "plots", label: "Plots", content: plots.root, onShow: () => plots.layout() },
     { id: "3d", label: "3-D view", content: view3d.root, onShow: () => view3d.layout() },
     { id: "events", label: "Event log", content: events.root },
+    { id: "recordings", label: "Recordings", content: recordings.root, onShow: () => void recordings.load() },
   ]);
   const centre = h("section", { class: "col centre" }, h("div", { class: "map-wrap vd" }, map.root), bottom.root);
   // Modes and the joystick first: in manual flight both must be in view without scrolling.

@@ -21,6 +21,22 @@ use crate::messages::{Level, StateMsg, TrackPoint};
 const MAX_HISTORY: usize = 300;
 /// Seconds between track points.
 const TRACK_PERIOD_S: f64 = 1.0;
+/// Most track points kept: a long day (hours on the pad, then the flight) must not grow the
+/// station, nor the `history` every new page is sent. Past it, the older half is thinned.
+pub(crate) const MAX_TRACK_POINTS: usize = 4096;
+
+/// Drops every other point of the older half of `track`, keeping its first point: the recent
+/// half stays at full resolution, and the further back, the coarser (each thinning halves
+/// what is older again), so the shape of the whole flight stays on the map.
+fn thin_track(track: &mut Vec<TrackPoint>) {
+    let half = track.len() / 2;
+    let mut i = 0;
+    track.retain(|_| {
+        let keep = i >= half || i % 2 == 0;
+        i += 1;
+        keep
+    });
+}
 
 /// Seconds the drone's clock may step back before the station takes it for a reboot.
 const REBOOT_STEP_BACK_S: f64 = 5.0;
@@ -244,6 +260,9 @@ impl StationCore {
                     lon_deg: lon,
                     alt_msl_m: alt,
                 });
+                if self.track.len() > MAX_TRACK_POINTS {
+                    thin_track(&mut self.track);
+                }
             }
             self.estimate = Some(est);
         } else {
@@ -294,5 +313,35 @@ impl StationCore {
         self.latest
             .status
             .map_or(FlightMode::Uncontrolled, |(s, _)| s.mode)
+    }
+}
+
+#[cfg(test)]
+mod track_tests {
+    use super::*;
+
+    #[test]
+    fn a_long_day_keeps_a_bounded_track_with_its_ends_and_recent_points() {
+        let mut track = Vec::new();
+        // Twelve hours at 1 Hz.
+        for t in 0..43_200 {
+            track.push(TrackPoint {
+                time_s: f64::from(t),
+                lat_deg: 50.0,
+                lon_deg: 14.0,
+                alt_msl_m: 300.0,
+            });
+            if track.len() > MAX_TRACK_POINTS {
+                thin_track(&mut track);
+            }
+        }
+        assert!(track.len() <= MAX_TRACK_POINTS, "{}", track.len());
+        assert!(track.len() > MAX_TRACK_POINTS / 2, "{}", track.len());
+        assert_eq!(track[0].time_s, 0.0);
+        assert_eq!(track.last().map(|p| p.time_s), Some(43_199.0));
+        assert!(track.windows(2).all(|w| w[0].time_s < w[1].time_s));
+        // The last 1,000 s are whole.
+        let recent = track.iter().filter(|p| p.time_s >= 42_200.0).count();
+        assert_eq!(recent, 1000);
     }
 }

@@ -5,6 +5,7 @@
 //! core does.
 
 mod replay_feed;
+mod replay_sessions;
 mod station_loop;
 mod tls;
 
@@ -29,6 +30,7 @@ use crate::recorder::Recording;
 use crate::replay::ReplayControl;
 
 pub use replay_feed::spawn_replay_feeder;
+pub use replay_sessions::{IDLE, MAX_SESSIONS, PreparedReplay, ReplayOpenError, serve_replay};
 pub use station_loop::STATE_PERIOD;
 pub use tls::tls_config;
 
@@ -207,6 +209,14 @@ async fn run_with(
     ));
 
     let (broadcast_tx, _) = broadcast::channel::<Utf8Bytes>(RELIABLE_BACKLOG);
+    // A live station opens replays of its recordings for its pages; a replay opens none.
+    let (replay_requests, replay_requests_rx) = match replay {
+        None => {
+            let (tx, rx) = mpsc::channel(4);
+            (Some(tx), Some(rx))
+        }
+        Some(_) => (None, None),
+    };
     let shared = Arc::new(Shared {
         core: Mutex::new(StationCore::new(config.clone(), wall_origin_ms)),
         config: config.clone(),
@@ -220,8 +230,18 @@ async fn run_with(
         broadcast_total: Default::default(),
         recording,
         replay,
+        recording_summaries: Default::default(),
+        replay_requests,
     });
     let (stop_tx, stop_rx) = watch::channel(false);
+    let sessions_task = replay_requests_rx.map(|rx| {
+        tokio::spawn(replay_sessions::replay_sessions(
+            config.clone(),
+            http_address,
+            rx,
+            stop_rx.clone(),
+        ))
+    });
     let station_task = tokio::spawn(station_loop::station_loop(station_loop::StationLoop {
         shared: shared.clone(),
         actions: actions_tx,
@@ -242,6 +262,9 @@ async fn run_with(
         let _ = stop_tx.send(true);
     };
     let served = serve(listener, tls, shared.clone(), stop).await;
+    if let Some(sessions) = sessions_task {
+        let _ = sessions.await;
+    }
     station_task.abort();
     link_task.abort();
     // The loop and the driver hold recording handles; the writer drains its queue and closes

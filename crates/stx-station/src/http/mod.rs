@@ -5,7 +5,8 @@
 //! - `auth`: tokens, names and roles;
 //! - `rest`: the reading endpoints; `commands`: the commanding ones (operators only);
 //! - `ws`: the WebSocket (state, events, command results; operators' sticks);
-//! - `kml`: the Google Earth feed; `replay`: the replay's pause, seek and speed.
+//! - `kml`: the Google Earth feed; `replay`: the replay's pause, seek and speed;
+//! - `recordings`: the past recordings: list, download, open in a replay.
 //!
 //! Handlers only lock the core for a moment, build their answer, and wake the daemon when they
 //! gave the core something for the link ([`Shared::link_due`]); nothing here waits on the
@@ -14,6 +15,7 @@
 mod auth;
 mod commands;
 mod kml;
+mod recordings;
 mod replay;
 mod rest;
 mod shared;
@@ -24,7 +26,9 @@ use axum::routing::{any, get, post};
 use tower_http::services::{ServeDir, ServeFile};
 
 pub use auth::Caller;
-pub use shared::{ClientCounters, HttpError, Shared, StateFrame};
+pub use shared::{
+    ClientCounters, HttpError, ReplayRefusal, ReplayRequest, Shared, StateFrame, SummaryCache,
+};
 
 use crate::requests::{CourseBody, HeadingBody, LocalizerBody, ModeBody, PlanBody, TargetBody};
 use commands::{arm_cutdown, command, confirm_cutdown, set_param};
@@ -54,6 +58,12 @@ pub fn router(state: std::sync::Arc<Shared>) -> Router {
         .route(
             "/api/replay",
             get(replay::replay_status).post(replay::replay_control),
+        )
+        .route("/api/recordings", get(recordings::recordings))
+        .route("/api/recordings/{name}", get(recordings::download))
+        .route(
+            "/api/recordings/{name}/replay",
+            post(recordings::open_replay),
         )
         .route("/api/ws", get(ws::websocket))
         // An API path that does not exist is an API error, never the dashboard's page.

@@ -48,7 +48,37 @@ pub struct Shared {
     pub recording: crate::recorder::Recording,
     /// The replay this station shows (`stx replay`); `None` when live.
     pub replay: Option<Arc<crate::replay::ReplayControl>>,
+    /// Recordings' summaries already read, for `GET /api/recordings`.
+    pub recording_summaries: SummaryCache,
+    /// Where `POST /api/recordings/{name}/replay` asks the daemon for a replay station;
+    /// `None` in a replay station (replays are opened from the live one).
+    pub replay_requests: Option<tokio::sync::mpsc::Sender<ReplayRequest>>,
 }
+
+/// Why a replay could not be opened: `(status, error, reason)` of the answer.
+pub type ReplayRefusal = (StatusCode, &'static str, String);
+
+/// A page's request to replay a recording, for the daemon's replay sessions.
+pub struct ReplayRequest {
+    /// The recording's path.
+    pub file: std::path::PathBuf,
+    /// Where the answer goes.
+    pub answer: tokio::sync::oneshot::Sender<Result<crate::replies::ReplayOpened, ReplayRefusal>>,
+}
+
+/// Summaries already read, by name, with the size and modification time they were read at:
+/// a closed recording is read once, the one being written each time it grew.
+#[derive(Default)]
+pub struct SummaryCache(pub(crate) Mutex<SummaryEntries>);
+
+type SummaryEntries = std::collections::HashMap<
+    String,
+    (
+        u64,
+        std::time::SystemTime,
+        crate::recording::summary::RecordingSummary,
+    ),
+>;
 
 /// The newest `state`, numbered so a page can count the ones it skipped.
 #[derive(Debug, Clone, Default)]

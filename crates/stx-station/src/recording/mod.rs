@@ -27,6 +27,7 @@
 
 pub mod settings;
 pub mod station;
+pub mod summary;
 pub mod telemetry;
 pub mod tlog;
 
