@@ -65,6 +65,7 @@
 pub mod address;
 pub mod command;
 pub mod endpoint;
+pub mod fixtures;
 pub mod frame;
 pub mod manual;
 pub mod param;

@@ -141,12 +141,20 @@ impl Storage for Directory {
     }
 }
 
+/// Messages made on the writer's thread: see [`RecorderHandle::write_later`].
+pub type Encode = Box<dyn FnOnce() -> Vec<(ChannelId, Vec<u8>)> + Send>;
+
 enum Command {
     Message {
         channel: ChannelId,
         log_time: u64,
         publish_time: u64,
         payload: Vec<u8>,
+    },
+    Encode {
+        log_time: u64,
+        publish_time: u64,
+        encode: Encode,
     },
     Flush(SyncSender<()>),
     Finish,
@@ -170,26 +178,44 @@ impl RecorderHandle {
         publish_time: u64,
         payload: Vec<u8>,
     ) -> bool {
-        let command = Command::Message {
+        self.send(Command::Message {
             channel,
             log_time,
             publish_time,
             payload,
-        };
+        })
+    }
+
+    /// Queues `encode`, which the writer's thread runs to make the messages (channel and
+    /// JSON payload each), logged at `log_time` and published at `publish_time`. The caller
+    /// pays a move instead of the encoding: the link's hot path records this way. `false`:
+    /// dropped (queue full or writer stopped), counted as one lost message.
+    pub fn write_later(
+        &self,
+        log_time: u64,
+        publish_time: u64,
+        encode: impl FnOnce() -> Vec<(ChannelId, Vec<u8>)> + Send + 'static,
+    ) -> bool {
+        self.send(Command::Encode {
+            log_time,
+            publish_time,
+            encode: Box::new(encode),
+        })
+    }
+
+    fn send(&self, command: Command) -> bool {
         match self.tx.try_send(command) {
             Ok(()) => true,
             Err(TrySendError::Full(_)) => {
                 self.shared.lost(1);
-                self.shared.report(
-                    IssueKind::QueueFull,
-                    "the writer is behind: queue full".into(),
-                );
+                self.shared
+                    .report(IssueKind::QueueFull, "the writer is behind: queue full");
                 false
             }
             Err(TrySendError::Disconnected(_)) => {
                 self.shared.lost(1);
                 self.shared
-                    .report(IssueKind::Stopped, "the writer thread has stopped".into());
+                    .report(IssueKind::Stopped, "the writer thread has stopped");
                 false
             }
         }
@@ -283,7 +309,7 @@ impl Recorder {
             if thread.join().is_err() {
                 self.handle
                     .shared
-                    .report(IssueKind::Stopped, "the writer thread panicked".into());
+                    .report(IssueKind::Stopped, "the writer thread panicked");
             }
         }
     }
@@ -333,17 +359,14 @@ impl Writer {
                     log_time,
                     publish_time,
                     payload,
+                }) => self.write(channel, log_time, publish_time, &payload),
+                Ok(Command::Encode {
+                    log_time,
+                    publish_time,
+                    encode,
                 }) => {
-                    let now = self.now();
-                    if let Err(e) = self
-                        .core
-                        .write(now, channel, log_time, publish_time, &payload)
-                    {
-                        self.shared.lost(1);
-                        self.shared.report(IssueKind::Core, e.to_string());
-                        if matches!(e, crate::writer::WriteError::Mcap(_)) {
-                            let _ = self.core.start_new_file(now);
-                        }
+                    for (channel, payload) in encode() {
+                        self.write(channel, log_time, publish_time, &payload);
                     }
                 }
                 Ok(Command::Flush(ack)) => {
@@ -358,7 +381,7 @@ impl Writer {
                     // Messages other handles queued after the finish will not be written.
                     let late = rx
                         .try_iter()
-                        .filter(|c| matches!(c, Command::Message { .. }))
+                        .filter(|c| matches!(c, Command::Message { .. } | Command::Encode { .. }))
                         .count();
                     self.shared.lost(late as u64);
                     break;
@@ -375,6 +398,20 @@ impl Writer {
             self.shared.report(IssueKind::Core, e.to_string());
         }
         self.apply_outputs();
+    }
+
+    fn write(&mut self, channel: ChannelId, log_time: u64, publish_time: u64, payload: &[u8]) {
+        let now = self.now();
+        if let Err(e) = self
+            .core
+            .write(now, channel, log_time, publish_time, payload)
+        {
+            self.shared.lost(1);
+            self.shared.report(IssueKind::Core, e.to_string());
+            if matches!(e, crate::writer::WriteError::Mcap(_)) {
+                let _ = self.core.start_new_file(now);
+            }
+        }
     }
 
     fn retry_if_due(&mut self) {

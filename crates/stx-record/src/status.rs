@@ -109,7 +109,9 @@ impl Shared {
     }
 
     /// Notes a problem; logs it unless one of its kind was logged within `log_every`.
-    pub(crate) fn report(&self, kind: IssueKind, message: String) {
+    /// `message` is only copied when it differs from the last one: a full queue reports every
+    /// message it drops, and that must stay cheap.
+    pub(crate) fn report(&self, kind: IssueKind, message: impl AsRef<str> + Into<String>) {
         let now = Instant::now();
         let mut issues = self.issues();
         let occurrences = {
@@ -138,14 +140,22 @@ impl Shared {
                 ?kind,
                 occurrences,
                 not_logged_since_last = silenced,
-                "recording: {message}"
+                "recording: {}",
+                message.as_ref()
             );
         }
-        issues.last = Some(RecorderIssue {
-            kind,
-            message,
-            occurrences,
-        });
+        match &mut issues.last {
+            Some(last) if last.kind == kind && last.message == message.as_ref() => {
+                last.occurrences = occurrences;
+            }
+            last => {
+                *last = Some(RecorderIssue {
+                    kind,
+                    message: message.into(),
+                    occurrences,
+                });
+            }
+        }
     }
 
     pub(crate) fn snapshot(&self) -> RecorderStatus {
@@ -175,8 +185,8 @@ mod tests {
         for i in 0..5 {
             shared.report(IssueKind::Write, format!("disk full {i}"));
         }
-        shared.report(IssueKind::QueueFull, "queue full".into());
-        shared.report(IssueKind::Write, "disk full again".into());
+        shared.report(IssueKind::QueueFull, "queue full");
+        shared.report(IssueKind::Write, "disk full again");
         let status = shared.snapshot();
         let last = status.last_error.unwrap();
         assert_eq!(last.kind, IssueKind::Write);

@@ -280,3 +280,44 @@ fn a_stalled_disk_never_holds_up_the_caller() {
         "{status:?}"
     );
 }
+
+#[test]
+fn messages_encoded_later_are_written_by_the_writer_in_order_and_counted() {
+    let state = tempfile::tempdir().unwrap();
+    let started = SystemTime::UNIX_EPOCH + Duration::from_secs(1_767_225_600);
+    let (core, ch) = new_core();
+    let recorder = Recorder::spawn(core, Directory::new(state.path(), started), quick()).unwrap();
+    let handle = recorder.handle();
+    for i in 0..100 {
+        if i % 2 == 0 {
+            assert!(handle.write_json(ch, T0 + i, &log(i)));
+        } else {
+            // Two messages from one deferred encoding.
+            let encode = move || {
+                vec![
+                    (ch, serde_json::to_vec(&log(i)).unwrap()),
+                    (ch, serde_json::to_vec(&log(i)).unwrap()),
+                ]
+            };
+            assert!(handle.write_later(T0 + i, T0 + i, encode));
+        }
+    }
+    let status = recorder.finish();
+    assert_eq!((status.messages_written, status.messages_lost), (150, 0));
+    let path = std::fs::read_dir(state.path())
+        .unwrap()
+        .next()
+        .unwrap()
+        .unwrap()
+        .path();
+    let mut rec = Recording::open(&path).unwrap();
+    let read: Vec<foxglove::Log> = rec
+        .messages()
+        .unwrap()
+        .map(|m| serde_json::from_slice(&m.unwrap().data).unwrap())
+        .collect();
+    let expected: Vec<foxglove::Log> = (0..100)
+        .flat_map(|i| std::iter::repeat_n(log(i), if i % 2 == 0 { 1 } else { 2 }))
+        .collect();
+    assert_eq!(read, expected);
+}

@@ -36,7 +36,7 @@ pub struct StationRecorder {
     recorder: Mutex<Option<Recorder>>,
     handle: RecorderHandle,
     channels: StationChannels,
-    telemetry: TelemetryChannels,
+    telemetry: std::sync::Arc<TelemetryChannels>,
     frames: ChannelId,
     started: Instant,
     wall_origin_ms: u64,
@@ -121,9 +121,11 @@ impl Recording {
     pub fn telemetry(&self, telemetry: &stx_link::telemetry::Telemetry) {
         let Some(r) = self.on() else { return };
         let t = r.now_ns();
-        for (ch, payload) in r.telemetry.records(t, telemetry) {
-            r.handle.write(ch, t, t, payload);
-        }
+        // Encoded on the writer's thread: the station loop only moves the message there.
+        let channels = r.telemetry.clone();
+        let telemetry = telemetry.clone();
+        r.handle
+            .write_later(t, t, move || channels.records(t, &telemetry));
     }
 
     /// The tap that records the link's bytes, if recording.
@@ -232,7 +234,7 @@ impl StationRecorder {
             handle: recorder.handle(),
             recorder: Mutex::new(Some(recorder)),
             channels,
-            telemetry,
+            telemetry: std::sync::Arc::new(telemetry),
             frames,
             started,
             wall_origin_ms,
@@ -246,9 +248,14 @@ impl StationRecorder {
     }
 }
 
-/// Unix time now on the mission clock, ns.
+/// Unix time now on the mission clock, ns, in whole milliseconds: the resolution of
+/// MAVLink's own clocks, and plenty to replay and debrief a flight. The nanoseconds of a local
+/// clock are noise that does not compress — twice in every message header and once more in
+/// each raw frame, they were 6 MB of a 3-hour recording. Messages of the same millisecond
+/// keep their order: readers order ties as they are in the file.
 fn now_ns(started: Instant, wall_origin_ms: u64) -> u64 {
-    wall_ns(wall_origin_ms).saturating_add(started.elapsed().as_nanos() as u64)
+    let ms = wall_origin_ms.saturating_add(started.elapsed().as_millis() as u64);
+    wall_ns(ms)
 }
 
 /// Records the link's bytes from the driver's thread.
@@ -264,11 +271,11 @@ impl FrameTap for Tap {
         let t = now_ns(self.started, self.wall_origin_ms);
         let direction = if sent { Direction::Tx } else { Direction::Rx };
         let radio = u16::try_from(path).unwrap_or(u16::MAX);
-        self.handle.write(
-            self.frames,
-            t,
-            t,
-            MavlinkFrame::encode(direction, radio, t, bytes),
-        );
+        // Encoded (base64, JSON) on the writer's thread: the link's hot path copies the bytes.
+        let frames = self.frames;
+        let bytes = bytes.to_vec();
+        self.handle.write_later(t, t, move || {
+            vec![(frames, MavlinkFrame::encode(direction, radio, t, &bytes))]
+        });
     }
 }

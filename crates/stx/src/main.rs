@@ -87,7 +87,11 @@ fn main() -> ExitCode {
     if cli.command.is_offline_report() {
         default_sigpipe();
     }
-    if matches!(cli.command, Command::Serve(_) | Command::Replay(_)) {
+    // The benches run the station in their own process: as the daemon does.
+    if matches!(
+        cli.command,
+        Command::Serve(_) | Command::Replay(_) | Command::Bench(_)
+    ) {
         large_buffers_back_to_the_system();
     }
     let result = match cli.command {

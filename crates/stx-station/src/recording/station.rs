@@ -9,6 +9,7 @@ use serde_json::{Value, json};
 use stx_record::foxglove::{self, LocationFix, Log, LogLevel, PositionCovarianceType, Timestamp};
 use stx_record::{ChannelId, ChannelSpec, RecorderCore, WriteError};
 
+use super::compact_json;
 use crate::config::StationConfig;
 use crate::messages::{
     CommandResultMsg, EstimateView, EventMsg, Level, ParamsMsg, StateMsg, TouchdownView,
@@ -119,19 +120,20 @@ impl StationChannels {
         })
     }
 
-    /// A `state` message, and the estimate and predicted landing it holds for the map.
+    /// A `state` message (as [`recorded_state`] keeps it), and the estimate and predicted
+    /// landing it holds for the map.
     /// `ground_alt_msl_m` is the launch site's altitude (predictions are to its ground).
     pub fn state(&self, state: &StateMsg, ground_alt_msl_m: f64) -> Vec<(ChannelId, Vec<u8>)> {
         let ts = Timestamp::from_nanos(wall_ns(state.wall_ms));
-        let mut out = vec![(self.state, to_json(state))];
+        let mut out = vec![(self.state, compact_json(&recorded_state(state)))];
         if let Some(e) = &state.estimate {
-            out.push((self.estimate_position, to_json(&estimate_fix(ts, e))));
+            out.push((self.estimate_position, compact_json(&estimate_fix(ts, e))));
         }
         if let Some(p) = &state.prediction {
             let touchdown = p.planned.as_ref().unwrap_or(&p.uncontrolled);
             out.push((
                 self.predicted_landing,
-                to_json(&touchdown_fix(ts, touchdown, ground_alt_msl_m)),
+                compact_json(&touchdown_fix(ts, touchdown, ground_alt_msl_m)),
             ));
         }
         out
@@ -151,27 +153,30 @@ impl StationChannels {
             file: String::new(),
             line: 0,
         };
-        vec![(self.events, to_json(event)), (self.log, to_json(&log))]
+        vec![
+            (self.events, compact_json(event)),
+            (self.log, compact_json(&log)),
+        ]
     }
 
     /// An accepted request.
     pub fn command(&self, record: &CommandRecord) -> (ChannelId, Vec<u8>) {
-        (self.commands, to_json(record))
+        (self.commands, compact_json(record))
     }
 
     /// A request's result.
     pub fn command_result(&self, result: &CommandResultMsg) -> (ChannelId, Vec<u8>) {
-        (self.command_results, to_json(result))
+        (self.command_results, compact_json(result))
     }
 
     /// The parameter table.
     pub fn params(&self, params: &ParamsMsg) -> (ChannelId, Vec<u8>) {
-        (self.params, to_json(params))
+        (self.params, compact_json(params))
     }
 
     /// The configuration, without secrets.
     pub fn config(&self, config: &StationConfig) -> (ChannelId, Vec<u8>) {
-        (self.config, to_json(&redacted(config)))
+        (self.config, compact_json(&redacted(config)))
     }
 }
 
@@ -184,12 +189,6 @@ impl stx_record::Named for crate::config::TokenConfig {
 /// Unix ms → ns.
 pub fn wall_ns(wall_ms: u64) -> u64 {
     wall_ms.saturating_mul(1_000_000)
-}
-
-fn to_json<T: Serialize + ?Sized>(value: &T) -> Vec<u8> {
-    // The station's messages are plain data (numbers, strings, maps with string keys):
-    // serialising them cannot fail.
-    serde_json::to_vec(value).unwrap_or_default()
 }
 
 /// The configuration as JSON with every token replaced by its holder's name and role. The
@@ -239,6 +238,21 @@ fn touchdown_fix(timestamp: Timestamp, t: &TouchdownView, ground_alt_msl_m: f64)
         // Horizontal only: the point is on the ground.
         position_covariance_type: PositionCovarianceType::Approximated,
     }
+}
+
+/// `state` as recorded: what the dashboard showed, less two parts another record holds
+/// exactly — `link.ages_s` (each telemetry message's age, which its `/telemetry/…` log times
+/// give to the nanosecond) and `recording` (this file's own figures; a replay shows none).
+/// Noise-like and changing every second, they were nearly a tenth of a flight's file.
+pub fn recorded_state(state: &StateMsg) -> Value {
+    let mut v = serde_json::to_value(state).unwrap_or(Value::Null);
+    if let Some(ages) = v.pointer_mut("/link/ages_s") {
+        *ages = json!({});
+    }
+    if let Some(recording) = v.get_mut("recording") {
+        *recording = Value::Null;
+    }
+    v
 }
 
 #[cfg(test)]

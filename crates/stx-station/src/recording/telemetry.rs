@@ -9,7 +9,6 @@ use std::time::Duration;
 
 use nalgebra::UnitQuaternion;
 use schemars::{JsonSchema, schema_for};
-use serde::Serialize;
 use serde_json::Value;
 use stx_link::telemetry::{
     Actuators, AirData, Attitude, BatteryStatus, GlobalPosition, GpsRaw, GuidanceStatus, Hud,
@@ -20,6 +19,7 @@ use stx_record::foxglove::{
 };
 use stx_record::{ChannelId, ChannelSpec, RecorderCore, WriteError};
 
+use super::compact_json;
 use super::{VEHICLE_ATTITUDE, VEHICLE_GPS, telemetry_topic};
 
 /// Every telemetry message the station decodes: its MAVLink name and the JSON Schema of its
@@ -83,9 +83,9 @@ impl TelemetryChannels {
         }
         let ts = Timestamp::from_nanos(log_time_ns);
         match telemetry {
-            Telemetry::GpsRaw(g) => out.push((self.gps, to_json(&gps_fix(ts, g)))),
+            Telemetry::GpsRaw(g) => out.push((self.gps, compact_json(&gps_fix(ts, g)))),
             Telemetry::Attitude(a) => {
-                out.push((self.attitude, to_json(&attitude_transform(ts, a))))
+                out.push((self.attitude, compact_json(&attitude_transform(ts, a))))
             }
             _ => {}
         }
@@ -93,27 +93,22 @@ impl TelemetryChannels {
     }
 }
 
-fn to_json<T: Serialize + ?Sized>(value: &T) -> Vec<u8> {
-    // Plain numbers, strings and enums: serialising cannot fail.
-    serde_json::to_vec(value).unwrap_or_default()
-}
-
 /// The message's typed value, without the enum's tag (the topic names it).
 fn value_json(t: &Telemetry) -> Vec<u8> {
     match t {
-        Telemetry::Status(v) => to_json(v),
-        Telemetry::GpsRaw(v) => to_json(v),
-        Telemetry::Position(v) => to_json(v),
-        Telemetry::Attitude(v) => to_json(v),
-        Telemetry::AirData(v) => to_json(v),
-        Telemetry::Hud(v) => to_json(v),
-        Telemetry::Actuators(v) => to_json(v),
-        Telemetry::System(v) => to_json(v),
-        Telemetry::Battery(v) => to_json(v),
-        Telemetry::StatusText(v) => to_json(v),
-        Telemetry::Wind(v) => to_json(v),
-        Telemetry::Guidance(v) => to_json(v),
-        Telemetry::PredictedLanding(v) => to_json(v),
+        Telemetry::Status(v) => compact_json(v),
+        Telemetry::GpsRaw(v) => compact_json(v),
+        Telemetry::Position(v) => compact_json(v),
+        Telemetry::Attitude(v) => compact_json(v),
+        Telemetry::AirData(v) => compact_json(v),
+        Telemetry::Hud(v) => compact_json(v),
+        Telemetry::Actuators(v) => compact_json(v),
+        Telemetry::System(v) => compact_json(v),
+        Telemetry::Battery(v) => compact_json(v),
+        Telemetry::StatusText(v) => compact_json(v),
+        Telemetry::Wind(v) => compact_json(v),
+        Telemetry::Guidance(v) => compact_json(v),
+        Telemetry::PredictedLanding(v) => compact_json(v),
     }
 }
 
