@@ -19,6 +19,7 @@ use std::fs::{File, OpenOptions};
 use std::io::{self, Write};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
+use std::sync::atomic::Ordering;
 use std::sync::mpsc::{self, Receiver, RecvTimeoutError, SyncSender, TrySendError};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant, SystemTime};
@@ -165,6 +166,8 @@ enum Command {
 pub struct RecorderHandle {
     tx: SyncSender<Command>,
     shared: Arc<Shared>,
+    /// The queue's capacity: [`RecorderHandle::drop_if_full`] compares `Shared::queued` with it.
+    capacity: usize,
 }
 
 impl RecorderHandle {
@@ -196,6 +199,9 @@ impl RecorderHandle {
         publish_time: u64,
         encode: impl FnOnce() -> Vec<(ChannelId, Vec<u8>)> + Send + 'static,
     ) -> bool {
+        if self.drop_if_full() {
+            return false;
+        }
         self.send(Command::Encode {
             log_time,
             publish_time,
@@ -203,13 +209,29 @@ impl RecorderHandle {
         })
     }
 
+    /// `true` when the queue is full: one message is counted lost, and the caller should not
+    /// build it. A writer far behind then costs the link's hot path a load and two atomic
+    /// additions a message, no allocation.
+    pub fn drop_if_full(&self) -> bool {
+        if self.shared.queued.load(Ordering::Relaxed) < self.capacity {
+            return false;
+        }
+        self.shared.lost(1);
+        self.shared.queue_full();
+        true
+    }
+
     fn send(&self, command: Command) -> bool {
-        match self.tx.try_send(command) {
+        self.shared.queued.fetch_add(1, Ordering::Relaxed);
+        let sent = self.tx.try_send(command);
+        if sent.is_err() {
+            self.shared.queued.fetch_sub(1, Ordering::Relaxed);
+        }
+        match sent {
             Ok(()) => true,
             Err(TrySendError::Full(_)) => {
                 self.shared.lost(1);
-                self.shared
-                    .report(IssueKind::QueueFull, "the writer is behind: queue full");
+                self.shared.queue_full();
                 false
             }
             Err(TrySendError::Disconnected(_)) => {
@@ -281,7 +303,11 @@ impl Recorder {
             .name("stx-record".into())
             .spawn(move || writer.run(rx))?;
         Ok(Self {
-            handle: RecorderHandle { tx, shared },
+            handle: RecorderHandle {
+                tx,
+                shared,
+                capacity: config.queue_capacity.max(1),
+            },
             thread: Some(thread),
         })
     }
@@ -353,7 +379,14 @@ impl Writer {
                 Some(deadline) => deadline.saturating_sub(now),
                 None => self.retry_after,
             };
-            match rx.recv_timeout(wait) {
+            let received = rx.recv_timeout(wait);
+            if matches!(
+                received,
+                Ok(Command::Message { .. } | Command::Encode { .. })
+            ) {
+                self.shared.queued.fetch_sub(1, Ordering::Relaxed);
+            }
+            match received {
                 Ok(Command::Message {
                     channel,
                     log_time,

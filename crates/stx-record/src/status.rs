@@ -75,7 +75,17 @@ pub(crate) struct Shared {
     files_started: AtomicU32,
     issues: Mutex<Issues>,
     log_every: Duration,
+    origin: Instant,
+    /// Commands in the writer's queue (added before sending, taken off as received).
+    pub(crate) queued: std::sync::atomic::AtomicUsize,
+    /// Messages dropped for a full queue and not yet reported ([`Shared::queue_full`]).
+    queue_full_pending: AtomicU64,
+    /// When a full queue was last reported, ms after `origin`, plus one (0: never).
+    queue_full_reported: AtomicU64,
 }
+
+/// A full queue is reported at most this often, ms.
+const QUEUE_FULL_REPORT_MS: u64 = 100;
 
 impl Shared {
     pub(crate) fn new(log_every: Duration) -> Self {
@@ -86,6 +96,10 @@ impl Shared {
             files_started: AtomicU32::new(0),
             issues: Mutex::new(Issues::default()),
             log_every,
+            origin: Instant::now(),
+            queued: std::sync::atomic::AtomicUsize::new(0),
+            queue_full_pending: AtomicU64::new(0),
+            queue_full_reported: AtomicU64::new(0),
         }
     }
 
@@ -108,15 +122,44 @@ impl Shared {
         self.issues().current_file = None;
     }
 
+    /// A message dropped because the writer's queue is full: counted at once, reported (the
+    /// problem, its count, the log) at most every [`QUEUE_FULL_REPORT_MS`], so a writer far
+    /// behind costs the link's hot path two atomic additions a message, not a lock or a clock.
+    pub(crate) fn queue_full(&self) {
+        let pending = self.queue_full_pending.fetch_add(1, Ordering::Relaxed) + 1;
+        // The clock is read on the first drop after a report and then every 256th: soon
+        // enough to report, and no clock read for most drops.
+        if pending % 256 != 1 {
+            return;
+        }
+        let now = self.origin.elapsed().as_millis() as u64 + 1;
+        let last = self.queue_full_reported.load(Ordering::Relaxed);
+        if last != 0 && now < last + QUEUE_FULL_REPORT_MS {
+            return;
+        }
+        if self
+            .queue_full_reported
+            .compare_exchange(last, now, Ordering::Relaxed, Ordering::Relaxed)
+            .is_err()
+        {
+            return;
+        }
+        let n = self.queue_full_pending.swap(0, Ordering::Relaxed);
+        self.report_times(IssueKind::QueueFull, "the writer is behind: queue full", n);
+    }
+
     /// Notes a problem; logs it unless one of its kind was logged within `log_every`.
-    /// `message` is only copied when it differs from the last one: a full queue reports every
-    /// message it drops, and that must stay cheap.
     pub(crate) fn report(&self, kind: IssueKind, message: impl AsRef<str> + Into<String>) {
+        self.report_times(kind, message, 1);
+    }
+
+    /// `message` is only copied when it differs from the last one.
+    fn report_times(&self, kind: IssueKind, message: impl AsRef<str> + Into<String>, times: u64) {
         let now = Instant::now();
         let mut issues = self.issues();
         let occurrences = {
             let n = issues.occurrences.entry(kind).or_insert(0);
-            *n += 1;
+            *n += times;
             *n
         };
         let due = match issues.logged.get_mut(&kind) {
@@ -160,13 +203,20 @@ impl Shared {
 
     pub(crate) fn snapshot(&self) -> RecorderStatus {
         let issues = self.issues();
+        let mut last_error = issues.last.clone();
+        // Drops since the last report of a full queue count too.
+        if let Some(last) = &mut last_error
+            && last.kind == IssueKind::QueueFull
+        {
+            last.occurrences += self.queue_full_pending.load(Ordering::Relaxed);
+        }
         RecorderStatus {
             bytes_written: self.bytes_written.load(Ordering::Relaxed),
             messages_written: self.messages_written.load(Ordering::Relaxed),
             messages_lost: self.messages_lost.load(Ordering::Relaxed),
             files_started: self.files_started.load(Ordering::Relaxed),
             current_file: issues.current_file.clone(),
-            last_error: issues.last.clone(),
+            last_error,
         }
     }
 
@@ -192,5 +242,21 @@ mod tests {
         assert_eq!(last.kind, IssueKind::Write);
         assert_eq!(last.occurrences, 6);
         assert_eq!(last.message, "disk full again");
+    }
+
+    #[test]
+    fn every_drop_of_a_full_queue_is_counted_though_few_are_reported() {
+        let shared = Shared::new(Duration::from_secs(3600));
+        for _ in 0..1000 {
+            shared.lost(1);
+            shared.queue_full();
+        }
+        let status = shared.snapshot();
+        assert_eq!(status.messages_lost, 1000);
+        let last = status.last_error.unwrap();
+        assert_eq!(last.kind, IssueKind::QueueFull);
+        assert_eq!(last.occurrences, 1000);
+        // Reported once (the first drop); the rest wait for the next report.
+        assert_eq!(shared.issues().occurrences[&IssueKind::QueueFull], 1);
     }
 }

@@ -7,7 +7,9 @@
 //!
 //! - `udp_datagrams`: one frame per datagram, as the station's UDP radios deliver them (one raw
 //!   entry recorded per frame);
-//! - `stream_chunks`: 4 KiB reads, as from a serial or TCP radio (one raw entry per read).
+//! - `udp_datagrams_not_recording`: the same without the recording, for comparison;
+//! - `stream_chunks`: 4 KiB reads, as from a serial or TCP radio (one raw entry per read) —
+//!   the input of stx-link's `ingest` bench.
 //!
 //! The writer thread is fed through a bounded queue and never holds the link up: at these
 //! rates it falls behind and counts what it could not write. After the runs the bench prints
@@ -87,6 +89,27 @@ fn ingest_recording(c: &mut Criterion) {
                 now += Duration::from_micros(300);
                 link.handle_datagram_on(0, now, black_box(f));
                 n += drain(&mut link, &recording);
+            }
+            assert_eq!(n, FRAMES);
+            n
+        })
+    });
+    // The same datagrams without recording, to show what recording costs.
+    group.bench_function("udp_datagrams_not_recording", |b| {
+        b.iter(|| {
+            let mut link =
+                StationLink::new(GroundEndpoint::new(GroundConfig::default(), Duration::ZERO));
+            let mut now = Duration::ZERO;
+            let mut n = 0;
+            for f in &frames {
+                now += Duration::from_micros(300);
+                link.handle_datagram_on(0, now, black_box(f));
+                while let Some(event) = link.poll_event() {
+                    if let LinkReport::Event(GroundEvent::Telemetry { telemetry, .. }) = &event {
+                        black_box(telemetry);
+                        n += 1;
+                    }
+                }
             }
             assert_eq!(n, FRAMES);
             n

@@ -120,6 +120,9 @@ impl Recording {
     /// Records a decoded telemetry message, received now.
     pub fn telemetry(&self, telemetry: &stx_link::telemetry::Telemetry) {
         let Some(r) = self.on() else { return };
+        if r.handle.drop_if_full() {
+            return;
+        }
         let t = r.now_ns();
         // Encoded on the writer's thread: the station loop only moves the message there.
         let channels = r.telemetry.clone();
@@ -268,6 +271,9 @@ struct Tap {
 
 impl FrameTap for Tap {
     fn frame(&mut self, path: usize, sent: bool, bytes: &[u8]) {
+        if self.handle.drop_if_full() {
+            return;
+        }
         let t = now_ns(self.started, self.wall_origin_ms);
         let direction = if sent { Direction::Tx } else { Direction::Rx };
         let radio = u16::try_from(path).unwrap_or(u16::MAX);
