@@ -363,6 +363,15 @@ impl StationConfig {
             .find(|t| bool::from(t.token.as_bytes().ct_eq(token.as_bytes())))
             .map(|t| (t.name.as_str(), t.role))
     }
+
+    /// The first operator's token: what `stx serve`, `stx replay` and the benches put in the
+    /// dashboard's address they print.
+    pub fn operator_token(&self) -> Option<&str> {
+        self.tokens
+            .iter()
+            .find(|t| t.role == Role::Operator)
+            .map(|t| t.token.as_str())
+    }
 }
 
 #[cfg(test)]

@@ -129,11 +129,9 @@ fn start_station(
     config.link.address = "udpin:127.0.0.1:0".into();
     config.web_dir = std::env::temp_dir().join("stx-bench-no-dashboard");
     let operator = config
-        .tokens
-        .iter()
-        .find(|t| t.role == Role::Operator)
-        .map(|t| t.token.clone())
-        .context("the station config has no operator token")?;
+        .operator_token()
+        .context("the station config has no operator token")?
+        .to_owned();
     let (stop_tx, stop_rx) = oneshot::channel::<()>();
     let (started_tx, started_rx) = std::sync::mpsc::channel();
     std::thread::Builder::new()

@@ -62,12 +62,7 @@ pub fn run(args: ReplayArgs) -> anyhow::Result<()> {
         .build()
         .context("starting the async runtime")?;
     runtime.block_on(async {
-        let operator = config
-            .tokens
-            .iter()
-            .find(|t| t.role == stx_station::config::Role::Operator)
-            .map(|t| t.token.clone())
-            .unwrap_or_default();
+        let operator = config.operator_token().unwrap_or_default().to_owned();
         serve_replay(config, prepared, shutdown_signal(), |running| {
             announce(&format!(
                 "stx replay: open {}://{}/?token={operator}\n",

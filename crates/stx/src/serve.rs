@@ -111,12 +111,7 @@ pub fn run(args: ServeArgs) -> anyhow::Result<()> {
         .build()
         .context("starting the async runtime")?;
     runtime.block_on(async move {
-        let operator = config
-            .tokens
-            .iter()
-            .find(|t| t.role == stx_station::config::Role::Operator)
-            .map(|t| t.token.clone())
-            .unwrap_or_default();
+        let operator = config.operator_token().unwrap_or_default().to_owned();
         let (stop_tx, stop_rx) = tokio::sync::watch::channel(false);
         tokio::spawn(async move {
             shutdown_signal().await;

@@ -99,6 +99,12 @@ fn list(dir: &Path, current: Option<&str>, cache: &SummaryCache) -> RecordingsBo
             Err(reason) => unreadable.push(UnreadableRecording { name, reason }),
         }
     }
+    // Files gone from the directory leave the cache too.
+    cache
+        .0
+        .lock()
+        .unwrap_or_else(|e| e.into_inner())
+        .retain(|name, _| recordings.iter().any(|r| &r.name == name));
     recordings.sort_by(|a, b| (b.start_ms, &b.name).cmp(&(a.start_ms, &a.name)));
     unreadable.sort_by(|a, b| a.name.cmp(&b.name));
     RecordingsBody {

@@ -72,9 +72,11 @@ pub fn telemetry_topic(mavlink_name: &str) -> String {
 pub fn compact_json<T: serde::Serialize + ?Sized>(value: &T) -> Vec<u8> {
     // The station's messages are plain data (numbers, strings, maps with string keys):
     // serialising them cannot fail.
-    let Ok(mut v) = serde_json::to_value(value) else {
-        return Vec::new();
-    };
+    serde_json::to_value(value).map_or_else(|_| Vec::new(), compact_value)
+}
+
+/// [`compact_json`] of a JSON value already built.
+pub fn compact_value(mut v: serde_json::Value) -> Vec<u8> {
     round_numbers(&mut v);
     serde_json::to_vec(&v).unwrap_or_default()
 }

@@ -9,7 +9,7 @@ use serde_json::{Value, json};
 use stx_record::foxglove::{self, LocationFix, Log, LogLevel, PositionCovarianceType, Timestamp};
 use stx_record::{ChannelId, ChannelSpec, RecorderCore, WriteError};
 
-use super::compact_json;
+use super::{compact_json, compact_value};
 use crate::config::StationConfig;
 use crate::messages::{
     CommandResultMsg, EstimateView, EventMsg, Level, ParamsMsg, StateMsg, TouchdownView,
@@ -125,7 +125,7 @@ impl StationChannels {
     /// `ground_alt_msl_m` is the launch site's altitude (predictions are to its ground).
     pub fn state(&self, state: &StateMsg, ground_alt_msl_m: f64) -> Vec<(ChannelId, Vec<u8>)> {
         let ts = Timestamp::from_nanos(wall_ns(state.wall_ms));
-        let mut out = vec![(self.state, compact_json(&recorded_state(state)))];
+        let mut out = vec![(self.state, compact_value(recorded_state(state)))];
         if let Some(e) = &state.estimate {
             out.push((self.estimate_position, compact_json(&estimate_fix(ts, e))));
         }
