@@ -18,6 +18,7 @@ use stx_gnc::estimator::{Estimator, EstimatorConfig, EstimatorConfigError};
 use stx_gnc::guidance::{Guidance, PhaseEvent};
 use stx_gnc::mission::{FlightMode, GuidancePhase};
 
+use crate::dispersions::ServoErrors;
 use crate::geometry::{height_above_ground_m, lowest_point};
 use crate::sensors::{
     Delivery, DeliveryQueue, SensorConfig, SensorConfigError, SensorSuite, Truth,
@@ -215,6 +216,8 @@ pub struct GuidedFlight<N: Navigator> {
     /// Each time guidance called the target out of reach: when, and the best reachable point
     /// (north, east, m) it announced then.
     pub best_reachable_announced: Vec<(f64, [f64; 2])>,
+    /// What the servos do with guidance's commands (perfect unless a dispersion set says).
+    pub servos: ServoErrors,
 }
 
 impl<N: Navigator> GuidedFlight<N> {
@@ -242,6 +245,7 @@ impl<N: Navigator> GuidedFlight<N> {
             phases: vec![(phase_name(phase), time_s)],
             events: Vec::new(),
             best_reachable_announced: Vec::new(),
+            servos: ServoErrors::default(),
         }
     }
 
@@ -257,7 +261,14 @@ impl<N: Navigator> GuidedFlight<N> {
             .air_at(self.model.environment.ground_altitude_msl_m - est.position_ned_m.z)
             .density_kg_per_m3;
         let command = self.guidance.update(&est, assumed);
-        self.model.set_controls(command.controls);
+        let controls = if self.servos.is_perfect() {
+            command.controls
+        } else {
+            let travel = self.model.vehicle.main_line_travel_m;
+            self.servos
+                .apply(command.controls, self.model.controls(), travel)
+        };
+        self.model.set_controls(controls);
         for event in self.guidance.drain_events() {
             self.phases.push((phase_name(event.to), event.time_s));
             if event.to == GuidancePhase::BestReachable {
@@ -312,7 +323,8 @@ impl<N: Navigator> GuidedFlight<N> {
 /// reached, the state there and the contact time if the stack touched down.
 ///
 /// If the steps fail (hard main-line reversals can spin the drone about its lines faster than
-/// a 0.05 s step follows), the same period is flown again from the same state with steps four
+/// a 0.05 s step follows; a speed or rate above 1,000 m/s or rad/s counts as failed), the same
+/// period is flown again from the same state with steps four
 /// and then sixteen times shorter, so a run is deterministic and only its rare violent seconds
 /// cost more.
 pub fn fly_period(
@@ -341,6 +353,19 @@ pub fn fly_period(
                 observer: None,
             },
         );
+        // A step that diverged without overflowing yet (speeds of kilometres per second) is
+        // as lost as a non-finite one, and is flown again with the shorter steps too.
+        if let Ok(o) = &outcome
+            && let Some(component) = idx::SPEEDS
+                .into_iter()
+                .find(|&k| o.state[k].is_nan() || o.state[k].abs() >= 1e3)
+        {
+            outcome = Err(IntegrateError::NonFiniteStep {
+                time_s,
+                step_s: step_s / refinement,
+                component,
+            });
+        }
         if !matches!(outcome, Err(IntegrateError::NonFiniteStep { .. })) {
             break;
         }

@@ -8,6 +8,9 @@
 //!   [`run::Run`], and [`geometry`] says where the stack's lowest point and lines are;
 //! - [`sensors`] turns the flown state into the drone's GPS, AHRS and pitot measurements, with
 //!   their rates, latencies, noise, biases and dropouts, for the estimator;
+//! - [`dispersions`] draws each flight's vehicle, sensor and servo errors and wind shape from a
+//!   dispersion set, so that campaigns and the simulated drone fly a world guidance does not
+//!   know exactly;
 //! - [`summary`] reduces a run to the figures it is judged by;
 //! - [`montecarlo`] flies many spiral landings from random releases and winds;
 //! - [`speed`] measures the flight model's speed (`stx bench dynamics`);
@@ -22,6 +25,7 @@
 //! reports about itself.
 
 pub mod closed_loop;
+pub mod dispersions;
 pub mod drone;
 pub mod geometry;
 pub mod guided;

@@ -48,6 +48,11 @@ pub struct DroneArgs {
     /// serial:PATH:BAUD.
     #[arg(long, default_value = "udpout:127.0.0.1:14550")]
     connect: String,
+    /// Fly a vehicle and sensors drawn (with the mission's seed) from a dispersion set:
+    /// `nominal`, `realistic` (config/dispersions/) or a dispersion file, as
+    /// `stx montecarlo --dispersions` does. Without it, the nominal vehicle.
+    #[arg(long, value_name = "nominal|realistic|FILE")]
+    dispersions: Option<String>,
     /// A built-in mission (mission, mission-short) or a path to a mission TOML file.
     #[arg(long, default_value = "mission")]
     scenario: String,
@@ -189,6 +194,12 @@ impl DroneArgs {
         options.link.system_id = self.system_id;
         options.signing = signing;
         options.linger = Some(Duration::from_secs_f64(self.linger));
+        options.dispersions = self
+            .dispersions
+            .as_deref()
+            .map(stx_sim::dispersions::Dispersions::load)
+            .transpose()
+            .map_err(|e| bad(anyhow::Error::new(e).context("--dispersions")))?;
         Ok(options)
     }
 }

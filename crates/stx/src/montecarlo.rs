@@ -1,18 +1,45 @@
 //! `stx montecarlo`: many spiral landings with the full model, sensors and onboard software,
 //! from random release points and winds; prints the landing statistics.
 
+use std::path::PathBuf;
+
 use anyhow::{Context, bail};
-use clap::Args;
+use clap::{Args, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 use stx_gnc::estimator::EstimatorConfig;
 use stx_sim::closed_loop::SensedNavigation;
-use stx_sim::montecarlo::{MonteCarloConfig, MonteCarloReport, run_all};
-use stx_sim::sensors::SensorConfig;
+use stx_sim::dispersions::Dispersions;
+use stx_sim::montecarlo::{CampaignPart, MonteCarloConfig, MonteCarloReport, Shard, run_all};
 
 use crate::BadInput;
 
 #[derive(Args)]
+#[command(args_conflicts_with_subcommands = true)]
 pub struct MonteCarloArgs {
+    #[command(subcommand)]
+    command: Option<MonteCarloCommand>,
+    #[command(flatten)]
+    campaign: CampaignArgs,
+}
+
+#[derive(Subcommand)]
+enum MonteCarloCommand {
+    /// Merge the parts written by `--shard K/N --out FILE` into the campaign's report.
+    Merge {
+        /// Every part of the campaign (one per shard).
+        #[arg(required = true)]
+        parts: Vec<PathBuf>,
+        /// Print one JSON object instead of a table.
+        #[arg(long)]
+        json: bool,
+        /// Include every run in the JSON.
+        #[arg(long)]
+        details: bool,
+    },
+}
+
+#[derive(Args)]
+struct CampaignArgs {
     /// Number of runs.
     #[arg(long, default_value_t = 100)]
     runs: usize,
@@ -43,10 +70,62 @@ pub struct MonteCarloArgs {
     replay: Option<usize>,
     /// Control gains file (as `stx tune` writes; default: the built-in gains).
     #[arg(long)]
-    gains: Option<std::path::PathBuf>,
+    gains: Option<PathBuf>,
+    /// How each run's world differs from the one guidance assumes: `nominal`, `realistic`
+    /// (config/dispersions/) or a dispersion file.
+    #[arg(long, default_value = "nominal", value_name = "nominal|realistic|FILE")]
+    dispersions: String,
+    /// Fly only shard K of N of the campaign (runs K−1, K−1+N, …) and write them with `--out`;
+    /// `stx montecarlo merge` puts the parts together.
+    #[arg(long, value_name = "K/N", requires = "out")]
+    shard: Option<String>,
+    /// Where `--shard` writes its part (JSON).
+    #[arg(long, requires = "shard")]
+    out: Option<PathBuf>,
 }
 
 pub fn run(args: MonteCarloArgs) -> anyhow::Result<()> {
+    match args.command {
+        Some(MonteCarloCommand::Merge {
+            parts,
+            json,
+            details,
+        }) => merge(&parts, json, details),
+        None => campaign(args.campaign),
+    }
+}
+
+fn merge(paths: &[PathBuf], json: bool, details: bool) -> anyhow::Result<()> {
+    let mut parts = Vec::new();
+    for path in paths {
+        let text = std::fs::read_to_string(path)
+            .with_context(|| format!("reading part {}", path.display()))?;
+        let part: CampaignPart = serde_json::from_str(&text).map_err(|e| {
+            BadInput(anyhow::anyhow!(
+                "{} is not a campaign part: {e}",
+                path.display()
+            ))
+        })?;
+        parts.push(part);
+    }
+    let report = stx_sim::montecarlo::merge(parts).map_err(|e| BadInput(e.into()))?;
+    print_report(&report, json, details)
+}
+
+fn print_report(report: &MonteCarloReport, json: bool, details: bool) -> anyhow::Result<()> {
+    if json {
+        let mut value = serde_json::to_value(report)?;
+        if !details && let Some(object) = value.as_object_mut() {
+            object.remove("results");
+        }
+        println!("{}", serde_json::to_string(&value)?);
+    } else {
+        print_table(report);
+    }
+    Ok(())
+}
+
+fn campaign(args: CampaignArgs) -> anyhow::Result<()> {
     if args.runs == 0 {
         return Err(BadInput(anyhow::anyhow!("--runs must be at least 1")).into());
     }
@@ -65,6 +144,14 @@ pub fn run(args: MonteCarloArgs) -> anyhow::Result<()> {
         ))
         .into());
     }
+    let shard = args
+        .shard
+        .as_deref()
+        .map(Shard::parse)
+        .transpose()
+        .map_err(|e| BadInput(anyhow::anyhow!("--shard: {e}")))?;
+    let dispersions = Dispersions::load(&args.dispersions)
+        .map_err(|e| BadInput(anyhow::Error::new(e).context("--dispersions")))?;
     let threads = args
         .threads
         .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
@@ -76,23 +163,26 @@ pub fn run(args: MonteCarloArgs) -> anyhow::Result<()> {
         flare: !args.no_flare,
         threads,
         only_run: args.replay,
+        shard,
+        dispersions,
         ..MonteCarloConfig::default()
     };
     if let Some(path) = &args.gains {
         config.guidance.gains = crate::inputs::load_gains(path)?;
     }
-    let sensors = SensorConfig::default();
     let estimator = EstimatorConfig::default();
     // Fail on bad settings before any thread starts.
-    SensedNavigation::new(&sensors, estimator.clone(), 0).context("navigation settings")?;
-    let bar = ProgressBar::new(args.runs as u64);
+    SensedNavigation::new(&config.sensors, estimator.clone(), 0).context("navigation settings")?;
+    let bar = ProgressBar::new(config.indices().len() as u64);
     bar.set_style(
         ProgressStyle::with_template("{bar:40} {pos}/{len} runs, {elapsed} elapsed, ~{eta} left")
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
     let report = run_all(
         &config,
-        |c| SensedNavigation::new(&sensors, estimator.clone(), c.seed).map_err(|e| e.to_string()),
+        |c, sensors| {
+            SensedNavigation::new(sensors, estimator.clone(), c.seed).map_err(|e| e.to_string())
+        },
         |done| bar.set_position(done as u64),
     )
     .context("Monte Carlo")?;
@@ -100,37 +190,49 @@ pub fn run(args: MonteCarloArgs) -> anyhow::Result<()> {
     if !report.failed_runs.is_empty() && report.failed_runs.len() == report.runs {
         bail!("every run failed; first: {:?}", report.failed_runs.first());
     }
+    if let (Some(shard), Some(out)) = (shard, &args.out) {
+        let part = CampaignPart::of(report, shard);
+        let text = serde_json::to_string(&part)?;
+        std::fs::write(out, text).with_context(|| format!("writing {}", out.display()))?;
+        eprintln!(
+            "shard {}/{}: {} runs ({} failed) in {:.1} s written to {}",
+            shard.index,
+            shard.count,
+            part.results.len() + part.failed_runs.len(),
+            part.failed_runs.len(),
+            part.wall_time_s,
+            out.display()
+        );
+        return Ok(());
+    }
     if args.replay.is_some() {
         match report.results.first() {
             Some(run) => println!("{}", serde_json::to_string(run)?),
             None => bail!("the run failed: {:?}", report.failed_runs),
         }
-    } else if args.json {
-        let mut value = serde_json::to_value(&report)?;
-        if !args.details
-            && let Some(object) = value.as_object_mut()
-        {
-            object.remove("results");
-        }
-        println!("{}", serde_json::to_string(&value)?);
-    } else {
-        print_table(&report);
+        return Ok(());
     }
-    Ok(())
+    print_report(&report, args.json, args.details)
 }
 
 fn print_table(r: &MonteCarloReport) {
+    let c = &r.campaign;
     println!(
-        "{} runs, seed {}, wind up to {} m/s, released {} m above the target{}",
+        "{} runs, seed {}, wind up to {} m/s, released {} m above the target{}, dispersions: {}",
         r.runs,
-        r.seed,
-        r.wind_max_mps,
-        r.altitude_m,
-        if r.flare { "" } else { ", no flare" }
+        c.seed,
+        c.wind_max_mps,
+        c.altitude_m,
+        if c.flare { "" } else { ", no flare" },
+        c.dispersions.name
     );
     println!(
-        "miss distance: median {:.1} m, 95th percentile {:.1} m, worst {:.1} m",
-        r.miss_m.median, r.miss_m.p95, r.miss_m.max
+        "miss distance (first ground contact; {} failed runs count as misses): median {:.1} m, \
+         95th percentile {:.1} m, worst {:.1} m",
+        r.failed_runs.len(),
+        r.miss_m.median,
+        r.miss_m.p95,
+        r.miss_m.max
     );
     println!(
         "into the wind (within 30°): {:.1} % of touchdowns ({} in calm air, below 0.5 m/s, count \

@@ -3,6 +3,9 @@
 use serde::Serialize;
 use stx_gnc::guidance::GuidanceConfig;
 
+use crate::dispersions::Dispersions;
+use crate::sensors::SensorConfig;
+
 /// What to run.
 #[derive(Debug, Clone, Serialize)]
 pub struct MonteCarloConfig {
@@ -23,6 +26,13 @@ pub struct MonteCarloConfig {
     /// Fly only this run (by index), keeping its phase events and track: replays one run of a
     /// campaign exactly, since its conditions depend only on the seed and the index.
     pub only_run: Option<usize>,
+    /// Fly only this shard of the campaign's runs.
+    pub shard: Option<Shard>,
+    /// How each run's world differs from the one guidance assumes (every run draws its own).
+    pub dispersions: Dispersions,
+    /// The sensors' settings before dispersion.
+    #[serde(skip)]
+    pub sensors: SensorConfig,
     /// Guidance settings.
     #[serde(skip)]
     pub guidance: GuidanceConfig,
@@ -39,7 +49,53 @@ impl Default for MonteCarloConfig {
             flare: true,
             threads: 2,
             only_run: None,
+            shard: None,
+            dispersions: Dispersions::nominal(),
+            sensors: SensorConfig::default(),
             guidance: GuidanceConfig::default(),
+        }
+    }
+}
+
+/// Shard `index` (1-based) of `count`: the runs whose index is `index − 1` modulo `count`, so
+/// that every shard gets easy and hard runs alike.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, serde::Deserialize)]
+pub struct Shard {
+    /// Which shard, 1…count.
+    pub index: usize,
+    /// How many shards.
+    pub count: usize,
+}
+
+impl Shard {
+    /// Parses `K/N` (1 ≤ K ≤ N).
+    pub fn parse(text: &str) -> Result<Self, String> {
+        let bad = || format!("shard `{text}` is not K/N with 1 ≤ K ≤ N");
+        let (k, n) = text.split_once('/').ok_or_else(bad)?;
+        let (index, count) = (
+            k.trim().parse::<usize>().map_err(|_| bad())?,
+            n.trim().parse::<usize>().map_err(|_| bad())?,
+        );
+        if index == 0 || index > count {
+            return Err(bad());
+        }
+        Ok(Self { index, count })
+    }
+
+    /// Whether run `run` belongs to this shard.
+    pub fn owns(&self, run: usize) -> bool {
+        run % self.count == self.index - 1
+    }
+}
+
+impl MonteCarloConfig {
+    /// The run indices this configuration flies, in order.
+    pub fn indices(&self) -> Vec<usize> {
+        match self.only_run {
+            Some(only) => vec![only],
+            None => (0..self.runs)
+                .filter(|i| self.shard.is_none_or(|s| s.owns(*i)))
+                .collect(),
         }
     }
 }

@@ -1,9 +1,11 @@
 //! What a campaign gave: the statistics operators judge it by ([`MonteCarloReport`]) and the
 //! worst runs, named so that each can be replayed.
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
+use super::config::MonteCarloConfig;
 use super::run::{RunConditions, RunResult};
+use crate::dispersions::Dispersions;
 
 /// A run among the worst of a campaign, enough to replay it (`only_run`).
 #[derive(Debug, Clone, Serialize)]
@@ -36,7 +38,7 @@ pub struct Stats {
 }
 
 impl Stats {
-    /// Statistics of `values` (NaN-free).
+    /// Statistics of `values` (NaN-free; infinities rank last).
     pub fn of(values: &[f64]) -> Self {
         if values.is_empty() {
             return Self::default();
@@ -58,20 +60,51 @@ impl Stats {
     }
 }
 
-/// The campaign's result (printed by `stx montecarlo --json`).
-#[derive(Debug, Clone, Serialize)]
-pub struct MonteCarloReport {
-    /// Runs flown.
-    pub runs: usize,
+/// What defines a campaign: every shard of it must agree on all of this.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CampaignHeader {
+    /// Runs in the whole campaign.
+    pub campaign_runs: usize,
     /// Campaign seed.
     pub seed: u64,
     /// Largest mean wind, m/s.
     pub wind_max_mps: f64,
     /// Release height above the target, m.
     pub altitude_m: f64,
+    /// Release points within this distance of the target, m.
+    pub release_radius_m: f64,
     /// Whether guidance flared.
     pub flare: bool,
-    /// Distance from the target at touchdown, m.
+    /// The dispersion set every run drew from.
+    pub dispersions: Dispersions,
+}
+
+impl CampaignHeader {
+    /// The header of `config`'s campaign.
+    pub fn of(config: &MonteCarloConfig) -> Self {
+        Self {
+            campaign_runs: config.runs,
+            seed: config.seed,
+            wind_max_mps: config.wind_max_mps,
+            altitude_m: config.altitude_m,
+            release_radius_m: config.release_radius_m,
+            flare: config.flare,
+            dispersions: config.dispersions.clone(),
+        }
+    }
+}
+
+/// The campaign's result (printed by `stx montecarlo --json`).
+#[derive(Debug, Clone, Serialize)]
+pub struct MonteCarloReport {
+    /// What was flown.
+    #[serde(flatten)]
+    pub campaign: CampaignHeader,
+    /// Runs in this report (flown or failed).
+    pub runs: usize,
+    /// Distance from the target at the first ground contact (the lowest body, usually the
+    /// transponder), m. Failed runs count as misses beyond any landing: with any, the maximum
+    /// is infinite (`null` in JSON) and the percentiles rank them last.
     pub miss_m: Stats,
     /// Share of touchdowns with the heading within 30° of upwind (runs in calm air, where no
     /// upwind exists, count as into the wind).
@@ -94,7 +127,8 @@ pub struct MonteCarloReport {
     pub unreachable_from_best_m: Stats,
     /// The same from the best reachable point announced last, m.
     pub unreachable_from_last_best_m: Stats,
-    /// Runs that failed to fly (integration error), with their index and reason.
+    /// Runs that failed to fly (integration error, time-out, a refused draw), with their index
+    /// and reason.
     pub failed_runs: Vec<(usize, String)>,
     /// Wall-clock time, s.
     pub wall_time_s: f64,
@@ -102,6 +136,67 @@ pub struct MonteCarloReport {
     pub worst: Vec<WorstRun>,
     /// Every run.
     pub results: Vec<RunResult>,
+}
+
+impl MonteCarloReport {
+    /// The statistics of `results` and `failed_runs` (sorted by index) of `campaign`.
+    pub fn assemble(
+        campaign: CampaignHeader,
+        results: Vec<RunResult>,
+        failed_runs: Vec<(usize, String)>,
+        wall_time_s: f64,
+    ) -> Self {
+        let misses: Vec<f64> = results
+            .iter()
+            .map(|r| r.miss_m)
+            .chain(failed_runs.iter().map(|_| f64::INFINITY))
+            .collect();
+        let speeds: Vec<f64> = results
+            .iter()
+            .map(|r| r.touchdown_vertical_speed_mps)
+            .collect();
+        let wind_errors: Vec<f64> = results.iter().map(|r| r.wind_estimate_rmse_mps).collect();
+        let pooled = if results.is_empty() {
+            0.0
+        } else {
+            (wind_errors.iter().map(|e| e * e).sum::<f64>() / wind_errors.len() as f64).sqrt()
+        };
+        let mut by_miss: Vec<&RunResult> = results.iter().collect();
+        by_miss.sort_by(|a, b| b.miss_m.total_cmp(&a.miss_m).then(a.index.cmp(&b.index)));
+        let worst = by_miss
+            .iter()
+            .take(WORST_RUNS)
+            .map(|r| WorstRun {
+                index: r.index,
+                miss_m: r.miss_m,
+                long_short_m: r.long_short_m,
+                left_right_m: r.left_right_m,
+                heading_vs_upwind_deg: r.heading_vs_upwind_deg,
+                conditions: r.conditions.clone(),
+            })
+            .collect();
+        let announced = |f: fn(&RunResult) -> Option<f64>| {
+            Stats::of(&results.iter().filter_map(f).collect::<Vec<_>>())
+        };
+        Self {
+            campaign,
+            runs: results.len() + failed_runs.len(),
+            miss_m: Stats::of(&misses),
+            into_wind_fraction: into_wind_fraction(&results, true),
+            into_wind_fraction_strict: into_wind_fraction(&results, false),
+            calm_runs: results.iter().filter(|r| r.calm).count(),
+            touchdown_vertical_speed_mps: Stats::of(&speeds),
+            wind_estimate_rmse_mps: pooled,
+            wind_estimate_rmse_per_run_mps: Stats::of(&wind_errors),
+            unreachable_runs: results.iter().filter(|r| r.unreachable).count(),
+            unreachable_from_best_m: announced(|r| r.from_best_reachable_m),
+            unreachable_from_last_best_m: announced(|r| r.from_last_best_reachable_m),
+            failed_runs,
+            wall_time_s,
+            worst,
+            results,
+        }
+    }
 }
 
 /// Largest angle between heading and upwind at touchdown that counts as into the wind, degrees.
@@ -126,13 +221,17 @@ pub const WORST_RUNS: usize = 5;
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::montecarlo::config::MonteCarloConfig;
     use crate::montecarlo::run::conditions;
 
     fn landed(heading_vs_upwind_deg: f64, calm: bool) -> RunResult {
         RunResult {
             index: 0,
             conditions: conditions(&MonteCarloConfig::default(), 0),
+            vehicle_draw: Default::default(),
+            wind_shape: crate::dispersions::WindShape::draw(
+                &Dispersions::nominal(),
+                &mut <rand_chacha::ChaCha8Rng as rand::SeedableRng>::seed_from_u64(0),
+            ),
             miss_m: 1.0,
             heading_vs_upwind_deg,
             calm,
@@ -169,5 +268,28 @@ mod tests {
         assert_eq!(into_wind_fraction(&runs, true), 0.5);
         assert_eq!(into_wind_fraction(&runs, false), 0.0);
         assert_eq!(into_wind_fraction(&[], true), 0.0);
+    }
+}
+
+#[cfg(test)]
+mod failed_run_tests {
+    use super::*;
+
+    #[test]
+    fn failed_runs_count_as_the_worst_misses() {
+        // Four landings and one failure: the failure ranks last.
+        let mut values = vec![1.0, 2.0, 3.0, 4.0];
+        values.push(f64::INFINITY);
+        let s = Stats::of(&values);
+        assert_eq!(s.median, 3.0);
+        assert!(s.p95.is_infinite() && s.max.is_infinite());
+        let report = MonteCarloReport::assemble(
+            CampaignHeader::of(&MonteCarloConfig::default()),
+            Vec::new(),
+            vec![(3, "still flying".into())],
+            0.0,
+        );
+        assert_eq!(report.runs, 1);
+        assert!(report.miss_m.median.is_infinite());
     }
 }

@@ -7,7 +7,7 @@ use std::sync::Arc;
 use nalgebra::Vector3;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use stx_dynamics::atmosphere::StandardAtmosphere;
 use stx_dynamics::integrate::{Hooks, IntegrateError, Rk4, integrate};
 use stx_dynamics::model::{Environment, ParafoilModel};
@@ -22,10 +22,12 @@ use stx_gnc::mission::{FlightMode, GuidancePhase};
 
 use super::config::MonteCarloConfig;
 use crate::closed_loop::{GuidedFlight, Navigator};
+use crate::dispersions::{DispersedFlight, DrawSummary, WindShape};
 use crate::guided::{CONTROL_PERIOD_S, STEP_S};
+use crate::sensors::SensorConfig;
 
 /// The conditions of one run.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct RunConditions {
     /// Release point relative to the target (north, east), m.
     pub release_ne_m: [f64; 2],
@@ -35,17 +37,21 @@ pub struct RunConditions {
     pub wind_speed_mps: f64,
     /// Direction it blows from at the ground, degrees.
     pub wind_from_deg: f64,
-    /// Seed of this run's turbulence and sensors.
+    /// Seed of this run's turbulence, sensors and dispersions.
     pub seed: u64,
 }
 
 /// What one run gave.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct RunResult {
     /// Index in the campaign.
     pub index: usize,
     /// Its conditions.
     pub conditions: RunConditions,
+    /// How its vehicle differed from nominal (all ones and zero in a nominal campaign).
+    pub vehicle_draw: DrawSummary,
+    /// Its wind's shape.
+    pub wind_shape: WindShape,
     /// Distance from the target to where the stack touched down, m.
     pub miss_m: f64,
     /// Canopy heading at touchdown minus the upwind direction, degrees.
@@ -61,17 +67,17 @@ pub struct RunResult {
     pub unreachable: bool,
     /// The best reachable point (north, east, m) guidance announced when it first called the
     /// target out of reach.
-    #[serde(skip_serializing_if = "Option::is_none")]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub best_reachable_ne_m: Option<[f64; 2]>,
     /// Distance from that point to where the stack touched down, m.
-    #[serde(skip_serializing_if = "Option::is_none")]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub from_best_reachable_m: Option<f64>,
     /// The best reachable point guidance announced last (it announces it again when it moves
     /// as the wind estimate firms up), north and east, m.
-    #[serde(skip_serializing_if = "Option::is_none")]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub last_best_reachable_ne_m: Option<[f64; 2]>,
     /// Distance from that point to the touchdown, m.
-    #[serde(skip_serializing_if = "Option::is_none")]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub from_last_best_reachable_m: Option<f64>,
     /// Flight time, s.
     pub flight_time_s: f64,
@@ -81,15 +87,15 @@ pub struct RunResult {
     /// See `long_short_m`.
     pub left_right_m: f64,
     /// Guidance phase changes with their reasons (kept only when one run is replayed).
-    #[serde(skip_serializing_if = "Vec::is_empty")]
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub events: Vec<PhaseEvent>,
     /// The flight every second (kept only when one run is replayed).
-    #[serde(skip_serializing_if = "Vec::is_empty")]
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub track: Vec<TrackPoint>,
 }
 
 /// One second of a replayed run: truth and what guidance saw.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct TrackPoint {
     /// Time, s.
     pub time_s: f64,
@@ -168,27 +174,38 @@ pub fn conditions(config: &MonteCarloConfig, index: usize) -> RunConditions {
     }
 }
 
-/// The wind of a run: the mean speed sheared over height (±20 % about the mean from the
-/// ground to the release height, veering up to ±20°) plus Dryden turbulence of 10 % of the
-/// mean speed (at least 0.1 m/s).
+/// The wind of a run: the mean speed sheared over height (by the shape's fraction about the
+/// mean from the ground to the release height, veering by its angle), turning by its low-level
+/// angle near the ground, plus Dryden turbulence of 10 % of the mean speed (at least 0.1 m/s)
+/// times its gust factor.
 pub fn wind_field(
     c: &RunConditions,
+    shape: &WindShape,
     altitude_m: f64,
 ) -> Result<WindComposite, stx_dynamics::wind::WindError> {
-    let mut rng = ChaCha8Rng::seed_from_u64(c.seed ^ 0x005E_ED0F_517D);
-    let shear = 0.4 * rng.random::<f64>() - 0.2;
-    let veer_deg = 40.0 * rng.random::<f64>() - 20.0;
-    let rows = (0..=4)
-        .map(|k| {
-            let f = k as f64 / 4.0;
+    let top = altitude_m + 100.0;
+    let low = shape.low_level_height_m;
+    let mut heights: Vec<f64> = (0..=4).map(|k| k as f64 / 4.0 * top).collect();
+    if shape.low_level_turn_deg != 0.0 {
+        heights.extend([low, 2.0 * low].into_iter().filter(|h| *h < top));
+        heights.sort_by(f64::total_cmp);
+        heights.dedup();
+    }
+    let rows = heights
+        .into_iter()
+        .map(|h| {
+            let f = h / top;
+            // The low-level turn is whole below `low` and fades out by twice that height.
+            let turn = shape.low_level_turn_deg * ((2.0 * low - h) / low).clamp(0.0, 1.0);
             ProfileRow {
-                altitude_m: f * (altitude_m + 100.0),
-                speed_mps: c.wind_speed_mps * (1.0 - shear + 2.0 * shear * f),
-                from_deg: (c.wind_from_deg + veer_deg * f).rem_euclid(360.0),
+                altitude_m: h,
+                speed_mps: c.wind_speed_mps
+                    * (1.0 - shape.shear_fraction + 2.0 * shape.shear_fraction * f),
+                from_deg: (c.wind_from_deg + shape.veer_deg * f + turn).rem_euclid(360.0),
             }
         })
         .collect();
-    let sigma = (0.1 * c.wind_speed_mps).max(0.1);
+    let sigma = (0.1 * c.wind_speed_mps).max(0.1) * shape.gust_factor;
     let turbulence = Turbulence::new(TurbulenceParams {
         sigma_horizontal_mps: sigma,
         sigma_vertical_mps: 0.5 * sigma,
@@ -204,19 +221,35 @@ pub fn wind_field(
     })
 }
 
+/// The wind shape of run `c` under the campaign's dispersions.
+pub fn wind_shape(config: &MonteCarloConfig, c: &RunConditions) -> WindShape {
+    WindShape::draw(
+        &config.dispersions,
+        &mut ChaCha8Rng::seed_from_u64(c.seed ^ 0x005E_ED0F_517D),
+    )
+}
+
 /// Flies run `index` with navigation from `navigator(&conditions)`.
 pub fn run_one<N: Navigator>(
     config: &MonteCarloConfig,
     vehicle: &Vehicle,
     template: &StateVector,
     index: usize,
-    navigator: impl Fn(&RunConditions) -> Result<N, String>,
+    navigator: impl Fn(&RunConditions, &SensorConfig) -> Result<N, String>,
 ) -> Result<RunResult, String> {
     let c = conditions(config, index);
-    let composite = Arc::new(wind_field(&c, config.altitude_m).map_err(|e| e.to_string())?);
+    let shape = wind_shape(config, &c);
+    let composite = Arc::new(wind_field(&c, &shape, config.altitude_m).map_err(|e| e.to_string())?);
+    let drawn = DispersedFlight::draw(
+        &config.dispersions,
+        &vehicle.config,
+        &config.sensors,
+        c.seed,
+    )
+    .map_err(|e| format!("dispersed vehicle refused: {e}"))?;
     let wind: Arc<dyn WindField> = composite.clone();
     let model = ParafoilModel::new(
-        vehicle.clone(),
+        drawn.vehicle,
         Environment {
             atmosphere: Arc::new(StandardAtmosphere),
             wind: wind.clone(),
@@ -244,10 +277,11 @@ pub fn run_one<N: Navigator>(
         x,
         0.0,
         guidance,
-        navigator(&c)?,
+        navigator(&c, &drawn.sensors)?,
         STEP_S,
         CONTROL_PERIOD_S,
     );
+    flight.servos = drawn.servos;
     let mut wind_error_sq = 0.0;
     let mut wind_samples = 0usize;
     let replay = config.only_run == Some(index);
@@ -308,6 +342,8 @@ pub fn run_one<N: Navigator>(
         |b: [f64; 2]| (touchdown.position_ne_m[0] - b[0]).hypot(touchdown.position_ne_m[1] - b[1]);
     Ok(RunResult {
         index,
+        vehicle_draw: drawn.summary,
+        wind_shape: shape,
         miss_m: touchdown.position_ne_m[0].hypot(touchdown.position_ne_m[1]),
         heading_vs_upwind_deg: heading_vs_upwind,
         calm: mean_wind_at_touchdown.x.hypot(mean_wind_at_touchdown.y) < CALM_WIND_MPS,

@@ -7,6 +7,8 @@ use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
 
 use serde::Serialize;
 use stx_dynamics::vehicle::Vehicle;
+
+use crate::dispersions::DispersedFlight;
 use stx_link::sansio::IoStats;
 use stx_link::signing::persist::{persist_signing_mark, start_signing};
 use stx_link_tokio::{Action, DriveOptions, DriverEvent, Transport, TransportError, drive};
@@ -35,6 +37,13 @@ pub enum FlyError {
         mission: String,
         #[source]
         source: DroneError,
+    },
+    /// The vehicle drawn from the dispersion set is one the model refuses.
+    #[error("the dispersed vehicle of mission {mission} is refused")]
+    Dispersed {
+        mission: String,
+        #[source]
+        source: stx_dynamics::vehicle::VehicleError,
     },
     /// The link's address is bad or cannot be opened.
     #[error("opening {address}")]
@@ -72,7 +81,11 @@ impl FlyError {
     pub fn is_input(&self) -> bool {
         matches!(
             self,
-            Self::Drone { .. } | Self::Open { .. } | Self::Signing(_) | Self::PersistMark(_)
+            Self::Drone { .. }
+                | Self::Dispersed { .. }
+                | Self::Open { .. }
+                | Self::Signing(_)
+                | Self::PersistMark(_)
         )
     }
 }
@@ -135,11 +148,29 @@ impl Flight {
     /// for a drone that cannot be built.
     pub async fn start(options: FlyOptions) -> Result<Self, FlyError> {
         let mission = options.mission.name.clone();
-        let drone = Drone::new(&options.mission, Vehicle::straplex()).map_err(|source| {
-            FlyError::Drone {
-                mission: mission.clone(),
-                source,
+        // A dispersed drone flies a vehicle and sensors drawn from the mission's seed; its
+        // onboard software keeps the nominal vehicle, as on a real flight.
+        let (mission_config, vehicle) = match &options.dispersions {
+            Some(d) => {
+                let drawn = DispersedFlight::draw(
+                    d,
+                    &Vehicle::straplex().config,
+                    &options.mission.sensors,
+                    options.mission.seed,
+                )
+                .map_err(|source| FlyError::Dispersed {
+                    mission: mission.clone(),
+                    source,
+                })?;
+                let mut m = options.mission.clone();
+                m.sensors = drawn.sensors;
+                (m, drawn.vehicle)
             }
+            None => (options.mission.clone(), Vehicle::straplex()),
+        };
+        let drone = Drone::new(&mission_config, vehicle).map_err(|source| FlyError::Drone {
+            mission: mission.clone(),
+            source,
         })?;
         let transport = Transport::open_str(&options.connect)
             .await

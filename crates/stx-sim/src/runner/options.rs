@@ -78,6 +78,9 @@ pub struct FlyOptions {
     /// How long to keep answering on the ground after landing, real time; `None`: until the
     /// shutdown future resolves (what a station running the drone beside it wants).
     pub linger: Option<Duration>,
+    /// Fly a vehicle and sensors drawn from this dispersion set (with the mission's seed)
+    /// instead of the nominal ones; the servos stay perfect.
+    pub dispersions: Option<crate::dispersions::Dispersions>,
 }
 
 impl FlyOptions {
@@ -91,6 +94,7 @@ impl FlyOptions {
             link: LinkConfig::vehicle(),
             signing: None,
             linger: Some(Duration::ZERO),
+            dispersions: None,
         }
     }
 }

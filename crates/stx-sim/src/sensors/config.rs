@@ -195,6 +195,10 @@ pub struct PitotConfig {
     pub differential_offset_sigma_pa: f64,
     /// Random walk of that offset (thermal drift), Pa/√s.
     pub differential_offset_random_walk_pa_per_sqrt_s: f64,
+    /// Scale error of the differential pressure (the tube's placement in the drone's flow and
+    /// its calibration), drawn once per run with this 1-σ as a fraction: the sensor reads
+    /// `(1 + k)·q`. Clipped at ±3 σ.
+    pub differential_scale_sigma: f64,
     /// White noise on the static pressure, 1-σ, Pa.
     pub static_noise_pa: f64,
     /// Constant static-pressure bias, drawn once per run with this 1-σ, Pa.
@@ -216,6 +220,7 @@ impl Default for PitotConfig {
             differential_noise_pa: 0.5,
             differential_offset_sigma_pa: 0.3,
             differential_offset_random_walk_pa_per_sqrt_s: 0.005,
+            differential_scale_sigma: 0.0,
             static_noise_pa: 2.0,
             static_bias_sigma_pa: 20.0,
             temperature_noise_k: 0.3,
@@ -363,6 +368,12 @@ impl SensorConfig {
         non_negative(
             "pitot.differential_offset_random_walk_pa_per_sqrt_s",
             p.differential_offset_random_walk_pa_per_sqrt_s,
+        )?;
+        check(
+            "pitot.differential_scale_sigma",
+            p.differential_scale_sigma,
+            |v| (0.0..=0.3).contains(&v),
+            "in [0, 0.3]",
         )?;
         non_negative("pitot.static_noise_pa", p.static_noise_pa)?;
         non_negative("pitot.static_bias_sigma_pa", p.static_bias_sigma_pa)?;

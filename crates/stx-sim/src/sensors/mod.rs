@@ -47,6 +47,7 @@ use stx_gnc::measurement::Measurement;
 pub use config::{AhrsConfig, GpsConfig, PitotConfig, SensorConfig, SensorConfigError};
 pub use queue::DeliveryQueue;
 pub use suite::SensorSuite;
+pub(crate) use suite::rng_for;
 
 /// What the sensors look at: the drone's true state at one instant.
 #[derive(Debug, Clone, Copy, PartialEq)]

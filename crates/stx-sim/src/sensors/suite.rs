@@ -201,6 +201,8 @@ struct Pitot {
     schedule: Schedule,
     rng: ChaCha8Rng,
     differential_offset_pa: f64,
+    /// `1 + k` of [`PitotConfig::differential_scale_sigma`].
+    differential_scale: f64,
     static_bias_pa: f64,
     temperature_bias_k: f64,
 }
@@ -214,7 +216,7 @@ impl Pitot {
             c.differential_offset_random_walk_pa_per_sqrt_s * due.elapsed_s.sqrt() * gauss(rng);
         let u_x = truth.air_velocity_body_mps.x;
         let rho = truth.air.density_kg_per_m3;
-        let differential_pressure_pa = 0.5 * rho * u_x * u_x.abs()
+        let differential_pressure_pa = self.differential_scale * 0.5 * rho * u_x * u_x.abs()
             + self.differential_offset_pa
             + c.differential_noise_pa * gauss(rng);
         let static_pressure_pa =
@@ -242,9 +244,11 @@ mod stream {
     pub const AHRS_DROPOUT: u64 = 12;
     pub const PITOT_DROPOUT: u64 = 13;
     pub const GPS_BIAS: u64 = 21;
+    pub const PITOT_SCALE: u64 = 23;
 }
 
-fn rng_for(seed: u64, stream: u64) -> ChaCha8Rng {
+/// The generator of stream `stream` of `seed`: independent sequences from one seed.
+pub(crate) fn rng_for(seed: u64, stream: u64) -> ChaCha8Rng {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     rng.set_stream(stream);
     rng
@@ -323,6 +327,10 @@ impl SensorSuite {
         let differential_offset_pa = p.differential_offset_sigma_pa * gauss(&mut pitot_rng);
         let static_bias_pa = p.static_bias_sigma_pa * gauss(&mut pitot_rng);
         let temperature_bias_k = p.temperature_bias_sigma_k * gauss(&mut pitot_rng);
+        // Its own stream, so that a run without a scale error draws the same noise as before.
+        let differential_scale = 1.0
+            + p.differential_scale_sigma
+                * gauss(&mut rng_for(seed, stream::PITOT_SCALE)).clamp(-3.0, 3.0);
         let pitot = Pitot {
             schedule: Schedule::new(
                 p.rate_hz,
@@ -335,6 +343,7 @@ impl SensorSuite {
             config: p.clone(),
             rng: pitot_rng,
             differential_offset_pa,
+            differential_scale,
             static_bias_pa,
             temperature_bias_k,
         };
@@ -358,6 +367,11 @@ impl SensorSuite {
     /// heading error with.
     pub fn ahrs_bias_rad(&self) -> Vector3<f64> {
         Vector3::from(self.ahrs.bias_rad)
+    }
+
+    /// This run's differential-pressure scale, `1 + k`.
+    pub fn differential_scale(&self) -> f64 {
+        self.pitot.differential_scale
     }
 
     /// This run's differential-pressure offset, Pa.

@@ -58,7 +58,8 @@
 //! and whether it is known (`wind.rs`), the pattern's axis, frame and scaled branches
 //! (`pattern.rs`), the energy sums (`energy.rs`) with the corner turn rate of the gains in
 //! force (`turn_rate.rs`), the glide's reach (`reach.rs`) and the final approach's geometry
-//! (`final_approach.rs`). The phase machine (`phases.rs`) then takes at most one decision on
+//! (`final_approach.rs`), all with the glide learned so far in flight (`learned.rs`). The
+//! phase machine (`phases.rs`) then takes at most one decision on
 //! it, and the steering (`steering.rs`) flies the phase it leaves the vehicle in; the final
 //! approach's brakes, S-turns and flare are in `final_approach.rs`. The settings are in
 //! `config.rs`. Only this module holds the parts' memories together; the parts do not know
@@ -67,6 +68,7 @@
 pub(super) mod config;
 mod energy;
 mod final_approach;
+mod learned;
 mod pattern;
 mod phases;
 mod reach;
@@ -76,6 +78,7 @@ mod turn_rate;
 mod wind;
 
 pub use config::{FinalLaw, SpiralConfig};
+pub use learned::LearnedGlide;
 pub use turn_rate::corner_turn_rate_rad_s;
 
 use serde::{Deserialize, Serialize};
@@ -139,6 +142,10 @@ pub struct Spiral {
     final_approach: FinalApproach,
     /// The best reachable point last announced.
     announced: Announcement,
+    /// The glide learned in flight, which every plan is made with.
+    glide: LearnedGlide,
+    /// Symmetric brake of the last commands, 0…1.
+    last_brake: f64,
     status: SpiralStatus,
 }
 
@@ -152,8 +159,15 @@ impl Spiral {
             corner_rate: CornerRate::default(),
             final_approach: FinalApproach::default(),
             announced: Announcement::default(),
+            glide: LearnedGlide::default(),
+            last_brake: 0.0,
             status: SpiralStatus::default(),
         }
+    }
+
+    /// What has been learned in flight of the glide.
+    pub fn learned_glide(&self) -> &LearnedGlide {
+        &self.glide
     }
 
     /// The phase.
@@ -179,6 +193,13 @@ impl Spiral {
         est: &Estimate,
         density: f64,
     ) -> (Controls, Change) {
+        self.glide
+            .update(&config.performance, est, self.last_brake, density);
+        let learned = GuidanceConfig {
+            performance: self.glide.performance(&config.performance),
+            ..*config
+        };
+        let config = &learned;
         let situation = self.assess(config, plan, est, density);
         let change = self
             .machine
@@ -192,6 +213,7 @@ impl Spiral {
             density,
         );
 
+        self.last_brake = 0.5 * (controls.brake_left + controls.brake_right);
         let phase = self.machine.phase;
         if phase != GuidancePhase::FinalApproach {
             self.final_approach.end();

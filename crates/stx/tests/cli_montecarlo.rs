@@ -1,0 +1,174 @@
+//! `stx montecarlo` over shards and dispersion files, through the real binary: a campaign split
+//! into shards and merged gives the one-machine report; bad parts and bad dispersion files are
+//! refused with a clear message and exit code 2.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn stx(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_stx"))
+        .args(args)
+        .output()
+        .expect("stx runs")
+}
+
+fn temp_dir(name: &str) -> PathBuf {
+    let dir =
+        std::env::temp_dir().join(format!("stx-cli-montecarlo-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    dir
+}
+
+/// A small campaign: short flights, realistic dispersions.
+const CAMPAIGN: [&str; 9] = [
+    "montecarlo",
+    "--runs",
+    "5",
+    "--seed",
+    "9",
+    "--altitude",
+    "120",
+    "--dispersions",
+    "realistic",
+];
+
+fn json(out: &Output) -> serde_json::Value {
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let mut v: serde_json::Value =
+        serde_json::from_slice(&out.stdout).expect("one JSON object on stdout");
+    v.as_object_mut().expect("an object").remove("wall_time_s");
+    v
+}
+
+fn shard(dir: &Path, k: usize, n: usize) -> PathBuf {
+    let out = dir.join(format!("part{k}.json"));
+    let spec = format!("{k}/{n}");
+    let mut args = CAMPAIGN.to_vec();
+    args.extend(["--shard", &spec, "--out", out.to_str().expect("utf-8 path")]);
+    let run = stx(&args);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    out
+}
+
+#[test]
+fn shards_merged_give_exactly_the_one_machine_report() {
+    let dir = temp_dir("merge");
+    let mut whole = CAMPAIGN.to_vec();
+    whole.extend(["--json", "--details", "--threads", "2"]);
+    let one_machine = json(&stx(&whole));
+    assert_eq!(one_machine["runs"], 5);
+    assert_eq!(one_machine["dispersions"]["name"], "realistic");
+
+    let parts: Vec<PathBuf> = (1..=3).map(|k| shard(&dir, k, 3)).collect();
+    let mut merge = vec!["montecarlo", "merge", "--json", "--details"];
+    // Given in another order than flown: the merge sorts the runs.
+    for p in parts.iter().rev() {
+        merge.push(p.to_str().expect("utf-8 path"));
+    }
+    let merged = json(&stx(&merge));
+    assert_eq!(
+        merged, one_machine,
+        "every statistic and every run, wall time aside"
+    );
+
+    // A part missing, or one from another campaign, is refused by name.
+    let missing = stx(&[
+        "montecarlo",
+        "merge",
+        parts[0].to_str().expect("path"),
+        parts[1].to_str().expect("path"),
+    ]);
+    assert_eq!(missing.status.code(), Some(2));
+    assert!(
+        String::from_utf8_lossy(&missing.stderr).contains("each of 1…3 must be given once"),
+        "{}",
+        String::from_utf8_lossy(&missing.stderr)
+    );
+    let other = dir.join("other.json");
+    let run = stx(&[
+        "montecarlo",
+        "--runs",
+        "5",
+        "--seed",
+        "10",
+        "--altitude",
+        "120",
+        "--dispersions",
+        "realistic",
+        "--shard",
+        "3/3",
+        "--out",
+        other.to_str().expect("path"),
+    ]);
+    assert!(run.status.success());
+    let mixed = stx(&[
+        "montecarlo",
+        "merge",
+        parts[0].to_str().expect("path"),
+        parts[1].to_str().expect("path"),
+        other.to_str().expect("path"),
+    ]);
+    assert_eq!(mixed.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&mixed.stderr).contains("another campaign"));
+    let not_a_part = dir.join("garbage.json");
+    std::fs::write(&not_a_part, "{\"runs\": 3}").expect("write");
+    let garbage = stx(&["montecarlo", "merge", not_a_part.to_str().expect("path")]);
+    assert_eq!(garbage.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&garbage.stderr).contains("is not a campaign part"));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_bad_dispersion_file_or_shard_is_refused_by_name() {
+    let dir = temp_dir("bad");
+    let file = dir.join("d.toml");
+    let text = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../config/dispersions/realistic.toml"),
+    )
+    .expect("the shipped file")
+    .replace("mass_sigma = 0.10", "mass_sigma = -0.1");
+    std::fs::write(&file, text).expect("write");
+    let out = stx(&[
+        "montecarlo",
+        "--runs",
+        "1",
+        "--dispersions",
+        file.to_str().expect("path"),
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("mass.mass_sigma"), "{err}");
+    let out = stx(&[
+        "montecarlo",
+        "--runs",
+        "1",
+        "--dispersions",
+        "/nonexistent.toml",
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    // The simulated drone reads the same files, and refuses the same way.
+    let out = stx(&["drone", "--dispersions", file.to_str().expect("path")]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("mass.mass_sigma"));
+    let out = stx(&[
+        "montecarlo",
+        "--runs",
+        "4",
+        "--shard",
+        "5/4",
+        "--out",
+        "x.json",
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("K/N"));
+    let _ = std::fs::remove_dir_all(&dir);
+}
