@@ -19,7 +19,7 @@ use stx_gnc::guidance::{Guidance, PhaseEvent};
 use stx_gnc::mission::{FlightMode, GuidancePhase};
 
 use crate::dispersions::ServoErrors;
-use crate::geometry::{height_above_ground_m, lowest_point};
+use crate::geometry::{height_of_lowest_m, lowest_of};
 use crate::sensors::{
     Delivery, DeliveryQueue, SensorConfig, SensorConfigError, SensorSuite, Truth,
 };
@@ -218,7 +218,22 @@ pub struct GuidedFlight<N: Navigator> {
     pub best_reachable_announced: Vec<(f64, [f64; 2])>,
     /// What the servos do with guidance's commands (perfect unless a dispersion set says).
     pub servos: ServoErrors,
+    /// The bodies whose ground contact ends a period: all of them, until the transponder is
+    /// down and the payload flies on ([`Self::land_payload`]).
+    pub touching: &'static [Body],
 }
+
+/// The bodies still flying once the transponder lies on the ground.
+pub const PAYLOAD_BODIES: [Body; 3] = [Body::Canopy, Body::Drone, Body::Capsule];
+
+/// What is left of the transponder's mass once its line is slack, as a fraction: a slack line
+/// carries no force, and 1 % (17 g) keeps its two pendulum angles in the equations well posed
+/// without a weight the stack would feel (0.2 % of its weight).
+pub const SLACK_TRANSPONDER_MASS_FRACTION: f64 = 0.01;
+
+/// Longest the payload is flown on after the transponder's contact before the run counts as
+/// failed, s (its line is 5 m; the stack sinks at 1–3 m/s).
+pub const PAYLOAD_LANDING_MAX_S: f64 = 20.0;
 
 impl<N: Navigator> GuidedFlight<N> {
     /// A flight starting at `state` at `time_s`, integrated with RK4 steps of `step_s` and
@@ -246,6 +261,7 @@ impl<N: Navigator> GuidedFlight<N> {
             events: Vec::new(),
             best_reachable_announced: Vec::new(),
             servos: ServoErrors::default(),
+            touching: &Body::ALL,
         }
     }
 
@@ -305,16 +321,42 @@ impl<N: Navigator> GuidedFlight<N> {
     /// The period is integrated by [`fly_period`].
     pub fn advance(&mut self) -> Result<Option<Touchdown>, IntegrateError> {
         self.guide();
-        let (time_s, state, contact_s) = fly_period(
+        let (time_s, state, contact_s) = fly_period_over(
             &mut self.model,
             self.time_s,
             &self.state,
             self.step_s,
             self.control_period_s,
+            self.touching,
         )?;
         self.time_s = time_s;
         self.state = state;
-        Ok(contact_s.map(|t| touchdown(&self.model, &self.state, t)))
+        Ok(contact_s.map(|t| touchdown_of(&self.model, &self.state, t, self.touching)))
+    }
+
+    /// Flies on after the first contact `first` until the capsule (the payload) is down, and
+    /// returns its touchdown. When the transponder touched first its line goes slack: the
+    /// stack, lighter by the transponder's weight, flies on under guidance (still flaring)
+    /// until the capsule touches. The slack line is modelled by keeping the transponder's
+    /// pendulum with [`SLACK_TRANSPONDER_MASS_FRACTION`] of its mass and no drag, let through
+    /// the ground. When another body touched first, that contact is the payload's landing too.
+    pub fn land_payload(&mut self, first: Touchdown) -> Result<Touchdown, String> {
+        if first.body != Body::Transponder {
+            return Ok(first);
+        }
+        let transponder = &mut self.model.vehicle.transponder;
+        transponder.mass_kg *= SLACK_TRANSPONDER_MASS_FRACTION;
+        transponder.drag_area_m2 = 0.0;
+        self.touching = &PAYLOAD_BODIES;
+        let give_up_s = self.time_s + PAYLOAD_LANDING_MAX_S;
+        while self.time_s < give_up_s {
+            if let Some(t) = self.advance().map_err(|e| e.to_string())? {
+                return Ok(t);
+            }
+        }
+        Err(format!(
+            "the payload still flying {PAYLOAD_LANDING_MAX_S} s after the transponder touched"
+        ))
     }
 }
 
@@ -334,8 +376,20 @@ pub fn fly_period(
     step_s: f64,
     period_s: f64,
 ) -> Result<(f64, StateVector, Option<f64>), IntegrateError> {
+    fly_period_over(model, time_s, state, step_s, period_s, &Body::ALL)
+}
+
+/// [`fly_period`] stopping at the ground contact of one of `bodies` only.
+pub fn fly_period_over(
+    model: &mut ParafoilModel,
+    time_s: f64,
+    state: &StateVector,
+    step_s: f64,
+    period_s: f64,
+    bodies: &[Body],
+) -> Result<(f64, StateVector, Option<f64>), IntegrateError> {
     let vehicle = model.vehicle.clone();
-    let mut event = |_t: f64, x: &StateVector| height_above_ground_m(&vehicle, x);
+    let mut event = |_t: f64, x: &StateVector| height_of_lowest_m(&vehicle, x, bodies);
     let end_s = time_s + period_s;
     let mut outcome = Err(IntegrateError::InvalidSpan {
         start_time_s: time_s,
@@ -377,8 +431,18 @@ pub fn fly_period(
 /// How the stack in `state` meets the ground at `time_s`: the lowest body, its position and
 /// vertical speed, the canopy's heading and where the wind comes from there.
 pub fn touchdown(model: &ParafoilModel, state: &StateVector, time_s: f64) -> Touchdown {
+    touchdown_of(model, state, time_s, &Body::ALL)
+}
+
+/// [`touchdown`] of the lowest of `bodies`.
+pub fn touchdown_of(
+    model: &ParafoilModel,
+    state: &StateVector,
+    time_s: f64,
+    bodies: &[Body],
+) -> Touchdown {
     let k = Kinematics::new(&model.vehicle, state, model.controls().main_line_m);
-    let (body, _) = lowest_point(&model.vehicle, &k);
+    let (body, _) = lowest_of(&model.vehicle, &k, bodies);
     let p = k.position_ned_m[body as usize];
     let v = k.velocity_ned_mps(body);
     let wind = model.environment.wind.wind_ned_mps(time_s, &p);

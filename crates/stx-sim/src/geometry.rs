@@ -9,26 +9,38 @@ use stx_dynamics::vehicle::Vehicle;
 /// Far above the ground the canopy's height stands in for it (both are positive there), which
 /// spares walking the chain at every step.
 pub fn height_above_ground_m(vehicle: &Vehicle, x: &StateVector) -> f64 {
+    height_of_lowest_m(vehicle, x, &Body::ALL)
+}
+
+/// Height above the ground of the lowest point of `bodies`, m (the canopy's height while the
+/// stack is high up).
+pub fn height_of_lowest_m(vehicle: &Vehicle, x: &StateVector, bodies: &[Body]) -> f64 {
     let canopy_height = -x[idx::POSITION + 2];
     let stack_height_m = 30.0;
     if canopy_height > stack_height_m {
         return canopy_height;
     }
     let k = Kinematics::new(vehicle, x, 0.0);
-    lowest_point(vehicle, &k).1
+    lowest_of(vehicle, &k, bodies).1
 }
 
 /// The body whose lowest point is nearest the ground, and that point's height, m.
 pub fn lowest_point(vehicle: &Vehicle, k: &Kinematics) -> (Body, f64) {
+    lowest_of(vehicle, k, &Body::ALL)
+}
+
+/// Among `bodies`, the one whose lowest point is nearest the ground, and that point's height,
+/// m.
+pub fn lowest_of(vehicle: &Vehicle, k: &Kinematics, bodies: &[Body]) -> (Body, f64) {
     let half_heights = [
         0.5 * vehicle.config.canopy.thickness_m,
         0.5 * vehicle.config.drone.height_m,
         0.5 * vehicle.capsule.height_m,
         0.5 * vehicle.transponder.height_m,
     ];
-    Body::ALL
-        .into_iter()
-        .map(|b| {
+    bodies
+        .iter()
+        .map(|&b| {
             (
                 b,
                 -k.position_ned_m[b as usize].z - half_heights[b as usize],

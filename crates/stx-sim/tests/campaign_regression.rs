@@ -8,15 +8,16 @@ use stx_sim::closed_loop::SensedNavigation;
 use stx_sim::dispersions::Dispersions;
 use stx_sim::montecarlo::{MonteCarloConfig, run_all};
 
-/// Bounds set on 2026-11-25 from this campaign's figures then (median 9.6 m, p95 54.0 m, one
-/// failed run: run 24, whose dispersed stack goes non-finite at 174.3 s whatever the step,
-/// down to 0.8 ms) with about 20 % of room.
-const MEDIAN_BOUND_M: f64 = 11.5;
-const P95_BOUND_M: f64 = 65.0;
+/// Bounds on the payload's (the capsule's) miss, set on 2026-11-25 from this campaign's
+/// figures then (median 6.8 m, p95 41.1 m, no failed run; the first contact's: 9.3 m and 43.2 m)
+/// with about 20 % of room; one failed run is allowed, as a dispersed stack can go non-finite
+/// whatever the step (seen in about 0.5 % of realistic runs).
+const MEDIAN_BOUND_M: f64 = 8.5;
+const P95_BOUND_M: f64 = 50.0;
 const FAILED_BOUND: usize = 1;
 
 #[test]
-fn regression_sixty_realistic_runs_keep_their_miss_and_failures() {
+fn regression_sixty_realistic_runs_keep_their_payload_miss_and_failures() {
     let config = MonteCarloConfig {
         runs: 60,
         seed: 2026,
@@ -33,15 +34,15 @@ fn regression_sixty_realistic_runs_keep_their_miss_and_failures() {
         |_| {},
     )
     .expect("the campaign runs");
-    let m = report.miss_m;
+    let m = report.payload_miss_m;
     eprintln!(
-        "60 realistic runs, seed 2026: miss (first contact) median {:.1} m, p95 {:.1} m, max {:.1} m; \
-         {} failed; touchdown vertical speed median {:.2} m/s; wind RMS {:.2} m/s",
+        "60 realistic runs, seed 2026: payload miss median {:.1} m, p95 {:.1} m, max {:.1} m; \
+         {} failed; payload touchdown vertical speed median {:.2} m/s; wind RMS {:.2} m/s",
         m.median,
         m.p95,
         m.max,
         report.failed_runs.len(),
-        report.touchdown_vertical_speed_mps.median,
+        report.payload_touchdown_vertical_speed_mps.median,
         report.wind_estimate_rmse_mps
     );
     assert_eq!(report.runs, 60);

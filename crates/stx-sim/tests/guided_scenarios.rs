@@ -229,9 +229,10 @@ fn a_too_strong_wind_with_the_estimator_in_the_loop_is_called_and_flown_to_the_b
 /// upwind final). Guidance chose the brake from the polar alone, the stack sank faster than the
 /// polar says with the brakes working in gusts, and the brakes stayed on while it was already
 /// short. Now the final learns the glide it flies and releases the brakes in time. (Bound 20 m
-/// until 2026-11-25, then 25 m: with the glide learned over the whole descent, run 171 lands
-/// 21.3 m off, 18.0 m short, where it landed just inside 20 m before; the campaign figures
-/// that decided for the learning are in issue 13's closing note.)
+/// until 2026-11-25, then 25 m: with the glide and the main-line trim learned in flight and the
+/// final aimed for the capsule, run 171's first contact is 20.7 m off, 18.2 m short, where it
+/// was just inside 20 m before; the campaign figures that decided for the learning are in
+/// issue 13's closing note.)
 #[test]
 fn finals_into_a_strong_headwind_no_longer_fall_short() {
     for (index, before_m) in [(171, 38.5), (254, 33.7), (260, 30.1)] {

@@ -235,6 +235,15 @@ fn print_table(r: &MonteCarloReport) {
         r.miss_m.max
     );
     println!(
+        "payload (capsule) miss: median {:.1} m, 95th percentile {:.1} m, worst {:.1} m; its \
+         vertical speed at touchdown: median {:.2} m/s, 95th percentile {:.2} m/s",
+        r.payload_miss_m.median,
+        r.payload_miss_m.p95,
+        r.payload_miss_m.max,
+        r.payload_touchdown_vertical_speed_mps.median,
+        r.payload_touchdown_vertical_speed_mps.p95
+    );
+    println!(
         "into the wind (within 30°): {:.1} % of touchdowns ({} in calm air, below 0.5 m/s, count \
          as into the wind; judged like the others: {:.1} %)",
         100.0 * r.into_wind_fraction,

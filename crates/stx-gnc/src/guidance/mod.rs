@@ -5,11 +5,13 @@
 //! landing is the state machine of [`spiral`] (seed §5.3). Every phase change is an event with a
 //! reason, kept for the operator's log. What guidance is configured with ([`GuidanceConfig`])
 //! and what the operator asked it to fly ([`Plan`]) have files of their own, which the spiral
-//! reads without depending on this module's [`Guidance`].
+//! reads without depending on this module's [`Guidance`]. Every guided command flies with the
+//! main-line trim learned in flight ([`trim`]); the spiral also learns the glide.
 
 mod config;
 mod plan;
 pub mod spiral;
+pub mod trim;
 
 pub use config::GuidanceConfig;
 pub use plan::Plan;
@@ -54,6 +56,10 @@ pub struct Guidance {
     events: Vec<PhaseEvent>,
     /// Phases of the localizer and glide-slope laws at the last update, in localizer mode.
     law_phases: Option<(LawPhase, Option<LawPhase>)>,
+    /// The main line's trim learned in flight.
+    trim: trim::MainLineTrim,
+    /// Main line sent at the last update, trim included, m.
+    last_main_line_m: f64,
 }
 
 impl Guidance {
@@ -66,7 +72,14 @@ impl Guidance {
             spiral: spiral::Spiral::new(),
             events: Vec::new(),
             law_phases: None,
+            trim: trim::MainLineTrim::default(),
+            last_main_line_m: 0.0,
         }
+    }
+
+    /// The main line's trim learned in flight.
+    pub fn trim(&self) -> &trim::MainLineTrim {
+        &self.trim
     }
 
     /// In localizer mode, the phases of its horizontal law and (with a glide slope) its
@@ -251,6 +264,15 @@ impl Guidance {
                 controls
             }
         };
+        // Every guided command flies with the trim learned; hands-off and manual ones do not.
+        let guided = !matches!(self.mode, FlightMode::Uncontrolled | FlightMode::Manual);
+        let mut controls = controls;
+        if guided {
+            self.trim
+                .update(&self.config.performance, est, self.last_main_line_m);
+            controls.main_line_m -= self.trim.offset_m;
+        }
+        self.last_main_line_m = controls.main_line_m;
         Command {
             controls,
             phase: self.phase(),

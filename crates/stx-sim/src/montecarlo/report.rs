@@ -106,6 +106,11 @@ pub struct MonteCarloReport {
     /// transponder), m. Failed runs count as misses beyond any landing: with any, the maximum
     /// is infinite (`null` in JSON) and the percentiles rank them last.
     pub miss_m: Stats,
+    /// Distance from the target to the capsule's (the payload's) touchdown, m; failed runs
+    /// count as [`Self::miss_m`] says.
+    pub payload_miss_m: Stats,
+    /// The capsule's vertical speed at its touchdown, m/s.
+    pub payload_touchdown_vertical_speed_mps: Stats,
     /// Share of touchdowns with the heading within 30° of upwind (runs in calm air, where no
     /// upwind exists, count as into the wind).
     pub into_wind_fraction: f64,
@@ -178,10 +183,21 @@ impl MonteCarloReport {
         let announced = |f: fn(&RunResult) -> Option<f64>| {
             Stats::of(&results.iter().filter_map(f).collect::<Vec<_>>())
         };
+        let payload_misses: Vec<f64> = results
+            .iter()
+            .map(|r| r.payload_miss_m)
+            .chain(failed_runs.iter().map(|_| f64::INFINITY))
+            .collect();
+        let payload_speeds: Vec<f64> = results
+            .iter()
+            .map(|r| r.payload_touchdown_vertical_speed_mps)
+            .collect();
         Self {
             campaign,
             runs: results.len() + failed_runs.len(),
             miss_m: Stats::of(&misses),
+            payload_miss_m: Stats::of(&payload_misses),
+            payload_touchdown_vertical_speed_mps: Stats::of(&payload_speeds),
             into_wind_fraction: into_wind_fraction(&results, true),
             into_wind_fraction_strict: into_wind_fraction(&results, false),
             calm_runs: results.iter().filter(|r| r.calm).count(),
@@ -236,6 +252,9 @@ mod tests {
             heading_vs_upwind_deg,
             calm,
             touchdown_vertical_speed_mps: 2.5,
+            payload_miss_m: 1.0,
+            payload_touchdown_vertical_speed_mps: 2.0,
+            payload_after_first_contact_s: 2.0,
             wind_estimate_rmse_mps: 0.2,
             unreachable: false,
             best_reachable_ne_m: None,

@@ -61,6 +61,13 @@ pub struct RunResult {
     pub calm: bool,
     /// Vertical speed of the first body to touch, m/s.
     pub touchdown_vertical_speed_mps: f64,
+    /// Distance from the target to where the capsule (the payload) touched down, m: after
+    /// the transponder's contact the stack flies on until it does.
+    pub payload_miss_m: f64,
+    /// The capsule's vertical speed at its touchdown, m/s.
+    pub payload_touchdown_vertical_speed_mps: f64,
+    /// Time from the first contact to the capsule's, s.
+    pub payload_after_first_contact_s: f64,
     /// RMS of the horizontal wind-estimate error from 30 s after release on, m/s.
     pub wind_estimate_rmse_mps: f64,
     /// Guidance found the target out of reach at some point.
@@ -327,6 +334,7 @@ pub fn run_one<N: Navigator>(
             ));
         }
     };
+    let payload = flight.land_payload(touchdown)?;
     let heading_vs_upwind = if touchdown.upwind_rad.is_finite() {
         wrap_pi(touchdown.heading_rad - touchdown.upwind_rad).to_degrees()
     } else {
@@ -348,6 +356,9 @@ pub fn run_one<N: Navigator>(
         heading_vs_upwind_deg: heading_vs_upwind,
         calm: mean_wind_at_touchdown.x.hypot(mean_wind_at_touchdown.y) < CALM_WIND_MPS,
         touchdown_vertical_speed_mps: touchdown.vertical_speed_mps,
+        payload_miss_m: payload.position_ne_m[0].hypot(payload.position_ne_m[1]),
+        payload_touchdown_vertical_speed_mps: payload.vertical_speed_mps,
+        payload_after_first_contact_s: payload.time_s - touchdown.time_s,
         wind_estimate_rmse_mps: if wind_samples > 0 {
             (wind_error_sq / wind_samples as f64).sqrt()
         } else {

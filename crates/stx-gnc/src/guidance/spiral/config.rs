@@ -38,6 +38,12 @@ pub struct SpiralConfig {
     /// Touchdown aimed this far beyond the target along the final, m (corrects the trail of
     /// the hanging bodies and the flare's dynamics, measured by the Monte Carlo).
     pub aim_beyond_m: f64,
+    /// Height of the payload's (the capsule's) lowest point above the lowest hanging body's
+    /// (the transponder's), m. Once the transponder touches, its line goes slack and the
+    /// stack sinks this much further, flying on, before the capsule touches; the final aims
+    /// the transponder's contact short by the way flown meanwhile, so that the payload comes
+    /// down on the target. 0 aims the first contact at the target.
+    pub payload_height_m: f64,
     /// Headwind added to the measured wind when planning the final, m/s.
     pub wind_margin_mps: f64,
     /// Headwind added as a share of the measured wind when planning the final.
@@ -78,6 +84,9 @@ impl Default for SpiralConfig {
             reach_margin: 1.0,
             wind_filter_s: 10.0,
             aim_beyond_m: 0.0,
+            // The transponder's 5 m line less half the capsule's and the transponder's
+            // heights (0.2 m each, config/vehicle/straplex.toml).
+            payload_height_m: 4.8,
             wind_margin_mps: 0.2,
             wind_margin_fraction: 0.1,
             final_law: FinalLaw::GlideInversion,

@@ -71,8 +71,9 @@ impl FinalGeometry {
             course_rad: final_course,
         };
         let flare_glide = perf.ground_glide(1.0, w_along_measured, density).max(0.0);
-        let to_go_before_flare =
-            -final_line.along_track_m(position) - flare_glide * sc.flare_height_m + sc.aim_beyond_m;
+        let to_go_before_flare = -final_line.along_track_m(position)
+            - flare_glide * sc.flare_height_m
+            + aim_beyond_m(sc, perf, w_along_measured, density);
         let height_to_flare = height - sc.hang_height_m - sc.flare_height_m;
         // The way across to the line, if not on it yet, is flown too (brakes released).
         let across_m = final_line.cross_track_m(position).abs();
@@ -187,13 +188,11 @@ impl FinalApproach {
                     let slope = *self
                         .slope
                         .get_or_insert((height_to_flare / to_go_before_flare).clamp(0.05, 20.0));
+                    let beyond = aim_beyond_m(sc, perf, geometry.headwind_mps, density)
+                        - flare_glide * sc.flare_height_m;
                     let aim_ne = [
-                        target_ne[0]
-                            + (sc.aim_beyond_m - flare_glide * sc.flare_height_m)
-                                * final_course.cos(),
-                        target_ne[1]
-                            + (sc.aim_beyond_m - flare_glide * sc.flare_height_m)
-                                * final_course.sin(),
+                        target_ne[0] + beyond * final_course.cos(),
+                        target_ne[1] + beyond * final_course.sin(),
                     ];
                     let path = GlidePath {
                         line: Localizer {
@@ -297,6 +296,21 @@ impl FinalApproach {
             + gain * (flown - polar - self.glide_correction))
             .clamp(-GLIDE_CORRECTION_LIMIT, GLIDE_CORRECTION_LIMIT);
     }
+}
+
+/// How far beyond the target the first contact is aimed along the final, m: the setting's
+/// `aim_beyond_m`, less the way the stack flies with full brakes into `headwind_mps` while it
+/// sinks the payload's height after the transponder touched, so that the payload lands on the
+/// target.
+fn aim_beyond_m(
+    sc: &SpiralConfig,
+    perf: &GlidePerformance,
+    headwind_mps: f64,
+    density: f64,
+) -> f64 {
+    let flare_ground_speed = (perf.horizontal_airspeed(1.0, density) - headwind_mps).max(0.0);
+    let payload_delay_s = sc.payload_height_m / perf.sink_rate(1.0, 0.0, density);
+    sc.aim_beyond_m - flare_ground_speed * payload_delay_s
 }
 
 /// The main line that follows `line` (localizer control).
