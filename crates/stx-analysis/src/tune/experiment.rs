@@ -110,6 +110,9 @@ impl Experiment {
     fn guidance(&self, gains: &ControlGains, plan: Plan) -> Guidance {
         let mut config = self.base;
         config.gains = *gains;
+        // The step experiments judge the laws themselves: learning a trim from a step's
+        // transient would be judging something else.
+        config.freeze_learning = true;
         let mut g = Guidance::new(config);
         g.set_plan(plan, 0.0);
         g.set_mode(self.mode, 0.0);

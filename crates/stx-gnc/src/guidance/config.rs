@@ -17,4 +17,7 @@ pub struct GuidanceConfig {
     pub performance: GlidePerformance,
     /// Spiral-landing settings.
     pub spiral: SpiralConfig,
+    /// Keep the nominal glide and no main-line trim instead of learning them in flight: for
+    /// judging the control laws alone (the gain tuning's step experiments). Default: learn.
+    pub freeze_learning: bool,
 }

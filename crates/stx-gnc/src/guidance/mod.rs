@@ -265,7 +265,8 @@ impl Guidance {
             }
         };
         // Every guided command flies with the trim learned; hands-off and manual ones do not.
-        let guided = !matches!(self.mode, FlightMode::Uncontrolled | FlightMode::Manual);
+        let guided = !matches!(self.mode, FlightMode::Uncontrolled | FlightMode::Manual)
+            && !self.config.freeze_learning;
         let mut controls = controls;
         if guided {
             self.trim

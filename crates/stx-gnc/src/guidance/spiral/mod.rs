@@ -193,8 +193,10 @@ impl Spiral {
         est: &Estimate,
         density: f64,
     ) -> (Controls, Change) {
-        self.glide
-            .update(&config.performance, est, self.last_brake, density);
+        if !config.freeze_learning {
+            self.glide
+                .update(&config.performance, est, self.last_brake, density);
+        }
         let learned = GuidanceConfig {
             performance: self.glide.performance(&config.performance),
             ..*config
