@@ -77,7 +77,7 @@ struct CampaignArgs {
     dispersions: String,
     /// Fly only shard K of N of the campaign (runs K−1, K−1+N, …) and write them with `--out`;
     /// `stx montecarlo merge` puts the parts together.
-    #[arg(long, value_name = "K/N", requires = "out")]
+    #[arg(long, value_name = "K/N", requires = "out", conflicts_with = "replay")]
     shard: Option<String>,
     /// Where `--shard` writes its part (JSON).
     #[arg(long, requires = "shard")]

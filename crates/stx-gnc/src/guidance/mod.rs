@@ -11,7 +11,7 @@
 mod config;
 mod plan;
 pub mod spiral;
-pub mod trim;
+mod trim;
 
 pub use config::GuidanceConfig;
 pub use plan::Plan;
@@ -75,11 +75,6 @@ impl Guidance {
             trim: trim::MainLineTrim::default(),
             last_main_line_m: 0.0,
         }
-    }
-
-    /// The main line's trim learned in flight.
-    pub fn trim(&self) -> &trim::MainLineTrim {
-        &self.trim
     }
 
     /// In localizer mode, the phases of its horizontal law and (with a glide slope) its

@@ -151,15 +151,18 @@ impl MonteCarloReport {
         failed_runs: Vec<(usize, String)>,
         wall_time_s: f64,
     ) -> Self {
-        let misses: Vec<f64> = results
-            .iter()
-            .map(|r| r.miss_m)
-            .chain(failed_runs.iter().map(|_| f64::INFINITY))
-            .collect();
-        let speeds: Vec<f64> = results
-            .iter()
-            .map(|r| r.touchdown_vertical_speed_mps)
-            .collect();
+        // A miss statistic ranks failed runs beyond every landing; other statistics are of
+        // the landings alone.
+        let miss = |f: fn(&RunResult) -> f64| {
+            let values: Vec<f64> = results
+                .iter()
+                .map(f)
+                .chain(failed_runs.iter().map(|_| f64::INFINITY))
+                .collect();
+            Stats::of(&values)
+        };
+        let of_landings =
+            |f: fn(&RunResult) -> f64| Stats::of(&results.iter().map(f).collect::<Vec<_>>());
         let wind_errors: Vec<f64> = results.iter().map(|r| r.wind_estimate_rmse_mps).collect();
         let pooled = if results.is_empty() {
             0.0
@@ -183,25 +186,18 @@ impl MonteCarloReport {
         let announced = |f: fn(&RunResult) -> Option<f64>| {
             Stats::of(&results.iter().filter_map(f).collect::<Vec<_>>())
         };
-        let payload_misses: Vec<f64> = results
-            .iter()
-            .map(|r| r.payload_miss_m)
-            .chain(failed_runs.iter().map(|_| f64::INFINITY))
-            .collect();
-        let payload_speeds: Vec<f64> = results
-            .iter()
-            .map(|r| r.payload_touchdown_vertical_speed_mps)
-            .collect();
         Self {
             campaign,
             runs: results.len() + failed_runs.len(),
-            miss_m: Stats::of(&misses),
-            payload_miss_m: Stats::of(&payload_misses),
-            payload_touchdown_vertical_speed_mps: Stats::of(&payload_speeds),
+            miss_m: miss(|r| r.miss_m),
+            payload_miss_m: miss(|r| r.payload_miss_m),
+            payload_touchdown_vertical_speed_mps: of_landings(|r| {
+                r.payload_touchdown_vertical_speed_mps
+            }),
             into_wind_fraction: into_wind_fraction(&results, true),
             into_wind_fraction_strict: into_wind_fraction(&results, false),
             calm_runs: results.iter().filter(|r| r.calm).count(),
-            touchdown_vertical_speed_mps: Stats::of(&speeds),
+            touchdown_vertical_speed_mps: of_landings(|r| r.touchdown_vertical_speed_mps),
             wind_estimate_rmse_mps: pooled,
             wind_estimate_rmse_per_run_mps: Stats::of(&wind_errors),
             unreachable_runs: results.iter().filter(|r| r.unreachable).count(),

@@ -369,11 +369,6 @@ impl SensorSuite {
         Vector3::from(self.ahrs.bias_rad)
     }
 
-    /// This run's differential-pressure scale, `1 + k`.
-    pub fn differential_scale(&self) -> f64 {
-        self.pitot.differential_scale
-    }
-
     /// This run's differential-pressure offset, Pa.
     pub fn differential_offset_pa(&self) -> f64 {
         self.pitot.differential_offset_pa

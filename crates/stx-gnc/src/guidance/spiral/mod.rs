@@ -78,7 +78,6 @@ mod turn_rate;
 mod wind;
 
 pub use config::{FinalLaw, SpiralConfig};
-pub use learned::LearnedGlide;
 pub use turn_rate::corner_turn_rate_rad_s;
 
 use serde::{Deserialize, Serialize};
@@ -86,6 +85,7 @@ use stx_dynamics::state::Controls;
 
 use self::energy::Energy;
 use self::final_approach::{FinalApproach, FinalGeometry};
+use self::learned::LearnedGlide;
 use self::pattern::{Axis, Pattern, WindFrame};
 use self::phases::{Change, PhaseMachine};
 use self::reach::{Announcement, Reach};
@@ -163,11 +163,6 @@ impl Spiral {
             last_brake: 0.0,
             status: SpiralStatus::default(),
         }
-    }
-
-    /// What has been learned in flight of the glide.
-    pub fn learned_glide(&self) -> &LearnedGlide {
-        &self.glide
     }
 
     /// The phase.
