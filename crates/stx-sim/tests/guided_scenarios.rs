@@ -255,6 +255,63 @@ fn finals_into_a_strong_headwind_no_longer_fall_short() {
     }
 }
 
+/// Regression (issue 13 item 7, 2026-11-25): seed 2 run 131 of 300 (nominal stack, wind
+/// 3.6 m/s) came to its base leg too low for the final straight across into the wind, flew it
+/// anyway and landed 33.5 m short. Base now joins the longest final its height reaches
+/// diagonally (with a 0.3 m/s allowance for a stronger headwind); the stack lands 4.2 m off.
+#[test]
+fn a_base_leg_too_low_for_the_whole_final_joins_it_diagonally_and_lands_near_the_target() {
+    let config = MonteCarloConfig {
+        runs: 300,
+        seed: 2,
+        threads: 1,
+        only_run: Some(131),
+        ..MonteCarloConfig::default()
+    };
+    let report = fly_sensed(&config);
+    let run = &report.results[0];
+    assert!(run.conditions.wind_speed_mps > 3.0, "a strong wind");
+    assert!(!run.unreachable, "{:?}", run.events);
+    assert!(
+        run.miss_m < 10.0 && run.long_short_m > -10.0,
+        "was 33.5 m short: missed by {:.1} m, {:.1} m long",
+        run.miss_m,
+        run.long_short_m
+    );
+}
+
+/// Regression (2026-11-27): with heading gains of three quarters of the defaults (HK1 0.0067,
+/// HK2 0.0135), seed 11 run 810 (nominal stack, wind 3.9 m/s) was sent from its upwind leg
+/// back to a downwind leg and never turned: near ±180° the course law's error flipped sign
+/// every control period (the drone twists with each command and the course estimate with
+/// it), the main line chattered at ±6 mm and the stack flew upwind for 52 s to the ground,
+/// 149 m off. The turn's side is now latched; its capsule lands 4.8 m off (bound 15 m).
+#[test]
+fn a_reversal_onto_the_downwind_leg_is_flown_one_way_and_not_chattered() {
+    let mut config = MonteCarloConfig {
+        runs: 1000,
+        seed: 11,
+        threads: 1,
+        only_run: Some(810),
+        ..MonteCarloConfig::default()
+    };
+    config.guidance.gains.hk1_m_per_rad = 0.0067;
+    config.guidance.gains.hk2_m_s_per_rad = 0.0135;
+    let report = fly_sensed(&config);
+    let run = &report.results[0];
+    let reversal = run
+        .events
+        .iter()
+        .find(|e| e.reason.contains("downwind leg now"))
+        .expect("sent back to a downwind leg");
+    assert!(reversal.to == stx_gnc::mission::GuidancePhase::Branch1);
+    assert!(
+        run.payload_miss_m < 15.0,
+        "was 149 m off: the capsule lands {:.1} m off",
+        run.payload_miss_m
+    );
+}
+
 /// The campaign `config` flown with the default sensors and estimator.
 fn fly_sensed(config: &MonteCarloConfig) -> stx_sim::montecarlo::MonteCarloReport {
     run_all(

@@ -1,5 +1,7 @@
-//! `stx tune`: optimise one controller's gains on the linearised closed loop, check them on
-//! the nonlinear model, write the gains file guidance reads, and plot the step responses.
+//! `stx tune`: optimise one controller's gains on the linearised closed loop, then on stacks
+//! drawn from a dispersion set flown with the sensors and estimator (`--dispersions`,
+//! `--draws`), check them on the nonlinear model, write the gains file guidance reads, and
+//! plot the step responses.
 
 use std::fs;
 use std::io::IsTerminal;
@@ -10,9 +12,11 @@ use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use stx_analysis::figures::tune_figure;
 use stx_analysis::gains_file::gains_file;
-use stx_analysis::tune::{Controller, StepMetrics, TuneReport, tune};
+use stx_analysis::tune::{Controller, SensedSet, SensedSpec, StepMetrics, TuneReport, tune};
 use stx_gnc::control::ControlGains;
 use stx_gnc::guidance::GuidanceConfig;
+use stx_sim::dispersions::Dispersions;
+use stx_sim::sensors::SensorConfig;
 
 use crate::BadInput;
 use crate::inputs::{load_gains, load_vehicle};
@@ -43,6 +47,21 @@ pub struct TuneArgs {
     /// Print the report as one JSON object on stdout.
     #[arg(long)]
     json: bool,
+    /// The stacks the gains are last tuned and judged on, flown with the sensors and the
+    /// estimator: `nominal`, `realistic` (config/dispersions/) or a dispersion file.
+    #[arg(
+        long,
+        default_value = "realistic",
+        value_name = "nominal|realistic|FILE"
+    )]
+    dispersions: String,
+    /// How many stacks are drawn from --dispersions; 0 tunes and judges on the nominal model
+    /// with perfect navigation only.
+    #[arg(long, default_value_t = 6)]
+    draws: usize,
+    /// Seed of the draws and of the sensors' noise.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
 }
 
 /// Where `stx tune` writes its gains unless told: untracked, so that tuning never rewrites the
@@ -72,11 +91,29 @@ pub fn run(args: TuneArgs) -> anyhow::Result<()> {
         ProgressStyle::with_template("{bar:40} {pos}/{len} simulations, {elapsed} elapsed")
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
+    let sensed = if args.draws > 0 {
+        let dispersions = Dispersions::load(&args.dispersions)
+            .map_err(|e| BadInput(anyhow::Error::new(e).context("--dispersions")))?;
+        let spec = SensedSpec {
+            dispersions,
+            sensors: SensorConfig::default(),
+            count: args.draws,
+            seed: args.seed,
+        };
+        let set = SensedSet::draw(args.controller, &vehicle, args.altitude, base, &spec);
+        for why in &set.excluded {
+            tracing::warn!("left out of the sensed check: {why}");
+        }
+        Some(set)
+    } else {
+        None
+    };
     let report = tune(
         args.controller,
         &vehicle,
         args.altitude,
         base,
+        sensed.as_ref(),
         |done, total| {
             bar.set_length(total as u64);
             bar.set_position(done as u64);
@@ -186,6 +223,21 @@ fn print_report(r: &TuneReport) {
         r.trim_airspeed_mps
     );
     println!("experiments: {}", r.experiment);
+    if let Some(set) = &r.sensed_set {
+        println!(
+            "sensed check: {} stacks drawn from the {} dispersions (seed {}), sensors and \
+             estimator in the loop, {:.0} s on the reference before each step{}",
+            set.draws.len(),
+            set.dispersions,
+            set.seed,
+            set.settle_s,
+            if set.excluded.is_empty() {
+                String::new()
+            } else {
+                format!("; left out: {}", set.excluded.join("; "))
+            }
+        );
+    }
     println!(
         "Nelder–Mead: {} linear simulations{}",
         r.evaluations,
@@ -233,10 +285,14 @@ fn print_report(r: &TuneReport) {
             }
         }
         println!(
-            "{:<10} mean cost: linear {:.3}, 14-DOF {}; closed-loop max Re λ {:.3} 1/s",
+            "{:<10} mean cost: linear {:.3}, 14-DOF {}{}; closed-loop max Re λ {:.3} 1/s",
             "",
             c.linear_cost,
             c.nonlinear_cost.map_or("-".into(), |v| format!("{v:.3}")),
+            c.sensed.as_ref().map_or(String::new(), |s| format!(
+                ", sensed {:.3} ({} failed steps)",
+                s.mean, s.failed_steps
+            )),
             c.closed_loop_max_real_part
         );
     }

@@ -207,7 +207,17 @@ fn tune_writes_a_gains_file_that_sim_and_montecarlo_read() {
     // Run where a checkout's config/ would be: the default output must not land there.
     let dir = temp_dir("tune");
     std::fs::create_dir_all(dir.join("config")).expect("config dir");
-    let out = stx_in(&dir, &["tune", "--controller", "localizer", "--json"]);
+    let out = stx_in(
+        &dir,
+        &[
+            "tune",
+            "--controller",
+            "localizer",
+            "--json",
+            "--draws",
+            "2",
+        ],
+    );
     assert!(
         out.status.success(),
         "{}",
@@ -237,7 +247,22 @@ fn tune_writes_a_gains_file_that_sim_and_montecarlo_read() {
             );
         }
         assert!(v[who]["nonlinear_cost"].as_f64().is_some(), "{who}");
+        // Judged on two realistic stacks flown with the sensors and the estimator.
+        assert_eq!(
+            v[who]["sensed"]["per_draw"].as_array().map(Vec::len),
+            Some(2),
+            "{who}"
+        );
+        assert!(v[who]["sensed"]["mean"].as_f64().is_some(), "{who}");
     }
+    assert_eq!(v["sensed_set"]["dispersions"], "realistic");
+    assert!(
+        v["verdict"]
+            .as_str()
+            .is_some_and(|t| t.contains("sensed, dispersed cost")),
+        "{}",
+        v["verdict"]
+    );
     // The localizer's large step starts in the approach phase: 40 m off the line.
     assert_eq!(v["current"]["large"]["step"], 40.0);
     let text = std::fs::read_to_string(&gains).expect("gains file");

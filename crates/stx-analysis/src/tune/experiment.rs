@@ -12,7 +12,8 @@ use stx_gnc::control::{ControlGains, Localizer};
 use stx_gnc::estimate::Estimate;
 use stx_gnc::guidance::{Guidance, GuidanceConfig, Plan};
 use stx_gnc::mission::FlightMode;
-use stx_sim::closed_loop::{GuidedFlight, PerfectNavigation, truth_estimate};
+use stx_sim::closed_loop::{GuidedFlight, Navigator, PerfectNavigation, truth_estimate};
+use stx_sim::dispersions::ServoErrors;
 use stx_sim::guided::{CONTROL_PERIOD_S, STEP_S};
 
 use super::controller::Controller;
@@ -108,11 +109,18 @@ impl Experiment {
     }
 
     fn guidance(&self, gains: &ControlGains, plan: Plan) -> Guidance {
+        self.guidance_learning(gains, plan, false)
+    }
+
+    /// Guidance with `gains` on `plan`, learning in flight if `learn`.
+    fn guidance_learning(&self, gains: &ControlGains, plan: Plan, learn: bool) -> Guidance {
         let mut config = self.base;
         config.gains = *gains;
-        // The step experiments judge the laws themselves: learning a trim from a step's
-        // transient would be judging something else.
-        config.freeze_learning = true;
+        // The step experiments on the models judge the laws themselves: learning a trim from
+        // a step's transient would be judging something else. On a dispersed stack with real
+        // sensors the learning is part of the loop the drone flies (a servo's offset makes
+        // the proportional laws miss by degrees until the trim is learned).
+        config.freeze_learning = !learn;
         let mut g = Guidance::new(config);
         g.set_plan(plan, 0.0);
         g.set_mode(self.mode, 0.0);
@@ -267,30 +275,65 @@ impl Experiment {
 
     /// The step response of the nonlinear model with `gains` (perfect navigation).
     pub fn nonlinear_response(&self, gains: &ControlGains) -> Result<StepResponse, TuneError> {
+        self.flown_response(gains, PerfectNavigation, ServoErrors::default(), 0.0, false)
+    }
+
+    /// The step response of the nonlinear model with `gains`, guidance fed by `navigator`
+    /// and commanding through `servos`, learning in flight if `learn`: first `settle_s`
+    /// seconds on the reference (an estimator needs them to converge, the learning to learn
+    /// the trim), then the step. The response is what guidance
+    /// controls, the estimate (a heading bias moves the truth off the reference whatever
+    /// the gains); times count from the step.
+    pub fn flown_response<N: Navigator>(
+        &self,
+        gains: &ControlGains,
+        navigator: N,
+        servos: ServoErrors,
+        settle_s: f64,
+        learn: bool,
+    ) -> Result<StepResponse, TuneError> {
         let model = ParafoilModel::new(self.vehicle.clone(), calm_environment());
+        let settling = settle_s > 0.0;
+        let first_plan = if settling {
+            self.plan_on_reference()
+        } else {
+            self.plan
+        };
         let mut flight = GuidedFlight::new(
             model,
             self.linear.trim.state,
             0.0,
-            self.guidance(gains, self.plan),
-            PerfectNavigation,
+            self.guidance_learning(gains, first_plan, learn),
+            navigator,
             STEP_S,
             CONTROL_PERIOD_S,
         );
+        flight.servos = servos;
+        let landed = |_| {
+            TuneError::Nonlinear("the stack reached the ground during the step: trim higher".into())
+        };
+        let fly = |flight: &mut GuidedFlight<N>| -> Result<(), TuneError> {
+            match flight
+                .advance()
+                .map_err(|e| TuneError::Nonlinear(e.to_string()))?
+            {
+                Some(t) => Err(landed(t)),
+                None => Ok(()),
+            }
+        };
+        while flight.time_s < settle_s - 1e-9 {
+            fly(&mut flight)?;
+        }
+        if settling {
+            flight.guidance.set_plan(self.plan, flight.time_s);
+        }
         let (periods, mut r) = self.empty_response();
         for _ in 0..periods {
-            let landed = flight
-                .advance()
-                .map_err(|e| TuneError::Nonlinear(e.to_string()))?;
+            fly(&mut flight)?;
             if let Some(est) = flight.estimate {
-                r.time_s.push(est.time_s);
+                r.time_s.push(est.time_s - settle_s);
                 r.output.push(self.response(&est));
                 r.command.push(self.command_of(&flight.model.controls()));
-            }
-            if landed.is_some() {
-                return Err(TuneError::Nonlinear(
-                    "the stack reached the ground during the step: trim higher".into(),
-                ));
             }
         }
         Ok(r)
@@ -337,7 +380,8 @@ impl Experiment {
         eigenvalues(&a_cl)
     }
 
-    fn plan_on_reference(&self) -> Plan {
+    /// The plan with the step removed: the vehicle starts on its reference.
+    pub(super) fn plan_on_reference(&self) -> Plan {
         let mut plan = self.plan;
         match self.controller {
             Controller::Heading => plan.heading_rad = 0.0,

@@ -9,8 +9,12 @@
 //!   canopy's heading and heading rate, turned into an estimate the way the simulator's
 //!   perfect navigation does. The laws, their phases and their saturation are not linearised.
 //! - *nonlinear*: `stx-sim`'s [`GuidedFlight`](stx_sim::closed_loop::GuidedFlight) flies the
-//!   31-state model from the same trim with perfect navigation (what the control loop can do,
-//!   not what the estimator costs: the Monte Carlo measures that).
+//!   31-state model from the same trim with perfect navigation (what the control loop can do).
+//! - *sensed, dispersed* (optional, the default of `stx tune`): the same steps flown on stacks
+//!   drawn from a dispersion set, each with its own sensors, servo errors and trim, guidance
+//!   fed by the sensor models and the estimator after 60 s of settling and learning on the
+//!   reference ([`SensedSet`]). The last search is on this cost and adoption is judged on it:
+//!   the drone flies through the estimator on a canopy that is not the model.
 //!
 //! Each controller has one step experiment: a 30° heading or course change, a 6 m cross-track
 //! offset onto a localizer, or starting 5 m above a glide path (with brakes trimmed at the
@@ -26,7 +30,8 @@
 //! The parts: [`Controller`] says what each controller tunes and how it is stepped
 //! (`controller.rs`); [`metrics()`] and [`cost()`] judge a step response (`metrics.rs`); an
 //! [`Experiment`] flies one controller's step on the linear and the nonlinear model
-//! (`experiment.rs`); [`tune()`] drives the optimiser and compares the candidates
+//! (`experiment.rs`), and on a drawn stack through the estimator for the [`SensedSet`]
+//! (`sensed.rs`); [`tune()`] drives the optimiser and compares the candidates
 //! (`optimiser.rs`). [`forced_responses`] (the open-loop comparison of the linear and
 //! nonlinear models `stx analyze` draws) lives in [`crate::forced_response`] and is
 //! re-exported here for its older path.
@@ -35,9 +40,13 @@ mod controller;
 mod experiment;
 mod metrics;
 mod optimiser;
+mod sensed;
 
 pub use crate::forced_response::{ResponseSamples, forced_responses, perturbed};
 pub use controller::Controller;
 pub use experiment::{Experiment, TuneError};
 pub use metrics::{SETTLING_BAND, StepMetrics, StepResponse, cost, metrics};
-pub use optimiser::{Candidate, MAX_EVALUATIONS, Trial, TuneReport, round_significant, tune};
+pub use optimiser::{
+    Candidate, MAX_EVALUATIONS, MAX_SENSED_EVALUATIONS, Trial, TuneReport, round_significant, tune,
+};
+pub use sensed::{SETTLE_S, SensedCost, SensedSet, SensedSpec, SensedSummary};

@@ -1,7 +1,9 @@
 //! The optimiser's driver: Nelder–Mead on the logarithm of the gains over the linear closed
 //! loop's cost, from the current gains and from the seed's, then a restart from the better;
-//! the result rounded, flown on the nonlinear model beside the current and the seed's gains,
-//! and adopted only if it does better there.
+//! with a sensed, dispersed set ([`SensedSet`]), a last Nelder–Mead from there on that set's
+//! cost. The result is rounded, flown on the nonlinear model (and the sensed set) beside the
+//! current and the seed's gains, and adopted only if it does better there: on the sensed set
+//! when there is one, else on the nominal model with perfect navigation.
 
 use serde::Serialize;
 use stx_dynamics::vehicle::Vehicle;
@@ -11,6 +13,7 @@ use stx_gnc::guidance::GuidanceConfig;
 use super::controller::Controller;
 use super::experiment::{Experiment, TuneError};
 use super::metrics::{StepMetrics, StepResponse};
+use super::sensed::{SensedCost, SensedSet, SensedSummary};
 use crate::nelder_mead::{NelderMeadOptions, minimize};
 
 /// One experiment flown with one gain set.
@@ -63,8 +66,11 @@ pub struct Candidate {
     pub large: Trial,
     /// Mean of the two linear costs: what the optimiser minimised.
     pub linear_cost: f64,
-    /// Mean of the two nonlinear costs (None if a flight failed): what adoption is judged on.
+    /// Mean of the two nonlinear costs (None if a flight failed): what adoption is judged on
+    /// without a sensed set.
     pub nonlinear_cost: Option<f64>,
+    /// The cost on the sensed, dispersed set, when tuned with one: what adoption is judged on.
+    pub sensed: Option<SensedCost>,
     /// Largest real part of the closed-loop eigenvalues other than the invariances, s⁻¹.
     pub closed_loop_max_real_part: f64,
     /// The closed-loop eigenvalues `[re, im]`.
@@ -92,6 +98,8 @@ pub struct TuneReport {
     pub tuned: Candidate,
     /// The seed's appendix A.13 gains.
     pub seed: Candidate,
+    /// The sensed, dispersed set tuned and judged on, if any.
+    pub sensed_set: Option<SensedSummary>,
     /// Cost evaluations of the optimiser, over its three runs.
     pub evaluations: usize,
     /// Whether the run that gave the result met its tolerance.
@@ -115,17 +123,21 @@ pub fn round_significant(v: f64, digits: i32) -> f64 {
 
 /// Cost evaluations of each optimiser run.
 pub const MAX_EVALUATIONS: usize = 120;
+/// Cost evaluations of the last run on the sensed set (each flies every draw's two steps).
+pub const MAX_SENSED_EVALUATIONS: usize = 30;
 
-/// Tunes `controller` starting from `current` (its other gains are kept), checks the result
-/// on the nonlinear model, and compares with the seed's. `progress(done, total)` is called as
-/// the optimiser and the checks proceed.
+/// Tunes `controller` starting from `current` (its other gains are kept), last on `sensed`
+/// if given, checks the result on the nonlinear model (and `sensed`), and compares with the
+/// seed's. `progress(done, total)` is called as the optimiser and the checks proceed.
 pub fn tune(
     controller: Controller,
     vehicle: &Vehicle,
     altitude_m: f64,
     base: GuidanceConfig,
+    sensed: Option<&SensedSet>,
     mut progress: impl FnMut(usize, usize),
 ) -> Result<TuneReport, TuneError> {
+    let sensed = sensed.filter(|set| !set.is_empty());
     let current = base.gains;
     let small = Experiment::new(controller, vehicle, altitude_m, base, controller.step())?;
     let large = Experiment::new(
@@ -156,7 +168,12 @@ pub fn tune(
         .zip(&anchor)
         .map(|(g, a)| (g.max(1e-6) / a).ln())
         .collect();
-    let total = 3 * MAX_EVALUATIONS + 10;
+    let sensed_evaluations = if sensed.is_some() {
+        MAX_SENSED_EVALUATIONS
+    } else {
+        0
+    };
+    let total = 3 * MAX_EVALUATIONS + sensed_evaluations + 10;
     let mut used = 0usize;
     let mut run = |from: &[f64], used_before: usize| {
         minimize(
@@ -182,11 +199,31 @@ pub fn tune(
     };
     let restarted = run(&better.x, used);
     used += restarted.evaluations;
-    let minimum = if restarted.cost <= better.cost {
+    let mut minimum = if restarted.cost <= better.cost {
         restarted
     } else {
         better
     };
+    if let Some(set) = sensed {
+        // The linear optimum is the start; the sensed cost has the last word.
+        let start_cost = set.cost(&gains_at(&minimum.x)).mean;
+        let used_before = used;
+        let on_sensed = minimize(
+            |p| set.cost(&gains_at(p)).mean,
+            &minimum.x,
+            &NelderMeadOptions {
+                initial_step: 0.3,
+                cost_tolerance: 1e-3,
+                position_tolerance: 0.02,
+                max_evaluations: MAX_SENSED_EVALUATIONS,
+            },
+            |n| progress(used_before + n.min(MAX_SENSED_EVALUATIONS), total),
+        );
+        used += on_sensed.evaluations;
+        if on_sensed.cost < start_cost {
+            minimum = on_sensed;
+        }
+    }
     // Three significant figures: what a person can read and type, and well inside the
     // optimum's flat bottom.
     let rounded: Vec<f64> = controller
@@ -214,6 +251,7 @@ pub fn tune(
             values: controller.get(&g),
             linear_cost: 0.5 * (small_trial.linear.cost + large_trial.linear.cost),
             nonlinear_cost,
+            sensed: sensed.map(|set| set.cost(&g)),
             small: small_trial,
             large: large_trial,
             closed_loop_max_real_part: max_real,
@@ -226,24 +264,31 @@ pub fn tune(
     progress(total - 3, total);
     let seed_c = candidate("seed A.13", controller.seed_gains(&current));
     progress(total, total);
-    let nonlinear_cost = |c: &Candidate| c.nonlinear_cost.unwrap_or(f64::INFINITY);
-    let (adopted, verdict) = if nonlinear_cost(&tuned_c) < nonlinear_cost(&current_c) {
+    // Judged on the sensed set when there is one: that is the system the drone flies.
+    let (judged, judged_cost): (&str, fn(&Candidate) -> f64) = if sensed.is_some() {
+        ("sensed, dispersed", |c| {
+            c.sensed.as_ref().map_or(f64::INFINITY, |s| s.mean)
+        })
+    } else {
+        ("nonlinear", |c| c.nonlinear_cost.unwrap_or(f64::INFINITY))
+    };
+    let (adopted, verdict) = if judged_cost(&tuned_c) < judged_cost(&current_c) {
         (
             true,
             format!(
-                "tuned gains lower the nonlinear cost from {:.3} to {:.3}",
-                nonlinear_cost(&current_c),
-                nonlinear_cost(&tuned_c)
+                "tuned gains lower the {judged} cost from {:.3} to {:.3}",
+                judged_cost(&current_c),
+                judged_cost(&tuned_c)
             ),
         )
     } else {
         (
             false,
             format!(
-                "tuned gains do not improve the nonlinear cost ({:.3} against {:.3} now): \
+                "tuned gains do not improve the {judged} cost ({:.3} against {:.3} now): \
                  current gains kept",
-                nonlinear_cost(&tuned_c),
-                nonlinear_cost(&current_c)
+                judged_cost(&tuned_c),
+                judged_cost(&current_c)
             ),
         )
     };
@@ -270,6 +315,7 @@ pub fn tune(
         current: current_c,
         tuned: tuned_c,
         seed: seed_c,
+        sensed_set: sensed.map(SensedSet::summary),
         evaluations: used,
         converged: minimum.converged,
         adopted,
@@ -280,6 +326,21 @@ pub fn tune(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Too much proportional gain and almost no damping: a lightly damped turn; the gains and
+    /// a guidance configuration flying them.
+    fn lightly_damped_heading() -> (ControlGains, GuidanceConfig) {
+        let bad = ControlGains {
+            hk1_m_per_rad: 0.04,
+            hk2_m_s_per_rad: 0.001,
+            ..ControlGains::default()
+        };
+        let base = GuidanceConfig {
+            gains: bad,
+            ..GuidanceConfig::default()
+        };
+        (bad, base)
+    }
 
     #[test]
     fn rounding_keeps_three_significant_figures() {
@@ -292,18 +353,9 @@ mod tests {
     #[test]
     fn tuning_the_heading_loop_from_bad_gains_lowers_its_cost_on_both_models() {
         let vehicle = Vehicle::straplex();
-        // Too much proportional gain and almost no damping: a lightly damped turn.
-        let bad = ControlGains {
-            hk1_m_per_rad: 0.04,
-            hk2_m_s_per_rad: 0.001,
-            ..ControlGains::default()
-        };
-        let base = GuidanceConfig {
-            gains: bad,
-            ..GuidanceConfig::default()
-        };
+        let (bad, base) = lightly_damped_heading();
         let mut calls = 0;
-        let report = tune(Controller::Heading, &vehicle, 600.0, base, |_, _| {
+        let report = tune(Controller::Heading, &vehicle, 600.0, base, None, |_, _| {
             calls += 1
         })
         .expect("tunes");
@@ -326,5 +378,55 @@ mod tests {
         let (lr, nr) = (l.rise_time_s.expect("rises"), n.rise_time_s.expect("rises"));
         assert!((lr - nr).abs() < 0.5, "{lr} vs {nr}");
         assert!((l.overshoot_pct - n.overshoot_pct).abs() < 3.0);
+    }
+
+    #[test]
+    fn with_a_sensed_set_the_gains_are_tuned_and_judged_on_dispersed_stacks_with_the_estimator() {
+        let vehicle = Vehicle::straplex();
+        let (bad, base) = lightly_damped_heading();
+        let spec = crate::tune::SensedSpec {
+            dispersions: stx_sim::dispersions::Dispersions::load("realistic").expect("set"),
+            sensors: stx_sim::sensors::SensorConfig::default(),
+            count: 2,
+            seed: 7,
+        };
+        let set = SensedSet::draw(Controller::Heading, &vehicle, 600.0, base, &spec);
+        assert_eq!(set.len() + set.excluded.len(), 2);
+        assert!(!set.is_empty(), "{:?}", set.excluded);
+        let report = tune(
+            Controller::Heading,
+            &vehicle,
+            600.0,
+            base,
+            Some(&set),
+            |_, _| {},
+        )
+        .expect("tunes");
+        let sensed = |c: &Candidate| c.sensed.as_ref().expect("judged on the set").mean;
+        // The lightly damped gains turn worse on the dispersed stacks too, and the tuned ones
+        // are adopted on that judgement.
+        assert!(report.adopted, "{}", report.verdict);
+        assert!(
+            report.verdict.contains("sensed, dispersed"),
+            "{}",
+            report.verdict
+        );
+        assert!(
+            sensed(&report.tuned) < sensed(&report.current),
+            "{} against {}",
+            sensed(&report.tuned),
+            sensed(&report.current)
+        );
+        // The set's costs are not the perfect-navigation model's: the estimator and the
+        // dispersed stacks are in the loop.
+        let perfect = report.tuned.nonlinear_cost.expect("flies");
+        assert!((sensed(&report.tuned) - perfect).abs() > 1e-3);
+        assert!(report.evaluations > 3 * MAX_EVALUATIONS.min(10));
+        assert_eq!(
+            report.sensed_set.as_ref().map(|s| s.draws.len()),
+            Some(set.len())
+        );
+        // Deterministic: the same set gives the same cost.
+        assert_eq!(set.cost(&bad).mean, set.cost(&bad).mean);
     }
 }

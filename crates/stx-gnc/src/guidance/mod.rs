@@ -60,6 +60,8 @@ pub struct Guidance {
     trim: trim::MainLineTrim,
     /// Main line sent at the last update, trim included, m.
     last_main_line_m: f64,
+    /// The side of a heading, course or localizer turn from nearly behind.
+    turn_latch: control::TurnLatch,
 }
 
 impl Guidance {
@@ -74,6 +76,7 @@ impl Guidance {
             law_phases: None,
             trim: trim::MainLineTrim::default(),
             last_main_line_m: 0.0,
+            turn_latch: control::TurnLatch::default(),
         }
     }
 
@@ -205,12 +208,14 @@ impl Guidance {
             FlightMode::Uncontrolled | FlightMode::Manual => neutral,
             FlightMode::Heading => main_line(control::heading(
                 g,
+                &mut self.turn_latch,
                 est.heading_rad,
                 est.heading_rate_rad_s,
                 self.plan.heading_rad,
             )),
             FlightMode::Course => main_line(control::course(
                 g,
+                &mut self.turn_latch,
                 est.course_rad,
                 est.heading_rate_rad_s,
                 self.plan.course_rad,
@@ -218,6 +223,7 @@ impl Guidance {
             FlightMode::Localizer => {
                 let horizontal = control::localizer(
                     g,
+                    &mut self.turn_latch,
                     &self.plan.localizer,
                     position,
                     est.course_rad,

@@ -17,6 +17,8 @@ pub(super) struct Energy {
     pub(super) s0: f64,
     /// Sink rate with the brakes at their trim, m/s.
     st: f64,
+    /// Horizontal airspeed with the brakes at their trim, m/s.
+    vt: f64,
     /// Turn rate the corners are planned with, rad/s.
     pub(super) turn_rate_rad_s: f64,
     /// Height a 90° corner costs beyond straight flight, m.
@@ -63,6 +65,7 @@ impl Energy {
             v0,
             s0,
             st,
+            vt,
             turn_rate_rad_s,
             turn_loss,
             g_down: v0 + w_along,
@@ -93,9 +96,113 @@ impl Energy {
         self.needed_from(x_entry, y) + self.s0 * (x_entry - x) / self.g_down
     }
 
+    /// Ground speed flying straight towards `(dx, dy)` (wind frame) with the brakes released
+    /// in a wind of `w` m/s along the axis, m/s.
+    fn ground_speed_towards(&self, dx: f64, dy: f64, w: f64) -> f64 {
+        let d = dx.hypot(dy);
+        // The air velocity plus the wind lies along the way: g² − 2g(w·d) + w² = v0².
+        let along = if d < 1e-9 { 0.0 } else { w * dx / d };
+        (along + (along * along - w * w + self.v0 * self.v0).max(0.0).sqrt()).max(0.3)
+    }
+
+    /// Height needed to fly straight from (x, y) to the final line at `join_x` (m downwind
+    /// of the target) and glide in from there, with `extra_headwind_mps` more wind than
+    /// planned, m.
+    pub(super) fn needed_via(&self, x: f64, y: f64, join_x: f64, extra_headwind_mps: f64) -> f64 {
+        let w = self.wind_along_planned_mps + extra_headwind_mps;
+        let (dx, dy) = (join_x - x, -y);
+        self.hang_height_m
+            + self.s0 * dx.hypot(dy) / self.ground_speed_towards(dx, dy, w)
+            + self.st * join_x.max(0.0) / (self.vt - w).max(0.3)
+            + 2.0 * self.turn_loss
+            + self.final_margin_m
+    }
+
+    /// Where a base leg from (x, y) should meet the final line, m downwind of the target,
+    /// with `height` m of height: straight across (`x`) if the height covers it even with
+    /// `extra_headwind_mps` more wind than planned; else the longest final it covers flown
+    /// to diagonally, or, if none, the one needing least.
+    ///
+    /// Into a strong headwind a base leg straight across gains nothing upwind while the
+    /// height goes, and the final's glide over the ground, airspeed less headwind, is most
+    /// sensitive to the wind's error: 4 m/s against a 6 m/s airspeed, across and then up a
+    /// 290 m final took about 100 m more height than the diagonal to a short final, and the
+    /// final fell 33 m short (seed 2, run 131).
+    pub(super) fn base_join_x(&self, x: f64, y: f64, height: f64, extra_headwind_mps: f64) -> f64 {
+        const STEPS: usize = 40;
+        let shortest = self.min_final_m.min(x);
+        let mut cheapest = (x, f64::INFINITY);
+        for k in 0..=STEPS {
+            let join_x = x - (x - shortest) * k as f64 / STEPS as f64;
+            let needed = self.needed_via(x, y, join_x, extra_headwind_mps);
+            if needed <= height {
+                return join_x;
+            }
+            if needed < cheapest.1 {
+                cheapest = (join_x, needed);
+            }
+        }
+        cheapest.0
+    }
+
     /// Height one loop of a pattern `2ax` × `2ay` takes, m.
     pub(super) fn loop_loss(&self, ax: f64, ay: f64) -> f64 {
         self.s0 * (2.0 * ay / self.g_cross * 2.0 + 2.0 * ax / self.g_up0 + 2.0 * ax / self.g_down)
             + 4.0 * self.turn_loss
     }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The sums of the default canopy at sea level into a 4 m/s headwind on the final.
+    fn into_a_strong_headwind() -> Energy {
+        let perf = GlidePerformance::default();
+        Energy::plan(
+            &SpiralConfig::default(),
+            &perf,
+            0.5,
+            perf.reference_density_kg_per_m3,
+            4.0,
+            0.3,
+        )
+    }
+
+    #[test]
+    fn a_base_leg_goes_straight_across_when_its_height_covers_the_whole_final() {
+        let e = into_a_strong_headwind();
+        let (x, y) = (250.0, 60.0);
+        let across = e.needed_via(x, y, x, WIND_MARGIN);
+        assert_eq!(e.base_join_x(x, y, across + 1.0, WIND_MARGIN), x);
+    }
+
+    #[test]
+    fn a_base_leg_too_low_for_the_whole_final_joins_a_shorter_one_diagonally() {
+        let e = into_a_strong_headwind();
+        let (x, y) = (250.0, 60.0);
+        let across = e.needed_via(x, y, x, WIND_MARGIN);
+        // Into the wind the diagonal to a short final costs less height than across and up.
+        let shortest = e.needed_via(x, y, e.min_final_m, WIND_MARGIN);
+        assert!(shortest < across - 10.0, "{shortest} vs {across}");
+        let height = 0.5 * (shortest + across);
+        let join = e.base_join_x(x, y, height, WIND_MARGIN);
+        assert!(join < x && join >= e.min_final_m, "{join}");
+        // The longest final the height reaches: its need is within the height, and a final
+        // a step (5 m) longer would need more.
+        assert!(e.needed_via(x, y, join, WIND_MARGIN) <= height);
+        assert!(e.needed_via(x, y, join + 6.0, WIND_MARGIN) > height);
+        // With no final in reach the cheapest is taken.
+        let lowest = e.base_join_x(x, y, 0.0, WIND_MARGIN);
+        let cheapest = e.needed_via(x, y, lowest, WIND_MARGIN);
+        assert!(cheapest <= shortest + 1e-9 && cheapest <= across);
+    }
+
+    #[test]
+    fn a_stronger_headwind_than_planned_needs_more_height_for_the_same_final() {
+        let e = into_a_strong_headwind();
+        assert!(e.needed_via(250.0, 60.0, 150.0, 0.3) > e.needed_via(250.0, 60.0, 150.0, 0.0));
+    }
+
+    const WIND_MARGIN: f64 = 0.3;
 }

@@ -9,7 +9,7 @@ use stx_dynamics::state::Controls;
 use super::config::{FinalLaw, SpiralConfig};
 use super::energy::Energy;
 use super::pattern::WindFrame;
-use crate::control::{self, GlidePath, Localizer};
+use crate::control::{self, GlidePath, Localizer, TurnLatch};
 use crate::estimate::Estimate;
 use crate::guidance::config::GuidanceConfig;
 use crate::performance::GlidePerformance;
@@ -111,6 +111,8 @@ pub(super) struct FinalApproach {
     glide_correction: f64,
     /// Estimate time of the last update on final, s.
     last_time_s: Option<f64>,
+    /// The side of a turn onto the final's line from nearly behind.
+    turn_latch: TurnLatch,
 }
 
 impl Default for FinalApproach {
@@ -121,6 +123,7 @@ impl Default for FinalApproach {
             slope: None,
             glide_correction: 0.0,
             last_time_s: None,
+            turn_latch: TurnLatch::default(),
         }
     }
 }
@@ -230,12 +233,13 @@ impl FinalApproach {
             let offset = if self.weave_right { 1.0 } else { -1.0 } * S_TURN_ANGLE_RAD;
             control::course(
                 gains,
+                &mut self.turn_latch,
                 est.course_rad,
                 est.heading_rate_rad_s,
                 final_course + offset,
             )
         } else {
-            follow(config, &final_line, est, position)
+            follow(config, &mut self.turn_latch, &final_line, est, position)
         };
         Controls {
             main_line_m,
@@ -246,13 +250,14 @@ impl FinalApproach {
 
     /// The flare: full brakes, still on the final line.
     pub(super) fn flare(
+        &mut self,
         config: &GuidanceConfig,
         geometry: &FinalGeometry,
         est: &Estimate,
         position: [f64; 2],
     ) -> Controls {
         Controls {
-            main_line_m: follow(config, &geometry.line, est, position),
+            main_line_m: follow(config, &mut self.turn_latch, &geometry.line, est, position),
             brake_right: 1.0,
             brake_left: 1.0,
         }
@@ -314,9 +319,16 @@ fn aim_beyond_m(
 }
 
 /// The main line that follows `line` (localizer control).
-fn follow(config: &GuidanceConfig, line: &Localizer, est: &Estimate, position: [f64; 2]) -> f64 {
+fn follow(
+    config: &GuidanceConfig,
+    latch: &mut TurnLatch,
+    line: &Localizer,
+    est: &Estimate,
+    position: [f64; 2],
+) -> f64 {
     control::localizer(
         &config.gains,
+        latch,
         line,
         position,
         est.course_rad,

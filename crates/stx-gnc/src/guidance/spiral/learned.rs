@@ -1,15 +1,15 @@
 //! What guidance learns in flight of how this stack glides: its horizontal airspeed and sink
-//! rate against the polar it was given, so that every plan (reach, pattern, final) is made
-//! with the glide the real canopy flies, not the model's.
+//! rate against the polar it was given, and how the brakes change them, so that every plan
+//! (reach, pattern, final) is made with the glide the real canopy flies, not the model's.
 //!
-//! A real canopy differs from any model by 10–30 % in its coefficients; a 20 % smaller lift
-//! slope turns a 1.7 m landing into 19 m when guidance plans with the model's polar. Two scale
-//! factors are learned, one on the polar's horizontal airspeed and one on its sink rate (the
-//! shape of the polar over the brake is kept), from straight flight with the brakes held:
-//! airspeed as the estimator's ground velocity less its wind, sink as its sink rate. Measured
-//! this way the airspeed carries the wind estimate's error along the track, which is what
-//! planning over the ground needs: flown into the wind, speed over the ground is then what
-//! the learned airspeed less the estimated wind predicts.
+//! A real canopy differs from any model by 10–30 % in its coefficients (more in its brake
+//! terms); a 20 % smaller lift slope turns a 1.7 m landing into 19 m when guidance plans with
+//! the model's polar. Two scale factors are learned, one on the polar's horizontal airspeed
+//! and one on its sink rate, each linear in the brake ([`BrakeScale`]): from straight flight
+//! with the brakes held, airspeed as the estimator's ground velocity less its wind, sink as
+//! its sink rate. Measured this way the airspeed carries the wind estimate's error along the
+//! track, which is what planning over the ground needs: flown into the wind, speed over the
+//! ground is then what the learned airspeed less the estimated wind predicts.
 
 use crate::estimate::Estimate;
 use crate::performance::{BRAKE_POINTS, GlidePerformance};
@@ -26,16 +26,65 @@ const BRAKE_HELD: f64 = 0.02;
 const MAX_TURN_RAD_S: f64 = 0.1;
 /// Sink rate below which nothing is learned (a flare, a thermal), m/s.
 const MIN_SINK_MPS: f64 = 1.0;
-/// Samples whose ratio to the polar is outside these bounds are not learned from.
+/// Samples whose ratio to the polar is outside these bounds are not learned from, and the
+/// learned scales stay within them.
 const SCALE_LIMITS: [f64; 2] = [0.6, 1.6];
+/// Weight of the prior "as the polar says" (scale 1), in seconds of samples: small, so that
+/// the first samples count, but enough to hold the scales before any.
+const PRIOR_S: f64 = 0.5;
+/// Weight of the prior "the brakes do what the polar says" (no slope of the scale over the
+/// brake), in seconds of samples per unit brake squared: a slope is learned only from
+/// samples at brake settings well apart, not from the scatter at one setting.
+const PRIOR_SLOPE_S: f64 = 0.3;
+
+/// A scale factor linear in the brake, `a + b·(brake − c)` about the samples' mean brake `c`,
+/// fitted by least squares to the samples with exponential forgetting, about the prior
+/// `a = 1, b = 0`. Flown at one brake setting (most of a flight) it learns `a` there and
+/// applies it at every setting; flown at two, it also learns how the brakes differ from the
+/// polar. (About the mean brake the two are fitted apart: the slope's prior does not hold
+/// back the level learned.)
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+struct BrakeScale {
+    /// Forgotten sums of weight, weight × brake, weight × brake².
+    moments: [f64; 3],
+    /// Forgotten sums of weight × ratio and weight × brake × ratio.
+    rhs: [f64; 2],
+}
+
+impl BrakeScale {
+    /// Adds a sample `ratio` at `brake` of weight `dt`, the earlier ones forgotten by `keep`.
+    fn add(&mut self, brake: f64, ratio: f64, dt: f64, keep: f64) {
+        let [m0, m1, m2] = self.moments;
+        self.moments = [
+            keep * m0 + dt,
+            keep * m1 + dt * brake,
+            keep * m2 + dt * brake * brake,
+        ];
+        self.rhs = [
+            keep * self.rhs[0] + dt * ratio,
+            keep * self.rhs[1] + dt * brake * ratio,
+        ];
+    }
+
+    /// The scale at `brake`.
+    fn at(&self, brake: f64) -> f64 {
+        let [m0, m1, m2] = self.moments;
+        let [r0, r1] = self.rhs;
+        let mean_brake = if m0 > 0.0 { m1 / m0 } else { 0.0 };
+        let level = (r0 + PRIOR_S) / (m0 + PRIOR_S);
+        let spread = (m2 - mean_brake * m1).max(0.0);
+        let slope = (r1 - mean_brake * r0) / (spread + PRIOR_SLOPE_S);
+        (level + slope * (brake - mean_brake)).clamp(SCALE_LIMITS[0], SCALE_LIMITS[1])
+    }
+}
 
 /// The learned scales and what learning them needs to remember.
 #[derive(Debug, Clone, Copy)]
 pub struct LearnedGlide {
     /// Horizontal airspeed flown over the polar's.
-    pub airspeed_scale: f64,
+    airspeed: BrakeScale,
     /// Sink rate flown over the polar's.
-    pub sink_scale: f64,
+    sink: BrakeScale,
     /// Seconds of straight, steady flight learned from.
     pub learned_s: f64,
     last_time_s: Option<f64>,
@@ -46,8 +95,8 @@ pub struct LearnedGlide {
 impl Default for LearnedGlide {
     fn default() -> Self {
         Self {
-            airspeed_scale: 1.0,
-            sink_scale: 1.0,
+            airspeed: BrakeScale::default(),
+            sink: BrakeScale::default(),
             learned_s: 0.0,
             last_time_s: None,
             held_brake: f64::NAN,
@@ -95,21 +144,34 @@ impl LearnedGlide {
             return;
         }
         // A plain average at first, then a moving one.
-        let gain = dt / (self.learned_s + dt).min(LEARN_TIME_S);
-        self.airspeed_scale += gain * (airspeed_ratio - self.airspeed_scale);
-        self.sink_scale += gain * (sink_ratio - self.sink_scale);
+        let keep = (-dt / LEARN_TIME_S).exp();
+        self.airspeed.add(brake, airspeed_ratio, dt, keep);
+        self.sink.add(brake, sink_ratio, dt, keep);
         self.learned_s += dt;
     }
 
+    /// Horizontal airspeed flown over the polar's at `brake`.
+    #[cfg(test)]
+    fn airspeed_scale(&self, brake: f64) -> f64 {
+        self.airspeed.at(brake)
+    }
+
+    /// Sink rate flown over the polar's at `brake`.
+    #[cfg(test)]
+    fn sink_scale(&self, brake: f64) -> f64 {
+        self.sink.at(brake)
+    }
+
     /// The polar `perf` with the learned scales: horizontal airspeed and sink rate scaled at
-    /// every brake setting.
+    /// every brake setting by the scale learned for it.
     pub fn performance(&self, perf: &GlidePerformance) -> GlidePerformance {
         if self.learned_s == 0.0 {
             return *perf;
         }
-        let (airspeed_scale, sink_scale) = (self.airspeed_scale, self.sink_scale);
         let mut learned = *perf;
         for k in 0..BRAKE_POINTS {
+            let brake = perf.brake_points[k];
+            let (airspeed_scale, sink_scale) = (self.airspeed.at(brake), self.sink.at(brake));
             let (v, s) = (perf.airspeed_mps[k], perf.sink_rate_mps[k]);
             let horizontal = (v * v - s * s).max(0.0).sqrt() * airspeed_scale;
             let sink = s * sink_scale;
@@ -128,46 +190,74 @@ mod tests {
     use crate::pointmass::{Conditions, PointMass};
     use stx_dynamics::state::Controls;
 
-    /// A point mass sinking `sink_scale` times the polar's flown for `seconds` with the brakes
-    /// at `brake` (turning if `turning`) in a 3 m/s wind; what was learned.
-    fn learn(sink_scale: f64, brake: f64, turning: bool, seconds: usize) -> LearnedGlide {
+    /// A point mass flying legs of (sink scale against the polar, brake, seconds), turning
+    /// if `turning`, in a 3 m/s wind; what was learned.
+    fn learn_legs(legs: &[(f64, f64, usize)], turning: bool) -> LearnedGlide {
         let perf = GlidePerformance::default();
         let wind = Vector3::new(-3.0, 1.0, 0.0);
-        let air = Conditions {
-            sink_scale,
-            ..Conditions::nominal(wind, perf.reference_density_kg_per_m3)
-        };
         let mut stack = PointMass::new(0.0, Vector3::new(0.0, 0.0, -800.0), 0.3);
-        let controls = Controls {
-            main_line_m: if turning { 0.02 } else { 0.0 },
-            brake_right: brake,
-            brake_left: brake,
-        };
         let mut learned = LearnedGlide::default();
-        for _ in 0..seconds * 4 {
-            for _ in 0..5 {
-                stack.step(&perf, &controls, &air, 0.05);
+        for &(sink_scale, brake, seconds) in legs {
+            let air = Conditions {
+                sink_scale,
+                ..Conditions::nominal(wind, perf.reference_density_kg_per_m3)
+            };
+            let controls = Controls {
+                main_line_m: if turning { 0.02 } else { 0.0 },
+                brake_right: brake,
+                brake_left: brake,
+            };
+            for _ in 0..seconds * 4 {
+                for _ in 0..5 {
+                    stack.step(&perf, &controls, &air, 0.05);
+                }
+                let est = stack.estimate(&wind);
+                learned.update(&perf, &est, brake, air.density_kg_per_m3);
             }
-            let est = stack.estimate(&wind);
-            learned.update(&perf, &est, brake, air.density_kg_per_m3);
         }
         learned
+    }
+
+    fn learn(sink_scale: f64, brake: f64, turning: bool, seconds: usize) -> LearnedGlide {
+        learn_legs(&[(sink_scale, brake, seconds)], turning)
     }
 
     #[test]
     fn a_stack_that_sinks_faster_than_its_polar_is_learned_in_straight_flight() {
         let nominal = learn(1.0, 0.0, false, 60);
-        assert!((nominal.sink_scale - 1.0).abs() < 0.01, "{nominal:?}");
-        assert!((nominal.airspeed_scale - 1.0).abs() < 0.01, "{nominal:?}");
+        assert!((nominal.sink_scale(0.0) - 1.0).abs() < 0.01, "{nominal:?}");
+        assert!(
+            (nominal.airspeed_scale(0.0) - 1.0).abs() < 0.01,
+            "{nominal:?}"
+        );
         let heavy = learn(1.2, 0.4, false, 60);
-        assert!((heavy.sink_scale - 1.2).abs() < 0.01, "{heavy:?}");
+        assert!((heavy.sink_scale(0.4) - 1.2).abs() < 0.01, "{heavy:?}");
+        // Learned at one brake setting, the others are assumed to scale alike.
+        assert!((heavy.sink_scale(0.0) - 1.2).abs() < 0.02, "{heavy:?}");
         let perf = GlidePerformance::default();
         let rho = perf.reference_density_kg_per_m3;
         let learned = heavy.performance(&perf);
         let planned = learned.sink_rate(0.4, 0.0, rho) / perf.sink_rate(0.4, 0.0, rho);
-        assert!((planned - heavy.sink_scale).abs() < 1e-9, "{planned}");
+        assert!((planned - heavy.sink_scale(0.4)).abs() < 1e-9, "{planned}");
         let planned = learned.horizontal_airspeed(0.0, rho) / perf.horizontal_airspeed(0.0, rho);
-        assert!((planned - heavy.airspeed_scale).abs() < 1e-9, "{planned}");
+        assert!(
+            (planned - heavy.airspeed_scale(0.0)).abs() < 1e-9,
+            "{planned}"
+        );
+    }
+
+    #[test]
+    fn brakes_that_sink_more_than_the_polar_says_are_learned_from_two_settings() {
+        // The polar is right with the brakes released, and 30 % short of the sink at 0.6.
+        let learned = learn_legs(&[(1.0, 0.0, 40), (1.3, 0.6, 40)], false);
+        assert!((learned.sink_scale(0.0) - 1.0).abs() < 0.05, "{learned:?}");
+        assert!((learned.sink_scale(0.6) - 1.3).abs() < 0.03, "{learned:?}");
+        // Between and beyond, the line through them.
+        assert!((learned.sink_scale(0.3) - 1.15).abs() < 0.04, "{learned:?}");
+        let perf = GlidePerformance::default();
+        let rho = perf.reference_density_kg_per_m3;
+        let planned = learned.performance(&perf).sink_rate(0.6, 0.0, rho);
+        assert!((planned / perf.sink_rate(0.6, 0.0, rho) - learned.sink_scale(0.6)).abs() < 1e-9);
     }
 
     #[test]

@@ -58,7 +58,8 @@
 //! and whether it is known (`wind.rs`), the pattern's axis, frame and scaled branches
 //! (`pattern.rs`), the energy sums (`energy.rs`) with the corner turn rate of the gains in
 //! force (`turn_rate.rs`), the glide's reach (`reach.rs`) and the final approach's geometry
-//! (`final_approach.rs`), all with the glide learned so far in flight (`learned.rs`). The
+//! (`final_approach.rs`), all with the glide learned so far in flight (`learned.rs`) and the
+//! turn rate (`learned_turn.rs`). The
 //! phase machine (`phases.rs`) then takes at most one decision on
 //! it, and the steering (`steering.rs`) flies the phase it leaves the vehicle in; the final
 //! approach's brakes, S-turns and flare are in `final_approach.rs`. The settings are in
@@ -69,6 +70,7 @@ pub(super) mod config;
 mod energy;
 mod final_approach;
 mod learned;
+mod learned_turn;
 mod pattern;
 mod phases;
 mod reach;
@@ -86,6 +88,7 @@ use stx_dynamics::state::Controls;
 use self::energy::Energy;
 use self::final_approach::{FinalApproach, FinalGeometry};
 use self::learned::LearnedGlide;
+use self::learned_turn::LearnedTurn;
 use self::pattern::{Axis, Pattern, WindFrame};
 use self::phases::{Change, PhaseMachine};
 use self::reach::{Announcement, Reach};
@@ -93,6 +96,7 @@ use self::situation::Situation;
 use self::steering::steer;
 use self::turn_rate::CornerRate;
 use self::wind::PlanningWind;
+use crate::control::TurnLatch;
 use crate::estimate::Estimate;
 use crate::guidance::config::GuidanceConfig;
 use crate::guidance::plan::Plan;
@@ -144,8 +148,14 @@ pub struct Spiral {
     announced: Announcement,
     /// The glide learned in flight, which every plan is made with.
     glide: LearnedGlide,
+    /// The turn rate learned in flight, which the corners are planned with.
+    turn: LearnedTurn,
     /// Symmetric brake of the last commands, 0…1.
     last_brake: f64,
+    /// Main line of the last commands, m.
+    last_main_line_m: f64,
+    /// The side of a turn from nearly behind, on the branches and towards a best point.
+    turn_latch: TurnLatch,
     status: SpiralStatus,
 }
 
@@ -160,7 +170,10 @@ impl Spiral {
             final_approach: FinalApproach::default(),
             announced: Announcement::default(),
             glide: LearnedGlide::default(),
+            turn: LearnedTurn::default(),
             last_brake: 0.0,
+            last_main_line_m: 0.0,
+            turn_latch: TurnLatch::default(),
             status: SpiralStatus::default(),
         }
     }
@@ -191,9 +204,13 @@ impl Spiral {
         if !config.freeze_learning {
             self.glide
                 .update(&config.performance, est, self.last_brake, density);
+            self.turn
+                .update(&config.performance, est, self.last_main_line_m);
         }
         let learned = GuidanceConfig {
-            performance: self.glide.performance(&config.performance),
+            performance: self
+                .turn
+                .performance(&self.glide.performance(&config.performance)),
             ..*config
         };
         let config = &learned;
@@ -208,9 +225,11 @@ impl Spiral {
             &situation,
             est,
             density,
+            &mut self.turn_latch,
         );
 
         self.last_brake = 0.5 * (controls.brake_left + controls.brake_right);
+        self.last_main_line_m = controls.main_line_m;
         let phase = self.machine.phase;
         if phase != GuidancePhase::FinalApproach {
             self.final_approach.end();
@@ -305,12 +324,16 @@ impl Spiral {
     fn report(&self, s: &Situation) -> SpiralStatus {
         let p = &s.pattern;
         let base_x = self.machine.base_x_m.unwrap_or(p.ax);
+        let final_entry_x = self.machine.base_join_x_m.unwrap_or(base_x);
         SpiralStatus {
             downwind_course_rad: p.frame.downwind_rad,
             final_course_rad: s.final_approach.course_rad,
             corners_ne_m: [0, 1, 2, 3].map(|k| p.frame.to_ne(p.corner(k))),
-            final_entry_ne_m: p.frame.to_ne([base_x, 0.0]),
-            final_approach_height_m: s.needed_to_turn_base(base_x),
+            final_entry_ne_m: p.frame.to_ne([final_entry_x, 0.0]),
+            final_approach_height_m: match self.machine.base_join_x_m {
+                Some(join_x) => s.energy.needed_via(base_x, p.downwind_y, join_x, 0.0),
+                None => s.needed_to_turn_base(base_x),
+            },
             height_m: s.height,
             reach_ratio: s.reach.reach_ratio,
             target_reachable: s.reach.reachable,

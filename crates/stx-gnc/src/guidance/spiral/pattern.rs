@@ -184,8 +184,14 @@ impl Pattern {
     }
 
     /// The line branch `k` is flown on; with `base_x_m`, Branch2 is the base leg across from
-    /// the downwind leg to the final-approach line at that `x`.
-    pub(super) fn branch_line(&self, k: usize, base_x_m: Option<f64>) -> Localizer {
+    /// the downwind leg to the final-approach line at that `x`, or, with `join_x_m`, from
+    /// there diagonally to the final line at `join_x_m`.
+    pub(super) fn branch_line(
+        &self,
+        k: usize,
+        base_x_m: Option<f64>,
+        join_x_m: Option<f64>,
+    ) -> Localizer {
         let downwind_y = self.downwind_y;
         let mut start = self.corner(k);
         let mut course = self.frame.downwind_rad + std::f64::consts::FRAC_PI_2 * k as f64;
@@ -194,8 +200,12 @@ impl Pattern {
             (1, Some(x_base)) => {
                 // The base leg: across from the downwind leg towards the final line.
                 start = [x_base, downwind_y];
-                if downwind_y > 0.0 {
-                    course += std::f64::consts::PI;
+                match join_x_m {
+                    Some(join_x) => {
+                        course = self.frame.downwind_rad + (-downwind_y).atan2(join_x - x_base);
+                    }
+                    None if downwind_y > 0.0 => course += std::f64::consts::PI,
+                    None => {}
                 }
             }
             _ => {}

@@ -8,7 +8,9 @@
 
 use super::config::SpiralConfig;
 use super::pattern::{BRANCHES, Pattern, branch_index, corner_xy};
-use super::reach::{Announcement, MIN_BEST_REACHABLE_S, REACH_CHECK_MIN_HEIGHT_M, Reach};
+use super::reach::{
+    Announcement, MIN_BEST_REACHABLE_S, REACH_CHECK_MIN_HEIGHT_M, Reach, WIND_ACCURACY_MPS,
+};
 use super::situation::Situation;
 use super::wind::wind_from_deg;
 use crate::mission::GuidancePhase;
@@ -56,6 +58,9 @@ pub(super) struct PhaseMachine {
     pub(super) approach_from_ne_m: Option<[f64; 2]>,
     /// Where the base leg is turned, m downwind of the target, once decided.
     pub(super) base_x_m: Option<f64>,
+    /// Where that base leg meets the final line, m downwind of the target, when it is flown
+    /// diagonally (short of height into a headwind); otherwise it is flown straight across.
+    pub(super) base_join_x_m: Option<f64>,
     /// Lateral offset of the downwind leg (Branch1), m: −a in the pattern, or where the
     /// vehicle was when it ran short of height and went for the downwind leg directly.
     pub(super) downwind_y_m: Option<f64>,
@@ -82,6 +87,7 @@ impl PhaseMachine {
             entry_branch: GuidancePhase::Branch1,
             approach_from_ne_m: None,
             base_x_m: None,
+            base_join_x_m: None,
             downwind_y_m: None,
             extending: false,
             phase_since_s: 0.0,
@@ -184,6 +190,7 @@ impl PhaseMachine {
                 let miss = s.reach.miss_m();
                 let best = s.reach.best_ne(target_ne);
                 self.base_x_m = None;
+                self.base_join_x_m = None;
                 self.extending = false;
                 self.downwind_y_m = None;
                 change = self.enter(
@@ -205,6 +212,7 @@ impl PhaseMachine {
                     && in_phase_s >= MIN_FINAL_BEFORE_REENTRY_S =>
             {
                 self.base_x_m = None;
+                self.base_join_x_m = None;
                 if x < sc.max_final_m - 2.0 * turn_distance {
                     // Downwind on a leg beside the final line, and base again from it when
                     // the height has come down to what the glide in needs.
@@ -287,22 +295,32 @@ impl PhaseMachine {
                 && height <= needed_direct + LOW_MARGIN_M =>
             {
                 if x >= sc.min_final_m && y.abs() > 2.0 * turn_distance {
-                    // Straight across to the final line (what `needed_direct` plans), as a base
-                    // leg from here: the final's localizer would intercept it at 45°, a longer
-                    // way that the height was not counted for.
+                    // A base leg from here to the final line (what `needed_direct` plans): the
+                    // final's localizer would intercept it at 45°, a longer way that the height
+                    // was not counted for. Straight across if the height covers it, else
+                    // diagonally to a shorter final.
+                    let join_x = s.energy.base_join_x(x, y, height, WIND_ACCURACY_MPS);
                     self.base_x_m = Some(x);
+                    self.base_join_x_m = (join_x < x - 1.0).then_some(join_x);
                     self.downwind_y_m = Some(y);
+                    let way = match self.base_join_x_m {
+                        Some(j) => format!(
+                            "diagonally to a final {j:.0} m out ({:.0} m needed that way)",
+                            s.energy.needed_via(x, y, j, 0.0)
+                        ),
+                        None => format!("{:.0} m across to a final {x:.0} m out", y.abs()),
+                    };
                     change = self.enter(
                         GuidancePhase::Branch2,
                         format!(
                             "short of height ({height:.0} m, {needed_direct:.0} m needed to glide \
-                             in from here): base leg now, {:.0} m across to a final {x:.0} m out",
-                            y.abs()
+                             in from here): base leg now, {way}"
                         ),
                         now_s,
                     );
                 } else if x >= sc.min_final_m {
                     self.base_x_m = Some(x);
+                    self.base_join_x_m = None;
                     change = self.enter(
                         GuidancePhase::FinalApproach,
                         format!(
@@ -385,6 +403,7 @@ impl PhaseMachine {
                 let needed = needed_to_turn_base(x_base.max(sc.min_final_m));
                 if x_base >= sc.min_final_m.min(ax) && height <= needed {
                     self.base_x_m = Some(x_base);
+                    self.base_join_x_m = None;
                     self.extending = false;
                     change = self.enter(
                         GuidancePhase::Branch2,
@@ -399,6 +418,7 @@ impl PhaseMachine {
                     );
                 } else if x_base >= sc.max_final_m {
                     self.base_x_m = Some(x_base);
+                    self.base_join_x_m = None;
                     self.extending = false;
                     change = self.enter(
                         GuidancePhase::Branch2,
@@ -413,6 +433,7 @@ impl PhaseMachine {
                 } else if !self.extending && to_corner < turn_distance {
                     if height - loop_loss >= needed_to_turn_base(ax) {
                         self.base_x_m = None;
+                        self.base_join_x_m = None;
                         change = self.enter(
                             GuidancePhase::Branch2,
                             format!(
@@ -434,9 +455,16 @@ impl PhaseMachine {
                 if let Some(x_base) = self.base_x_m {
                     // Final once the base leg meets the final line, not before the vehicle is
                     // out at the base leg (sent back downwind from the final line, it starts
-                    // on that line).
+                    // on that line). A diagonal leg turns less onto the final, and later.
                     let from_side = downwind_y.signum();
-                    if y * from_side < turn_distance && x >= x_base - turn_distance {
+                    let (meets_x, lead) = match self.base_join_x_m {
+                        Some(j) => {
+                            let turn = std::f64::consts::PI - (-downwind_y).atan2(j - x_base).abs();
+                            (j, turn_distance * (0.5 * turn).tan() * turn.sin())
+                        }
+                        None => (x_base, turn_distance),
+                    };
+                    if y * from_side < lead && x >= meets_x - turn_distance {
                         // The final course is taken from the wind as it is now.
                         self.reorient = true;
                         change = self.enter(

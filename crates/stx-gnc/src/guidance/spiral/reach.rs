@@ -13,7 +13,7 @@ pub(super) const REACH_CHECK_MIN_HEIGHT_M: f64 = 60.0;
 /// makes over the time left.
 const MIN_SHORTFALL_M: f64 = 20.0;
 /// Accuracy of the wind estimate guidance counts on, m/s (the project's goal for it, RMS).
-const WIND_ACCURACY_MPS: f64 = 0.3;
+pub(super) const WIND_ACCURACY_MPS: f64 = 0.3;
 /// The best reachable point is announced again when it has moved this far, m (the recovery
 /// team drives to it).
 const BEST_POINT_MOVED_M: f64 = 50.0;

@@ -7,7 +7,7 @@ use super::final_approach::FinalApproach;
 use super::pattern::branch_index;
 use super::phases::PhaseMachine;
 use super::situation::Situation;
-use crate::control::{self, Localizer};
+use crate::control::{self, Localizer, TurnLatch};
 use crate::estimate::Estimate;
 use crate::guidance::config::GuidanceConfig;
 use crate::mission::GuidancePhase;
@@ -21,12 +21,14 @@ pub(super) fn steer(
     s: &Situation,
     est: &Estimate,
     density: f64,
+    latch: &mut TurnLatch,
 ) -> Controls {
     let gains = &config.gains;
     let position = s.position;
-    let horizontal = |line: &Localizer| {
+    let mut horizontal = |line: &Localizer| {
         control::localizer(
             gains,
+            &mut *latch,
             line,
             position,
             est.course_rad,
@@ -34,7 +36,10 @@ pub(super) fn steer(
         )
         .main_line_m
     };
-    let branch_line = |k: usize| s.pattern.branch_line(k, machine.base_x_m);
+    let branch_line = |k: usize| {
+        s.pattern
+            .branch_line(k, machine.base_x_m, machine.base_join_x_m)
+    };
     match machine.phase {
         GuidancePhase::Idle | GuidancePhase::Landed => Controls::default(),
         GuidancePhase::Approximation => {
@@ -69,10 +74,11 @@ pub(super) fn steer(
             s.ground_m,
             density,
         ),
-        GuidancePhase::Flare => FinalApproach::flare(config, &s.final_approach, est, position),
+        GuidancePhase::Flare => final_approach.flare(config, &s.final_approach, est, position),
         GuidancePhase::BestReachable => Controls {
             main_line_m: control::heading(
                 gains,
+                latch,
                 est.heading_rad,
                 est.heading_rate_rad_s,
                 s.reach

@@ -4,7 +4,7 @@
 use nalgebra::Vector3;
 use stx_dynamics::state::Controls;
 
-use crate::control::{self, ControlGains};
+use crate::control::{self, ControlGains, TurnLatch};
 use crate::performance::GlidePerformance;
 use crate::pointmass::{Conditions, PointMass};
 
@@ -23,7 +23,13 @@ pub fn corner_turn_rate_rad_s(gains: &ControlGains, perf: &GlidePerformance) -> 
     let air = Conditions::nominal(Vector3::zeros(), perf.reference_density_kg_per_m3);
     let mut mass = PointMass::new(0.0, Vector3::zeros(), 0.0);
     while mass.time_s < LONGEST_S {
-        let main_line_m = control::course(gains, mass.heading_rad, mass.turn_rate_rad_s, quarter);
+        let main_line_m = control::course(
+            gains,
+            &mut TurnLatch::default(),
+            mass.heading_rad,
+            mass.turn_rate_rad_s,
+            quarter,
+        );
         let controls = Controls {
             main_line_m,
             ..Controls::default()
@@ -43,10 +49,16 @@ pub fn corner_turn_rate_rad_s(gains: &ControlGains, perf: &GlidePerformance) -> 
     quarter / LONGEST_S
 }
 
-/// The corner turn rate in use, with the gains and performance it was computed for: computing
-/// it flies a point mass, so it is kept until either changes.
+/// The corner turn rate in use, with the gains and turn model it was computed for: computing
+/// it flies a point mass, so it is kept until either changes by more than [`RATE_STEP`].
+/// Only the turn model matters (the heading of the point mass does not depend on its glide),
+/// so the glide learned at every update does not cost a new flight.
 #[derive(Debug, Clone, Copy, Default)]
-pub(super) struct CornerRate(Option<(ControlGains, GlidePerformance, f64)>);
+pub(super) struct CornerRate(Option<(ControlGains, [f64; 3], f64)>);
+
+/// Relative change of the (learned) maximum turn rate for which the corner rate is computed
+/// again.
+const RATE_STEP: f64 = 0.01;
 
 impl CornerRate {
     /// The rate to plan the corners with, rad/s: `set_rad_s` if the operator set one (> 0),
@@ -58,15 +70,25 @@ impl CornerRate {
         perf: &GlidePerformance,
     ) -> f64 {
         if set_rad_s > 0.0 {
-            set_rad_s
-        } else {
-            match self.0 {
-                Some((g, p, rate)) if g == *gains && p == *perf => rate,
-                _ => {
-                    let rate = corner_turn_rate_rad_s(gains, perf);
-                    self.0 = Some((*gains, *perf, rate));
-                    rate
-                }
+            return set_rad_s;
+        }
+        let key = [
+            perf.max_turn_rate_rad_s,
+            perf.turn_main_line_scale_m,
+            perf.turn_time_constant_s,
+        ];
+        match self.0 {
+            Some((g, k, rate))
+                if g == *gains
+                    && k[1..] == key[1..]
+                    && (k[0] - key[0]).abs() <= RATE_STEP * k[0].abs() =>
+            {
+                rate
+            }
+            _ => {
+                let rate = corner_turn_rate_rad_s(gains, perf);
+                self.0 = Some((*gains, key, rate));
+                rate
             }
         }
     }

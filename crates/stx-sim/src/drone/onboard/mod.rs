@@ -68,7 +68,7 @@ use std::collections::VecDeque;
 
 use nalgebra::Vector3;
 use stx_dynamics::state::Controls;
-use stx_gnc::control::{self, Localizer};
+use stx_gnc::control::{self, Localizer, TurnLatch};
 use stx_gnc::estimate::Estimate;
 use stx_gnc::geo::LocalFrame;
 use stx_gnc::guidance::{Guidance, Plan};
@@ -151,6 +151,8 @@ pub struct Onboard {
     /// The automatic cutdown was asked for (once is enough).
     cutdown_requested: bool,
     texts: VecDeque<(Severity, String)>,
+    /// The side of the into-wind turn when it starts from nearly downwind.
+    turn_latch: TurnLatch,
 }
 
 /// A guidance mode that steers on position (needs GPS or a good dead reckoning).
@@ -207,6 +209,7 @@ impl Onboard {
             had_fix: false,
             cutdown_requested: false,
             texts: VecDeque::new(),
+            turn_latch: TurnLatch::default(),
         }
     }
 
@@ -411,6 +414,7 @@ impl Onboard {
             return Controls {
                 main_line_m: control::heading(
                     &self.settings.guidance.gains,
+                    &mut self.turn_latch,
                     est.heading_rad,
                     est.heading_rate_rad_s,
                     heading_rad,

@@ -3,11 +3,16 @@
 //! control, `VU`).
 //!
 //! Every angle error is wrapped to (−π, π] before it is used, so a heading of 179° against a
-//! target of −179° is a 2° error, not 358°. Outputs saturate to the servos' range. Signs: a
+//! target of −179° is a 2° error, not 358°; a turn of more than 150° keeps the side it
+//! started on until less than 90° is left ([`TurnLatch`], `turn_latch.rs`), so a reversal
+//! is flown one way. Outputs saturate to the servos' range. Signs: a
 //! positive main-line command turns right; more brake steepens the glide.
 
 use serde::{Deserialize, Serialize};
 use stx_dynamics::rotation::wrap_pi;
+
+mod turn_latch;
+pub use turn_latch::{LATCH_RAD, RELEASE_RAD, TurnLatch};
 
 /// Gains and limits of the control laws, with units. The station can read and write each one
 /// as a named parameter.
@@ -153,32 +158,53 @@ pub enum LawPhase {
     Following,
 }
 
-/// The main-line command of a PD law on an angle error, saturated.
-fn pd(gains: &ControlGains, error_rad: f64, rate_rad_s: f64, extra_m: f64) -> f64 {
-    let command =
-        -gains.hk1_m_per_rad * wrap_pi(error_rad) - gains.hk2_m_s_per_rad * rate_rad_s - extra_m;
+/// The main-line command of a PD law on an angle error (resolved by `latch`), saturated.
+fn pd(
+    gains: &ControlGains,
+    latch: &mut TurnLatch,
+    error_rad: f64,
+    rate_rad_s: f64,
+    extra_m: f64,
+) -> f64 {
+    let command = -gains.hk1_m_per_rad * latch.resolve(error_rad)
+        - gains.hk2_m_s_per_rad * rate_rad_s
+        - extra_m;
     command.clamp(-gains.main_line_limit_m, gains.main_line_limit_m)
 }
 
 /// Heading hold (eqs. 5.1–5.3): `HU = −HK1·(ψ − H0) − HK2·ψ̇`.
 pub fn heading(
     gains: &ControlGains,
+    latch: &mut TurnLatch,
     heading_rad: f64,
     heading_rate_rad_s: f64,
     target_rad: f64,
 ) -> f64 {
-    pd(gains, heading_rad - target_rad, heading_rate_rad_s, 0.0)
+    pd(
+        gains,
+        latch,
+        heading_rad - target_rad,
+        heading_rate_rad_s,
+        0.0,
+    )
 }
 
 /// Course hold (eqs. 5.4–5.6): the course over the ground replaces the heading, so the
 /// vehicle crabs into a crosswind; the heading rate stands in for the course rate.
 pub fn course(
     gains: &ControlGains,
+    latch: &mut TurnLatch,
     course_rad: f64,
     heading_rate_rad_s: f64,
     target_rad: f64,
 ) -> f64 {
-    pd(gains, course_rad - target_rad, heading_rate_rad_s, 0.0)
+    pd(
+        gains,
+        latch,
+        course_rad - target_rad,
+        heading_rate_rad_s,
+        0.0,
+    )
 }
 
 /// A localizer: the line through `point_ne_m` (north, east) with course `course_rad`.
@@ -236,6 +262,7 @@ pub struct LocalizerOutput {
 /// Following: hold the line's course with an added cross-track term.
 pub fn localizer(
     gains: &ControlGains,
+    latch: &mut TurnLatch,
     line: &Localizer,
     position_ne_m: [f64; 2],
     course_rad: f64,
@@ -247,7 +274,7 @@ pub fn localizer(
         let intercept = (ct.abs().min(cd) / cd).atan() * ct.signum();
         let desired = line.course_rad - intercept;
         LocalizerOutput {
-            main_line_m: pd(gains, course_rad - desired, heading_rate_rad_s, 0.0),
+            main_line_m: pd(gains, latch, course_rad - desired, heading_rate_rad_s, 0.0),
             phase: LawPhase::Approach,
             cross_track_m: ct,
             desired_course_rad: wrap_pi(desired),
@@ -256,6 +283,7 @@ pub fn localizer(
         LocalizerOutput {
             main_line_m: pd(
                 gains,
+                latch,
                 course_rad - line.course_rad,
                 heading_rate_rad_s,
                 gains.hk3_m_per_m * ct,
@@ -389,8 +417,8 @@ mod tests {
     #[test]
     fn the_shipped_gains_file_holds_the_defaults() {
         // config/gains.toml is documented as the built-in defaults: keep them one.
-        let shipped =
-            ControlGains::from_toml_str(include_str!("../../../config/gains.toml")).expect("valid");
+        let shipped = ControlGains::from_toml_str(include_str!("../../../../config/gains.toml"))
+            .expect("valid");
         assert_eq!(shipped, ControlGains::default());
     }
 
@@ -419,28 +447,54 @@ mod tests {
     fn heading_error_turns_the_short_way_round_through_180_degrees() {
         let g = gains();
         // Heading 179°, wanted −179°: 2° to the right, so turn right (positive).
-        let u = heading(&g, 179f64.to_radians(), 0.0, (-179f64).to_radians());
+        let u = heading(
+            &g,
+            &mut TurnLatch::default(),
+            179f64.to_radians(),
+            0.0,
+            (-179f64).to_radians(),
+        );
         assert!(u > 0.0, "{u}");
         assert!((u - g.hk1_m_per_rad * 2f64.to_radians()).abs() < 1e-12);
         // And the mirror case turns left.
-        assert!(heading(&g, (-179f64).to_radians(), 0.0, 179f64.to_radians()) < 0.0);
+        assert!(
+            heading(
+                &g,
+                &mut TurnLatch::default(),
+                (-179f64).to_radians(),
+                0.0,
+                179f64.to_radians()
+            ) < 0.0
+        );
         // A rate towards the target damps the command.
-        let damped = heading(&g, 179f64.to_radians(), 0.1, (-179f64).to_radians());
+        let damped = heading(
+            &g,
+            &mut TurnLatch::default(),
+            179f64.to_radians(),
+            0.1,
+            (-179f64).to_radians(),
+        );
         assert!(damped < u);
     }
 
     #[test]
     fn commands_saturate_at_the_main_line_limit() {
         let g = gains();
-        assert_eq!(heading(&g, 0.0, -100.0, 0.0), g.main_line_limit_m);
-        assert_eq!(course(&g, 0.0, 100.0, 0.0), -g.main_line_limit_m);
+        assert_eq!(
+            heading(&g, &mut TurnLatch::default(), 0.0, -100.0, 0.0),
+            g.main_line_limit_m
+        );
+        assert_eq!(
+            course(&g, &mut TurnLatch::default(), 0.0, 100.0, 0.0),
+            -g.main_line_limit_m
+        );
     }
 
     #[test]
     fn course_law_uses_the_course_not_the_heading() {
         let g = gains();
-        assert_eq!(course(&g, 0.5, 0.0, 0.5), 0.0);
-        assert!(course(&g, 0.4, 0.0, 0.5) > 0.0);
+        assert_eq!(course(&g, &mut TurnLatch::default(), 0.5, 0.0, 0.5), 0.0);
+        assert!(course(&g, &mut TurnLatch::default(), 0.4, 0.0, 0.5) > 0.0);
     }
 
     #[test]
@@ -465,17 +519,28 @@ mod tests {
             point_ne_m: [100.0, 200.0],
             course_rad: PI / 2.0,
         };
+        // Flying the line's course from `position`.
+        let at = |position| {
+            localizer(
+                &g,
+                &mut TurnLatch::default(),
+                &line,
+                position,
+                PI / 2.0,
+                0.0,
+            )
+        };
         // Far to the left of the line (north of it): intercept course 90° + 45°, to the right.
-        let far = localizer(&g, &line, [100.0 + 5.0 * cd, 0.0], PI / 2.0, 0.0);
+        let far = at([100.0 + 5.0 * cd, 0.0]);
         assert_eq!(far.phase, LawPhase::Approach);
         assert!((far.desired_course_rad - 135f64.to_radians()).abs() < 1e-9);
         assert!(far.main_line_m > 0.0, "turns right towards the line");
         // Close: following phase, cross-track term pulls back towards the line.
-        let near = localizer(&g, &line, [100.0 + 0.1 * cd, 150.0], PI / 2.0, 0.0);
+        let near = at([100.0 + 0.1 * cd, 150.0]);
         assert_eq!(near.phase, LawPhase::Following);
         assert!(near.main_line_m > 0.0 && near.cross_track_m < 0.0);
         // On the line, on course: nothing to do.
-        let on = localizer(&g, &line, [100.0, 150.0], PI / 2.0, 0.0);
+        let on = at([100.0, 150.0]);
         assert!(on.main_line_m.abs() < 1e-12);
     }
 
