@@ -393,9 +393,11 @@ fn a_strong_wind_is_called_as_soon_as_the_estimate_has_converged() {
     assert!(called.time_s <= 26.0, "called at {} s", called.time_s);
 }
 
-/// The point "(N north, E east)" of a best-reachable event's reason.
+/// The point "(N north, E east)" of a best-reachable event's reason (other parentheses,
+/// such as the reach ratio's, may follow it).
 fn best_point_in(reason: &str) -> [f64; 2] {
-    let start = reason.rfind('(').unwrap_or(0) + 1;
+    let point = reason.rfind(" N, ").unwrap_or(reason.len());
+    let start = reason[..point].rfind('(').unwrap_or(0) + 1;
     let numbers: Vec<f64> = reason[start..]
         .split(|c: char| !(c.is_ascii_digit() || c == '-' || c == '.'))
         .filter_map(|w| w.parse().ok())

@@ -79,6 +79,24 @@ pub enum GainsError {
 }
 
 impl ControlGains {
+    /// The gains for a canopy that turns `turn_scale` times as fast per main-line command as
+    /// the one they were tuned for: the main-line gains divided by it, so the heading loop
+    /// keeps the gain it was tuned with (a canopy drawn with 30 % more turn authority
+    /// otherwise flies the same laws with 30 % more loop gain, and overshoots).
+    pub fn for_turn_scale(&self, turn_scale: f64) -> Self {
+        let k = if turn_scale.is_finite() && turn_scale > 0.0 {
+            turn_scale
+        } else {
+            1.0
+        };
+        Self {
+            hk1_m_per_rad: self.hk1_m_per_rad / k,
+            hk2_m_s_per_rad: self.hk2_m_s_per_rad / k,
+            hk3_m_per_m: self.hk3_m_per_m / k,
+            ..*self
+        }
+    }
+
     /// Reads gains from TOML text (the format `stx tune` writes: the fields of this struct at
     /// the top level; missing fields take their defaults) and validates them.
     pub fn from_toml_str(text: &str) -> Result<Self, GainsError> {
@@ -158,15 +176,17 @@ pub enum LawPhase {
     Following,
 }
 
-/// The main-line command of a PD law on an angle error (resolved by `latch`), saturated.
+/// The main-line command of a PD law on the angle from `wanted_rad` to `actual_rad`
+/// (resolved by `latch`), saturated.
 fn pd(
     gains: &ControlGains,
     latch: &mut TurnLatch,
-    error_rad: f64,
+    actual_rad: f64,
+    wanted_rad: f64,
     rate_rad_s: f64,
     extra_m: f64,
 ) -> f64 {
-    let command = -gains.hk1_m_per_rad * latch.resolve(error_rad)
+    let command = -gains.hk1_m_per_rad * latch.resolve(actual_rad, wanted_rad)
         - gains.hk2_m_s_per_rad * rate_rad_s
         - extra_m;
     command.clamp(-gains.main_line_limit_m, gains.main_line_limit_m)
@@ -183,7 +203,8 @@ pub fn heading(
     pd(
         gains,
         latch,
-        heading_rad - target_rad,
+        heading_rad,
+        target_rad,
         heading_rate_rad_s,
         0.0,
     )
@@ -201,7 +222,8 @@ pub fn course(
     pd(
         gains,
         latch,
-        course_rad - target_rad,
+        course_rad,
+        target_rad,
         heading_rate_rad_s,
         0.0,
     )
@@ -274,7 +296,7 @@ pub fn localizer(
         let intercept = (ct.abs().min(cd) / cd).atan() * ct.signum();
         let desired = line.course_rad - intercept;
         LocalizerOutput {
-            main_line_m: pd(gains, latch, course_rad - desired, heading_rate_rad_s, 0.0),
+            main_line_m: pd(gains, latch, course_rad, desired, heading_rate_rad_s, 0.0),
             phase: LawPhase::Approach,
             cross_track_m: ct,
             desired_course_rad: wrap_pi(desired),
@@ -284,7 +306,8 @@ pub fn localizer(
             main_line_m: pd(
                 gains,
                 latch,
-                course_rad - line.course_rad,
+                course_rad,
+                line.course_rad,
                 heading_rate_rad_s,
                 gains.hk3_m_per_m * ct,
             ),

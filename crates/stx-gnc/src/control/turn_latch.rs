@@ -9,7 +9,10 @@
 //! all (seed 11, run 169 with lower heading gains: a reversal onto the downwind leg never
 //! flown, 76 s upwind to the ground, 232 m off). A latch takes the side of the error when
 //! it first exceeds [`LATCH_RAD`] and keeps the error on that side, unwrapped, until less
-//! than [`RELEASE_RAD`] is left: the reversal is flown one way.
+//! than [`RELEASE_RAD`] is left: the reversal is flown one way. The side belongs to the
+//! direction wanted when it was taken: when the wanted direction moves by more than
+//! [`RETARGET_RAD`] (a new plan, a new phase), the side is chosen anew, so a turn is never
+//! flown the long way round to a target that is no longer behind.
 
 use std::f64::consts::PI;
 
@@ -19,36 +22,44 @@ use stx_dynamics::rotation::wrap_pi;
 pub const LATCH_RAD: f64 = 5.0 * PI / 6.0;
 /// The side is kept until the error is smaller than this (90°).
 pub const RELEASE_RAD: f64 = PI / 2.0;
+/// A wanted direction that moved by more than this (30°) since the side was taken releases it.
+pub const RETARGET_RAD: f64 = PI / 6.0;
 
 /// The turn's side, held from when its error first exceeded [`LATCH_RAD`].
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct TurnLatch {
-    /// `Some(true)`: the error is kept positive; `Some(false)`: negative.
-    positive: Option<bool>,
+    /// The side (`true`: the error is kept positive) and the wanted direction it was taken
+    /// for, rad.
+    held: Option<(bool, f64)>,
 }
 
 impl TurnLatch {
-    /// The error to act on: `error_rad` wrapped to (−π, π], or, while latched, on the latched
-    /// side (up to ±2π).
-    pub fn resolve(&mut self, error_rad: f64) -> f64 {
-        let e = wrap_pi(error_rad);
+    /// The error to act on when flying `actual_rad` towards `wanted_rad`: their difference
+    /// wrapped to (−π, π], or, while a side is held, on that side (up to ±2π).
+    pub fn resolve(&mut self, actual_rad: f64, wanted_rad: f64) -> f64 {
+        let e = wrap_pi(actual_rad - wanted_rad);
         if !e.is_finite() || e.abs() < RELEASE_RAD {
-            self.positive = None;
+            self.held = None;
             return e;
         }
-        if self.positive.is_none() && e.abs() > LATCH_RAD {
-            self.positive = Some(e > 0.0);
+        if let Some((_, for_rad)) = self.held
+            && wrap_pi(wanted_rad - for_rad).abs() > RETARGET_RAD
+        {
+            self.held = None;
         }
-        match self.positive {
-            Some(true) if e < 0.0 => e + 2.0 * PI,
-            Some(false) if e > 0.0 => e - 2.0 * PI,
+        if self.held.is_none() && e.abs() > LATCH_RAD {
+            self.held = Some((e > 0.0, wanted_rad));
+        }
+        match self.held {
+            Some((true, _)) if e < 0.0 => e + 2.0 * PI,
+            Some((false, _)) if e > 0.0 => e - 2.0 * PI,
             _ => e,
         }
     }
 
     /// Whether a side is held.
     pub fn is_latched(&self) -> bool {
-        self.positive.is_some()
+        self.held.is_some()
     }
 }
 
@@ -63,8 +74,8 @@ mod tests {
     #[test]
     fn small_errors_are_only_wrapped() {
         let mut latch = TurnLatch::default();
-        assert!((latch.resolve(deg(370.0)) - deg(10.0)).abs() < 1e-12);
-        assert!((latch.resolve(deg(-140.0)) - deg(-140.0)).abs() < 1e-12);
+        assert!((latch.resolve(deg(370.0), 0.0) - deg(10.0)).abs() < 1e-12);
+        assert!((latch.resolve(deg(-140.0), 0.0) - deg(-140.0)).abs() < 1e-12);
         assert!(!latch.is_latched());
     }
 
@@ -73,17 +84,21 @@ mod tests {
         let mut latch = TurnLatch::default();
         // The first large error is +170°: turn so as to reduce it, and keep doing so when
         // the estimate swings 30° past ±180°.
-        assert!((latch.resolve(deg(170.0)) - deg(170.0)).abs() < 1e-12);
+        assert!((latch.resolve(deg(170.0), 0.0) - deg(170.0)).abs() < 1e-12);
         for jitter in [-200.0, 160.0, -175.0, 185.0, 150.0] {
-            let e = latch.resolve(deg(jitter));
+            let e = latch.resolve(deg(jitter), 0.0);
             assert!(e > 0.0, "{jitter}° resolved to {:.1}°", e.to_degrees());
             assert!((wrap_pi(e) - wrap_pi(deg(jitter))).abs() < 1e-9);
         }
+        // The wanted direction moves by 80°: the error of −100° to it is flown the short way,
+        // not 260° round on the side held for the old one.
+        let mut moved = latch;
+        assert!((moved.resolve(deg(-20.0), deg(80.0)) - deg(-100.0)).abs() < 1e-9);
         // Released once the turn has brought the error under 90°; a new reversal picks anew.
-        assert!((latch.resolve(deg(80.0)) - deg(80.0)).abs() < 1e-12);
+        assert!((latch.resolve(deg(80.0), 0.0) - deg(80.0)).abs() < 1e-12);
         assert!(!latch.is_latched());
-        assert!(latch.resolve(deg(-179.0)) < 0.0);
-        assert!(latch.resolve(deg(179.0)) < 0.0);
+        assert!(latch.resolve(deg(-179.0), 0.0) < 0.0);
+        assert!(latch.resolve(deg(179.0), 0.0) < 0.0);
     }
 
     /// A course reversal flown by the course law at 4 Hz on a stack whose course estimate

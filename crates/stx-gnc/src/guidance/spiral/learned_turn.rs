@@ -100,11 +100,19 @@ mod tests {
     use super::*;
     use crate::control::{self, ControlGains};
     use crate::pointmass::{Conditions, PointMass};
+    use std::f64::consts::FRAC_PI_2;
+    use stx_dynamics::rotation::wrap_pi;
     use stx_dynamics::state::Controls;
 
     /// A point mass whose turn rate is `factor` times its polar's, steered through 90° course
     /// changes by the course law for `seconds` (or flown straight); what was learned.
     fn learn(factor: f64, seconds: usize, turning: bool) -> LearnedTurn {
+        fly(factor, seconds, turning, false).0
+    }
+
+    /// The same flight, the gains scheduled by the turn rate learned if `scheduled`; what was
+    /// learned and the rise time (to 90 %) of the last course change, s.
+    fn fly(factor: f64, seconds: usize, turning: bool, scheduled: bool) -> (LearnedTurn, f64) {
         let polar = GlidePerformance::default();
         let flown = GlidePerformance {
             max_turn_rate_rad_s: polar.max_turn_rate_rad_s * factor,
@@ -116,6 +124,7 @@ mod tests {
         let mut stack = PointMass::new(0.0, Vector3::new(0.0, 0.0, -800.0), 0.0);
         let mut learned = LearnedTurn::default();
         let mut command = 0.0;
+        let mut rise_s = None;
         for k in 0..seconds * 4 {
             for _ in 0..5 {
                 stack.step(
@@ -136,15 +145,27 @@ mod tests {
             } else {
                 0.0
             };
+            // Each change is a quarter turn to the right: the time to 90 % of it.
+            if k % 80 == 0 {
+                rise_s = None;
+            }
+            if rise_s.is_none() && wrap_pi(est.heading_rad - wanted) > -0.1 * FRAC_PI_2 {
+                rise_s = Some((k % 80) as f64 * 0.25);
+            }
+            let flown_gains = if scheduled {
+                gains.for_turn_scale(learned.scale())
+            } else {
+                gains
+            };
             command = control::course(
-                &gains,
+                &flown_gains,
                 &mut control::TurnLatch::default(),
                 est.heading_rad,
                 est.heading_rate_rad_s,
                 wanted,
             );
         }
-        learned
+        (learned, rise_s.unwrap_or(f64::INFINITY))
     }
 
     #[test]
@@ -161,6 +182,21 @@ mod tests {
             let planned = learned.performance(&perf).turn_rate(0.005) / perf.turn_rate(0.005);
             assert!((planned - learned.scale()).abs() < 1e-9);
         }
+    }
+
+    #[test]
+    fn gains_scheduled_by_the_learned_turn_rate_turn_a_quick_canopy_like_the_nominal_one() {
+        let (_, nominal) = fly(1.0, 120, true, false);
+        let (learned, quick) = fly(1.6, 120, true, false);
+        let (_, scheduled) = fly(1.6, 120, true, true);
+        assert!((learned.scale() - 1.6).abs() < 0.1, "{}", learned.scale());
+        // 60 % more turn authority under the same gains is a different loop (here a quicker
+        // one); the scheduled gains give back the loop they were tuned for.
+        assert!(quick < nominal - 0.5, "{quick} s against {nominal} s");
+        assert!(
+            (scheduled - nominal).abs() < 0.3 * (nominal - quick),
+            "scheduled {scheduled} s, nominal {nominal} s, unscheduled {quick} s"
+        );
     }
 
     #[test]

@@ -59,7 +59,7 @@
 //! (`pattern.rs`), the energy sums (`energy.rs`) with the corner turn rate of the gains in
 //! force (`turn_rate.rs`), the glide's reach (`reach.rs`) and the final approach's geometry
 //! (`final_approach.rs`), all with the glide learned so far in flight (`learned.rs`) and the
-//! turn rate (`learned_turn.rs`). The
+//! turn rate (`learned_turn.rs`), the main-line gains divided by the turn rate's scale. The
 //! phase machine (`phases.rs`) then takes at most one decision on
 //! it, and the steering (`steering.rs`) flies the phase it leaves the vehicle in; the final
 //! approach's brakes, S-turns and flare are in `final_approach.rs`. The settings are in
@@ -207,10 +207,13 @@ impl Spiral {
             self.turn
                 .update(&config.performance, est, self.last_main_line_m);
         }
+        // Whole per cent: the corner rate is flown again only when the gains change.
+        let turn_scale = (self.turn.scale() * 100.0).round() / 100.0;
         let learned = GuidanceConfig {
             performance: self
                 .turn
                 .performance(&self.glide.performance(&config.performance)),
+            gains: config.gains.for_turn_scale(turn_scale),
             ..*config
         };
         let config = &learned;

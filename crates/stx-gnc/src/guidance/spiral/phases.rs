@@ -20,6 +20,10 @@ pub(super) type Change = Option<(GuidancePhase, GuidancePhase, String)>;
 
 /// Height below the direct glide-in need at which guidance stops the pattern, m.
 const LOW_MARGIN_M: f64 = 10.0;
+/// Longest base leg flown diagonally to a shorter final, m across the wind: the plan's
+/// margin for a stronger headwind grows with the way, and from further out the diagonal
+/// arrives far too high for its short final (1.35 km out, planned 998 m, used 809 m).
+const MAX_DIAGONAL_ACROSS_M: f64 = 300.0;
 /// Height above the steepest glide on final at which guidance goes back downwind, m.
 const REENTER_EXCESS_M: f64 = 40.0;
 /// Least time on the final approach before guidance may call it too high and leave it, s:
@@ -66,6 +70,9 @@ pub(super) struct PhaseMachine {
     pub(super) downwind_y_m: Option<f64>,
     /// The downwind leg is extended past its corner until the height allows turning base.
     extending: bool,
+    /// The flare began while flying to the best reachable point, off the final line: it
+    /// holds the heading into the wind rather than a line it may be drifting backwards on.
+    pub(super) flare_off_line: bool,
     /// Time the current phase was entered, s.
     phase_since_s: f64,
     /// The pattern's axis may follow the wind at the next update: in the approximation, and
@@ -90,6 +97,7 @@ impl PhaseMachine {
             base_join_x_m: None,
             downwind_y_m: None,
             extending: false,
+            flare_off_line: false,
             phase_since_s: 0.0,
             reorient: true,
             loop_number: 0,
@@ -168,6 +176,7 @@ impl PhaseMachine {
             GuidancePhase::Idle | GuidancePhase::Landed => {}
             GuidancePhase::Flare => {}
             _ if sc.flare && lowest_body_height <= sc.flare_height_m => {
+                self.flare_off_line = self.phase == GuidancePhase::BestReachable;
                 change = self.enter(
                     GuidancePhase::Flare,
                     format!(
@@ -299,7 +308,11 @@ impl PhaseMachine {
                     // final's localizer would intercept it at 45°, a longer way that the height
                     // was not counted for. Straight across if the height covers it, else
                     // diagonally to a shorter final.
-                    let join_x = s.energy.base_join_x(x, y, height, WIND_ACCURACY_MPS);
+                    let join_x = if y.abs() <= MAX_DIAGONAL_ACROSS_M {
+                        s.energy.base_join_x(x, y, height, WIND_ACCURACY_MPS)
+                    } else {
+                        x
+                    };
                     self.base_x_m = Some(x);
                     self.base_join_x_m = (join_x < x - 1.0).then_some(join_x);
                     self.downwind_y_m = Some(y);

@@ -74,17 +74,27 @@ pub(super) fn steer(
             s.ground_m,
             density,
         ),
-        GuidancePhase::Flare => final_approach.flare(config, &s.final_approach, est, position),
-        GuidancePhase::BestReachable => Controls {
-            main_line_m: control::heading(
-                gains,
-                latch,
-                est.heading_rad,
-                est.heading_rate_rad_s,
-                s.reach
-                    .heading_rad(s.lowest_body_height, s.final_approach.course_rad),
-            ),
-            ..Controls::default()
-        },
+        GuidancePhase::Flare if !machine.flare_off_line => {
+            final_approach.flare(config, &s.final_approach, est, position)
+        }
+        GuidancePhase::Flare | GuidancePhase::BestReachable => {
+            let brake = if machine.phase == GuidancePhase::Flare {
+                1.0
+            } else {
+                0.0
+            };
+            Controls {
+                main_line_m: control::heading(
+                    gains,
+                    latch,
+                    est.heading_rad,
+                    est.heading_rate_rad_s,
+                    s.reach
+                        .heading_rad(s.lowest_body_height, s.final_approach.course_rad),
+                ),
+                brake_right: brake,
+                brake_left: brake,
+            }
+        }
     }
 }
