@@ -117,6 +117,33 @@ impl Directory {
     }
 }
 
+/// When the run that wrote the file `name` started, as its name says (the names
+/// [`Directory::file_name`] gives), Unix milliseconds; `None` for any other name. A file
+/// just begun holds no message yet that could say so.
+pub fn run_started_ms_from_name(name: &str) -> Option<u64> {
+    let stamp = name.strip_prefix("stx-")?.get(..16)?;
+    let digits = |range: std::ops::Range<usize>| stamp.get(range)?.parse::<u32>().ok();
+    if stamp.as_bytes().get(8) != Some(&b'T') || stamp.as_bytes().get(15) != Some(&b'Z') {
+        return None;
+    }
+    let month = time::Month::try_from(u8::try_from(digits(4..6)?).ok()?).ok()?;
+    let date = time::Date::from_calendar_date(
+        i32::try_from(digits(0..4)?).ok()?,
+        month,
+        u8::try_from(digits(6..8)?).ok()?,
+    )
+    .ok()?;
+    let at = date
+        .with_hms(
+            u8::try_from(digits(9..11)?).ok()?,
+            u8::try_from(digits(11..13)?).ok()?,
+            u8::try_from(digits(13..15)?).ok()?,
+        )
+        .ok()?
+        .assume_utc();
+    u64::try_from(at.unix_timestamp()).ok().map(|s| s * 1000)
+}
+
 impl Storage for Directory {
     fn create(&mut self, part: u32) -> io::Result<(PathBuf, Box<dyn StorageFile>)> {
         std::fs::create_dir_all(&self.dir)?;
@@ -512,6 +539,27 @@ impl Writer {
             }
             self.shared.file_closed();
             self.file = FileState::Closed;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_file_name_says_when_its_run_started() {
+        let started = SystemTime::UNIX_EPOCH + Duration::from_secs(1_795_000_212);
+        let name = Directory::new("/tmp", started).file_name(2);
+        assert_eq!(run_started_ms_from_name(&name), Some(1_795_000_212_000));
+        let counted = name.replace(".mcap", "-1.mcap");
+        assert_eq!(run_started_ms_from_name(&counted), Some(1_795_000_212_000));
+        for other in [
+            "flight.mcap",
+            "stx-2026.mcap",
+            "stx-20261399T000000Z-001.mcap",
+        ] {
+            assert_eq!(run_started_ms_from_name(other), None, "{other}");
         }
     }
 }

@@ -1291,7 +1291,8 @@ export interface RecordingSummary {
    */
   size_bytes: number;
   /**
-   * Unix time of the first message, ms (`null` for a recording with no messages).
+   * Unix time of the first message, ms; for a recording with no message yet, when its
+   * name says its run started (`null` if the name does not say).
    */
   start_ms: number | null;
   /**

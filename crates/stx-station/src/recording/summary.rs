@@ -27,7 +27,8 @@ pub struct RecordingSummary {
     pub name: String,
     /// Size on disk, B.
     pub size_bytes: u64,
-    /// Unix time of the first message, ms (`null` for a recording with no messages).
+    /// Unix time of the first message, ms; for a recording with no message yet, when its
+    /// name says its run started (`null` if the name does not say).
     pub start_ms: Option<u64>,
     /// From the first message to the last, ms.
     pub duration_ms: u64,
@@ -97,7 +98,11 @@ pub fn summarize<R: Read + Seek>(
     Ok(RecordingSummary {
         name: name.to_owned(),
         size_bytes,
-        start_ms: range.map(|(start, _)| start / 1_000_000),
+        // A file just begun has no message yet (its first chunk is still being written):
+        // its name says when its run started, so it is listed as the newest, not the oldest.
+        start_ms: range
+            .map(|(start, _)| start / 1_000_000)
+            .or_else(|| stx_record::file::run_started_ms_from_name(name)),
         duration_ms: range.map_or(0, |(start, end)| (end - start) / 1_000_000),
         messages: recording.message_count(),
         mission: info.as_ref().map(|i| i.mission().to_owned()),
@@ -271,5 +276,12 @@ mod tests {
         let s = summary(recording(&[], true));
         assert_eq!((s.start_ms, s.duration_ms, s.messages), (None, 0, 0));
         assert_eq!(s.last_stage, None);
+    }
+
+    #[test]
+    fn a_recording_just_begun_starts_when_its_name_says() {
+        let mut r = Recording::from_reader(Cursor::new(recording(&[], true))).expect("opens");
+        let s = summarize("stx-20261128T005951Z-001.mcap", 0, &mut r).expect("summarises");
+        assert_eq!((s.start_ms, s.messages), (Some(1_795_827_591_000), 0));
     }
 }
