@@ -254,6 +254,16 @@ pub fn run_one<N: Navigator>(
         c.seed,
     )
     .map_err(|e| format!("dispersed vehicle refused: {e}"))?;
+    // A failed run names the stack it was flying: a model that fails is usually a draw far
+    // from nominal (a low rigging angle settles into a deep stall).
+    let draw = drawn.summary;
+    let with_draw = |e: String| {
+        format!(
+            "{e} (drawn stack: lift slope ×{:.2}, zero-lift drag ×{:.2}, brake lift ×{:.2}, \
+             mass ×{:.2}, rigging {:+.1}°)",
+            draw.cl_alpha, draw.cd0, draw.cl_ds, draw.mass, draw.rigging_deg
+        )
+    };
     let wind: Arc<dyn WindField> = composite.clone();
     let model = ParafoilModel::new(
         drawn.vehicle,
@@ -295,7 +305,7 @@ pub fn run_one<N: Navigator>(
     let mut track = Vec::new();
     let mut next_track_s = 0.0;
     let touchdown = loop {
-        if let Some(t) = flight.advance().map_err(|e| e.to_string())? {
+        if let Some(t) = flight.advance().map_err(|e| with_draw(e.to_string()))? {
             break t;
         }
         if replay
@@ -334,7 +344,7 @@ pub fn run_one<N: Navigator>(
             ));
         }
     };
-    let payload = flight.land_payload(touchdown)?;
+    let payload = flight.land_payload(touchdown).map_err(with_draw)?;
     let heading_vs_upwind = if touchdown.upwind_rad.is_finite() {
         wrap_pi(touchdown.heading_rad - touchdown.upwind_rad).to_degrees()
     } else {
