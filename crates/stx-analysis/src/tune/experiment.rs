@@ -309,15 +309,14 @@ impl Experiment {
             CONTROL_PERIOD_S,
         );
         flight.servos = servos;
-        let landed = |_| {
-            TuneError::Nonlinear("the stack reached the ground during the step: trim higher".into())
-        };
         let fly = |flight: &mut GuidedFlight<N>| -> Result<(), TuneError> {
             match flight
                 .advance()
                 .map_err(|e| TuneError::Nonlinear(e.to_string()))?
             {
-                Some(t) => Err(landed(t)),
+                Some(_) => Err(TuneError::Nonlinear(
+                    "the stack reached the ground during the step: trim higher".into(),
+                )),
                 None => Ok(()),
             }
         };

@@ -12,7 +12,7 @@ use serde::{Deserialize, Serialize};
 use stx_dynamics::rotation::wrap_pi;
 
 mod turn_latch;
-pub use turn_latch::{LATCH_RAD, RELEASE_RAD, TurnLatch};
+pub use turn_latch::{LATCH_RAD, RELEASE_RAD, RETARGET_RAD, TurnLatch};
 
 /// Gains and limits of the control laws, with units. The station can read and write each one
 /// as a named parameter.

@@ -58,7 +58,8 @@ impl TurnLatch {
     }
 
     /// Whether a side is held.
-    pub fn is_latched(&self) -> bool {
+    #[cfg(test)]
+    fn is_latched(&self) -> bool {
         self.held.is_some()
     }
 }

@@ -104,6 +104,13 @@ impl PhaseMachine {
         }
     }
 
+    /// Where the base leg is turned (m downwind of the target) and, flown diagonally, where
+    /// it meets the final line; both together, so a base leg never keeps another's join.
+    fn set_base(&mut self, x_m: Option<f64>, join_x_m: Option<f64>) {
+        self.base_x_m = x_m;
+        self.base_join_x_m = join_x_m;
+    }
+
     /// Whether the pattern's axis may follow the wind at this update; it may not at the next
     /// unless a decision allows it again.
     pub(super) fn take_reorient(&mut self) -> bool {
@@ -198,8 +205,7 @@ impl PhaseMachine {
             {
                 let miss = s.reach.miss_m();
                 let best = s.reach.best_ne(target_ne);
-                self.base_x_m = None;
-                self.base_join_x_m = None;
+                self.set_base(None, None);
                 self.extending = false;
                 self.downwind_y_m = None;
                 change = self.enter(
@@ -220,8 +226,7 @@ impl PhaseMachine {
                 if final_excess_m > REENTER_EXCESS_M
                     && in_phase_s >= MIN_FINAL_BEFORE_REENTRY_S =>
             {
-                self.base_x_m = None;
-                self.base_join_x_m = None;
+                self.set_base(None, None);
                 if x < sc.max_final_m - 2.0 * turn_distance {
                     // Downwind on a leg beside the final line, and base again from it when
                     // the height has come down to what the glide in needs.
@@ -313,8 +318,7 @@ impl PhaseMachine {
                     } else {
                         x
                     };
-                    self.base_x_m = Some(x);
-                    self.base_join_x_m = (join_x < x - 1.0).then_some(join_x);
+                    self.set_base(Some(x), (join_x < x - 1.0).then_some(join_x));
                     self.downwind_y_m = Some(y);
                     let way = match self.base_join_x_m {
                         Some(j) => format!(
@@ -332,8 +336,7 @@ impl PhaseMachine {
                         now_s,
                     );
                 } else if x >= sc.min_final_m {
-                    self.base_x_m = Some(x);
-                    self.base_join_x_m = None;
+                    self.set_base(Some(x), None);
                     change = self.enter(
                         GuidancePhase::FinalApproach,
                         format!(
@@ -415,8 +418,7 @@ impl PhaseMachine {
                 let x_base = x + turn_distance;
                 let needed = needed_to_turn_base(x_base.max(sc.min_final_m));
                 if x_base >= sc.min_final_m.min(ax) && height <= needed {
-                    self.base_x_m = Some(x_base);
-                    self.base_join_x_m = None;
+                    self.set_base(Some(x_base), None);
                     self.extending = false;
                     change = self.enter(
                         GuidancePhase::Branch2,
@@ -430,8 +432,7 @@ impl PhaseMachine {
                         now_s,
                     );
                 } else if x_base >= sc.max_final_m {
-                    self.base_x_m = Some(x_base);
-                    self.base_join_x_m = None;
+                    self.set_base(Some(x_base), None);
                     self.extending = false;
                     change = self.enter(
                         GuidancePhase::Branch2,
@@ -445,8 +446,7 @@ impl PhaseMachine {
                     );
                 } else if !self.extending && to_corner < turn_distance {
                     if height - loop_loss >= needed_to_turn_base(ax) {
-                        self.base_x_m = None;
-                        self.base_join_x_m = None;
+                        self.set_base(None, None);
                         change = self.enter(
                             GuidancePhase::Branch2,
                             format!(
