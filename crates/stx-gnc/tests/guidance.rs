@@ -427,6 +427,7 @@ fn the_two_point_localizer_is_intercepted_and_followed_through_both_points() {
     let mut mass = PointMass::new(0.0, Vector3::new(150.0, -150.0, -600.0), 0.0);
     let mut law_phases = Vec::new();
     let mut passed_second = false;
+    let mut overshoot_m = 0.0_f64;
     while mass.time_s < 200.0 {
         let command = guidance.update(&mass.estimate(&wind), 1.2);
         if let Some((horizontal, _)) = guidance.law_phases()
@@ -443,6 +444,8 @@ fn the_two_point_localizer_is_intercepted_and_followed_through_both_points() {
             );
         }
         let p = [mass.position_ned_m.x, mass.position_ned_m.y];
+        // Past the line (it starts on the negative side): the capture's overshoot.
+        overshoot_m = overshoot_m.max(line.cross_track_m(p));
         if line.along_track_m(p) > line.along_track_m(to) {
             passed_second = true;
             assert!(
@@ -455,5 +458,14 @@ fn the_two_point_localizer_is_intercepted_and_followed_through_both_points() {
         }
     }
     assert!(passed_second, "flew past the second point");
-    assert_eq!(law_phases, [LawPhase::Approach, LawPhase::Following]);
+    // The capture overshoots by 8.3 m with the heading gains of 2026-11-28 (three quarters of
+    // the earlier ones, which stayed inside the 8 m where the law is back in its approach
+    // phase): one return to the approach phase is allowed, the overshoot bounded.
+    assert!(
+        overshoot_m < 10.0,
+        "overshot the line by {overshoot_m:.1} m"
+    );
+    assert_eq!(law_phases[..2], [LawPhase::Approach, LawPhase::Following]);
+    assert!(law_phases.len() <= 4, "{law_phases:?}");
+    assert_eq!(law_phases.last(), Some(&LawPhase::Following));
 }

@@ -105,7 +105,8 @@ mod tests {
     /// A course reversal flown by the course law at 4 Hz on a stack whose course estimate
     /// jumps against the command (the drone's twist, 4°/mm as measured in seed 11 run 169),
     /// turning at the polar's rate with its lags. Returns how far from the wanted course the
-    /// stack is after 30 s, degrees.
+    /// stack is after 40 s, degrees (30 s with the higher heading gains before 2026-11-28:
+    /// today's turn more gently and end the reversal 11° off at 30 s, 8° at 40 s).
     fn reversal(latched: bool) -> f64 {
         use crate::control::{ControlGains, course};
         let gains = ControlGains::default();
@@ -114,7 +115,7 @@ mod tests {
         let (mut chi, mut rate, mut servo, mut command) = (0.0f64, 0.0, 0.0, 0.0);
         let mut latch = TurnLatch::default();
         let mut last_measured: Option<f64> = None;
-        for step in 0..600 {
+        for step in 0..800 {
             let measured = chi - twist_rad_per_m * servo;
             if step % period == 0 {
                 let measured_rate = last_measured
@@ -139,13 +140,13 @@ mod tests {
         let off = reversal(true);
         assert!(
             off < 10.0,
-            "latched: {off:.0}° from the wanted course after 30 s"
+            "latched: {off:.1}° from the wanted course after 40 s"
         );
         // Wrapped alone, the same loop chatters near ±180° and barely turns.
         let unlatched = reversal(false);
         assert!(
             unlatched > 120.0,
-            "wrapped alone: {unlatched:.0}° off after 30 s"
+            "wrapped alone: {unlatched:.0}° off after 40 s"
         );
     }
 }

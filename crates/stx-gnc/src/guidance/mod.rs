@@ -122,6 +122,9 @@ impl Guidance {
             };
             let from = self.phase();
             self.mode = mode;
+            // The drone may fly the new mode without asking guidance (manual sticks), so the
+            // trim cannot rely on seeing the gap in its updates.
+            self.trim.interrupt();
             self.spiral = spiral::Spiral::new();
             self.spiral.force_phase(to);
             if from != to {
@@ -273,6 +276,8 @@ impl Guidance {
             self.trim
                 .update(&self.config.performance, est, self.last_main_line_m);
             controls.main_line_m -= self.trim.offset_m;
+        } else {
+            self.trim.interrupt();
         }
         self.last_main_line_m = controls.main_line_m;
         Command {

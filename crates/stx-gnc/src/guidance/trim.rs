@@ -38,14 +38,18 @@ impl MainLineTrim {
     /// the last update.
     pub fn update(&mut self, perf: &GlidePerformance, est: &Estimate, sent_m: f64) {
         let now = est.time_s;
-        let Some(dt) = self
-            .last_time_s
-            .replace(now)
-            .map(|t| (now - t).max(0.0))
-            .filter(|dt| *dt > 0.0)
-        else {
+        let Some(last_s) = self.last_time_s.replace(now) else {
+            // Whatever was flown before (nothing, or commands this trim never saw) the
+            // stack turns at the rate measured now; the model's rate relaxes from there.
+            if est.heading_rate_rad_s.is_finite() {
+                self.expected_rate_rad_s = est.heading_rate_rad_s;
+            }
             return;
         };
+        let dt = now - last_s;
+        if dt <= 0.0 {
+            return;
+        }
         let effective = sent_m + self.offset_m;
         let scale = perf.turn_main_line_scale_m;
         // The turn rate follows the command with the model's time constant.
@@ -63,6 +67,15 @@ impl MainLineTrim {
         let gain = dt / (self.learned_s + dt).clamp(LEARN_TIME_S / 3.0, LEARN_TIME_S);
         self.offset_m = (self.offset_m + gain * error_m).clamp(-MAX_TRIM_M, MAX_TRIM_M);
         self.learned_s += dt;
+    }
+
+    /// Commands this trim did not see are being flown (manual or hands-off flight): it learns
+    /// again from the next guided update on, with its expected turn rate taken from the rate
+    /// measured then. Learning across such a gap compared a manual turn with the model's rate
+    /// for the last guided command and pinned the trim at its limit (a rehearsal's final
+    /// approach flown 30° off its line with the law's command cancelled by the trim).
+    pub fn interrupt(&mut self) {
+        self.last_time_s = None;
     }
 }
 
@@ -110,5 +123,39 @@ mod tests {
         assert!(rate.abs() < 0.01, "still turning at {rate} rad/s");
         let (trim, _) = fly(0.0, 60);
         assert!(trim.offset_m.abs() < 1e-4, "{trim:?}");
+    }
+
+    /// Straight guided flight, 5 s of a hard manual turn the trim does not see, and guided
+    /// straight flight again: nothing of the manual turn is learned as trim.
+    #[test]
+    fn a_manual_turn_between_guided_updates_is_not_learned_as_trim() {
+        let perf = GlidePerformance::default();
+        let wind = Vector3::zeros();
+        let air = Conditions::nominal(wind, perf.reference_density_kg_per_m3);
+        let mut stack = PointMass::new(0.0, Vector3::new(0.0, 0.0, -2000.0), 0.0);
+        let mut trim = MainLineTrim::default();
+        let mut largest = 0.0_f64;
+        for k in 0..4 * 60 {
+            let est = stack.estimate(&wind);
+            let manual = (30 * 4..35 * 4).contains(&k);
+            let sent = if manual {
+                trim.interrupt();
+                -0.012
+            } else {
+                let sent = -0.004 * est.heading_rate_rad_s - trim.offset_m;
+                trim.update(&perf, &est, sent);
+                sent
+            };
+            let controls = Controls {
+                main_line_m: sent,
+                ..Controls::default()
+            };
+            for _ in 0..5 {
+                stack.step(&perf, &controls, &air, 0.05);
+            }
+            largest = largest.max(trim.offset_m.abs());
+        }
+        // Learning across the gap put 2.4 mm here.
+        assert!(largest < 5e-4, "trim reached {largest} m");
     }
 }
