@@ -18,11 +18,14 @@
 //!   the spiral and the landing prediction work and which seed equations they follow);
 //! - [`performance`] summarises how the parafoil flies, [`pointmass`] flies that summary fast,
 //!   and [`predict`] uses it to say where the vehicle will land;
+//! - [`ascent_wind`] measures the wind profile from the balloon's drift during the ascent, by
+//!   altitude band with its uncertainty, and joins it to the forecast for the predictions;
 //! - [`geo`] links the mission's local NED frame to latitude, longitude and altitude;
 //! - [`plan_upload`] turns an uploaded plan (waypoints, landing point) into guidance's plan,
 //!   the same way on the drone and in the station's replica;
 //! - [`params`] describes every onboard setting the station may read and write, once, for
 //!   the drone's parameter table and the station's editor alike.
+pub mod ascent_wind;
 pub mod control;
 pub mod estimate;
 pub mod estimator;
