@@ -168,15 +168,22 @@ pub struct StationConfig {
     #[serde(default = "default_web_dir")]
     pub web_dir: PathBuf,
     /// Map tile URL template for the dashboard (`{z}/{x}/{y}`); a path starting with `/tiles/`
-    /// is served from `tiles_dir`. Absent: the map shows its offline grid.
+    /// is served from `tile_pack` and `tiles_dir`. Absent: `/tiles/{z}/{x}/{y}.EXT` when a
+    /// tile pack opened, else the map shows its metric grid.
     #[serde(default)]
     pub tile_url: Option<String>,
-    /// Attribution shown under the map.
+    /// Attribution shown under the map; empty: the tile pack's own, if it has one.
     #[serde(default)]
     pub tile_attribution: String,
     /// Directory of offline tiles `{z}/{x}/{y}.png`, served under `/tiles/`.
     #[serde(default)]
     pub tiles_dir: Option<PathBuf>,
+    /// Offline map in one file, an MBTiles (`.mbtiles`, SQLite) or PMTiles v3 (`.pmtiles`)
+    /// pack of raster tiles prepared at home, served under `/tiles/`. A tile it lacks is
+    /// looked for in `tiles_dir`. Opened at start: a missing or unreadable pack is logged and
+    /// shown on the map, which then draws its metric grid; the station runs on.
+    #[serde(default)]
+    pub tile_pack: Option<PathBuf>,
     /// Origin of the mission's local frame (launch site).
     pub origin: LocalFrame,
     /// The drone link.
@@ -334,6 +341,14 @@ impl StationConfig {
                 return invalid("tls.key_path", "a PEM private-key file");
             }
         }
+        if let Some(pack) = &self.tile_pack {
+            let extension = pack.extension().and_then(|e| e.to_str());
+            if !extension.is_some_and(|e| {
+                e.eq_ignore_ascii_case("mbtiles") || e.eq_ignore_ascii_case("pmtiles")
+            }) {
+                return invalid("tile_pack", "an .mbtiles or .pmtiles file");
+            }
+        }
         if let Err((field, rule)) = self.recording.check() {
             return invalid(field, rule);
         }
@@ -434,6 +449,37 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(err.contains("token"), "{err}");
+    }
+
+    #[test]
+    fn a_tile_pack_must_be_an_mbtiles_or_pmtiles_file_and_need_not_exist_yet() {
+        let with = |line: &str| {
+            DEFAULT_STATION_TOML.replacen(
+                "tile_attribution",
+                &format!("{line}\ntile_attribution"),
+                1,
+            )
+        };
+        for good in [
+            "/srv/maps/field.mbtiles",
+            "field.PMTiles",
+            "/nonexistent/alentejo.pmtiles",
+        ] {
+            let c = StationConfig::from_toml_str(&with(&format!("tile_pack = \"{good}\"")))
+                .expect(good);
+            assert_eq!(c.tile_pack, Some(PathBuf::from(good)));
+        }
+        for bad in ["", "/srv/maps/field.zip", "/srv/maps/tiles", "mbtiles"] {
+            let err = StationConfig::from_toml_str(&with(&format!("tile_pack = \"{bad}\"")))
+                .unwrap_err()
+                .to_string();
+            assert!(
+                err.contains("`tile_pack`") && err.contains(".mbtiles or .pmtiles"),
+                "{bad}: {err}"
+            );
+        }
+        let c = StationConfig::from_toml_str(DEFAULT_STATION_TOML).expect("valid");
+        assert_eq!(c.tile_pack, None);
     }
 
     const KEY: &str = "5ec2e75ec2e75ec2e75ec2e75ec2e75ec2e75ec2e75ec2e75ec2e75ec2e75ec2";

@@ -22,7 +22,9 @@
 //! - `http`: the axum routes (auth, REST, WebSocket, KML, static files);
 //! - `daemon`: the tokio wiring of link driver, core and HTTP, with graceful shutdown;
 //! - `recorder`: the run's recording (stx-record's writer thread) fed from the station loop
-//!   and the link driver.
+//!   and the link driver;
+//! - `tile_pack`: the offline map's tile pack (MBTiles or PMTiles), opened at start and read
+//!   for `/tiles/`.
 
 pub mod config;
 pub mod contract;
@@ -41,3 +43,5 @@ pub mod recording;
 pub mod replay;
 pub mod replies;
 pub mod requests;
+#[cfg(feature = "daemon")]
+pub mod tile_pack;

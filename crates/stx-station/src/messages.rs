@@ -36,6 +36,13 @@ pub struct StationInfo {
     pub tile_attribution: String,
     /// Tiles are served by the station itself (no internet needed).
     pub offline_tiles: bool,
+    /// Why the configured tile pack gives no map (missing, unreadable, vector tiles): the map
+    /// shows this over its metric grid.
+    pub offline_tiles_error: Option<String>,
+    /// Deepest zoom the tile pack has; deeper, the map enlarges these tiles.
+    pub tile_max_zoom: Option<u8>,
+    /// The tile pack's extent: west, south, east, north, degrees (no tiles asked outside).
+    pub tile_bounds: Option<[f64; 4]>,
     /// Modes the operator may select.
     #[schemars(with = "Vec<FlightMode>")]
     pub modes: Vec<String>,

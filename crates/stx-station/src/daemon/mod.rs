@@ -28,6 +28,7 @@ use crate::http::{Shared, StateFrame, router};
 use crate::link::StationLink;
 use crate::recorder::Recording;
 use crate::replay::ReplayControl;
+use crate::tile_pack::LoadedPack;
 
 pub use replay_feed::spawn_replay_feeder;
 pub use replay_sessions::{IDLE, MAX_SESSIONS, PreparedReplay, ReplayOpenError, serve_replay};
@@ -231,6 +232,7 @@ async fn run_with(
         recording,
         replay,
         recording_summaries: Default::default(),
+        tiles: LoadedPack::load(config.tile_pack.as_deref()).await,
         replay_requests,
     });
     let (stop_tx, stop_rx) = watch::channel(false);

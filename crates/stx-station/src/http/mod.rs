@@ -6,7 +6,8 @@
 //! - `rest`: the reading endpoints; `commands`: the commanding ones (operators only);
 //! - `ws`: the WebSocket (state, events, command results; operators' sticks);
 //! - `kml`: the Google Earth feed; `replay`: the replay's pause, seek and speed;
-//! - `recordings`: the past recordings: list, download, open in a replay.
+//! - `recordings`: the past recordings: list, download, open in a replay;
+//! - `tiles`: the offline map's tiles, from the tile pack and the tiles directory.
 //!
 //! Handlers only lock the core for a moment, build their answer, and wake the daemon when they
 //! gave the core something for the link ([`Shared::link_due`]); nothing here waits on the
@@ -19,6 +20,7 @@ mod recordings;
 mod replay;
 mod rest;
 mod shared;
+mod tiles;
 mod ws;
 
 use axum::Router;
@@ -72,7 +74,9 @@ pub fn router(state: std::sync::Arc<Shared>) -> Router {
         .route("/api/{*rest}", any(api_not_found))
         .route("/kml", get(kml::kml_link))
         .route("/kml/live", get(kml::kml_live));
-    if let Some(tiles) = &state.config.tiles_dir {
+    if state.tiles.pack.is_some() {
+        app = app.route("/tiles/{*path}", get(tiles::tile));
+    } else if let Some(tiles) = &state.config.tiles_dir {
         app = app.nest_service("/tiles", ServeDir::new(tiles));
     }
     app.fallback_service(ServeDir::new(web_dir).fallback(ServeFile::new(index)))

@@ -14,9 +14,27 @@ use super::auth::Caller;
 use super::shared::{AppState, HttpError, Shared, error};
 use crate::messages::{Session, StationInfo};
 use crate::replies::{ClientsBody, EventsBody, TrackBody};
+use crate::tile_pack::TilePack;
 
 pub(crate) fn session_of(state: &Shared, caller: &Caller) -> Session {
     let c = &state.config;
+    let pack = state.tiles.drawable().map(TilePack::info);
+    let tile_url = c.tile_url.clone().or_else(|| {
+        pack.map(|i| match i.format {
+            Some(format) => format!("/tiles/{{z}}/{{x}}/{{y}}.{}", format.name()),
+            None => "/tiles/{z}/{x}/{y}".into(),
+        })
+    });
+    let tile_attribution = match (c.tile_attribution.is_empty(), pack) {
+        (true, Some(info)) => info.attribution.clone().unwrap_or_default(),
+        _ => c.tile_attribution.clone(),
+    };
+    // The pack's zooms and extent bound the map's requests only when every tile it shows
+    // comes from the pack (no directory filling in, no online source).
+    let from_station = tile_url
+        .as_deref()
+        .is_some_and(|u| u.starts_with("/tiles/"));
+    let pack_alone = pack.filter(|_| from_station && c.tiles_dir.is_none());
     Session {
         role: caller.role,
         name: caller.name.clone(),
@@ -27,9 +45,12 @@ pub(crate) fn session_of(state: &Shared, caller: &Caller) -> Session {
                 lon_deg: c.origin.lon_deg,
                 alt_msl_m: c.origin.alt_msl_m,
             },
-            tile_url: c.tile_url.clone(),
-            tile_attribution: c.tile_attribution.clone(),
-            offline_tiles: c.tiles_dir.is_some(),
+            tile_url,
+            tile_attribution,
+            offline_tiles: c.tiles_dir.is_some() || pack.is_some(),
+            offline_tiles_error: state.tiles.error.clone(),
+            tile_max_zoom: pack_alone.and_then(|i| i.max_zoom),
+            tile_bounds: pack_alone.and_then(|i| i.bounds),
             modes: FlightMode::ALL
                 .iter()
                 .map(|m| {

@@ -50,6 +50,8 @@ pub struct Shared {
     pub replay: Option<Arc<crate::replay::ReplayControl>>,
     /// Recordings' summaries already read, for `GET /api/recordings`.
     pub recording_summaries: SummaryCache,
+    /// The offline map's tile pack, opened at start (or why not).
+    pub tiles: crate::tile_pack::LoadedPack,
     /// Where `POST /api/recordings/{name}/replay` asks the daemon for a replay station;
     /// `None` in a replay station (replays are opened from the live one).
     pub replay_requests: Option<tokio::sync::mpsc::Sender<ReplayRequest>>,
