@@ -209,6 +209,11 @@ export interface StationInfo {
    */
   offline_tiles: boolean;
   /**
+   * Why the configured tile pack gives no map (missing, unreadable, vector tiles): the map
+   * shows this over its metric grid.
+   */
+  offline_tiles_error: string | null;
+  /**
    * Origin of the local frame.
    */
   origin: LatLonAlt;
@@ -220,6 +225,17 @@ export interface StationInfo {
    * Tile attribution.
    */
   tile_attribution: string;
+  /**
+   * The tile pack's extent: west, south, east, north, degrees (no tiles asked outside).
+   *
+   * @minItems 4
+   * @maxItems 4
+   */
+  tile_bounds: [number, number, number, number] | null;
+  /**
+   * Deepest zoom the tile pack has; deeper, the map enlarges these tiles.
+   */
+  tile_max_zoom: number | null;
   /**
    * Tile URL template, if any.
    */

@@ -38,7 +38,8 @@ const STATE = {
 const SESSION = {
   role: "operator", name: "ops-1",
   station: { name: "STRAPLEX ground", origin: { lat_deg: 38.5333, lon_deg: -7.8889, alt_msl_m: 245 }, tile_url: "/tiles/{z}/{x}/{y}.png", tile_attribution: "©",
-    offline_tiles: true, modes: ["uncontrolled", "manual", "heading", "course", "localizer", "spiral_landing"], replay: false },
+    offline_tiles: true, offline_tiles_error: null, tile_max_zoom: 16, tile_bounds: [-7.95, 38.5, -7.8, 38.58],
+    modes: ["uncontrolled", "manual", "heading", "course", "localizer", "spiral_landing"], replay: false },
 };
 const j = (v: unknown): string => JSON.stringify(v);
 const api = contract();
@@ -178,6 +179,18 @@ describe("history, hello, command_result", () => {
   it("command_result with the read-back value", () => {
     const d = decodeMessage(j({ type: "command_result", request_id: "r1", command: "set_param", outcome: "accepted", attempts: 2, detail: "HK1", value: 0.015 }));
     expect(d.ok && d.msg.type === "command_result" && [d.msg.attempts, d.msg.value]).toEqual([2, 0.015]);
+  });
+  it("a station's tile pack fields: kept when sound, null when garbled", () => {
+    const station = (extra: object) => ({ role: "viewer", name: "v", station: { name: "s", origin: { lat_deg: 1, lon_deg: 2 }, ...extra } });
+    const ok = parseSession(station({ offline_tiles_error: "tile pack x.mbtiles: no such file", tile_max_zoom: 15, tile_bounds: [-8, 38, -7, 39] }));
+    expect(ok.ok && [ok.value.station.offline_tiles_error, ok.value.station.tile_max_zoom, ok.value.station.tile_bounds]).toEqual([
+      "tile pack x.mbtiles: no such file", 15, [-8, 38, -7, 39]]);
+    for (const tile_bounds of [[-7, 38, -8, 39], [-8, 38, -7], [-8, 95, -7, 96], "w,s,e,n"]) {
+      const p = parseSession(station({ tile_bounds }));
+      expect(p.ok && p.value.station.tile_bounds).toBeNull();
+    }
+    const none = parseSession(station({}));
+    expect(none.ok && [none.value.station.offline_tiles_error, none.value.station.tile_max_zoom]).toEqual([null, null]);
   });
   it("sessions with an unknown role are refused", () => {
     expect(parseSession({ role: "admin", station: { origin: { lat_deg: 0, lon_deg: 0 } } }).ok).toBe(false);

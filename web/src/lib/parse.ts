@@ -120,6 +120,13 @@ const position = (v: unknown): Position | null => {
   return ll === null || !isObj(v) ? null : { ...ll, alt_msl_m: num(v, "alt_msl_m") };
 };
 
+/** West, south, east, north in range with west < east and south < north, else null. */
+const bounds = (v: unknown): [number, number, number, number] | null => {
+  if (!Array.isArray(v) || v.length !== 4) return null;
+  const [w, s, e, n] = v as unknown[];
+  return isLon(w) && isLat(s) && isLon(e) && isLat(n) && w < e && s < n ? [w, s, e, n] : null;
+};
+
 function parseStation(o: Obj): Station | null {
   const origin = position(o.origin);
   if (origin === null) return null;
@@ -130,6 +137,9 @@ function parseStation(o: Obj): Station | null {
     tile_url: str(o, "tile_url"),
     tile_attribution: str(o, "tile_attribution") ?? "",
     offline_tiles: bool(o, "offline_tiles") ?? false,
+    offline_tiles_error: str(o, "offline_tiles_error"),
+    tile_max_zoom: num(o, "tile_max_zoom"),
+    tile_bounds: bounds(o.tile_bounds),
     modes,
     replay: bool(o, "replay") ?? false,
   };

@@ -13,7 +13,7 @@ import { distanceM, ellipsePoints, fromLocal, gridValues, niceStep, toLocal } fr
 import { fmt, fmtDir, fmtDistance } from "../lib/format";
 import { boxAround, keyPoints, needsFraming, type Box } from "../lib/framing";
 import { isLanded } from "../lib/recovery";
-import { tilesBadge } from "../lib/tiles";
+import { packNote, tilesBadge } from "../lib/tiles";
 import { withToken } from "../lib/token";
 import type { LandingPrediction, LatLon, State, Station, TrackPoint } from "../lib/types";
 
@@ -59,6 +59,8 @@ export class MapView {
   private lastTrackKey = "";
 
   private tiles: L.TileLayer | null = null;
+  /** Why the station's tile pack gives no map, as it said. */
+  private readonly packError: string | null;
 
   constructor(station: Station, tileToken: string | null) {
     this.origin = station.origin;
@@ -69,7 +71,15 @@ export class MapView {
       // Tiles are fetched by <img>, which cannot send the Authorization header: a station-relative
       // tile URL gets the token as a query parameter, like the WebSocket.
       const url = station.tile_url.startsWith("/") && tileToken !== null ? withToken(station.tile_url, tileToken) : station.tile_url;
-      this.tiles = L.tileLayer(url, { maxZoom: 19, attribution: station.tile_attribution });
+      // A station's tile pack covers one region to one zoom: deeper, its tiles are enlarged;
+      // outside, none are asked (each would be a failed tile on the badge).
+      const b = station.tile_bounds;
+      this.tiles = L.tileLayer(url, {
+        maxZoom: 19,
+        attribution: station.tile_attribution,
+        ...(station.tile_max_zoom !== null ? { maxNativeZoom: station.tile_max_zoom } : {}),
+        ...(b !== null ? { bounds: L.latLngBounds([b[1], b[0]], [b[3], b[2]]) } : {}),
+      });
       this.tiles.on("tileload", () => this.onTile(true));
       this.tiles.on("tileerror", () => this.onTile(false));
       this.tiles.addTo(this.map);
@@ -86,15 +96,18 @@ export class MapView {
     for (const layer of [this.pattern, this.final, this.ellUncontrolled, this.ellPlanned, this.track, this.draftPlan, this.draftLocalizer]) layer.addTo(this.map);
 
     // Badges drawn on top of the map: tiles status, wind, final approach, landing, follow toggle.
-    const tb = tilesBadge(this.tiles !== null, 0, 0);
+    this.packError = station.offline_tiles_error;
+    const tb = tilesBadge(this.tiles !== null, 0, 0, this.packError);
     this.tilesStatus = h("div", { class: "map-badge", "data-testid": "map-tiles-status", "data-state": tb.state }, tb.text);
+    const note = packNote(this.packError);
+    const packNoteEl = h("div", { class: "map-badge pack-error", "data-testid": "map-tiles-error", role: "status", hidden: note === null }, note ?? "");
     this.windArrow = h("div", { class: "wind-arrow", "aria-hidden": "true" }, "➜");
     this.windText = h("span", { "data-testid": "map-wind" }, "wind —");
     this.finalText = h("div", { class: "map-badge final", "data-testid": "map-final", hidden: true });
     this.landedText = h("div", { class: "map-badge landed", "data-testid": "map-landed", hidden: true });
     this.followBtn = h("button", { type: "button", class: "small on", "data-testid": "map-follow", "aria-pressed": "true", title: "keep the vehicle, target, pattern and predicted landings in view (off when you drag or zoom)" }, "Follow");
     this.followBtn.addEventListener("click", () => this.setFollow(!this.follow));
-    const overlay = h("div", { class: "map-overlay", "data-testid": "map-overlay" }, this.tilesStatus, h("div", { class: "map-badge wind" }, this.windArrow, this.windText), this.finalText, this.landedText, this.followBtn);
+    const overlay = h("div", { class: "map-overlay", "data-testid": "map-overlay" }, this.tilesStatus, packNoteEl, h("div", { class: "map-badge wind" }, this.windArrow, this.windText), this.finalText, this.landedText, this.followBtn);
     L.DomEvent.disableClickPropagation(overlay);
     L.DomEvent.disableScrollPropagation(overlay);
     el.append(overlay);
@@ -262,7 +275,7 @@ export class MapView {
   private onTile(ok: boolean): void {
     if (ok) this.tilesLoaded += 1;
     else this.tilesFailed += 1;
-    const b = tilesBadge(true, this.tilesLoaded, this.tilesFailed);
+    const b = tilesBadge(true, this.tilesLoaded, this.tilesFailed, this.packError);
     const offline = b.state === "offline";
     // A tile source that answers nothing (offline field, no cache): stop asking, so the browser
     // does not log a failed request for every pan; the grid carries the map. A reload tries again.
