@@ -21,8 +21,11 @@ fn scratch(name: &str) -> PathBuf {
     dir
 }
 
+/// A tile's XYZ address and its bytes.
+type TileAt = ((u8, u32, u32), Vec<u8>);
+
 /// An MBTiles pack: tiles given at XYZ addresses, stored in TMS rows (`2^z - 1 - y`).
-fn write_mbtiles(path: &Path, tiles: &[((u8, u32, u32), Vec<u8>)]) {
+fn write_mbtiles(path: &Path, tiles: &[TileAt]) {
     let db = Connection::open(path).expect("db");
     db.execute_batch(
         "CREATE TABLE metadata (name TEXT, value TEXT);
