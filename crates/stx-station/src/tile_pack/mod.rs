@@ -1,6 +1,6 @@
 //! Offline map tile packs: one file, prepared at home, that holds the map of the field (fields,
 //! roads, water) for a laptop with no internet. The station opens it at start and serves its
-//! tiles under `/tiles/{z}/{x}/{y}`; the dashboard's map and the recovery page draw them.
+//! tiles under `/tiles/{z}/{x}/{y}`, which the dashboard's map draws.
 //!
 //! Two formats, told apart by the file's extension:
 //! - MBTiles (`.mbtiles`, [`mbtiles`]): SQLite, what most tile tools export;
