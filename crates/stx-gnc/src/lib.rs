@@ -20,6 +20,8 @@
 //!   and [`predict`] uses it to say where the vehicle will land;
 //! - [`ascent_wind`] measures the wind profile from the balloon's drift during the ascent, by
 //!   altitude band with its uncertainty, and joins it to the forecast for the predictions;
+//! - [`keep_out`] reads the keep-out zones (GeoJSON polygons) into the local frame and says
+//!   whether a point lies in one and whether a leg crosses one;
 //! - [`geo`] links the mission's local NED frame to latitude, longitude and altitude;
 //! - [`plan_upload`] turns an uploaded plan (waypoints, landing point) into guidance's plan,
 //!   the same way on the drone and in the station's replica;
@@ -31,6 +33,7 @@ pub mod estimate;
 pub mod estimator;
 pub mod geo;
 pub mod guidance;
+pub mod keep_out;
 pub mod measurement;
 pub mod mission;
 pub mod params;

@@ -1,0 +1,245 @@
+//! Keep-out zones: the places the payload must not land on (water, a border, forest, roads,
+//! people), read from GeoJSON (RFC 7946) polygons and asked in the mission's local frame
+//! whether a point lies in one and whether a straight leg crosses one.
+//!
+//! A zone is a few hundred metres to a few kilometres across, so its rings are flattened once
+//! into the local north–east plane of [`LocalFrame`] (the error of that flat-Earth step is
+//! centimetres at these sizes) and every later question is plane geometry: the even–odd rule
+//! for inside (holes in a polygon are outside its zone), segment intersection for a leg. The
+//! `geojson` crate parses and checks the text's structure; what it leaves to its users (rings
+//! closed and long enough, coordinates finite and on the globe) is checked here, and a bad file
+//! is refused with the feature and the rule it breaks.
+
+use geojson::{GeoJson, GeometryValue, PolygonType};
+use thiserror::Error;
+
+use crate::geo::LocalFrame;
+
+/// Why a keep-out file was refused.
+#[derive(Debug, Error, PartialEq)]
+pub enum KeepOutError {
+    /// Not GeoJSON.
+    #[error("keep-out zones are not GeoJSON: {0}")]
+    Parse(String),
+    /// A feature whose geometry is not an area.
+    #[error("keep-out feature {feature}: a {found} is not an area (Polygon or MultiPolygon)")]
+    NotAnArea {
+        /// Index of the feature in the file.
+        feature: usize,
+        /// The geometry's type.
+        found: String,
+    },
+    /// A ring that is not a closed polygon boundary.
+    #[error("keep-out feature {feature}: ring {ring} {reason}")]
+    Ring {
+        /// Index of the feature in the file.
+        feature: usize,
+        /// Index of the ring in its polygon (0 the boundary, then holes).
+        ring: usize,
+        /// The rule broken.
+        reason: &'static str,
+    },
+    /// A position off the globe or not a number.
+    #[error(
+        "keep-out feature {feature}: position [{lon}, {lat}] is not a longitude in −180…180° and a latitude in −90…90°"
+    )]
+    Position {
+        /// Index of the feature in the file.
+        feature: usize,
+        /// Longitude given, degrees.
+        lon: f64,
+        /// Latitude given, degrees.
+        lat: f64,
+    },
+}
+
+/// One zone: a polygon in the local frame.
+#[derive(Debug, Clone, PartialEq)]
+pub struct KeepOutZone {
+    /// The feature's `name` property, else `zone N` (N its index in the file).
+    pub name: String,
+    /// Rings as (north, east) in metres, closing point dropped: the boundary first, then holes.
+    pub rings_ne_m: Vec<Vec<[f64; 2]>>,
+}
+
+impl KeepOutZone {
+    /// Whether `p` (north, east, m) lies in the zone (not in one of its holes).
+    pub fn contains(&self, p: [f64; 2]) -> bool {
+        // Even–odd over every ring: a point in a hole crosses the boundary and the hole.
+        self.rings_ne_m
+            .iter()
+            .filter(|ring| ring_contains(ring, p))
+            .count()
+            % 2
+            == 1
+    }
+
+    /// Whether the straight leg from `a` to `b` (north, east, m) enters the zone: an end in
+    /// it, or an edge crossed.
+    pub fn crossed_by(&self, a: [f64; 2], b: [f64; 2]) -> bool {
+        self.contains(a)
+            || self.contains(b)
+            || self
+                .rings_ne_m
+                .iter()
+                .flat_map(|ring| edges(ring))
+                .any(|(c, d)| segments_cross(a, b, c, d))
+    }
+}
+
+/// The zones of one mission.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct KeepOutZones {
+    /// The zones, in the file's order (a MultiPolygon gives one zone per polygon).
+    pub zones: Vec<KeepOutZone>,
+}
+
+impl KeepOutZones {
+    /// Reads a GeoJSON FeatureCollection, Feature or bare geometry of Polygons and
+    /// MultiPolygons, placing it in `frame`.
+    pub fn from_geojson(text: &str, frame: &LocalFrame) -> Result<Self, KeepOutError> {
+        let parsed: GeoJson = text
+            .parse()
+            .map_err(|e: geojson::Error| KeepOutError::Parse(e.to_string()))?;
+        let features: Vec<(Option<String>, Option<geojson::Geometry>)> = match parsed {
+            GeoJson::FeatureCollection(fc) => fc
+                .features
+                .into_iter()
+                .map(|f| (name_of(&f), f.geometry))
+                .collect(),
+            GeoJson::Feature(f) => vec![(name_of(&f), f.geometry)],
+            GeoJson::Geometry(g) => vec![(None, Some(g))],
+        };
+        let mut zones = Vec::new();
+        for (feature, (name, geometry)) in features.into_iter().enumerate() {
+            let name = name.unwrap_or_else(|| format!("zone {feature}"));
+            let polygons = match geometry.map(|g| g.value) {
+                Some(GeometryValue::Polygon { coordinates }) => vec![coordinates],
+                Some(GeometryValue::MultiPolygon { coordinates }) => coordinates,
+                Some(other) => {
+                    return Err(KeepOutError::NotAnArea {
+                        feature,
+                        found: other.type_name().to_string(),
+                    });
+                }
+                None => {
+                    return Err(KeepOutError::NotAnArea {
+                        feature,
+                        found: "feature without geometry".into(),
+                    });
+                }
+            };
+            for polygon in polygons {
+                zones.push(KeepOutZone {
+                    name: name.clone(),
+                    rings_ne_m: flatten(&polygon, frame, feature)?,
+                });
+            }
+        }
+        Ok(Self { zones })
+    }
+
+    /// The first zone `p` (north, east, m) lies in.
+    pub fn zone_at(&self, p: [f64; 2]) -> Option<&KeepOutZone> {
+        self.zones.iter().find(|z| z.contains(p))
+    }
+
+    /// The first zone the straight leg from `a` to `b` enters.
+    pub fn crossed_by(&self, a: [f64; 2], b: [f64; 2]) -> Option<&KeepOutZone> {
+        self.zones.iter().find(|z| z.crossed_by(a, b))
+    }
+}
+
+fn name_of(feature: &geojson::Feature) -> Option<String> {
+    feature
+        .properties
+        .as_ref()?
+        .get("name")?
+        .as_str()
+        .map(str::to_string)
+}
+
+/// The polygon's rings in the local plane, each checked and its closing point dropped.
+fn flatten(
+    polygon: &PolygonType,
+    frame: &LocalFrame,
+    feature: usize,
+) -> Result<Vec<Vec<[f64; 2]>>, KeepOutError> {
+    if polygon.is_empty() {
+        return Err(KeepOutError::Ring {
+            feature,
+            ring: 0,
+            reason: "is missing: a polygon needs its boundary",
+        });
+    }
+    polygon
+        .iter()
+        .enumerate()
+        .map(|(ring, positions)| {
+            let bad = |reason| KeepOutError::Ring {
+                feature,
+                ring,
+                reason,
+            };
+            if positions.len() < 4 {
+                return Err(bad(
+                    "has fewer than 4 positions (a triangle and its closing point)",
+                ));
+            }
+            let mut points = Vec::with_capacity(positions.len());
+            for position in positions {
+                let &[lon, lat, ..] = position.as_slice() else {
+                    return Err(bad("has a position with fewer than 2 numbers"));
+                };
+                if !(lon.is_finite() && lat.is_finite()) || lon.abs() > 180.0 || lat.abs() > 90.0 {
+                    return Err(KeepOutError::Position { feature, lon, lat });
+                }
+                let ned = frame.to_ned(lat, lon, frame.alt_msl_m);
+                points.push([ned.x, ned.y]);
+            }
+            if positions.first().map(|p| p.as_slice()) != positions.last().map(|p| p.as_slice()) {
+                return Err(bad(
+                    "is not closed (its last position must repeat its first)",
+                ));
+            }
+            points.pop();
+            Ok(points)
+        })
+        .collect()
+}
+
+/// A ring's edges, the closing one included.
+fn edges(ring: &[[f64; 2]]) -> impl Iterator<Item = ([f64; 2], [f64; 2])> + '_ {
+    ring.iter()
+        .zip(ring.iter().cycle().skip(1))
+        .map(|(a, b)| (*a, *b))
+}
+
+/// Even–odd ray cast towards +east.
+fn ring_contains(ring: &[[f64; 2]], p: [f64; 2]) -> bool {
+    let mut inside = false;
+    for (a, b) in edges(ring) {
+        if (a[0] > p[0]) != (b[0] > p[0]) {
+            let east = a[1] + (p[0] - a[0]) / (b[0] - a[0]) * (b[1] - a[1]);
+            if p[1] < east {
+                inside = !inside;
+            }
+        }
+    }
+    inside
+}
+
+/// Whether segments `ab` and `cd` cross or touch.
+fn segments_cross(a: [f64; 2], b: [f64; 2], c: [f64; 2], d: [f64; 2]) -> bool {
+    let cross = |o: [f64; 2], p: [f64; 2], q: [f64; 2]| {
+        (p[0] - o[0]) * (q[1] - o[1]) - (p[1] - o[1]) * (q[0] - o[0])
+    };
+    let (d1, d2) = (cross(c, d, a), cross(c, d, b));
+    let (d3, d4) = (cross(a, b, c), cross(a, b, d));
+    // Collinear segments (all four zero) would pass the sign tests even when apart; an
+    // overlap along an edge is caught by the ends' `contains` instead.
+    d1 * d2 <= 0.0 && d3 * d4 <= 0.0 && !(d1 == 0.0 && d2 == 0.0 && d3 == 0.0 && d4 == 0.0)
+}
+
+#[cfg(test)]
+mod tests;
