@@ -179,11 +179,7 @@ mod tests {
     const PNG: &[u8] = b"\x89PNG\r\n\x1a\n\0\0\0\rIHDR";
 
     fn scratch(name: &str) -> PathBuf {
-        let dir =
-            std::env::temp_dir().join(format!("stx-station-mbtiles-{}-{name}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).expect("scratch dir");
-        dir
+        super::super::scratch_dir("mbtiles", name)
     }
 
     /// A pack with `metadata` rows and tiles at their XYZ addresses, stored in TMS rows as

@@ -401,6 +401,19 @@ pub(crate) fn plain_text(text: &str) -> String {
     out.split_whitespace().collect::<Vec<_>>().join(" ")
 }
 
+/// An empty directory of its own for a test's packs, `format` and `name` keeping the tests
+/// of both readers apart when they run at once.
+#[cfg(test)]
+fn scratch_dir(format: &str, name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!(
+        "stx-station-{format}-{}-{name}",
+        std::process::id()
+    ));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("scratch dir");
+    dir
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

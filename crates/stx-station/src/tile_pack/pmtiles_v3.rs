@@ -154,11 +154,7 @@ mod tests {
     use pmtiles::PmTilesWriter;
 
     fn scratch(name: &str) -> PathBuf {
-        let dir =
-            std::env::temp_dir().join(format!("stx-station-pmtiles-{}-{name}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).expect("scratch dir");
-        dir
+        super::super::scratch_dir("pmtiles", name)
     }
 
     fn png(tag: u32) -> Vec<u8> {
