@@ -20,262 +20,32 @@
 // new live station listing the recordings (size, run, landing and miss, download, open in replay).
 //
 // Usage: node tests/browser/live.mjs [path/to/stx]   (default target/release/stx)
-// Env: CHROMIUM (default /usr/bin/chromium), SIM_SPEED (default 5).
+// Env: CHROMIUM (default /usr/bin/chromium), SIM_SPEED (default 5). The harness every browser test
+// shares (chromium, the tally, the contract, processes): ./harness.mjs.
 
-import { spawn } from "node:child_process";
-import { createSocket } from "node:dgram";
-import { mkdir, mkdtemp, readFile, readdir, stat } from "node:fs/promises";
-import { tmpdir } from "node:os";
-import { createRequire } from "node:module";
-import { basename, dirname, join, resolve } from "node:path";
-import { fileURLToPath, pathToFileURL } from "node:url";
+import { readFile, readdir, stat } from "node:fs/promises";
+import { basename, join } from "node:path";
+import {
+  OPERATOR, VIEWER, FIELD_HOST, root, out, speed, sleep, check, newContext, distanceM, bearingDeg, fromNorthEast, angleDiff, shownMetres, rad,
+  run, recordDir, startStation, freeUdpPort, apiOf, until, text, attr, watchErrors, hold, lastRequest, stopChildren, runFlights,
+} from "./harness.mjs";
 
-const here = dirname(fileURLToPath(import.meta.url));
-const root = resolve(here, "../..");
-// playwright-core comes from the dashboard's own locked dependencies (web/package-lock.json).
-const { chromium } = createRequire(join(root, "web/package.json"))("playwright-core");
-const { contract } = await import(pathToFileURL(join(root, "web/scripts/contract.mjs")).href);
-const out = join(root, "tests/output/browser");
-await mkdir(out, { recursive: true });
-
-const stxBin = resolve(process.argv[2] ?? join(root, "target/release/stx"));
-const speed = Number(process.env.SIM_SPEED ?? 5);
-const OPERATOR = "operator-token";
-const VIEWER = "viewer-token";
-const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
-const started = Date.now();
-const FIELD_HOST = "stx-field.test";
-
-const results = [];
-let failed = false;
-function check(name, ok, detail = "") {
-  results.push(`${ok ? "PASS" : "FAIL"}  ${name}${detail ? ` — ${detail}` : ""}`);
-  console.log(results[results.length - 1]);
-  if (!ok) failed = true;
-}
-
-// ------------------------------------------------------------------ the API's contract
-const api = contract();
-const seen = new Map(); // contract name (or WebSocket type) -> how many were valid
-let broken = null; // the first message that broke the contract
-const pendingBodies = [];
-let lastRequestId = null;
-/** Checks one message against the contract's definition `name`; remembers the first that breaks it. */
-function conform(where, name, value) {
-  const error = api.check(name, value);
-  if (error !== null) {
-    if (broken === null) {
-      broken = `${where}: ${error} in ${JSON.stringify(value).slice(0, 300)}`;
-      console.log(`CONTRACT BROKEN  ${broken}`);
-    }
-    return;
-  }
-  const key = name === "ServerMessage" || name === "ClientMessage" ? `${name}:${value.type}` : name;
-  seen.set(key, (seen.get(key) ?? 0) + 1);
-}
-/** What the contract calls a REST body: `[request body or null, response body]` for one call. */
-function restNames(method, path, status) {
-  if (status >= 400) return [null, "ErrorBody"];
-  const gets = { "/api/session": "Session", "/api/state": "StateMsg", "/api/params": "ParamsMsg", "/api/events": "EventsBody", "/api/track": "TrackBody", "/api/clients": "ClientsBody" };
-  if (method === "GET" && gets[path]) return [null, gets[path]];
-  if (method === "GET" && /^\/api\/commands\/[^/]+$/.test(path)) return [null, "CommandResultMsg"];
-  const commands = { mode: "ModeBody", heading: "HeadingBody", course: "CourseBody", localizer: "LocalizerBody", target: "TargetBody", plan: "PlanBody" };
-  const command = /^\/api\/commands\/(\w+)$/.exec(path)?.[1];
-  if (method === "POST" && command && commands[command]) return [commands[command], "CommandAccepted"];
-  if (method === "POST" && /^\/api\/params\/[^/]+$/.test(path)) return ["ParamBody", "CommandAccepted"];
-  if (method === "POST" && path === "/api/cutdown/arm") return [null, "CutdownArm"];
-  if (method === "POST" && path === "/api/cutdown/confirm") return ["ConfirmBody", "CommandAccepted"];
-  if (path === "/api/replay") return [method === "POST" ? "ReplayBody" : null, "ReplayView"];
-  if (method === "GET" && path === "/api/recordings") return [null, "RecordingsBody"];
-  if (method === "POST" && /^\/api\/recordings\/[^/]+\/replay$/.test(path)) return [null, "ReplayOpened"];
-  return [null, null];
-}
-function conformRest(where, method, path, status, request, body) {
-  const [requestName, responseName] = restNames(method, path, status);
-  if (responseName === null) {
-    broken ??= `${where}: ${method} ${path} (${status}) is not in the contract`;
-    return;
-  }
-  if (requestName !== null && request !== undefined) conform(`${where} ${method} ${path} request`, requestName, request);
-  conform(`${where} ${method} ${path} → ${status}`, responseName, body);
-  if (responseName === "CommandAccepted" && typeof body?.request_id === "string") lastRequestId = body.request_id;
-}
-/** Validates everything a browser context's pages exchange with the station. */
-function watchContract(ctx, label) {
-  const frames = (page) => page.on("websocket", (ws) => {
-    if (!new URL(ws.url()).pathname.startsWith("/api/ws")) return;
-    const json = (f, dir) => {
-      try {
-        return JSON.parse(f.payload);
-      } catch {
-        broken ??= `${label} WebSocket ${dir}: not JSON: ${String(f.payload).slice(0, 80)}`;
-        return undefined;
-      }
-    };
-    ws.on("framereceived", (f) => {
-      const m = json(f, "received");
-      if (m !== undefined) conform(`${label} WebSocket, station → page`, "ServerMessage", m);
-    });
-    ws.on("framesent", (f) => {
-      const m = json(f, "sent");
-      if (m !== undefined) conform(`${label} WebSocket, page → station`, "ClientMessage", m);
-    });
-  });
-  ctx.on("page", frames);
-  ctx.on("response", (r) => {
-    const url = new URL(r.url());
-    if (!url.pathname.startsWith("/api/") || url.pathname === "/api/ws") return;
-    const req = r.request();
-    let request;
-    try {
-      request = req.postData() === null ? undefined : req.postDataJSON();
-    } catch {
-      request = req.postData();
-    }
-    pendingBodies.push(r.text().then(
-      (text) => {
-        let body;
-        try {
-          body = JSON.parse(text);
-        } catch {
-          broken ??= `${label} ${req.method()} ${url.pathname} → ${r.status()}: not JSON: ${text.slice(0, 80)}`;
-          return;
-        }
-        conformRest(label, req.method(), url.pathname, r.status(), request, body);
-      },
-      () => {}, // the page went away before the body arrived
-    ));
-  });
-}
-async function newContext(label, options) {
-  const ctx = await browser.newContext(options);
-  watchContract(ctx, label);
-  return ctx;
-}
-
-// ------------------------------------------------------------------ geodesy for the checks
-const R = 6371008.8;
-const rad = Math.PI / 180;
-/** Great-circle distance, m. */
-function distanceM(a, b) {
-  const h = Math.sin(((b.lat_deg - a.lat_deg) * rad) / 2) ** 2 + Math.cos(a.lat_deg * rad) * Math.cos(b.lat_deg * rad) * Math.sin(((b.lon_deg - a.lon_deg) * rad) / 2) ** 2;
-  return 2 * R * Math.asin(Math.sqrt(h));
-}
-/** Initial great-circle bearing from a to b, degrees [0, 360). */
-function bearingDeg(a, b) {
-  const y = Math.sin((b.lon_deg - a.lon_deg) * rad) * Math.cos(b.lat_deg * rad);
-  const x = Math.cos(a.lat_deg * rad) * Math.sin(b.lat_deg * rad) - Math.sin(a.lat_deg * rad) * Math.cos(b.lat_deg * rad) * Math.cos((b.lon_deg - a.lon_deg) * rad);
-  return (Math.atan2(y, x) / rad + 360) % 360;
-}
-/** North/east metres from a site to lat/lon on the WGS-84 tangent plane (as stx-gnc's LocalFrame). */
-function fromNorthEast(site, north_m, east_m) {
-  const s = Math.sin(site.lat_deg * rad);
-  const w = Math.sqrt(1 - 6.69437999014e-3 * s * s);
-  const meridian = (6378137 * (1 - 6.69437999014e-3)) / w ** 3;
-  const prime = 6378137 / w;
-  return { lat_deg: site.lat_deg + north_m / meridian / rad, lon_deg: site.lon_deg + east_m / (prime * Math.cos(site.lat_deg * rad)) / rad };
-}
-const angleDiff = (a, b) => Math.abs(((a - b + 540) % 360) - 180);
-/** "812 m" / "1.23 km" → metres. */
-const shownMetres = (t) => (/km/.test(t) ? parseFloat(t) * 1000 : parseFloat(t));
-
-// ------------------------------------------------------------------ processes
-const children = [];
-const logs = [];
-function run(args, label) {
-  const p = spawn(stxBin, args, { cwd: root, stdio: ["ignore", "pipe", "pipe"], env: { ...process.env, RUST_LOG: "warn" } });
-  const io = { proc: p, out: "", err: "", label };
-  p.stdout.on("data", (d) => (io.out += d));
-  p.stderr.on("data", (d) => (io.err += d));
-  children.push(io);
-  logs.push(io);
-  return io;
-}
-/** Each station of the test records its run here (not in the user's state directory). */
-const recordDir = await mkdtemp(join(tmpdir(), "stx-browser-recordings-"));
-async function startStation(args) {
-  const io = run(["serve", "--listen", "127.0.0.1:0", "--record-dir", recordDir, ...args], "stx serve");
-  for (let i = 0; i < 100 && !/open (http:\/\/\S+)\/\?token=/.test(io.out); i++) await sleep(100);
-  const found = /open (http:\/\/\S+)\/\?token=/.exec(io.out);
-  if (!found) throw new Error(`stx serve did not start:\n${io.out}\n${io.err}`);
-  return { io, base: found[1] };
-}
-/** A free loopback UDP port for the station's link (the drone must know it before it starts). */
-async function freeUdpPort() {
-  const s = createSocket("udp4");
-  await new Promise((r) => s.bind(0, "127.0.0.1", r));
-  const port = s.address().port;
-  await new Promise((r) => s.close(r));
-  return port;
-}
-
-/** The station's API, as the drone's telemetry arrives in it. */
-function apiOf(base) {
-  return async (path, token = VIEWER, init = {}) => {
-    const r = await fetch(`${base}${path}`, { ...init, headers: { authorization: `Bearer ${token}`, "content-type": "application/json", ...(init.headers ?? {}) } });
-    const body = await r.json().catch(() => null);
-    const request = typeof init.body === "string" ? JSON.parse(init.body) : undefined;
-    conformRest("test", init.method ?? "GET", new URL(r.url).pathname, r.status, request, body);
-    return { status: r.status, body };
-  };
-}
-async function until(what, pred, timeoutMs, everyMs = 200) {
-  const t0 = Date.now();
-  let last;
-  while (Date.now() - t0 < timeoutMs) {
-    last = await what();
-    if (pred(last)) return last;
-    await sleep(everyMs);
-  }
-  return last;
-}
-
-const browser = await chromium.launch({
-  executablePath: process.env.CHROMIUM ?? "/usr/bin/chromium",
-  // FIELD_HOST is the station under a name that is not loopback, as a phone reaches the field
-  // laptop: plain HTTP there is not a secure context, so the browser gives no position.
-  args: ["--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking", "--disable-component-update", "--disable-sync", "--no-first-run", "--enable-unsafe-swiftshader", `--host-resolver-rules=MAP ${FIELD_HOST} 127.0.0.1`],
-});
-const text = (page, id) => page.locator(`[data-testid="${id}"]`).first().innerText();
-const attr = (page, id, name) => page.locator(`[data-testid="${id}"]`).first().getAttribute(name);
-const rectOf = (page, sel) => page.evaluate((s) => {
-  const e = document.querySelector(s);
-  if (!e) return null;
-  const b = e.getBoundingClientRect();
-  return { left: b.left, top: b.top, right: b.right, bottom: b.bottom, width: b.width, height: b.height };
-}, sel);
-const pageErrors = [];
-function watchErrors(page, label) {
-  page.on("pageerror", (e) => pageErrors.push(`${label}: ${e.message}`));
-  page.on("console", (m) => {
-    if (m.type() === "error" && !/Failed to load resource/.test(m.text())) pageErrors.push(`${label}: ${m.text()}`);
-  });
-}
-/** Presses the pointer on an element for `ms`, as a person holding a button. */
-async function hold(page, id, ms) {
-  const b = await page.locator(`[data-testid="${id}"]`).boundingBox();
-  await page.mouse.move(b.x + b.width / 2, b.y + b.height / 2);
-  await page.mouse.down();
-  await sleep(ms);
-  await page.mouse.up();
-}
 /** Values the altitude plot holds (what uPlot draws: null is a gap), with their times. */
 const altitudePlot = (page) => page.evaluate(() => {
   const u = document.querySelector('[data-testid="plot-altitude"]')?.uplot;
   return u ? { t: Array.from(u.data[0]), v: Array.from(u.data[1]) } : null;
 });
 
-try {
+// Each kind the pages must have met, so that the contract check cannot pass on silence.
+const expected = ["RecordingsBody", "ReplayOpened", "ServerMessage:hello", "ServerMessage:state", "ServerMessage:history", "ServerMessage:event", "ServerMessage:command_result", "ServerMessage:params",
+  "ClientMessage:manual", "ClientMessage:manual_release", "Session", "StateMsg", "ParamsMsg", "EventsBody", "TrackBody", "ClientsBody", "CommandResultMsg", "CommandAccepted",
+  "CutdownArm", "ErrorBody", "ModeBody", "TargetBody", "ParamBody", "ConfirmBody"];
+await runFlights(async () => {
   await missionShort();
   const rehearsed = await rehearsal();
   const replayed = await replay(rehearsed.station);
   await pastRecordings(replayed, rehearsed.landing);
-} catch (e) {
-  check("the test ran to the end", false, e instanceof Error ? (e.stack ?? e.message) : String(e));
-} finally {
-  await browser.close();
-  for (const c of children) c.proc.kill("SIGTERM");
-}
+}, expected);
 
 // ==================================================================== 1. mission-short, ascent
 async function missionShort() {
@@ -353,7 +123,7 @@ async function missionShort() {
   check("the page shows the cutdown accepted by the drone", (await page.locator('[data-testid="command-item"][data-command="cutdown"]').first().getAttribute("data-status")) === "accepted");
   await page.screenshot({ path: join(out, "live-cutdown.png") });
   await ctx.close();
-  for (const c of children.splice(0)) c.proc.kill("SIGTERM");
+  stopChildren();
 }
 
 // ==================================================================== 2. rehearsal, under the parafoil
@@ -643,11 +413,11 @@ async function rehearsal() {
     clients: await api("/api/clients"),
     track: await api("/api/track?every_s=5"),
     events: await api("/api/events?since_s=0"),
-    result: lastRequestId === null ? null : await api(`/api/commands/${encodeURIComponent(lastRequestId)}`),
+    result: lastRequest() === null ? null : await api(`/api/commands/${encodeURIComponent(lastRequest())}`),
     unknown: await api("/api/no-such-endpoint"),
   };
   check("REST: clients, track, events, a command's result and a 404, as the contract has them", rest.clients.body?.clients?.length >= 1 && rest.track.body?.points?.length > 0 && rest.events.body?.events?.length > 0 && rest.result?.status === 200 && rest.unknown.status === 404,
-    `${rest.clients.body?.clients?.length} clients, ${rest.track.body?.points?.length} track points, ${rest.events.body?.events?.length} events, result of ${lastRequestId}: ${rest.result?.status}, unknown endpoint: ${rest.unknown.status}`);
+    `${rest.clients.body?.clients?.length} clients, ${rest.track.body?.points?.length} track points, ${rest.events.body?.events?.length} events, result of ${lastRequest()}: ${rest.result?.status}, unknown endpoint: ${rest.unknown.status}`);
 
   // ---------------------------------------------------------------- recovery page without the phone's position
   const nctx = await newContext("recovery without position", { viewport: { width: 390, height: 844 }, isMobile: true, hasTouch: true });
@@ -814,17 +584,3 @@ async function pastRecordings(rehearsalFile, landing) {
   await popup.close();
   await ctx.close();
 }
-
-check("no page errors", pageErrors.length === 0, pageErrors.slice(0, 5).join(" | "));
-await Promise.allSettled(pendingBodies);
-// Each kind the pages must have met, so that the check below cannot pass on silence.
-const expected = ["RecordingsBody", "ReplayOpened", "ServerMessage:hello", "ServerMessage:state", "ServerMessage:history", "ServerMessage:event", "ServerMessage:command_result", "ServerMessage:params",
-  "ClientMessage:manual", "ClientMessage:manual_release", "Session", "StateMsg", "ParamsMsg", "EventsBody", "TrackBody", "ClientsBody", "CommandResultMsg", "CommandAccepted",
-  "CutdownArm", "ErrorBody", "ModeBody", "TargetBody", "ParamBody", "ConfirmBody"];
-const missing = expected.filter((k) => !seen.has(k));
-check("every message between the station and the pages matches the contract (web/src/generated/api.schema.json)", broken === null && missing.length === 0,
-  broken ?? (missing.length > 0 ? `never seen: ${missing.join(", ")}` : [...seen].map(([k, n]) => `${k} ${n}`).join(", ")));
-const passed = results.filter((r) => r.startsWith("PASS")).length;
-console.log(`\n${passed} passed, ${results.length - passed} failed in ${((Date.now() - started) / 1000).toFixed(0)} s; screenshots in ${out}`);
-if (failed) for (const c of logs) console.log(`${c.label} stderr (tail):\n${c.err.split("\n").slice(-20).join("\n")}`);
-process.exit(failed ? 1 : 0);
