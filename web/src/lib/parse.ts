@@ -127,7 +127,7 @@ const bounds = (v: unknown): [number, number, number, number] | null => {
   return isLon(w) && isLat(s) && isLon(e) && isLat(n) && w < e && s < n ? [w, s, e, n] : null;
 };
 
-function parseStation(o: Obj): Station | null {
+export function parseStation(o: Obj): Station | null {
   const origin = position(o.origin);
   if (origin === null) return null;
   const modes = Array.isArray(o.modes) ? o.modes.filter((m): m is FlightMode => typeof m === "string" && Object.hasOwn(MODES, m)) : [];

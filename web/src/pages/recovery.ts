@@ -11,17 +11,20 @@ import "../styles/recovery.css";
 import { Api } from "../lib/api";
 import { bearingDeg, distanceM } from "../lib/geo";
 import { cardinal, fmtDir, fmtDistance, fmtDuration, fmtLatLon, fmtWallUtc, wrap360 } from "../lib/format";
-import { isObj, parseState } from "../lib/parse";
+import { isObj, parseSession, parseState, parseStation } from "../lib/parse";
 import { parsePosition, positionUnavailable } from "../lib/position";
 import { recoveryPoint } from "../lib/recovery";
 import { resolveToken, searchWithoutToken } from "../lib/token";
-import type { LatLon, State } from "../lib/types";
+import type { LatLon, State, Station } from "../lib/types";
 import { h, setText } from "../ui/dom";
+import { RecoveryMap } from "../ui/recoveryMap";
 
 const POLL_MS = 2000;
 /** A point older than this is flagged: the vehicle may have moved a long way since. */
 const STALE_AFTER_S = 10;
 const CACHE_KEY = "stx.recovery.last";
+/** The station's map settings, kept so the map (and a cached tile pack) shows with no network. */
+const STATION_KEY = "stx.recovery.station";
 
 const token = resolveToken(location.search, sessionStorage);
 if (new URLSearchParams(location.search).has("token")) history.replaceState(null, "", `${location.pathname}${searchWithoutToken(location.search)}`);
@@ -36,6 +39,8 @@ let manual: LatLon | null = null;
 let geoErrorCode: number | null = null;
 let deviceHeading: number | null = null;
 let fetchError = "";
+/** Made once the station's map settings are known (from the session, or the saved copy). */
+let map: RecoveryMap | null = null;
 
 const el = {
   kind: h("div", { class: "kind", "data-testid": "rec-kind" }),
@@ -59,6 +64,7 @@ const el = {
   phoneClear: h("button", { type: "button", class: "btn", "data-testid": "rec-phone-clear", hidden: true }, "Forget"),
   phoneErr: h("div", { class: "form-error", role: "alert", "data-testid": "rec-phone-error" }),
   manualBox: h("details", { class: "manual", "data-testid": "rec-manual" }),
+  mapBox: h("div", { class: "rec-map-slot" }),
 };
 el.manualBox.append(
   h("summary", {}, "Enter your position by hand"),
@@ -70,7 +76,7 @@ document.getElementById("app")!.replaceChildren(
   h("header", {}, h("strong", {}, "STRAPLEX recovery"), h("a", { href: "index.html", class: "muted small" }, "live page")),
   el.stale,
   h("main", {}, el.kind, el.arrow, el.arrowNote, el.distance, el.bearing, el.point, el.decimal, el.ttl,
-    h("div", { class: "links" }, el.geo, el.osm, el.copy), el.copyStatus, el.updated, el.phone, el.why, el.manualBox),
+    h("div", { class: "links" }, el.geo, el.osm, el.copy), el.copyStatus, el.mapBox, el.updated, el.phone, el.why, el.manualBox),
 );
 
 el.copy.addEventListener("click", () => void copyPoint());
@@ -107,6 +113,7 @@ if ("serviceWorker" in navigator && window.isSecureContext) {
 }
 
 async function poll(): Promise<void> {
+  if (map === null) await loadStation();
   try {
     const raw = await api.get("/api/state");
     const p = isObj(raw) ? parseState(raw) : null;
@@ -124,6 +131,35 @@ async function poll(): Promise<void> {
     fetchError = e instanceof Error ? e.message : String(e);
   }
   render();
+}
+
+/** The station's map settings from the session (saved for offline use), else the saved copy. */
+async function loadStation(): Promise<void> {
+  let station: Station | null = null;
+  try {
+    const p = parseSession(await api.get("/api/session"));
+    if (p.ok) {
+      station = p.value.station;
+      try {
+        localStorage.setItem(STATION_KEY, JSON.stringify(station));
+      } catch {
+        // storage full or forbidden: the map only needs the network next time
+      }
+    }
+  } catch {
+    // no network: the saved copy below
+  }
+  if (station === null) {
+    try {
+      const saved: unknown = JSON.parse(localStorage.getItem(STATION_KEY) ?? "null");
+      station = isObj(saved) ? parseStation(saved) : null;
+    } catch {
+      station = null; // a corrupt copy is ignored
+    }
+  }
+  if (station === null) return;
+  map = new RecoveryMap(station, token);
+  el.mapBox.replaceChildren(map.root);
 }
 
 function loadCache(): void {
@@ -246,6 +282,7 @@ function render(): void {
       setText(el.arrowNote, "");
     }
   }
+  map?.update(pt, manual ?? phone);
   setText(el.updated, state ? `last update ${fmtWallUtc(state.wall_ms ?? stateAtMs)} · ${ageS === null ? "" : `${fmtDuration(ageS)} ago`}` : "");
   const noPos = positionUnavailable({ secure: window.isSecureContext, hasGeolocation: "geolocation" in navigator, errorCode: geoErrorCode, origin: location.origin });
   const phoneText = manual

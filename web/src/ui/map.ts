@@ -9,12 +9,12 @@
 import L from "leaflet";
 import "leaflet/dist/leaflet.css";
 import { h, setText } from "./dom";
+import { stationTileLayer } from "./tileLayer";
 import { distanceM, ellipsePoints, fromLocal, gridValues, niceStep, toLocal } from "../lib/geo";
 import { fmt, fmtDir, fmtDistance } from "../lib/format";
 import { boxAround, keyPoints, needsFraming, type Box } from "../lib/framing";
 import { isLanded } from "../lib/recovery";
 import { packNote, tilesBadge } from "../lib/tiles";
-import { withToken } from "../lib/token";
 import type { LandingPrediction, LatLon, State, Station, TrackPoint } from "../lib/types";
 
 const ll = (p: LatLon): L.LatLngExpression => [p.lat_deg, p.lon_deg];
@@ -67,19 +67,8 @@ export class MapView {
     const el = h("div", { class: "map", "data-testid": "map", role: "application", "aria-label": "map" });
     this.root = el;
     this.map = L.map(el, { zoomControl: true, attributionControl: true, preferCanvas: false }).setView(ll(this.origin), 15);
-    if (station.tile_url) {
-      // Tiles are fetched by <img>, which cannot send the Authorization header: a station-relative
-      // tile URL gets the token as a query parameter, like the WebSocket.
-      const url = station.tile_url.startsWith("/") && tileToken !== null ? withToken(station.tile_url, tileToken) : station.tile_url;
-      // A station's tile pack covers one region to one zoom: deeper, its tiles are enlarged;
-      // outside, none are asked (each would be a failed tile on the badge).
-      const b = station.tile_bounds;
-      this.tiles = L.tileLayer(url, {
-        maxZoom: 19,
-        attribution: station.tile_attribution,
-        ...(station.tile_max_zoom !== null ? { maxNativeZoom: station.tile_max_zoom } : {}),
-        ...(b !== null ? { bounds: L.latLngBounds([b[1], b[0]], [b[3], b[2]]) } : {}),
-      });
+    this.tiles = stationTileLayer(station, tileToken);
+    if (this.tiles) {
       this.tiles.on("tileload", () => this.onTile(true));
       this.tiles.on("tileerror", () => this.onTile(false));
       this.tiles.addTo(this.map);
