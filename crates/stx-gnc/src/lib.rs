@@ -17,7 +17,8 @@
 //!   `GNC_NOTES.md` beside this crate's `Cargo.toml`, which also says how the estimator,
 //!   the spiral and the landing prediction work and which seed equations they follow);
 //! - [`performance`] summarises how the parafoil flies, [`pointmass`] flies that summary fast,
-//!   and [`predict`] uses it to say where the vehicle will land;
+//!   and [`predict`] uses it to say where the vehicle will land, in the wind
+//!   [`descent_wind`] puts below the drone (the estimate's, or a profile corrected by it);
 //! - [`ascent_wind`] measures the wind profile from the balloon's drift during the ascent, by
 //!   altitude band with its uncertainty, and joins it to the forecast for the predictions;
 //! - [`keep_out`] reads the keep-out zones (GeoJSON polygons) into the local frame and says
@@ -29,6 +30,7 @@
 //!   the drone's parameter table and the station's editor alike.
 pub mod ascent_wind;
 pub mod control;
+pub mod descent_wind;
 pub mod estimate;
 pub mod estimator;
 pub mod geo;

@@ -11,7 +11,9 @@ use nalgebra::{Matrix2, Vector2, Vector3};
 use serde::{Deserialize, Serialize};
 use stx_dynamics::atmosphere::Atmosphere;
 use stx_dynamics::state::Controls;
+use stx_dynamics::wind::WindField;
 
+use crate::descent_wind::{DEFAULT_FADE_HEIGHT_M, DescentWind};
 use crate::estimate::Estimate;
 use crate::guidance::Guidance;
 use crate::mission::FlightMode;
@@ -60,6 +62,9 @@ pub struct PredictorConfig {
     pub sink_sigma_fraction: f64,
     /// Height of the drone above the lowest body, m: touchdown is when it is this high.
     pub hang_height_m: f64,
+    /// Height below the drone over which a wind profile's correction by the estimate fades
+    /// out, m (see [`crate::descent_wind`]); used only by [`predict_in_wind`] with a profile.
+    pub profile_fade_height_m: f64,
 }
 
 impl Default for PredictorConfig {
@@ -71,6 +76,7 @@ impl Default for PredictorConfig {
             airspeed_sigma_fraction: 0.05,
             sink_sigma_fraction: 0.05,
             hang_height_m: 8.4,
+            profile_fade_height_m: DEFAULT_FADE_HEIGHT_M,
         }
     }
 }
@@ -120,7 +126,8 @@ fn sigma_points(est: &Estimate, config: &PredictorConfig) -> Vec<(f64, Perturbat
 }
 
 /// Predicts both touchdowns from `est` with `guidance` (cloned; the real one is untouched),
-/// the ground `ground_altitude_msl_m` above sea level at the NED origin, and the atmosphere.
+/// the ground `ground_altitude_msl_m` above sea level at the NED origin, and the atmosphere,
+/// in the estimate's wind, the same at every altitude.
 pub fn predict(
     est: &Estimate,
     guidance: &Guidance,
@@ -129,6 +136,39 @@ pub fn predict(
     ground_altitude_msl_m: f64,
     config: &PredictorConfig,
 ) -> LandingPrediction {
+    predict_in_wind(
+        est,
+        guidance,
+        perf,
+        atmosphere,
+        ground_altitude_msl_m,
+        config,
+        None,
+    )
+}
+
+/// As [`predict`], but below the drone in `profile` (altitudes above the NED origin) when
+/// there is one: the estimate's wind at the drone's altitude, the profile's lower down, the
+/// difference between them fading out over `config.profile_fade_height_m`.
+pub fn predict_in_wind(
+    est: &Estimate,
+    guidance: &Guidance,
+    perf: &GlidePerformance,
+    atmosphere: &dyn Atmosphere,
+    ground_altitude_msl_m: f64,
+    config: &PredictorConfig,
+    profile: Option<&dyn WindField>,
+) -> LandingPrediction {
+    let wind = match profile {
+        Some(p) => DescentWind::with_profile(
+            est.wind_ned_mps,
+            p,
+            est.time_s,
+            &est.position_ned_m,
+            config.profile_fade_height_m,
+        ),
+        None => DescentWind::uniform(est.wind_ned_mps),
+    };
     let points = sigma_points(est, config);
     let fly = |planned: bool| {
         let outcomes: Vec<(f64, [f64; 2], f64)> = points
@@ -136,6 +176,7 @@ pub fn predict(
             .map(|(w, p)| {
                 let (ne, t) = fly_one(
                     est,
+                    &wind,
                     planned.then_some(guidance),
                     perf,
                     atmosphere,
@@ -161,8 +202,10 @@ pub fn predict(
     }
 }
 
+#[allow(clippy::too_many_arguments)]
 fn fly_one(
     est: &Estimate,
+    field: &DescentWind<'_>,
     guidance: Option<&Guidance>,
     perf: &GlidePerformance,
     atmosphere: &dyn Atmosphere,
@@ -170,11 +213,10 @@ fn fly_one(
     config: &PredictorConfig,
     p: &Perturbation,
 ) -> ([f64; 2], f64) {
-    let wind = Vector3::new(
-        est.wind_ned_mps.x + p.wind_ne_mps[0],
-        est.wind_ned_mps.y + p.wind_ne_mps[1],
-        0.0,
-    );
+    let wind_at = |mass: &PointMass| {
+        let w = field.wind_ne_mps(mass.time_s, &mass.position_ned_m);
+        Vector3::new(w.x + p.wind_ne_mps[0], w.y + p.wind_ne_mps[1], 0.0)
+    };
     let mut guidance = guidance.cloned();
     let mut mass = PointMass::new(
         est.time_s,
@@ -189,6 +231,7 @@ fn fly_one(
         let density = atmosphere
             .air_at(ground_altitude_msl_m - mass.position_ned_m.z)
             .density_kg_per_m3;
+        let wind = wind_at(&mass);
         if let Some(g) = guidance.as_mut()
             && steps.is_multiple_of(config.guidance_every.max(1))
         {
@@ -381,6 +424,94 @@ mod tests {
         assert!(
             p.time_to_land_s > 100.0 && p.time_to_land_s < 400.0,
             "{p:?}"
+        );
+    }
+
+    /// A profile blowing east (from the west) at `rows` (altitude m, speed m/s).
+    fn westerly(rows: &[(f64, f64)]) -> stx_dynamics::wind::WindProfile {
+        stx_dynamics::wind::WindProfile::new(
+            rows.iter()
+                .map(|&(altitude_m, speed_mps)| stx_dynamics::wind::ProfileRow {
+                    altitude_m,
+                    speed_mps,
+                    from_deg: 270.0,
+                })
+                .collect(),
+        )
+        .expect("valid profile")
+    }
+
+    /// Both predictions from `est` in `profile` (no plan), over sea-level ground and air.
+    fn in_profile(
+        est: &Estimate,
+        profile: &stx_dynamics::wind::WindProfile,
+        config: &PredictorConfig,
+    ) -> LandingPrediction {
+        let guidance = Guidance::new(GuidanceConfig::default());
+        let perf = GlidePerformance::default();
+        predict_in_wind(
+            est,
+            &guidance,
+            &perf,
+            &sea_level(),
+            0.0,
+            config,
+            Some(profile),
+        )
+    }
+
+    /// Two layers, 6 m/s above 400 m and 2 m/s below, the estimate agreeing with the upper
+    /// one: the uncontrolled glide drifts 6 m/s × its time above 400 m plus 2 m/s × its
+    /// time below (constant sink in sea-level air), where the estimate's wind alone would
+    /// drift 6 m/s all the way down.
+    #[test]
+    fn a_two_layer_profile_moves_the_touchdown_by_each_layers_wind_times_the_time_in_it() {
+        let perf = GlidePerformance::default();
+        let guidance = Guidance::new(GuidanceConfig::default());
+        let est = still_estimate(808.4, [0.0, 6.0], 0.3);
+        let config = PredictorConfig::default();
+        let profile = westerly(&[(0.0, 2.0), (400.0, 2.0), (400.001, 6.0), (3000.0, 6.0)]);
+        let layered = in_profile(&est, &profile, &config);
+        let uniform = predict(&est, &guidance, &perf, &sea_level(), 0.0, &config);
+        let sink = perf.sink_rate(0.0, 0.0, 1.225);
+        let (t_upper, t_lower) = ((808.4 - 0.01 * sink - 400.0) / sink, (400.0 - 8.4) / sink);
+        let east = layered.uncontrolled.position_ne_m[1];
+        // 0.5-s steps at 6 m/s: a few metres of discretisation.
+        assert!(
+            (east - (6.0 * t_upper + 2.0 * t_lower)).abs() < 3.0,
+            "east {east:.1} m, closed form {:.1} m",
+            6.0 * t_upper + 2.0 * t_lower
+        );
+        let shift = uniform.uncontrolled.position_ne_m[1] - east;
+        assert!((shift - 4.0 * t_lower).abs() < 3.0, "shift {shift:.1} m");
+        // The glide itself (north) does not depend on the wind.
+        let north_gap =
+            layered.uncontrolled.position_ne_m[0] - uniform.uncontrolled.position_ne_m[0];
+        assert!(north_gap.abs() < 0.5, "{north_gap}");
+        assert!(
+            (layered.uncontrolled.time_to_land_s - uniform.uncontrolled.time_to_land_s).abs() < 0.1
+        );
+    }
+
+    /// A profile of 2 m/s everywhere against an estimate of 5 m/s: the 3-m/s correction
+    /// fades linearly over 500 m, adding 3 m/s × half the time spent in those 500 m to the
+    /// profile's 2 m/s × the whole descent.
+    #[test]
+    fn a_biased_profile_is_corrected_by_the_estimate_fading_over_the_documented_height() {
+        let perf = GlidePerformance::default();
+        let est = still_estimate(808.4, [0.0, 5.0], 0.3);
+        let config = PredictorConfig {
+            profile_fade_height_m: 500.0,
+            ..PredictorConfig::default()
+        };
+        let profile = westerly(&[(0.0, 2.0)]);
+        let p = in_profile(&est, &profile, &config);
+        let sink = perf.sink_rate(0.0, 0.0, 1.225);
+        let expected = 2.0 * 800.0 / sink + 3.0 * 0.5 * 500.0 / sink;
+        let east = p.uncontrolled.position_ne_m[1];
+        assert!(
+            (east - expected).abs() < 3.0,
+            "east {east:.1} m, closed form {expected:.1} m"
         );
     }
 }
