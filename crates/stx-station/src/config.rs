@@ -11,6 +11,7 @@ use std::path::PathBuf;
 use subtle::ConstantTimeEq;
 
 use serde::{Deserialize, Serialize};
+use stx_gnc::ascent_wind::AscentWindConfig;
 use stx_gnc::geo::LocalFrame;
 use stx_gnc::guidance::GuidanceConfig;
 use stx_link::signing::{KeyText, SIGNING_KEY_ENV, SigningKey};
@@ -190,9 +191,15 @@ pub struct StationConfig {
     pub link: LinkSettings,
     /// Access tokens.
     pub tokens: Vec<TokenConfig>,
-    /// The forecast wind, for comparison with the estimate.
+    /// The forecast wind, for comparison with the estimate, and for the landing predictions
+    /// above and below the altitudes the ascent measured.
     #[serde(default)]
     pub forecast_wind: Vec<ForecastRow>,
+    /// How the wind is measured from the balloon's drift during the ascent (`[ascent_wind]`:
+    /// band height, fixes per band, what counts as rising; see
+    /// [`AscentWindConfig`]); the defaults suit a sounding balloon with a 1–10 Hz GPS.
+    #[serde(default)]
+    pub ascent_wind: AscentWindConfig,
     /// The guidance replica's settings (the same defaults as onboard).
     #[serde(default)]
     pub guidance: GuidanceConfig,
@@ -361,6 +368,11 @@ impl StationConfig {
         let o = &self.origin;
         if !(o.lat_deg.abs() <= 90.0 && o.lon_deg.abs() <= 180.0 && o.alt_msl_m.is_finite()) {
             return invalid("origin", "latitude within ±90°, longitude within ±180°");
+        }
+        if let Err(stx_gnc::ascent_wind::AscentWindConfigError::Invalid { field, rule, .. }) =
+            self.ascent_wind.validate()
+        {
+            return invalid(&format!("ascent_wind.{field}"), rule);
         }
         for (i, r) in self.forecast_wind.iter().enumerate() {
             if !(r.speed_mps >= 0.0 && r.alt_msl_m.is_finite() && r.from_deg.is_finite()) {

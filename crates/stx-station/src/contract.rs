@@ -17,7 +17,7 @@ use thiserror::Error;
 
 use crate::core::CutdownArm;
 use crate::messages::{
-    CommandResultMsg, ErrorBody, EventMsg, ParamsMsg, ReplayView, Session, StateMsg,
+    AscentWindMsg, CommandResultMsg, ErrorBody, EventMsg, ParamsMsg, ReplayView, Session, StateMsg,
 };
 use crate::replies::{
     ClientsBody, CommandAccepted, EventsBody, HelloMsg, HistoryMsg, LaggedMsg, PongMsg,
@@ -46,6 +46,8 @@ pub enum ServerMessage {
     CommandResult(CommandResultMsg),
     /// When the parameter table changes.
     Params(ParamsMsg),
+    /// When the ascent's measured wind bands change.
+    AscentWind(AscentWindMsg),
     /// Once, after connecting.
     History(HistoryMsg),
     /// When the page fell behind.
@@ -90,6 +92,7 @@ pub fn schema() -> Result<Value, ContractError> {
         sent.subschema_for::<ServerMessage>(),
         sent.subschema_for::<Session>(),
         sent.subschema_for::<ParamsMsg>(),
+        sent.subschema_for::<AscentWindMsg>(),
         sent.subschema_for::<EventsBody>(),
         sent.subschema_for::<TrackBody>(),
         sent.subschema_for::<ClientsBody>(),
@@ -123,7 +126,7 @@ pub fn schema() -> Result<Value, ContractError> {
     Ok(json!({
         "$schema": "http://json-schema.org/draft-07/schema#",
         "title": "stx station API",
-        "description": "Every message of the stx station's HTTP and WebSocket API (crates/stx-station/API.md), generated from the daemon's Rust types by `cargo run -p stx-station --example api_schema`: do not edit. The root is any one of them: on the WebSocket ServerMessage (station to page) and ClientMessage (page to station); over REST the bodies the station answers (Session, StateMsg, ParamsMsg, EventsBody, TrackBody, ClientsBody, CommandResultMsg, CommandAccepted, CutdownArm, ErrorBody, ReplayView, RecordingsBody, ReplayOpened) and the bodies of the commands (*Body).",
+        "description": "Every message of the stx station's HTTP and WebSocket API (crates/stx-station/API.md), generated from the daemon's Rust types by `cargo run -p stx-station --example api_schema`: do not edit. The root is any one of them: on the WebSocket ServerMessage (station to page) and ClientMessage (page to station); over REST the bodies the station answers (Session, StateMsg, ParamsMsg, AscentWindMsg, EventsBody, TrackBody, ClientsBody, CommandResultMsg, CommandAccepted, CutdownArm, ErrorBody, ReplayView, RecordingsBody, ReplayOpened) and the bodies of the commands (*Body).",
         "anyOf": messages,
         "definitions": definitions,
     }))

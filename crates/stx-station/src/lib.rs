@@ -10,7 +10,8 @@
 //!   own timers;
 //! - [`link`]: the ground endpoint as the link driver runs it, applying the core's link
 //!   actions and reporting their outcomes with the endpoint's events;
-//! - [`messages`] and [`replies`]: the API's JSON the station sends, [`requests`]: what it
+//! - [`messages`] (with [`ascent_wind_msg`]) and [`replies`]: the API's JSON the station
+//!   sends, [`requests`]: what it
 //!   reads (parameter ranges, units and meanings come from the onboard catalogue,
 //!   `stx_gnc::params`, shared with the drone); [`contract`]: all of them as one JSON Schema,
 //!   the contract the dashboard's TypeScript types are generated from; [`kml`]: the Google
@@ -26,6 +27,7 @@
 //! - `tile_pack`: the offline map's tile pack (MBTiles or PMTiles), opened at start and read
 //!   for `/tiles/`.
 
+pub mod ascent_wind_msg;
 pub mod config;
 pub mod contract;
 pub mod core;

@@ -12,6 +12,8 @@ use stx_link::telemetry::GpsFix;
 
 use crate::config::{ForecastRow, Role};
 
+pub use crate::ascent_wind_msg::{AscentBandView, AscentWindMsg};
+
 /// `GET /api/session` and the WebSocket's `hello`.
 #[derive(Debug, Clone, Serialize, JsonSchema)]
 pub struct Session {

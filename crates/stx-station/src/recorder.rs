@@ -109,6 +109,9 @@ impl Recording {
                 Outbound::Event(e) => r.channels.event(e),
                 Outbound::CommandResult(c) => vec![r.channels.command_result(c)],
                 Outbound::Params(p) => vec![r.channels.params(p)],
+                // Derived from the recorded telemetry: a replay through the station
+                // measures it again.
+                Outbound::AscentWind(_) => Vec::new(),
                 Outbound::Command(c) => vec![r.channels.command(c)],
             };
             for (ch, payload) in records {

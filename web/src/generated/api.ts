@@ -2,12 +2,13 @@
 // the daemon's Rust types by `cargo run -p stx-station --example api_schema`): do not edit.
 
 /**
- * Every message of the stx station's HTTP and WebSocket API (crates/stx-station/API.md), generated from the daemon's Rust types by `cargo run -p stx-station --example api_schema`: do not edit. The root is any one of them: on the WebSocket ServerMessage (station to page) and ClientMessage (page to station); over REST the bodies the station answers (Session, StateMsg, ParamsMsg, EventsBody, TrackBody, ClientsBody, CommandResultMsg, CommandAccepted, CutdownArm, ErrorBody, ReplayView, RecordingsBody, ReplayOpened) and the bodies of the commands (*Body).
+ * Every message of the stx station's HTTP and WebSocket API (crates/stx-station/API.md), generated from the daemon's Rust types by `cargo run -p stx-station --example api_schema`: do not edit. The root is any one of them: on the WebSocket ServerMessage (station to page) and ClientMessage (page to station); over REST the bodies the station answers (Session, StateMsg, ParamsMsg, AscentWindMsg, EventsBody, TrackBody, ClientsBody, CommandResultMsg, CommandAccepted, CutdownArm, ErrorBody, ReplayView, RecordingsBody, ReplayOpened) and the bodies of the commands (*Body).
  */
 export type StxStationAPI =
   | ServerMessage
   | Session
   | ParamsMsg
+  | AscentWindMsg
   | EventsBody
   | TrackBody
   | ClientsBody
@@ -31,7 +32,7 @@ export type StxStationAPI =
  * Every message the station sends on the WebSocket, told apart by `type`.
  */
 export type ServerMessage =
-  HelloMsg | StateMsg | EventMsg | CommandResultMsg | ParamsMsg | HistoryMsg | LaggedMsg | PongMsg;
+  HelloMsg | StateMsg | EventMsg | CommandResultMsg | ParamsMsg | AscentWindMsg | HistoryMsg | LaggedMsg | PongMsg;
 /**
  * Who may do what.
  */
@@ -82,6 +83,10 @@ export type Outcome = "in_progress" | "accepted" | "denied" | "failed" | "unsupp
  * Which part of the onboard software a parameter belongs to.
  */
 export type ParamGroup = "gains" | "spiral" | "failsafe" | "mission";
+/**
+ * Where a band's wind comes from.
+ */
+export type BandMethod = "gps_velocity" | "position_differences";
 /**
  * A message from the page on the WebSocket.
  */
@@ -1056,6 +1061,94 @@ export interface ParamView {
    * Value.
    */
   value: number;
+}
+/**
+ * The wind measured from the balloon's drift during the ascent, by altitude band: sent on
+ * the WebSocket when the bands change, and by `GET /api/ascent_wind`.
+ */
+export interface AscentWindMsg {
+  /**
+   * The end of the ascent (burst or cut-away) was seen: no more bands come.
+   */
+  ascent_over: boolean;
+  /**
+   * Height of a band, m.
+   */
+  band_height_m: number;
+  /**
+   * The bands with enough fixes, lowest first.
+   */
+  bands: AscentBandView[];
+  /**
+   * GPS fixes used so far.
+   */
+  fixes_used: number;
+  /**
+   * Mission clock, s.
+   */
+  time_s: number;
+  /**
+   * Always `ascent_wind`.
+   */
+  type: "ascent_wind";
+}
+/**
+ * One altitude band of the ascent's wind.
+ */
+export interface AscentBandView {
+  /**
+   * Highest altitude of the fixes used, above mean sea level, m.
+   */
+  alt_max_msl_m: number;
+  /**
+   * Lowest altitude of the fixes used, above mean sea level, m.
+   */
+  alt_min_msl_m: number;
+  /**
+   * Altitude the wind is reported at (the middle of the altitudes flown through), above
+   * mean sea level, m.
+   */
+  alt_msl_m: number;
+  /**
+   * Direction the wind blows from, degrees clockwise from north, 0…360.
+   */
+  from_deg: number;
+  /**
+   * From the GPS velocities or from position differences.
+   */
+  method: BandMethod;
+  /**
+   * GPS fixes used.
+   */
+  samples: number;
+  /**
+   * 1-σ of the east component, m/s.
+   */
+  sigma_east_mps: number;
+  /**
+   * 1-σ of the north component, m/s.
+   */
+  sigma_north_mps: number;
+  /**
+   * Wind speed, m/s.
+   */
+  speed_mps: number;
+  /**
+   * Last fix used, s on the drone's clock.
+   */
+  time_end_s: number;
+  /**
+   * First fix used, s on the drone's clock (continued across its restarts).
+   */
+  time_start_s: number;
+  /**
+   * East component of the wind, m/s.
+   */
+  wind_east_mps: number;
+  /**
+   * North component of the wind (where the air goes), m/s.
+   */
+  wind_north_mps: number;
 }
 /**
  * Sent once after `hello` and the first `state`: what happened before the page connected.

@@ -12,9 +12,12 @@
 //!   [`StationCore::on_link_event`], and every request ends in a `command_result`
 //!   (`operator` ties these together; `cutdown` arms and confirms the cutdown, `manual`
 //!   holds and releases the sticks);
+//! - `ascent`: the wind measured from the balloon's drift during the ascent, by altitude
+//!   band, and the profile ([`StationCore::wind_profile`]) the predictions fly in;
 //! - `params`: the drone's parameter table; `views`: the `state` and `params` messages.
 
 mod actions;
+mod ascent;
 mod commands;
 mod cutdown;
 mod manual;
@@ -40,6 +43,7 @@ use crate::config::StationConfig;
 use crate::messages::{EventMsg, Level, StateMsg, TrackPoint};
 
 pub use actions::{APPLY_WITHIN_S, ActionError, ActionId, LinkAction, LinkOp, OUTCOME_GRACE_S};
+pub use ascent::REFIT_EVERY_S;
 pub use commands::{ANSWER_PER_PLAN_ITEM_S, ANSWER_WITHIN_S, UPLOAD_RETRY_S, UPLOAD_TRIES};
 pub use cutdown::CutdownArm;
 pub use manual::MANUAL_SILENCE_S;
@@ -79,6 +83,8 @@ pub enum Outbound {
     CommandResult(crate::messages::CommandResultMsg),
     /// A `params` message.
     Params(crate::messages::ParamsMsg),
+    /// An `ascent_wind` message: the ascent's bands changed.
+    AscentWind(crate::messages::AscentWindMsg),
     /// An operator's request, accepted: for the recording (pages see its event).
     Command(crate::recording::station::CommandRecord),
 }
@@ -91,6 +97,8 @@ pub struct StationCore {
     wall_origin_ms: u64,
     pub(crate) latest: Latest,
     estimator: Estimator,
+    /// The wind measured from the ascent's drift.
+    ascent: ascent::AscentWinds,
     /// The drone's clock (s since its boot) from the newest time-stamped telemetry:
     /// navigation runs on it, so radio delays and accelerated rehearsals do not distort it.
     drone_time_s: Option<f64>,
@@ -137,6 +145,7 @@ impl StationCore {
             wall_origin_ms,
             latest: Latest::default(),
             estimator,
+            ascent: ascent::AscentWinds::new(config.ascent_wind),
             drone_time_s: None,
             estimate: None,
             guidance,
@@ -375,5 +384,7 @@ impl StationCore {
     }
 }
 
+#[cfg(test)]
+mod ascent_tests;
 #[cfg(test)]
 mod tests;

@@ -6,12 +6,13 @@
 
 use nalgebra::Vector3;
 use stx_dynamics::atmosphere::{Atmosphere, StandardAtmosphere};
+use stx_dynamics::wind::{WindField, WindProfile};
 use stx_gnc::estimate::Estimate;
 use stx_gnc::estimator::{Estimator, EstimatorConfig};
 use stx_gnc::guidance::{Guidance, Plan};
 use stx_gnc::measurement::{AirDataSample, AttitudeSample, GpsFix, Measurement};
 use stx_gnc::mission::FlightMode;
-use stx_gnc::predict::{LandingPrediction, PredictorConfig, predict};
+use stx_gnc::predict::{LandingPrediction, PredictorConfig, predict_in_wind};
 use stx_link::telemetry::Telemetry;
 
 use super::StationCore;
@@ -38,6 +39,15 @@ fn thin_track(track: &mut Vec<TrackPoint>) {
     });
 }
 
+/// The fix places the receiver in three dimensions (3-D, differential, RTK, static, PPP).
+pub(crate) fn has_3d_fix(g: &stx_link::telemetry::GpsRaw) -> bool {
+    use stx_link::telemetry::GpsFix as Fix;
+    matches!(
+        g.fix,
+        Fix::Fix3d | Fix::Dgps | Fix::RtkFloat | Fix::RtkFixed | Fix::Static | Fix::Ppp
+    )
+}
+
 /// Seconds the drone's clock may step back before the station takes it for a reboot.
 const REBOOT_STEP_BACK_S: f64 = 5.0;
 
@@ -59,6 +69,9 @@ pub struct PredictionJob {
     config: PredictorConfig,
     /// When the sensor data behind the estimate arrived (mission time, s).
     data_s: Option<f64>,
+    /// The ascent's measured winds with the forecast outside them (altitudes above the
+    /// frame's origin): the wind below the drone; `None`: the estimate's wind everywhere.
+    wind_profile: Option<WindProfile>,
 }
 
 /// A finished [`PredictionJob`].
@@ -68,16 +81,23 @@ pub struct Predicted {
 }
 
 impl PredictionJob {
-    /// Flies the plan and the uncontrolled glide from the estimate (milliseconds).
+    /// The wind profile below the drone this job flies in, if any.
+    pub fn wind_profile(&self) -> Option<&WindProfile> {
+        self.wind_profile.as_ref()
+    }
+
+    /// Flies the plan and the uncontrolled glide from the estimate (milliseconds), in the
+    /// wind profile below the drone when there is one.
     pub fn run(&self) -> Predicted {
         Predicted {
-            prediction: predict(
+            prediction: predict_in_wind(
                 &self.estimate,
                 &self.guidance,
                 &self.performance,
                 &StandardAtmosphere,
                 self.ground_altitude_msl_m,
                 &self.config,
+                self.wind_profile.as_ref().map(|p| p as &dyn WindField),
             ),
             data_s: self.data_s,
         }
@@ -101,6 +121,7 @@ impl StationCore {
                 );
                 self.drone_time_s = Some(t);
                 self.guided_at_s = None;
+                self.ascent_on_drone_restart(now_s, t);
                 self.want_plan_download(now_s);
             }
             Some(last) => self.drone_time_s = Some(last.max(t)),
@@ -135,10 +156,13 @@ impl StationCore {
                 self.latest.sensors_s = Some(now_s);
                 // GPS_RAW_INT's time may be the receiver's (Unix) clock: it is stamped with
                 // the drone's clock of the burst it came in.
-                if let Some(t) = self.drone_time_s
-                    && let Some(m) = self.gps_measurement(t, now_s, &g)
-                {
-                    self.estimator.handle(t, &m);
+                if let Some(t) = self.drone_time_s {
+                    if let Some(m) = self.gps_measurement(t, now_s, &g) {
+                        self.estimator.handle(t, &m);
+                    }
+                    if let Some(fix) = self.ascent_fix(now_s, &g) {
+                        self.ascent.push(now_s, t, fix);
+                    }
                 }
             }
             Telemetry::Position(p) => {
@@ -195,11 +219,7 @@ impl StationCore {
         now_s: f64,
         g: &stx_link::telemetry::GpsRaw,
     ) -> Option<Measurement> {
-        use stx_link::telemetry::GpsFix as Fix;
-        if !matches!(
-            g.fix,
-            Fix::Fix3d | Fix::Dgps | Fix::RtkFloat | Fix::RtkFixed | Fix::Static | Fix::Ppp
-        ) {
+        if !has_3d_fix(g) {
             return None;
         }
         let position = self.frame.to_ned(g.lat_deg, g.lon_deg, g.alt_msl_m);
@@ -268,6 +288,7 @@ impl StationCore {
         } else {
             self.estimate = None;
         }
+        self.refit_ascent_winds(now_s);
         self.handle_timeout(now_s);
         let state = self.state_msg_now(now_s);
         if now_s >= self.next_history_s {
@@ -290,6 +311,7 @@ impl StationCore {
             guidance: self.guidance.clone(),
             performance: self.config.guidance.performance,
             ground_altitude_msl_m: self.frame.alt_msl_m,
+            wind_profile: self.wind_profile(),
             config: PredictorConfig {
                 hang_height_m: self.config.guidance.spiral.hang_height_m,
                 ..PredictorConfig::default()

@@ -28,6 +28,23 @@ pub(super) fn sent_ops(core: &mut StationCore, now_s: f64) -> Vec<LinkOp> {
         .collect()
 }
 
+/// A 3-D GPS fix at `ms` on the drone's clock, at latitude, longitude (degrees) and altitude
+/// (m MSL), moving at `[north, east]` m/s.
+pub(super) fn gps_raw(ms: u32, [lat, lon, alt]: [f64; 3], [north, east]: [f64; 2]) -> GpsRaw {
+    GpsRaw {
+        time_usec: u64::from(ms) * 1000,
+        fix: Fix::Fix3d,
+        lat_deg: lat,
+        lon_deg: lon,
+        alt_msl_m: alt,
+        ground_speed_mps: Some(north.hypot(east)),
+        course_deg: Some(east.atan2(north).to_degrees().rem_euclid(360.0)),
+        satellites: Some(10),
+        h_acc_m: Some(1.5),
+        v_acc_m: Some(3.0),
+    }
+}
+
 /// Telemetry of a parafoil gliding north in still air at 6 m/s, sinking 3 m/s, from 800 m
 /// above the origin, as the drone sends it at 4 Hz.
 fn glide(core: &mut StationCore, from_s: f64, to_s: f64) -> Vector3<f64> {
@@ -65,18 +82,7 @@ fn glide_at_speed(core: &mut StationCore, from_s: f64, to_s: f64, speed: f64) ->
                 v_down_mps: 3.0,
                 heading_deg: Some(0.0),
             }),
-            Telemetry::GpsRaw(GpsRaw {
-                time_usec: u64::from(ms) * 1000,
-                fix: Fix::Fix3d,
-                lat_deg: lat,
-                lon_deg: lon,
-                alt_msl_m: alt,
-                ground_speed_mps: Some(6.0),
-                course_deg: Some(0.0),
-                satellites: Some(10),
-                h_acc_m: Some(1.5),
-                v_acc_m: Some(3.0),
-            }),
+            Telemetry::GpsRaw(gps_raw(ms, [lat, lon, alt], [6.0, 0.0])),
             Telemetry::Attitude(Attitude {
                 time_boot_ms: ms,
                 roll_rad: 0.0,

@@ -205,6 +205,7 @@ fn send_outbound(shared: &Shared, outbound: Vec<Outbound>) {
             Outbound::Event(e) => serde_json::to_string(&e),
             Outbound::CommandResult(r) => serde_json::to_string(&r),
             Outbound::Params(p) => serde_json::to_string(&p),
+            Outbound::AscentWind(a) => serde_json::to_string(&a),
             // Recorded only: pages see the request's event.
             Outbound::Command(_) => continue,
         };

@@ -34,7 +34,9 @@ pub use shared::{
 
 use crate::requests::{CourseBody, HeadingBody, LocalizerBody, ModeBody, PlanBody, TargetBody};
 use commands::{arm_cutdown, command, confirm_cutdown, set_param};
-use rest::{api_not_found, clients, command_result, events, params, session, state_now, track};
+use rest::{
+    api_not_found, ascent_wind, clients, command_result, events, params, session, state_now, track,
+};
 
 /// The router of the whole station.
 pub fn router(state: std::sync::Arc<Shared>) -> Router {
@@ -45,6 +47,7 @@ pub fn router(state: std::sync::Arc<Shared>) -> Router {
         .route("/api/state", get(state_now))
         .route("/api/params", get(params))
         .route("/api/params/{name}", post(set_param))
+        .route("/api/ascent_wind", get(ascent_wind))
         .route("/api/events", get(events))
         .route("/api/track", get(track))
         .route("/api/commands/{id}", get(command_result))

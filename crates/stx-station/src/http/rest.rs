@@ -1,5 +1,5 @@
-//! The reading endpoints of `API.md`: session, state, parameters, events, track, command
-//! results and connected pages; any other path under `/api/` is a 404 with a reason.
+//! The reading endpoints of `API.md`: session, state, parameters, ascent winds, events, track,
+//! command results and connected pages; any other path under `/api/` is a 404 with a reason.
 
 use std::sync::atomic::Ordering;
 
@@ -99,6 +99,11 @@ pub(crate) async fn state_now(State(state): State<AppState>, _caller: Caller) ->
 pub(crate) async fn params(State(state): State<AppState>, _caller: Caller) -> Response {
     let now = state.now_s();
     Json(state.core().params_msg(now)).into_response()
+}
+
+pub(crate) async fn ascent_wind(State(state): State<AppState>, _caller: Caller) -> Response {
+    let now = state.now_s();
+    Json(state.core().ascent_wind_msg(now)).into_response()
 }
 
 #[derive(Deserialize)]
