@@ -6,6 +6,9 @@
 // an event without text) is rejected with a reason, so the caller can count and show it.
 
 import type {
+  AscentBand,
+  AscentWindMsg,
+  BandMethod,
   CommandResult,
   Estimate,
   EventMsg,
@@ -106,6 +109,7 @@ const PHASES = {
 const FIXES = { no_gps: true, no_fix: true, fix2d: true, fix3d: true, dgps: true, rtk_float: true, rtk_fixed: true, static: true, ppp: true } as const satisfies Record<GpsFix, true>;
 const GROUPS = { gains: true, spiral: true, failsafe: true, mission: true } as const satisfies Record<ParamGroup, true>;
 const SOURCES = { guidance: true, link: true, command: true, station: true, vehicle: true } as const satisfies Record<WireServerMessageOf<"event">["source"], true>;
+const METHODS = { gps_velocity: true, position_differences: true } as const satisfies Record<BandMethod, true>;
 const TARGET_SOURCES = { drone_plan: true, drone_telemetry: true, operator: true } as const satisfies Record<NonNullable<Guidance["target_source"]>, true>;
 
 /** The value of `o[k]` if it is one of the names of `names`, else null. */
@@ -419,6 +423,42 @@ export function parseParams(v: Obj): Parsed<ParamsMsg> {
   return ok({ type: "params", params, complete: bool(v, "complete") ?? false, time_s: num(v, "time_s") });
 }
 
+/** A band needs its altitude, wind and σ (finite, σ ≥ 0) to be drawn; one without is dropped. */
+function parseAscentBand(v: unknown): AscentBand | null {
+  if (!isObj(v)) return null;
+  const [alt, n, e, sn, se] = ["alt_msl_m", "wind_north_mps", "wind_east_mps", "sigma_north_mps", "sigma_east_mps"].map((k) => num(v, k));
+  if (alt == null || n == null || e == null || sn == null || se == null || sn < 0 || se < 0) return null;
+  return {
+    alt_msl_m: alt,
+    alt_min_msl_m: num(v, "alt_min_msl_m"),
+    alt_max_msl_m: num(v, "alt_max_msl_m"),
+    speed_mps: num(v, "speed_mps"),
+    from_deg: num(v, "from_deg"),
+    wind_north_mps: n,
+    wind_east_mps: e,
+    sigma_north_mps: sn,
+    sigma_east_mps: se,
+    samples: num(v, "samples"),
+    method: oneOf(v, "method", METHODS),
+    time_start_s: num(v, "time_start_s"),
+    time_end_s: num(v, "time_end_s"),
+  };
+}
+
+export function parseAscentWind(v: Obj): Parsed<AscentWindMsg & { dropped: number }> {
+  if (!Array.isArray(v.bands)) return bad("ascent_wind without a bands array");
+  const bands = parseList(v.bands, parseAscentBand);
+  return ok({
+    type: "ascent_wind",
+    time_s: num(v, "time_s"),
+    band_height_m: num(v, "band_height_m"),
+    ascent_over: bool(v, "ascent_over") ?? false,
+    fixes_used: num(v, "fixes_used"),
+    bands: bands.items,
+    dropped: bands.dropped,
+  });
+}
+
 export function parseTrackPoint(v: unknown): TrackPoint | null {
   if (!isObj(v)) return null;
   const t = num(v, "time_s");
@@ -491,6 +531,12 @@ const DECODERS = {
   event: (v, wrap) => wrap(parseEvent(v)),
   command_result: (v, wrap) => wrap(parseCommandResult(v)),
   params: (v, wrap) => wrap(parseParams(v)),
+  ascent_wind: (v) => {
+    const a = parseAscentWind(v);
+    if (!a.ok) return { ok: false, error: a.error };
+    const { dropped, ...msg } = a.value;
+    return { ok: true, msg, dropped };
+  },
   history: (v) => {
     const h = parseHistory(v);
     if (!h.ok) return { ok: false, error: h.error };

@@ -15,6 +15,7 @@ export type {
   GuidancePhase,
   Level,
   Outcome,
+  BandMethod,
   ParamGroup,
   PlanBody,
   PlanItemBody,
@@ -129,6 +130,11 @@ export type Param = Lenient<Wire.ParamView, "name" | "units" | "description" | "
 
 export type ParamsMsg = Omit<Lenient<Wire.ParamsMsg, "type" | "complete">, "params"> & { params: Param[] };
 
+/** One altitude band of the wind measured during the ascent: a band without its wind and σ is dropped. */
+export type AscentBand = Lenient<Wire.AscentBandView, "alt_msl_m" | "wind_north_mps" | "wind_east_mps" | "sigma_north_mps" | "sigma_east_mps">;
+
+export type AscentWindMsg = Omit<Lenient<Wire.AscentWindMsg, "type" | "ascent_over">, "bands"> & { bands: AscentBand[] };
+
 export type TrackPoint = Lenient<Wire.TrackPoint, "time_s" | "lat_deg" | "lon_deg">;
 
 export type History = Omit<Lenient<Wire.HistoryMsg, "type">, "track" | "events" | "states"> & {
@@ -149,6 +155,7 @@ export type ServerMessage =
   | EventMsg
   | CommandResult
   | ParamsMsg
+  | AscentWindMsg
   | History
   | Lagged
   | Wire.PongMsg

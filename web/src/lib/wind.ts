@@ -1,6 +1,7 @@
-// The forecast wind profile at a given altitude, to compare with the onboard estimate.
+// The forecast wind profile at a given altitude, to compare with the onboard estimate, and the
+// ascent's measured bands with their uncertainty, as the wind panel draws them.
 
-import type { ForecastWind } from "./types";
+import type { AscentBand, ForecastWind } from "./types";
 import { wrap360 } from "./format";
 
 export interface WindAt {
@@ -100,4 +101,67 @@ export function directionPieces(points: readonly { alt_msl_m: number; from_deg: 
   }
   if (cur.length > 0) out.push(cur);
   return out;
+}
+
+/** A band of the ascent's measured wind as the wind panel draws it. */
+export interface AscentPoint {
+  alt_msl_m: number;
+  /** Altitudes the band's fixes span, m MSL (the band's own altitude when unknown). */
+  alt_min_msl_m: number;
+  alt_max_msl_m: number;
+  speed_mps: number;
+  from_deg: number;
+  /** 2-σ interval of the speed, m/s (never below 0). */
+  speed_lo_mps: number;
+  speed_hi_mps: number;
+  /** 2-σ half-width of the direction, degrees; null when the band's wind is too weak to have one (2σ ≥ 180°). */
+  dir_half_deg: number | null;
+  samples: number | null;
+}
+
+/**
+ * A band's speed and from-direction with their 2-σ intervals, from the wind's components and
+ * their 1-σ (first-order propagation: speed σ = √((n·σn)² + (e·σe)²)/s, direction σ =
+ * √((e·σn)² + (n·σe)²)/s² rad). At a speed within the noise the direction is undetermined.
+ */
+export function ascentPoint(b: AscentBand): AscentPoint {
+  const n = b.wind_north_mps;
+  const e = b.wind_east_mps;
+  const sn = b.sigma_north_mps;
+  const se = b.sigma_east_mps;
+  const speed = Math.hypot(n, e);
+  const from = wrap360((Math.atan2(-e, -n) * 180) / Math.PI);
+  const sigmaSpeed = speed > 1e-9 ? Math.hypot(n * sn, e * se) / speed : Math.max(sn, se);
+  const sigmaDir = speed > 1e-9 ? Math.hypot(e * sn, n * se) / (speed * speed) : Infinity;
+  const half = (2 * sigmaDir * 180) / Math.PI;
+  return {
+    alt_msl_m: b.alt_msl_m,
+    alt_min_msl_m: b.alt_min_msl_m ?? b.alt_msl_m,
+    alt_max_msl_m: b.alt_max_msl_m ?? b.alt_msl_m,
+    speed_mps: speed,
+    from_deg: from,
+    speed_lo_mps: Math.max(0, speed - 2 * sigmaSpeed),
+    speed_hi_mps: speed + 2 * sigmaSpeed,
+    dir_half_deg: half < 180 ? half : null,
+    samples: b.samples,
+  };
+}
+
+/**
+ * An interval of directions `centre ± half` (degrees) as pieces on the 0…360 axis: one piece,
+ * or two where it crosses north; the whole axis for an undetermined direction (`half` null).
+ */
+export function directionSpans(centre_deg: number, half_deg: number | null): [number, number][] {
+  if (half_deg === null || half_deg >= 180) return [[0, 360]];
+  const c = wrap360(centre_deg);
+  const lo = c - half_deg;
+  const hi = c + half_deg;
+  if (lo < 0) return [[0, hi], [lo + 360, 360]];
+  if (hi > 360) return [[lo, 360], [0, hi - 360]];
+  return [[lo, hi]];
+}
+
+/** The band whose fixes span `alt_msl_m`, else null. */
+export function ascentBandAt(points: readonly AscentPoint[], alt_msl_m: number): AscentPoint | null {
+  return points.find((p) => alt_msl_m >= p.alt_min_msl_m && alt_msl_m <= p.alt_max_msl_m) ?? null;
 }

@@ -7,7 +7,7 @@ import "../styles/live.css";
 import { Api, ApiError, type CommandBodies, type CommandPath } from "../lib/api";
 import { CommandTracker, type CommandEntry } from "../lib/commands";
 import { fmt, fmtMissionTime, label } from "../lib/format";
-import { parseParams, parseSession, isObj } from "../lib/parse";
+import { parseAscentWind, parseParams, parseSession, isObj } from "../lib/parse";
 import { LiveSocket, type SocketStatus } from "../lib/socket";
 import { landingBadge, phaseLabel } from "../lib/recovery";
 import { judgeStaleness, type StaleVerdict } from "../lib/staleness";
@@ -131,6 +131,8 @@ function build(session: Session): void {
         case "hello":
           role = m.session.role;
           applyRoleEverywhere();
+          // `ascent_wind` comes only when the bands change: (re)connected, the page reads them.
+          loadAscentWind();
           break;
         case "state":
           onState(m);
@@ -146,6 +148,9 @@ function build(session: Session): void {
           break;
         case "params":
           params.setParams(m.params, m.complete);
+          break;
+        case "ascent_wind":
+          wind.setAscent(m);
           break;
         case "lagged":
           // The station dropped messages for this page: say so rather than show a silent gap.
@@ -337,6 +342,16 @@ function build(session: Session): void {
       receivedAtMs = now - SILENT_SOCKET_S * 1000; // one kick per silence, not one per tick
       socket.kick();
     }
+  }
+
+  function loadAscentWind(): void {
+    api.get("/api/ascent_wind").then(
+      (r) => {
+        const a = isObj(r) ? parseAscentWind(r) : null;
+        if (a?.ok) wind.setAscent(a.value);
+      },
+      (e: unknown) => localEvent("warning", `ascent winds not loaded: ${e instanceof Error ? e.message : String(e)}`),
+    );
   }
 
   applyRoleEverywhere();

@@ -1,23 +1,28 @@
-// Wind: the onboard estimate (speed, from-direction, σ) against the forecast profile, drawn as two
-// profiles against altitude side by side — speed on the left, direction (from, 0…360°) on the
-// right — with the forecast dashed, the wind measured so far on the way down solid, and the
-// current estimate as a dot (with its σ on the speed side).
+// Wind: the onboard estimate (speed, from-direction, σ) against the forecast profile and the
+// wind the station measured from the balloon's drift during the ascent, drawn as profiles
+// against altitude side by side — speed on the left, direction (from, 0…360°) on the right —
+// with the forecast dashed, the ascent's bands as diamonds with their ±2σ bars (and the
+// altitudes each band spans), the wind measured so far on the way down solid, and the current
+// estimate as a dot (with its σ on the speed side).
 
 import { h, panel, readout, s, setText } from "./dom";
 import { fmt, fmtDir } from "../lib/format";
 import { linkStale } from "../lib/staleness";
-import { directionPieces, forecastAt, MeasuredProfile } from "../lib/wind";
-import type { ForecastWind, State } from "../lib/types";
+import { ascentBandAt, ascentPoint, directionPieces, directionSpans, forecastAt, MeasuredProfile, type AscentPoint } from "../lib/wind";
+import type { AscentWindMsg, ForecastWind, State } from "../lib/types";
 
 const W = 280;
-const H = 122;
-const T = 6;
+const H = 134;
+/** Top margin: the legend's row. */
+const T = 17;
 const B = 26;
 /** Speed chart x range and direction chart x range, in SVG units. */
 const SP = { l: 34, r: 146 };
 const DR = { l: 166, r: 274 };
 const FORECAST = { stroke: "#555", "stroke-width": 2, "stroke-dasharray": "5 3", fill: "none" };
 const MEASURED = { stroke: "#006b8f", "stroke-width": 2, fill: "none" };
+const ASCENT = "#b34700";
+const ASCENT_BAR = { stroke: ASCENT, "stroke-width": 1.5 };
 /** The smallest altitude band drawn, m. */
 const MIN_BAND_M = 300;
 
@@ -35,18 +40,46 @@ export class WindPanel {
   readonly root: HTMLElement;
   private readonly est: HTMLElement;
   private readonly fc: HTMLElement;
+  private readonly asc: HTMLElement;
   private readonly svg: SVGSVGElement;
   private readonly measured = new MeasuredProfile();
+  private ascent: AscentPoint[] = [];
+  private ascentOver = false;
+  private last: { profile: readonly ForecastWind[]; alt: number | null; speed: number | null; sigma: number | null; from: number | null } = { profile: [], alt: null, speed: null, sigma: null, from: null };
   private lastKey = "";
   private lastTime = -Infinity;
 
   constructor() {
     const a = readout("Estimate", "ro-wind");
     const b = readout("Forecast", "ro-wind-forecast", "the forecast profile at the current altitude");
+    const c = readout("Ascent", "ro-wind-ascent", "the wind measured from the balloon's drift during the ascent: the band at the current altitude (±2σ of the speed), or the bands measured");
     this.est = a.value;
     this.fc = b.value;
-    this.svg = s("svg", { viewBox: `0 0 ${W} ${H}`, class: "wind-chart", role: "img", "aria-label": "wind against altitude: speed (left) and direction it blows from (right); forecast dashed, measured solid, estimate dot", "data-testid": "wind-chart" });
-    this.root = panel("Wind", "panel-wind", h("div", { class: "ro-list" }, a.root, b.root), this.svg as unknown as Node);
+    this.asc = c.value;
+    this.svg = s("svg", { viewBox: `0 0 ${W} ${H}`, class: "wind-chart", role: "img", "aria-label": "wind against altitude: speed (left) and direction it blows from (right); forecast dashed, ascent bands diamonds with ±2σ bars, descent measured solid, estimate dot", "data-testid": "wind-chart" });
+    this.root = panel("Wind", "panel-wind", h("div", { class: "ro-list" }, a.root, b.root, c.root), this.svg as unknown as Node);
+  }
+
+  /** The ascent's bands (an `ascent_wind` message, or `GET /api/ascent_wind`). */
+  setAscent(msg: AscentWindMsg): void {
+    this.ascent = msg.bands.map(ascentPoint);
+    this.ascentOver = msg.ascent_over;
+    this.showAscentReadout();
+    this.draw();
+  }
+
+  private showAscentReadout(): void {
+    const alt = this.last.alt;
+    const here = alt === null ? null : ascentBandAt(this.ascent, alt);
+    let text = "—";
+    if (here) {
+      text = `${fmt(here.speed_mps, "m/s")} from ${here.dir_half_deg === null ? "—" : fmtDir(here.from_deg)} ±${fmt((here.speed_hi_mps - here.speed_lo_mps) / 2, "m/s", 2)}`;
+    } else if (this.ascent.length > 0) {
+      const lo = Math.min(...this.ascent.map((p) => p.alt_min_msl_m));
+      const hi = Math.max(...this.ascent.map((p) => p.alt_max_msl_m));
+      text = `${this.ascent.length} band${this.ascent.length === 1 ? "" : "s"}, ${lo.toFixed(0)}–${hi.toFixed(0)} m${this.ascentOver ? "" : " so far"}`;
+    }
+    setText(this.asc, text);
   }
 
   update(st: State): void {
@@ -59,23 +92,28 @@ export class WindPanel {
     if (st.time_s < this.lastTime) this.measured.clear();
     this.lastTime = st.time_s;
     if (!linkStale(st.link) && alt !== null && e?.wind_speed_mps != null && e.wind_from_deg != null) this.measured.add(alt, e.wind_speed_mps, e.wind_from_deg);
-    this.draw(st.forecast_wind, alt, e?.wind_speed_mps ?? null, e?.wind_sigma_mps ?? null, e?.wind_from_deg ?? null);
+    this.last = { profile: st.forecast_wind, alt, speed: e?.wind_speed_mps ?? null, sigma: e?.wind_sigma_mps ?? null, from: e?.wind_from_deg ?? null };
+    this.showAscentReadout();
+    this.draw();
   }
 
-  private draw(profile: readonly ForecastWind[], alt: number | null, speed: number | null, sigma: number | null, from: number | null): void {
+  private draw(): void {
+    const { profile, alt, speed, sigma, from } = this.last;
     let p = profile;
     const m = this.measured.points();
-    const key = `${p.map((x) => `${x.alt_msl_m}:${x.speed_mps}:${x.from_deg}`).join(",")}|${m.length}|${alt?.toFixed(0)}|${speed?.toFixed(2)}|${sigma?.toFixed(2)}|${from?.toFixed(0)}`;
+    const asc = this.ascent;
+    const ascKey = asc.map((x) => `${x.alt_msl_m.toFixed(0)}:${x.speed_mps.toFixed(2)}:${x.from_deg.toFixed(0)}:${x.speed_hi_mps.toFixed(2)}`).join(",");
+    const key = `${p.map((x) => `${x.alt_msl_m}:${x.speed_mps}:${x.from_deg}`).join(",")}|${m.length}|${ascKey}|${alt?.toFixed(0)}|${speed?.toFixed(2)}|${sigma?.toFixed(2)}|${from?.toFixed(0)}`;
     if (key === this.lastKey) return;
     this.lastKey = key;
     this.svg.replaceChildren();
-    if (p.length === 0 && m.length === 0) {
+    if (p.length === 0 && m.length === 0 && asc.length === 0) {
       this.svg.append(s("text", { x: W / 2, y: H / 2, "text-anchor": "middle", "font-size": 12 }, "no forecast, no measurement yet"));
       return;
     }
     // The altitude band flown so far (plus some room), not the whole forecast up to 12 km, where
     // a descent from 1 km would be a smear at the bottom; the forecast is sampled inside it.
-    const flown = m.map((x) => x.alt_msl_m).concat(alt === null ? [] : [alt]);
+    const flown = m.map((x) => x.alt_msl_m).concat(alt === null ? [] : [alt], asc.map((x) => x.alt_min_msl_m), asc.map((x) => x.alt_max_msl_m));
     let aMin: number;
     let aMax: number;
     if (flown.length > 0) {
@@ -89,7 +127,7 @@ export class WindPanel {
       aMax = Math.max(...p.map((x) => x.alt_msl_m), aMin + 1);
     }
     p = forecastIn(p, aMin, aMax);
-    const vTop = Math.max(1, ...p.map((x) => x.speed_mps), ...m.map((x) => x.speed_mps), (speed ?? 0) + (sigma ?? 0)) * 1.1;
+    const vTop = Math.max(1, ...p.map((x) => x.speed_mps), ...m.map((x) => x.speed_mps), ...asc.map((x) => x.speed_hi_mps), (speed ?? 0) + (sigma ?? 0)) * 1.1;
     const Y = (a: number): number => H - B - ((a - aMin) / (aMax - aMin)) * (H - T - B);
     const XS = (v: number): number => SP.l + (v / vTop) * (SP.r - SP.l);
     const XD = (d: number): number => DR.l + (d / 360) * (DR.r - DR.l);
@@ -109,7 +147,7 @@ export class WindPanel {
       s("text", { x: (SP.l + SP.r) / 2, y: H - 3, "text-anchor": "middle", "font-weight": 700 }, "speed m/s"),
       ...[0, 90, 180, 270, 360].map((d) => s("text", { x: XD(d), y: H - B + 10, "text-anchor": d === 0 ? "start" : d === 360 ? "end" : "middle" }, d === 0 ? "N" : d === 90 ? "E" : d === 180 ? "S" : d === 270 ? "W" : "N")),
       s("text", { x: (DR.l + DR.r) / 2, y: H - 3, "text-anchor": "middle", "font-weight": 700 }, "from °"));
-    this.svg.append(grid, frame, labels);
+    this.svg.append(grid, frame, labels, this.legend());
 
     // Speed profiles.
     if (p.length > 0) this.svg.append(line(p.map((x) => at(XS(x.speed_mps), Y(x.alt_msl_m))), FORECAST, "wind-forecast-speed"));
@@ -117,6 +155,23 @@ export class WindPanel {
     // Direction profiles, cut where they cross north.
     for (const piece of directionPieces(p)) this.svg.append(line(piece.map((x) => at(XD(x.from_deg), Y(x.alt_msl_m))), FORECAST, "wind-forecast-dir"));
     for (const piece of directionPieces(m)) if (piece.length > 1) this.svg.append(line(piece.map((x) => at(XD(x.from_deg), Y(x.alt_msl_m))), MEASURED, "wind-measured-dir"));
+
+    // The ascent's bands: the altitudes each spans, its ±2σ, and a diamond at its wind.
+    const diamond = (x: number, y: number, testid: string): SVGElement =>
+      s("path", { d: `M${x.toFixed(1)},${(y - 4).toFixed(1)} l4,4 l-4,4 l-4,-4 z`, fill: ASCENT, stroke: "#000", "stroke-width": 0.5, "data-testid": testid });
+    for (const b of asc) {
+      const y = Y(b.alt_msl_m);
+      const extent = (x: number): SVGElement => s("line", { x1: x, x2: x, y1: Y(b.alt_min_msl_m), y2: Y(b.alt_max_msl_m), stroke: ASCENT, "stroke-width": 1, "stroke-opacity": 0.5 });
+      this.svg.append(
+        extent(XS(b.speed_mps)),
+        s("line", { x1: XS(b.speed_lo_mps), x2: XS(b.speed_hi_mps), y1: y, y2: y, ...ASCENT_BAR, "data-testid": "wind-ascent-speed-bar" }),
+        diamond(XS(b.speed_mps), y, "wind-ascent-speed"),
+      );
+      for (const [lo, hi] of directionSpans(b.from_deg, b.dir_half_deg)) {
+        this.svg.append(s("line", { x1: XD(lo), x2: XD(hi), y1: y, y2: y, ...ASCENT_BAR, "stroke-dasharray": b.dir_half_deg === null ? "2 2" : "none", "data-testid": "wind-ascent-dir-bar" }));
+      }
+      if (b.dir_half_deg !== null) this.svg.append(extent(XD(b.from_deg)), diamond(XD(b.from_deg), y, "wind-ascent-dir"));
+    }
 
     if (alt !== null) {
       this.svg.append(
@@ -133,5 +188,16 @@ export class WindPanel {
         this.svg.append(s("circle", { cx: XD(d), cy: Y(alt), r: 4.5, fill: "#006b8f", stroke: "#000", "data-testid": "wind-est-dir" }));
       }
     }
+  }
+
+  /** What each mark is, in a row above the charts. */
+  private legend(): SVGElement {
+    const y = 9;
+    const item = (x: number, mark: SVGElement, label: string): SVGElement[] => [mark, s("text", { x: x + 14, y: y + 3, "font-size": 8 }, label)];
+    return s("g", { "data-testid": "wind-legend" },
+      ...item(4, s("line", { x1: 4, x2: 16, y1: y, y2: y, ...FORECAST }), "forecast"),
+      ...item(60, s("path", { d: `M66,${y - 4} l4,4 l-4,4 l-4,-4 z`, fill: ASCENT }), "ascent ±2σ"),
+      ...item(128, s("line", { x1: 128, x2: 140, y1: y, y2: y, ...MEASURED }), "descent"),
+      ...item(180, s("circle", { cx: 186, cy: y, r: 3.5, fill: "#006b8f", stroke: "#000" }), "estimate"));
   }
 }
