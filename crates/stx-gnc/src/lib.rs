@@ -21,6 +21,9 @@
 //!   [`descent_wind`] puts below the drone (the estimate's, or a profile corrected by it);
 //! - [`ascent_wind`] measures the wind profile from the balloon's drift during the ascent, by
 //!   altitude band with its uncertainty, and joins it to the forecast for the predictions;
+//! - [`footprint`] says which ground the stack can still reach from the estimate, with the
+//!   probability of reaching each point under the wind's uncertainty (50 % and 95 % contours)
+//!   and the keep-out zones it overlaps;
 //! - [`keep_out`] reads the keep-out zones (GeoJSON polygons) into the local frame and says
 //!   whether a point lies in one and whether a leg crosses one;
 //! - [`geo`] links the mission's local NED frame to latitude, longitude and altitude;
@@ -33,6 +36,7 @@ pub mod control;
 pub mod descent_wind;
 pub mod estimate;
 pub mod estimator;
+pub mod footprint;
 pub mod geo;
 pub mod guidance;
 pub mod keep_out;
