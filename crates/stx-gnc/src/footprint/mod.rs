@@ -17,11 +17,17 @@
 //! reach is the point-mass's ([`crate::pointmass`]) in closed form, layer by layer through the
 //! wind field and the atmosphere's density, and it costs microseconds per draw.
 //!
-//! What the vehicle cannot spend on reach is taken off: the reach is counted only above
-//! `reserve_height_m` (the final approach and flare, which guidance flies into the wind near
-//! the point), and `edge_margin_m` is taken off every radius for the turns towards the point
-//! and onto the final. Both are settings, calibrated against the 14-DOF model with guidance in
-//! the loop (`crates/stx-sim/tests/footprint_against_full_model.rs`).
+//! Guidance ends every landing with a final approach into the wind from about 150 m up
+//! (`GNC_NOTES.md`: "the 156 m a final needs"), so the footprint does too: the descent is
+//! split at `reserve_height_m`. Above it the vehicle may fly anywhere within its still-air
+//! reach of the drifting air mass (less `edge_margin_m` for the turns towards the point and
+//! onto the final); below it, it flies straight into the wind along the final, at any brake
+//! between released and full, and lands on the point. So the reachable points are the discs of
+//! final starts moved upwind by the final's run through the air and downwind by its drift:
+//! a point downwind costs the final's run twice (out past it and back), a point upwind none.
+//! In calm air (under 0.5 m/s over the final) the final may point anywhere and the disc keeps
+//! its whole still-air reach. The reserve and margin are settings, checked against the 14-DOF
+//! model with guidance in the loop (`crates/stx-sim/tests/footprint_against_full_model.rs`).
 //!
 //! # Uncertainty
 //!
@@ -53,7 +59,7 @@ pub use outline::{FootprintContour, FootprintPolygon, ZoneHit};
 
 use crate::estimate::Estimate;
 use crate::keep_out::KeepOutZones;
-use crate::performance::{BRAKE_POINTS, GlidePerformance};
+use crate::performance::GlidePerformance;
 
 /// The probability levels whose contours a footprint traces, ascending.
 pub const LEVELS: [f64; 2] = [0.5, 0.95];
@@ -112,10 +118,10 @@ pub struct Footprint {
     pub height_m: f64,
     /// Number of draws the probabilities are fractions of.
     pub draws: usize,
-    /// Where the air mass alone carries the undispersed vehicle by touchdown at released
-    /// brakes: the centre of its reach, (north, east) m.
+    /// Centre of the undispersed vehicle's reach at released brakes (final included),
+    /// (north, east) m: where it lands flying no further than its final needs.
     pub drift_point_ne_m: [f64; 2],
-    /// Reach radius of the undispersed vehicle at released brakes, m.
+    /// Radius of that reach, m.
     pub nominal_radius_m: f64,
     /// Probability of reaching each cell.
     pub grid: ProbabilityGrid,
@@ -151,17 +157,15 @@ pub fn footprint(
         });
     }
     let columns = reach::columns(input, config);
-    if !columns.iter().all(|c| {
-        c.time_s.is_finite()
-            && c.reach_m.is_finite()
-            && c.drift_ne_m.x.is_finite()
-            && c.drift_ne_m.y.is_finite()
-    }) {
+    let finite = |l: &reach::Leg| {
+        l.time_s.is_finite() && l.air_m.is_finite() && l.drift_ne_m.iter().all(|v| v.is_finite())
+    };
+    if !columns.iter().all(|c| finite(&c.above) && finite(&c.last)) {
         return Err(FootprintError::NotFinite {
             quantity: "wind or air below",
         });
     }
-    let discs: Vec<[reach::Disc; BRAKE_POINTS]> = (0..config.draws)
+    let discs: Vec<[reach::Disc; reach::DISCS]> = (0..config.draws)
         .map(|_| {
             let d = reach::draw(input, config, rng);
             reach::discs(&columns, &d, config.edge_margin_m)
