@@ -17,11 +17,13 @@ pub struct FootprintConfig {
     /// Thickness of the height layers the descent is integrated over, m (1…500): the wind
     /// field and the air density are read once per layer.
     pub layer_m: f64,
-    /// Height kept for the final approach and the flare, m (≥ 0): the reach in still air is
-    /// counted only above this height; the drift is counted all the way down.
+    /// Height kept for the final approach and the flare, m (≥ 0): below it the vehicle flies
+    /// into the wind to the point. Guidance's final needs about 156 m, plus a base leg when
+    /// the point lies downwind; 250 m is what the full-model test needed
+    /// (`crates/stx-sim/tests/footprint_against_full_model.rs`).
     pub reserve_height_m: f64,
     /// Distance taken off every reach for the turns a flight to the point needs (towards it,
-    /// onto the final), m (≥ 0).
+    /// onto the base leg and the final), m (≥ 0); 100 m set by the same test.
     pub edge_margin_m: f64,
     /// 1-σ of the wind below the vehicle that the estimate's own σ does not carry (the wind
     /// changes with height and time), m/s per horizontal component (≥ 0); added in quadrature
@@ -43,8 +45,8 @@ impl Default for FootprintConfig {
             draws: 400,
             cell_size_m: 25.0,
             layer_m: 25.0,
-            reserve_height_m: 150.0,
-            edge_margin_m: 50.0,
+            reserve_height_m: 250.0,
+            edge_margin_m: 100.0,
             extra_wind_sigma_mps: 0.5,
             airspeed_sigma_fraction: 0.05,
             sink_sigma_fraction: 0.05,
