@@ -26,6 +26,9 @@
 //!   and the keep-out zones it overlaps;
 //! - [`keep_out`] reads the keep-out zones (GeoJSON polygons) into the local frame and says
 //!   whether a point lies in one and whether a leg crosses one;
+//! - [`flight_path`] flies the whole stack unsteered — balloon ascent, round chute, parafoil
+//!   deployment and glide — through a forecast wind, and its Monte Carlo spread gives the
+//!   pre-flight plan: burst, deploy and landing regions and the target's reachability;
 //! - [`geo`] links the mission's local NED frame to latitude, longitude and altitude;
 //! - [`plan_upload`] turns an uploaded plan (waypoints, landing point) into guidance's plan,
 //!   the same way on the drone and in the station's replica;
@@ -36,6 +39,7 @@ pub mod control;
 pub mod descent_wind;
 pub mod estimate;
 pub mod estimator;
+pub mod flight_path;
 pub mod footprint;
 pub mod geo;
 pub mod guidance;
