@@ -29,6 +29,7 @@
 
 pub mod forecast;
 mod models;
+pub mod plan;
 pub mod reach;
 pub mod spread;
 
@@ -42,6 +43,7 @@ use crate::performance::GlidePerformance;
 use crate::pointmass::{Conditions, PointMass};
 pub use forecast::{Forecast, ForecastError, ForecastRow};
 pub use models::{Balloon, RoundChute};
+pub use plan::{PlanError, PlanReport, PlanRequest, plan};
 pub use reach::ReachDisc;
 pub use spread::{Dispersion, Ellipse, PlanInputs, PlanSpread, PointSpread, monte_carlo};
 
