@@ -14,7 +14,7 @@ pub mod spiral;
 mod trim;
 
 pub use config::GuidanceConfig;
-pub use plan::Plan;
+pub use plan::{Plan, PlanRefused};
 pub use spiral::{FinalLaw, SpiralConfig, SpiralStatus};
 
 use serde::{Deserialize, Serialize};
@@ -22,6 +22,7 @@ use stx_dynamics::state::Controls;
 
 use crate::control::{self, ControlGains, LawPhase};
 use crate::estimate::Estimate;
+use crate::keep_out::KeepOutZones;
 use crate::mission::{FlightMode, GuidancePhase};
 
 /// A change of guidance phase, with why.
@@ -62,6 +63,9 @@ pub struct Guidance {
     last_main_line_m: f64,
     /// The side of a heading, course or localizer turn from nearly behind.
     turn_latch: control::TurnLatch,
+    /// Where the payload must not land: the spiral keeps its low legs and its best reachable
+    /// point clear of them.
+    keep_out: KeepOutZones,
 }
 
 impl Guidance {
@@ -77,7 +81,29 @@ impl Guidance {
             trim: trim::MainLineTrim::default(),
             last_main_line_m: 0.0,
             turn_latch: control::TurnLatch::default(),
+            keep_out: KeepOutZones::default(),
         }
+    }
+
+    /// The keep-out zones in force.
+    pub fn keep_out(&self) -> &KeepOutZones {
+        &self.keep_out
+    }
+
+    /// Replaces the keep-out zones. A spiral under way keeps flying; it chooses its final
+    /// approach against the new zones at the next moment its axis may turn. A target already
+    /// in force is not checked again here: the station checks it when the zones change.
+    pub fn set_keep_out(&mut self, zones: KeepOutZones) {
+        self.spiral.set_keep_out(zones.clone());
+        self.keep_out = zones;
+    }
+
+    /// [`Guidance::set_plan`], refusing a plan whose target lies in a keep-out zone (the plan
+    /// in force is kept).
+    pub fn try_set_plan(&mut self, plan: Plan, time_s: f64) -> Result<(), PlanRefused> {
+        plan.check_keep_out(&self.keep_out)?;
+        self.set_plan(plan, time_s);
+        Ok(())
     }
 
     /// In localizer mode, the phases of its horizontal law and (with a glide slope) its
@@ -125,7 +151,7 @@ impl Guidance {
             // The drone may fly the new mode without asking guidance (manual sticks), so the
             // trim cannot rely on seeing the gap in its updates.
             self.trim.interrupt();
-            self.spiral = spiral::Spiral::new();
+            self.spiral = self.new_spiral();
             self.spiral.force_phase(to);
             if from != to {
                 self.record(time_s, from, to, reason);
@@ -144,7 +170,7 @@ impl Guidance {
         self.plan = plan;
         if self.mode == FlightMode::SpiralLanding {
             let from = self.spiral.phase();
-            self.spiral = spiral::Spiral::new();
+            self.spiral = self.new_spiral();
             self.spiral.force_phase(GuidancePhase::Approximation);
             self.record(
                 time_s,
@@ -171,6 +197,13 @@ impl Guidance {
     /// Takes the phase events recorded since the last call.
     pub fn drain_events(&mut self) -> Vec<PhaseEvent> {
         std::mem::take(&mut self.events)
+    }
+
+    /// A spiral that has not started, with the zones in force.
+    fn new_spiral(&self) -> spiral::Spiral {
+        let mut spiral = spiral::Spiral::new();
+        spiral.set_keep_out(self.keep_out.clone());
+        spiral
     }
 
     fn record(&mut self, time_s: f64, from: GuidancePhase, to: GuidancePhase, reason: String) {
@@ -264,6 +297,10 @@ impl Guidance {
                         .update(&self.config, &self.plan, est, density_kg_per_m3);
                 if let Some((from, to, reason)) = change {
                     self.record(est.time_s, from, to, reason);
+                }
+                let phase = self.spiral.phase();
+                for note in self.spiral.take_notes() {
+                    self.record(est.time_s, phase, phase, note);
                 }
                 controls
             }

@@ -3,8 +3,27 @@
 
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
+use thiserror::Error;
 
 use crate::control::{GlidePath, Localizer};
+use crate::keep_out::KeepOutZones;
+
+/// Why a plan was refused.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum PlanRefused {
+    /// The landing target lies in a keep-out zone.
+    #[error(
+        "the landing target ({north_m:.0} m N, {east_m:.0} m E) lies in keep-out zone '{zone}': choose a target outside it"
+    )]
+    TargetInZone {
+        /// The zone's name.
+        zone: String,
+        /// The target, north of the frame's origin, m.
+        north_m: f64,
+        /// The target, east of the frame's origin, m.
+        east_m: f64,
+    },
+}
 
 /// What the operator asked to fly: targets of every mode.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -25,6 +44,20 @@ pub struct Plan {
 }
 
 impl Plan {
+    /// Refuses a plan whose landing target lies in one of `zones` (the station asks before
+    /// sending a plan; guidance before flying one, [`Guidance::try_set_plan`](super::Guidance::try_set_plan)).
+    pub fn check_keep_out(&self, zones: &KeepOutZones) -> Result<(), PlanRefused> {
+        let target = [self.target_ned_m.x, self.target_ned_m.y];
+        match zones.zone_at(target) {
+            Some(zone) => Err(PlanRefused::TargetInZone {
+                zone: zone.name.clone(),
+                north_m: target[0],
+                east_m: target[1],
+            }),
+            None => Ok(()),
+        }
+    }
+
     /// The glide path localizer mode flies when the plan has a glide slope: down the localizer
     /// to its point, ending with the lowest hanging body — `hang_height_m` below the drone — on
     /// the target's ground. Aimed with the drone, the stack touched down the hang height's glide

@@ -69,6 +69,7 @@
 pub(super) mod config;
 mod energy;
 mod final_approach;
+mod keep_clear;
 mod learned;
 mod learned_turn;
 mod pattern;
@@ -100,6 +101,7 @@ use crate::control::TurnLatch;
 use crate::estimate::Estimate;
 use crate::guidance::config::GuidanceConfig;
 use crate::guidance::plan::Plan;
+use crate::keep_out::KeepOutZones;
 use crate::mission::GuidancePhase;
 
 /// The spiral's plan as it stands, for the operator's map.
@@ -157,6 +159,12 @@ pub struct Spiral {
     /// The side of a turn from nearly behind, on the branches and towards a best point.
     turn_latch: TurnLatch,
     status: SpiralStatus,
+    /// The keep-out zones the low legs and the best reachable point keep clear of.
+    keep_out: KeepOutZones,
+    /// The final-approach course chosen to keep clear of them.
+    clear_approach: keep_clear::ClearApproach,
+    /// Notes for the operator on keep-out choices since the last [`Spiral::take_notes`].
+    notes: Vec<String>,
 }
 
 impl Spiral {
@@ -175,7 +183,21 @@ impl Spiral {
             last_main_line_m: 0.0,
             turn_latch: TurnLatch::default(),
             status: SpiralStatus::default(),
+            keep_out: KeepOutZones::default(),
+            clear_approach: keep_clear::ClearApproach::default(),
+            notes: Vec::new(),
         }
+    }
+
+    /// Replaces the keep-out zones (see [`keep_clear`]); none flies the nominal spiral.
+    pub fn set_keep_out(&mut self, zones: KeepOutZones) {
+        self.keep_out = zones;
+    }
+
+    /// Takes the notes on keep-out choices (approach turned off the wind, nothing clear, best
+    /// point moved) made since the last call.
+    pub fn take_notes(&mut self) -> Vec<String> {
+        std::mem::take(&mut self.notes)
     }
 
     /// The phase.
@@ -266,9 +288,35 @@ impl Spiral {
 
         let wind = self.wind.update(est, sc.wind_filter_s);
         let reorient = self.machine.take_reorient();
+        let approach_course_rad = if self.keep_out.zones.is_empty() {
+            plan.approach_course_rad
+        } else {
+            // Into the wind, or in calm air along the axis held (the final is flown upwind,
+            // against the axis).
+            let into_wind = if wind.speed_mps >= sc.calm_wind_mps {
+                Some((-wind.ne_mps[1]).atan2(-wind.ne_mps[0]))
+            } else {
+                self.axis.downwind_rad().map(|d| d + std::f64::consts::PI)
+            };
+            let may_turn = reorient
+                || matches!(
+                    phase,
+                    GuidancePhase::Approximation | GuidancePhase::BestReachable
+                );
+            let (course, note) = self.clear_approach.course(
+                &self.keep_out,
+                plan.approach_course_rad,
+                into_wind,
+                target_ne,
+                sc,
+                may_turn,
+            );
+            self.notes.extend(note);
+            course
+        };
         let (downwind, frozen) =
             self.axis
-                .orient(phase, reorient, plan.approach_course_rad, &wind, sc, rel);
+                .orient(phase, reorient, approach_course_rad, &wind, sc, rel);
         let frame = WindFrame::new(target_ne, downwind);
         let [x, y] = frame.to_wind(rel);
         let turn_rate = self
@@ -305,6 +353,12 @@ impl Spiral {
             sc,
             phase == GuidancePhase::BestReachable,
         );
+        let mut reach = reach;
+        if !self.keep_out.zones.is_empty()
+            && let Some(best) = keep_clear::best_clear_rel(&self.keep_out, target_ne, &reach)
+        {
+            reach.move_best(best);
+        }
         let final_approach =
             FinalGeometry::assess(sc, perf, density, &frame, &energy, position, height);
         Situation {

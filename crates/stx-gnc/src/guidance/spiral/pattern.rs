@@ -47,6 +47,11 @@ pub(super) struct Axis {
 }
 
 impl Axis {
+    /// The downwind direction held, rad from north, once the axis has been set.
+    pub(super) fn downwind_rad(&self) -> Option<f64> {
+        self.downwind_rad
+    }
+
     /// The pattern's downwind direction for this update, rad, and whether the axis (and the
     /// half-length with it) is held. `reorient` says the phase machine lets the axis follow
     /// the wind at this update (the start of a loop, the turn onto the final); in the

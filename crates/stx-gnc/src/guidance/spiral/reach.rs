@@ -40,6 +40,9 @@ pub(super) struct Reach {
     pub(super) reachable: bool,
     /// The reachable point nearest the target, from the target (north, east), m.
     pub(super) best_rel: [f64; 2],
+    /// Whether `best_rel` was moved off the nearest point to keep clear of a keep-out zone
+    /// (then the stack flies to it, not towards the target).
+    pub(super) best_moved: bool,
 }
 
 impl Reach {
@@ -94,7 +97,15 @@ impl Reach {
             reach_ratio,
             reachable,
             best_rel,
+            best_moved: false,
         }
+    }
+
+    /// Flies to `best_rel` (from the target, north/east, m) instead of the nearest point: the
+    /// nearest lies in a keep-out zone.
+    pub(super) fn move_best(&mut self, best_rel: [f64; 2]) {
+        self.best_rel = best_rel;
+        self.best_moved = true;
     }
 
     /// The best reachable point (north, east), m, for the target at `target_ne`.
@@ -118,6 +129,9 @@ impl Reach {
     pub(super) fn heading_rad(&self, lowest_body_height: f64, final_course_rad: f64) -> f64 {
         if lowest_body_height < INTO_WIND_BELOW_M || self.drift_distance < 1e-6 {
             final_course_rad
+        } else if self.best_moved {
+            // The air heading carrying the drift point onto the point clear of the zones.
+            (self.best_rel[1] - self.drift[1]).atan2(self.best_rel[0] - self.drift[0])
         } else {
             (-self.drift[1]).atan2(-self.drift[0])
         }

@@ -1,0 +1,295 @@
+//! Keep-out zones in the spiral: which final-approach course keeps the low legs clear of
+//! them, and which reachable point outside them to fly to when the target is out of reach.
+//!
+//! A zone is a place the payload must not *land* on; flying over it high is harmless. What
+//! lands the payload in a zone is the low end of the flight, so the legs that must stay clear
+//! are the final approach (from where the base leg joins it, past the target by the flare's
+//! overshoot), the narrow wedge about it in which the stack converges onto it, and the base
+//! leg; the square spiral around the target, flown high, only decides between the two sides
+//! of the wind at the same turn. Guidance lands into the wind; a zone on that line turns the final approach
+//! away from the wind by the least multiple of [`COURSE_STEP_RAD`] (up to
+//! [`MAX_OFFSET_RAD`]) that clears it. The choice is taken when the pattern's axis may turn
+//! (approximation, the start of a loop, onto the final) and held in between, like the axis
+//! itself. When no course clears, guidance flies the nominal one and says why.
+//!
+//! With the target out of reach the best reachable point is the point of the glide's circle
+//! nearest the target; when that lies in a zone (or within [`POINT_MARGIN_M`] of one), the
+//! point of the glide's disc nearest the target and clear of every zone is flown to instead.
+
+use super::config::SpiralConfig;
+use super::reach::Reach;
+use crate::keep_out::KeepOutZones;
+
+/// Step between the candidate final-approach courses, rad (10°).
+const COURSE_STEP_RAD: f64 = 0.174_532_925_199_432_95;
+/// Largest turn of the final approach away from into-the-wind, rad (60°): further off the
+/// wind the crosswind at touchdown costs more than the zone saves, and the energy sums
+/// (planned along the wind) no longer hold.
+const MAX_OFFSET_RAD: f64 = 6.0 * COURSE_STEP_RAD;
+/// Half-angle of the wedge about the final approach kept clear, rad (8°): after the base leg
+/// the stack converges onto the final line from its side, near the target (where a zone
+/// matters) in the point-mass flights up to about 6° off it.
+const FINAL_WEDGE_RAD: f64 = 0.139_626_340_159_546_37;
+/// How far past the target the final approach is kept clear, m (a long landing's overshoot).
+const OVERSHOOT_M: f64 = 30.0;
+/// Least distance from a best reachable point to a zone, m: the point is where the payload
+/// comes down give or take the landing's scatter.
+pub(super) const POINT_MARGIN_M: f64 = 15.0;
+
+/// The legs a final-approach course flies low, in north/east from the target at `target_ne`,
+/// for a pattern of half-size `sc.half_size_m`: the final (from twice the half-size out,
+/// where an extended downwind leg turns base at the latest in the nominal pattern, to the
+/// overshoot past the target), the wedge of [`FINAL_WEDGE_RAD`] either side of it in which
+/// the stack converges onto it after the base leg, and the base leg from the downwind leg's
+/// side.
+fn low_legs(target_ne: [f64; 2], course_rad: f64, sc: &SpiralConfig) -> [[[f64; 2]; 2]; 4] {
+    // Downwind unit vector (x) and its right (y); the final is flown along −x.
+    let (s, c) = (course_rad + std::f64::consts::PI).sin_cos();
+    let at = |x: f64, y: f64| [target_ne[0] + x * c - y * s, target_ne[1] + x * s + y * c];
+    let a = sc.half_size_m;
+    let final_start = (2.0 * a).max(sc.min_final_m);
+    let (ws, wc) = FINAL_WEDGE_RAD.sin_cos();
+    [
+        [at(final_start, 0.0), at(-OVERSHOOT_M, 0.0)],
+        [at(final_start * wc, final_start * ws), target_ne],
+        [at(final_start * wc, -final_start * ws), target_ne],
+        [at(a, -a), at(a, 0.0)],
+    ]
+}
+
+/// The square spiral's four sides.
+fn square(target_ne: [f64; 2], course_rad: f64, sc: &SpiralConfig) -> [[[f64; 2]; 2]; 4] {
+    let (s, c) = (course_rad + std::f64::consts::PI).sin_cos();
+    let at = |x: f64, y: f64| [target_ne[0] + x * c - y * s, target_ne[1] + x * s + y * c];
+    let a = sc.half_size_m;
+    let k = [at(-a, -a), at(a, -a), at(a, a), at(-a, a)];
+    [[k[0], k[1]], [k[1], k[2]], [k[2], k[3]], [k[3], k[0]]]
+}
+
+/// The final-approach course keeping clear of the zones, held between the moments the
+/// pattern's axis may turn.
+#[derive(Debug, Clone, Copy, Default)]
+pub(super) struct ClearApproach {
+    /// The course chosen instead of into the wind, rad; `None` flies into the wind.
+    chosen_rad: Option<f64>,
+    /// Whether the last choice found nothing clear (said once until it changes).
+    none_clear: bool,
+}
+
+impl ClearApproach {
+    /// The final-approach course to plan with: the operator's, if set; else, when `may_turn`,
+    /// a new choice around `into_wind_rad` (the course into the wind, rad), else the one held.
+    /// The second value is a note for the operator when the choice changed.
+    pub(super) fn course(
+        &mut self,
+        zones: &KeepOutZones,
+        operator_rad: Option<f64>,
+        into_wind_rad: Option<f64>,
+        target_ne: [f64; 2],
+        sc: &SpiralConfig,
+        may_turn: bool,
+    ) -> (Option<f64>, Option<String>) {
+        if operator_rad.is_some() {
+            return (operator_rad, None);
+        }
+        let Some(into_wind) = into_wind_rad.filter(|_| may_turn) else {
+            return (self.chosen_rad, None);
+        };
+        let clear =
+            |legs: &[[[f64; 2]; 2]]| legs.iter().all(|[a, b]| zones.crossed_by(*a, *b).is_none());
+        let offsets = std::iter::once(0.0).chain((1..=6).flat_map(|k| {
+            let o = k as f64 * COURSE_STEP_RAD;
+            [o, -o]
+        }));
+        let candidates: Vec<f64> = offsets
+            .filter(|o| o.abs() <= MAX_OFFSET_RAD + 1e-9)
+            .map(|o| into_wind + o)
+            .collect();
+        let low_clear = |c: f64| clear(&low_legs(target_ne, c, sc));
+        let all_clear = |c: f64| low_clear(c) && clear(&square(target_ne, c, sc));
+        // The least turn whose low legs are clear; of the two sides at that turn, the one
+        // whose square is clear too.
+        let pick = candidates
+            .iter()
+            .copied()
+            .filter(|c| low_clear(*c))
+            .min_by(|a, b| {
+                let key = |c: f64| ((c - into_wind).abs(), !all_clear(c));
+                key(*a)
+                    .partial_cmp(&key(*b))
+                    .unwrap_or(std::cmp::Ordering::Equal)
+            });
+        let blocking = zones
+            .zones
+            .iter()
+            .find(|z| {
+                low_legs(target_ne, into_wind, sc)
+                    .iter()
+                    .any(|[a, b]| z.crossed_by(*a, *b))
+            })
+            .map(|z| z.name.clone());
+        let (new, note) = match (pick, blocking) {
+            // Into the wind is clear (its low legs at least): the nominal plan.
+            (Some(c), _) if c == into_wind => (None, None),
+            (Some(c), blocking) => {
+                let offset_deg = (c - into_wind).to_degrees();
+                let note = self.chosen_rad.is_none().then(|| {
+                    format!(
+                        "keep-out: the final approach into the wind crosses zone '{}'; \
+                         landing {offset_deg:+.0}° off the wind, on a course of {:.0}°, clear of every zone",
+                        blocking.unwrap_or_else(|| "?".into()),
+                        c.to_degrees().rem_euclid(360.0)
+                    )
+                });
+                self.none_clear = false;
+                (Some(c), note)
+            }
+            (None, blocking) => {
+                let note = (!self.none_clear).then(|| {
+                    format!(
+                        "keep-out: no final approach within {:.0}° of the wind clears the zones \
+                         (into the wind crosses '{}'); flying the nominal approach",
+                        MAX_OFFSET_RAD.to_degrees(),
+                        blocking.unwrap_or_else(|| "?".into())
+                    )
+                });
+                self.none_clear = true;
+                (None, note)
+            }
+        };
+        self.chosen_rad = new;
+        (new, note)
+    }
+}
+
+/// Whether `p` (north, east) lies in a zone or within [`POINT_MARGIN_M`] of one.
+fn near_zone(zones: &KeepOutZones, p: [f64; 2]) -> bool {
+    zones.zone_at(p).is_some()
+        || (0..8).any(|k| {
+            let (s, c) = (k as f64 * std::f64::consts::FRAC_PI_4).sin_cos();
+            zones
+                .crossed_by(p, [p[0] + POINT_MARGIN_M * c, p[1] + POINT_MARGIN_M * s])
+                .is_some()
+        })
+}
+
+/// The best reachable point clear of the zones, from the target (north, east), m, when the
+/// nominal one (`reach.best_rel`) is not clear; `None` when it is, or nothing in the glide's
+/// disc is. Candidates are the disc's points on rings of a tenth of its radius and 5° apart.
+pub(super) fn best_clear_rel(
+    zones: &KeepOutZones,
+    target_ne: [f64; 2],
+    reach: &Reach,
+) -> Option<[f64; 2]> {
+    let at = |rel: [f64; 2]| [target_ne[0] + rel[0], target_ne[1] + rel[1]];
+    if !near_zone(zones, at(reach.best_rel)) {
+        return None;
+    }
+    let mut best: Option<([f64; 2], f64)> = None;
+    for ring in 1..=10 {
+        let r = reach.reach * ring as f64 / 10.0;
+        for k in 0..72 {
+            let (s, c) = (k as f64 * 5.0_f64.to_radians()).sin_cos();
+            let rel = [reach.drift[0] + r * c, reach.drift[1] + r * s];
+            let miss = rel[0].hypot(rel[1]);
+            if best.is_none_or(|(_, m)| miss < m) && !near_zone(zones, at(rel)) {
+                best = Some((rel, miss));
+            }
+        }
+    }
+    best.map(|(rel, _)| rel)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::keep_out::KeepOutZone;
+
+    fn square_zone(name: &str, n0: f64, n1: f64, e0: f64, e1: f64) -> KeepOutZones {
+        KeepOutZones {
+            zones: vec![KeepOutZone {
+                name: name.into(),
+                rings_ne_m: vec![vec![[n0, e0], [n1, e0], [n1, e1], [n0, e1]]],
+            }],
+        }
+    }
+
+    #[test]
+    fn a_zone_on_the_final_into_the_wind_turns_the_approach_by_the_least_clear_step() {
+        let sc = SpiralConfig::default();
+        // Into the wind is north (course 0): the final comes from the south, over a pond
+        // 40–80 m south of the target.
+        let zones = square_zone("pond", -80.0, -40.0, -10.0, 10.0);
+        let mut clear = ClearApproach::default();
+        let (course, note) = clear.course(&zones, None, Some(0.0), [0.0, 0.0], &sc, true);
+        let course = course.expect("a turned approach");
+        assert!(course.abs() > 0.0 && course.abs() <= MAX_OFFSET_RAD + 1e-9);
+        assert!(note.unwrap().contains("'pond'"));
+        for [a, b] in low_legs([0.0, 0.0], course, &sc) {
+            assert!(zones.crossed_by(a, b).is_none());
+        }
+        // Held while the axis may not turn, whatever the wind.
+        let (held, note) = clear.course(&zones, None, Some(1.0), [0.0, 0.0], &sc, false);
+        assert_eq!((held, note), (Some(course), None));
+    }
+
+    #[test]
+    fn with_no_zone_on_the_way_or_an_operator_course_nothing_changes() {
+        let sc = SpiralConfig::default();
+        let zones = square_zone("far", 500.0, 600.0, 500.0, 600.0);
+        let mut clear = ClearApproach::default();
+        assert_eq!(
+            clear.course(&zones, None, Some(0.3), [0.0, 0.0], &sc, true),
+            (None, None)
+        );
+        let pond = square_zone("pond", -80.0, -40.0, -10.0, 10.0);
+        assert_eq!(
+            clear.course(&pond, Some(0.0), Some(0.0), [0.0, 0.0], &sc, true),
+            (Some(0.0), None)
+        );
+    }
+
+    #[test]
+    fn zones_all_around_fall_back_to_the_nominal_approach_with_a_reason() {
+        let sc = SpiralConfig::default();
+        // A ring of water around the target: every final crosses it.
+        let mut zones = square_zone("lake", -90.0, 90.0, -90.0, 90.0);
+        zones.zones[0].rings_ne_m.push(vec![
+            [-20.0, -20.0],
+            [20.0, -20.0],
+            [20.0, 20.0],
+            [-20.0, 20.0],
+        ]);
+        let mut clear = ClearApproach::default();
+        let (course, note) = clear.course(&zones, None, Some(0.0), [0.0, 0.0], &sc, true);
+        assert_eq!(course, None);
+        assert!(note.unwrap().contains("flying the nominal approach"));
+        // Said once.
+        assert_eq!(
+            clear.course(&zones, None, Some(0.0), [0.0, 0.0], &sc, true),
+            (None, None)
+        );
+    }
+
+    #[test]
+    fn a_best_reachable_point_in_a_zone_moves_to_the_nearest_clear_point_of_the_disc() {
+        let sc = SpiralConfig::default();
+        // Drift 400 m south of the target, reach 300 m: the nominal best point 100 m south.
+        let reach = Reach::assess([-400.0, 0.0], [0.0, 0.0], 108.4, 3.0, 1.0, &sc, false);
+        assert!(
+            (reach.best_rel[0] + 100.0).abs() < 1e-6,
+            "{:?}",
+            reach.best_rel
+        );
+        let zones = square_zone("forest", -150.0, -60.0, -40.0, 40.0);
+        let best = best_clear_rel(&zones, [0.0, 0.0], &reach).expect("moved");
+        assert!(!near_zone(&zones, best));
+        let from_drift = (best[0] - reach.drift[0]).hypot(best[1] - reach.drift[1]);
+        assert!(from_drift <= reach.reach + 1e-6);
+        // Beside the forest, not behind it: within 150 m of the target.
+        assert!(best[0].hypot(best[1]) < 150.0, "{best:?}");
+        // A point already clear is left alone.
+        let elsewhere = square_zone("far", 500.0, 600.0, 500.0, 600.0);
+        assert_eq!(best_clear_rel(&elsewhere, [0.0, 0.0], &reach), None);
+    }
+}
