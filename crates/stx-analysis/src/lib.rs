@@ -19,10 +19,15 @@
 //! - [`svg`] draws plots; [`figures`] makes the eigenvalue map and the step responses of an
 //!   analysis and of a tuning with it, and [`gains_file`] the gains file a tuning writes.
 //!
+//! - [`flight_log`] is a recorded flight (from a recording's telemetry or a CSV);
+//!   [`compare`] flies the model through one and sets the two side by side (issue 16).
+//!
 //! Pure: no files, no clocks, no randomness. The `stx` binary reads and writes files.
 
 pub mod analysis;
+pub mod compare;
 pub mod figures;
+pub mod flight_log;
 pub mod forced_response;
 pub mod gains_file;
 pub mod jacobian;
