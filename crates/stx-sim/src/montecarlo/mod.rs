@@ -38,6 +38,18 @@ pub fn run_all<N: Navigator>(
     navigator: impl Fn(&RunConditions, &SensorConfig) -> Result<N, String> + Sync,
     progress: impl Fn(usize) + Sync,
 ) -> Result<MonteCarloReport, IntegrateError> {
+    run_until(config, navigator, progress, || false)
+}
+
+/// [`run_all`] that stops starting runs once `stop()` is true (an operator's cancel, a time
+/// cap): the runs in flight finish and the report holds only the runs flown, so a cancelled
+/// campaign's report is smaller than asked, never padded.
+pub fn run_until<N: Navigator>(
+    config: &MonteCarloConfig,
+    navigator: impl Fn(&RunConditions, &SensorConfig) -> Result<N, String> + Sync,
+    progress: impl Fn(usize) + Sync,
+    stop: impl Fn() -> bool + Sync,
+) -> Result<MonteCarloReport, IntegrateError> {
     let started = Instant::now();
     let vehicle = Vehicle::straplex();
     let template = steady_glide_state(&vehicle)?;
@@ -50,6 +62,9 @@ pub fn run_all<N: Navigator>(
                 scope.spawn(|| {
                     let mut mine = Vec::new();
                     loop {
+                        if stop() {
+                            break mine;
+                        }
                         let Some(&index) = indices.get(next.fetch_add(1, Ordering::Relaxed)) else {
                             break mine;
                         };
