@@ -109,6 +109,14 @@ impl<'a> DescentWind<'a> {
     }
 }
 
+/// The descent wind as a field, for fast flights that take one (the reachable footprint).
+impl WindField for DescentWind<'_> {
+    fn wind_ned_mps(&self, time_s: f64, position_ned_m: &Vector3<f64>) -> Vector3<f64> {
+        let ne = self.wind_ne_mps(time_s, position_ned_m);
+        Vector3::new(ne.x, ne.y, 0.0)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -67,7 +67,10 @@ fn a_target_at_the_drifted_air_mass_is_reachable_and_one_far_upwind_is_not() {
     let (lat, lon, _) = frame.to_geodetic(&centre);
     request.target_lat_lon_deg = Some([lat, lon]);
     let reach = plan(&request).unwrap().target.unwrap();
-    assert!(reach.reachable_probability > edge + 0.2, "{reach:?} vs {edge}");
+    assert!(
+        reach.reachable_probability > edge + 0.2,
+        "{reach:?} vs {edge}"
+    );
     assert!((reach.from_unsteered_landing_m - radius).abs() < 1.0);
     // 50 km upwind of the launch: no sample's glide gets there.
     request.target_lat_lon_deg = Some([evora().lat_deg, evora().lon_deg - 0.6]);

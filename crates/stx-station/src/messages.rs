@@ -13,6 +13,8 @@ use stx_link::telemetry::GpsFix;
 use crate::config::{ForecastRow, Role};
 
 pub use crate::ascent_wind_msg::{AscentBandView, AscentWindMsg};
+mod footprint;
+pub use footprint::{FootprintContourView, FootprintView};
 
 /// `GET /api/session` and the WebSocket's `hello`.
 #[derive(Debug, Clone, Serialize, JsonSchema)]
@@ -398,6 +400,8 @@ pub struct StateMsg {
     pub guidance: Option<GuidanceView>,
     /// Prediction.
     pub prediction: Option<PredictionView>,
+    /// The ground still reachable under the parafoil; `null` before the first footprint.
+    pub footprint: Option<FootprintView>,
     /// Forecast wind.
     pub forecast_wind: Vec<ForecastRow>,
     /// Mission.

@@ -272,6 +272,10 @@ export interface StateMsg {
    */
   estimate: EstimateView | null;
   /**
+   * The ground still reachable under the parafoil; `null` before the first footprint.
+   */
+  footprint: FootprintView | null;
+  /**
    * Forecast wind.
    */
   forecast_wind: ForecastRow[];
@@ -411,6 +415,48 @@ export interface EstimateView {
    * Wind speed, m/s.
    */
   wind_speed_mps: number;
+}
+/**
+ * The latest reachable footprint.
+ */
+export interface FootprintView {
+  /**
+   * Seconds since it was computed.
+   */
+  age_s: number;
+  /**
+   * Mission clock when it was computed, s: the map shows it as the time of the refresh.
+   */
+  computed_s: number;
+  /**
+   * The regions, by ascending probability level (0.5, then 0.95).
+   */
+  contours: FootprintContourView[];
+  /**
+   * Number of dispersed draws its probabilities are fractions of.
+   */
+  draws: number;
+  /**
+   * Height it was computed from, m above the ground.
+   */
+  height_m: number;
+  /**
+   * Old (no refresh for several periods): show it as stale.
+   */
+  stale: boolean;
+}
+/**
+ * The ground reached with at least `level` probability.
+ */
+export interface FootprintContourView {
+  /**
+   * Probability level, 0…1.
+   */
+  level: number;
+  /**
+   * Polygons, each its outer ring then its holes; a ring is `[lat_deg, lon_deg]` points.
+   */
+  polygons: [number, number][][][];
 }
 /**
  * A row of the forecast wind profile.

@@ -14,6 +14,7 @@ import type {
   EventMsg,
   FlightMode,
   FlightStage,
+  Footprint,
   ForecastWind,
   Gps,
   GpsFix,
@@ -28,6 +29,7 @@ import type {
   Localizer,
   Mission,
   Recording,
+  Ring,
   Replay,
   N,
   OnboardLanding,
@@ -306,6 +308,46 @@ const parsePrediction = (o: Obj): Prediction => ({
   stale: bool(o, "stale"),
 });
 
+/** A ring of finite `[lat, lon]` pairs in range; `null` when any point is not one. */
+function parseRing(v: unknown): Ring | null {
+  if (!Array.isArray(v) || v.length < 3) return null;
+  const out: Ring = [];
+  for (const p of v) {
+    if (!Array.isArray(p) || p.length !== 2) return null;
+    const [lat, lon] = p as unknown[];
+    if (typeof lat !== "number" || typeof lon !== "number" || !(Math.abs(lat) <= 90) || !(Math.abs(lon) <= 180)) return null;
+    out.push([lat, lon]);
+  }
+  return out;
+}
+
+/** The footprint; a level or polygon that does not parse is left out rather than drawn wrong. */
+export function parseFootprint(o: Obj): Footprint | null {
+  const computed_s = num(o, "computed_s");
+  if (computed_s === null || !Array.isArray(o.contours)) return null;
+  const contours: Footprint["contours"] = [];
+  for (const c of o.contours) {
+    if (!isObj(c)) continue;
+    const level = num(c, "level");
+    if (level === null || !Array.isArray(c.polygons)) continue;
+    const polygons: Ring[][] = [];
+    for (const poly of c.polygons) {
+      if (!Array.isArray(poly)) continue;
+      const rings = poly.map(parseRing);
+      if (rings.length > 0 && rings.every((r): r is Ring => r !== null)) polygons.push(rings);
+    }
+    contours.push({ level, polygons });
+  }
+  return {
+    computed_s,
+    age_s: num(o, "age_s") ?? 0,
+    stale: bool(o, "stale") ?? false,
+    height_m: num(o, "height_m") ?? 0,
+    draws: num(o, "draws") ?? 0,
+    contours,
+  };
+}
+
 function parseForecast(v: unknown): ForecastWind[] {
   if (!Array.isArray(v)) return [];
   const out: ForecastWind[] = [];
@@ -332,6 +374,7 @@ export function parseState(v: Obj): Parsed<State> {
     estimate: sub(v, "estimate", parseEstimate),
     guidance: sub(v, "guidance", parseGuidance),
     prediction: sub(v, "prediction", parsePrediction),
+    footprint: sub(v, "footprint", parseFootprint),
     forecast_wind: parseForecast(v.forecast_wind),
     mission: m,
     recording: sub(v, "recording", parseRecording),

@@ -108,7 +108,7 @@ export type Replay = Lenient<Wire.ReplayView, "file" | "mode">;
 
 export type State = Omit<
   Lenient<Wire.StateMsg, "type" | "time_s" | "link" | "forecast_wind" | "mission">,
-  "link" | "vehicle" | "guidance" | "prediction" | "forecast_wind" | "recording" | "replay"
+  "link" | "vehicle" | "guidance" | "prediction" | "forecast_wind" | "recording" | "replay" | "footprint"
 > & {
   recording: Recording | null;
   replay: Replay | null;
@@ -116,7 +116,15 @@ export type State = Omit<
   vehicle: Vehicle | null;
   guidance: Guidance | null;
   prediction: Prediction | null;
+  footprint: Footprint | null;
   forecast_wind: ForecastWind[];
+};
+
+/** A ring of `[lat_deg, lon_deg]` points, Leaflet's own order. */
+export type Ring = [number, number][];
+/** The ground still reachable under the parafoil: per probability level, polygons (outer ring, then holes). */
+export type Footprint = Omit<Wire.FootprintView, "contours"> & {
+  contours: { level: number; polygons: Ring[][] }[];
 };
 
 export type EventMsg = Omit<Lenient<Wire.EventMsg, "type" | "level" | "text">, "source"> & {

@@ -15,7 +15,7 @@ import { fmt, fmtDir, fmtDistance } from "../lib/format";
 import { boxAround, keyPoints, needsFraming, type Box } from "../lib/framing";
 import { isLanded } from "../lib/recovery";
 import { packNote, tilesBadge } from "../lib/tiles";
-import type { LandingPrediction, LatLon, State, Station, TrackPoint } from "../lib/types";
+import type { Footprint, LandingPrediction, LatLon, Ring, State, Station, TrackPoint } from "../lib/types";
 
 const ll = (p: LatLon): L.LatLngExpression => [p.lat_deg, p.lon_deg];
 const MAX_TRACK = 20_000;
@@ -32,6 +32,10 @@ export class MapView {
   private readonly track = L.polyline([], { color: "#0b2f8a", weight: 3 });
   private readonly pattern = L.polygon([], { color: "#c000c0", weight: 2, dashArray: "6 5", fill: false, className: "map-pattern" });
   private readonly final = L.polyline([], { color: "#c000c0", weight: 4, className: "map-final-line" });
+  /** The reachable footprint: at least 95 % (light) and 50 % (darker) of the draws reach it. */
+  private readonly reach95 = L.polygon([], { color: "#2a7ab0", weight: 1, fillColor: "#2a7ab0", fillOpacity: 0.1, interactive: false, className: "map-footprint-95" });
+  private readonly reach50 = L.polygon([], { color: "#2a7ab0", weight: 2, fillColor: "#2a7ab0", fillOpacity: 0.22, interactive: false, className: "map-footprint-50" });
+  private readonly reachText: HTMLElement;
   private readonly ellPlanned = L.polygon([], { color: "#006400", weight: 2, fillOpacity: 0.12 });
   private readonly ellUncontrolled = L.polygon([], { color: "#c05800", weight: 2, fillOpacity: 0.08, dashArray: "4 4" });
   private readonly planned: L.Marker;
@@ -82,7 +86,7 @@ export class MapView {
     this.uncontrolled = L.marker(ll(this.origin), { icon: icon("mk-uncontrolled", DOT_SVG("#c05800"), 18, "map-pred-uncontrolled"), interactive: false });
     this.vehicle = L.marker(ll(this.origin), { icon: icon("mk-vehicle", VEHICLE_SVG, 40, "map-vehicle"), zIndexOffset: 1000, interactive: false });
     this.draftTarget = L.marker(ll(this.origin), { icon: icon("mk-draft", TARGET_SVG, 34, "map-draft-target"), interactive: false, opacity: 0.6 });
-    for (const layer of [this.pattern, this.final, this.ellUncontrolled, this.ellPlanned, this.track, this.draftPlan, this.draftLocalizer]) layer.addTo(this.map);
+    for (const layer of [this.reach95, this.reach50, this.pattern, this.final, this.ellUncontrolled, this.ellPlanned, this.track, this.draftPlan, this.draftLocalizer]) layer.addTo(this.map);
 
     // Badges drawn on top of the map: tiles status, wind, final approach, landing, follow toggle.
     this.packError = station.offline_tiles_error;
@@ -94,9 +98,10 @@ export class MapView {
     this.windText = h("span", { "data-testid": "map-wind" }, "wind —");
     this.finalText = h("div", { class: "map-badge final", "data-testid": "map-final", hidden: true });
     this.landedText = h("div", { class: "map-badge landed", "data-testid": "map-landed", hidden: true });
+    this.reachText = h("div", { class: "map-badge reach", "data-testid": "map-footprint", hidden: true, title: "ground the stack can still reach: darker in at least half of the dispersed draws, lighter in 95 %" });
     this.followBtn = h("button", { type: "button", class: "small on", "data-testid": "map-follow", "aria-pressed": "true", title: "keep the vehicle, target, pattern and predicted landings in view (off when you drag or zoom)" }, "Follow");
     this.followBtn.addEventListener("click", () => this.setFollow(!this.follow));
-    const overlay = h("div", { class: "map-overlay", "data-testid": "map-overlay" }, this.tilesStatus, packNoteEl, h("div", { class: "map-badge wind" }, this.windArrow, this.windText), this.finalText, this.landedText, this.followBtn);
+    const overlay = h("div", { class: "map-overlay", "data-testid": "map-overlay" }, this.tilesStatus, packNoteEl, h("div", { class: "map-badge wind" }, this.windArrow, this.windText), this.finalText, this.reachText, this.landedText, this.followBtn);
     L.DomEvent.disableClickPropagation(overlay);
     L.DomEvent.disableScrollPropagation(overlay);
     el.append(overlay);
@@ -165,6 +170,20 @@ export class MapView {
     this.track.setLatLngs(points.slice(-MAX_TRACK).map((p) => [p.lat_deg, p.lon_deg] as L.LatLngTuple));
   }
 
+  private showFootprint(f: Footprint | null, stale: boolean): void {
+    const level = (p: number): Ring[][] => f?.contours.find((c) => Math.abs(c.level - p) < 1e-6)?.polygons ?? [];
+    this.reach95.setLatLngs(level(0.95));
+    this.reach50.setLatLngs(level(0.5));
+    const old = stale || (f?.stale ?? false);
+    for (const layer of [this.reach95, this.reach50]) layer.setStyle({ color: old ? "#888" : "#2a7ab0", fillColor: old ? "#888" : "#2a7ab0" });
+    this.reachText.hidden = f === null;
+    if (f !== null) {
+      this.reachText.dataset.computed = f.computed_s.toFixed(1);
+      this.reachText.classList.toggle("stale", old);
+      setText(this.reachText, `reach 50 % / 95 % from ${fmt(f.height_m, "m", 0)} · ${fmt(f.age_s, "s", 0)} ago`);
+    }
+  }
+
   update(s: State, stale: boolean): void {
     const e = s.estimate;
     const landed = isLanded(s);
@@ -203,6 +222,7 @@ export class MapView {
       this.finalText.hidden = true;
     }
     const pred = landed ? null : s.prediction;
+    this.showFootprint(landed ? null : s.footprint, stale);
     this.showPrediction(this.planned, this.ellPlanned, pred?.planned ?? null, "planned", stale);
     this.showPrediction(this.uncontrolled, this.ellUncontrolled, pred?.uncontrolled ?? null, "uncontrolled", stale);
     for (const [layer, color] of [[this.pattern, "#c000c0"], [this.final, "#c000c0"]] as const) layer.setStyle({ color: stale ? "#888" : color });

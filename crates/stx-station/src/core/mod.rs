@@ -20,6 +20,7 @@ mod actions;
 mod ascent;
 mod commands;
 mod cutdown;
+mod footprint;
 mod manual;
 mod navigation;
 mod operator;
@@ -46,6 +47,7 @@ pub use actions::{APPLY_WITHIN_S, ActionError, ActionId, LinkAction, LinkOp, OUT
 pub use ascent::REFIT_EVERY_S;
 pub use commands::{ANSWER_PER_PLAN_ITEM_S, ANSWER_WITHIN_S, UPLOAD_RETRY_S, UPLOAD_TRIES};
 pub use cutdown::CutdownArm;
+pub use footprint::{FootprintDone, FootprintJob};
 pub use manual::MANUAL_SILENCE_S;
 pub use navigation::{Predicted, PredictionJob};
 pub use requests::{ApiError, CommandRequest};
@@ -107,6 +109,8 @@ pub struct StationCore {
     pub(crate) prediction: Option<LandingPrediction>,
     /// When the sensor data the prediction started from arrived (mission time, s).
     pub(crate) prediction_data_s: Option<f64>,
+    /// The latest reachable footprint and the mission time it was computed at, s.
+    pub(crate) footprint: Option<(stx_gnc::footprint::Footprint, f64)>,
     /// The plan download and where the replica's plan comes from.
     pub(crate) sync: sync::PlanSync,
     /// The drone's clock of the estimate guidance last ran on, s.
@@ -151,6 +155,7 @@ impl StationCore {
             guidance,
             prediction: None,
             prediction_data_s: None,
+            footprint: None,
             sync: sync::PlanSync::default(),
             guided_at_s: None,
             track: Vec::new(),

@@ -247,6 +247,7 @@ impl StationCore {
             estimate,
             guidance,
             prediction,
+            footprint: self.footprint_view(now_s),
             forecast_wind: self.config.forecast_wind.clone(),
             mission: MissionView {
                 stage: self.latest.status.map(|(s, _)| snake(s.stage)),

@@ -35,6 +35,9 @@ const TIMER_PERIOD: Duration = Duration::from_millis(100);
 const COALESCE: Duration = Duration::from_millis(1);
 /// Landing predictions run this often, off the station loop.
 const PREDICTION_PERIOD: Duration = Duration::from_secs(1);
+/// The reachable footprint is refreshed this often under the parafoil (the issue asks for at
+/// least every 5 s; one refresh takes tens of milliseconds).
+const FOOTPRINT_PERIOD: Duration = Duration::from_secs(2);
 
 /// The station loop's inputs and outputs.
 pub(super) struct StationLoop {
@@ -60,6 +63,9 @@ pub(super) async fn station_loop(mut io: StationLoop) {
     let mut prediction_timer = tokio::time::interval(PREDICTION_PERIOD);
     let (prediction_tx, mut prediction_rx) = mpsc::channel(1);
     let mut predicting = false;
+    let mut footprint_timer = tokio::time::interval(FOOTPRINT_PERIOD);
+    let (footprint_tx, mut footprint_rx) = mpsc::channel(1);
+    let mut footprinting = false;
     let mut burst_deadline: Option<tokio::time::Instant> = None;
     let mut last_state = tokio::time::Instant::now();
     // For the driver, oldest first, until it has room.
@@ -109,6 +115,21 @@ pub(super) async fn station_loop(mut io: StationLoop) {
                 if let Some(job) = job {
                     predicting = true;
                     let tx = prediction_tx.clone();
+                    tokio::task::spawn_blocking(move || {
+                        let _ = tx.blocking_send(job.run());
+                    });
+                }
+            }
+            Some(done) = footprint_rx.recv() => {
+                footprinting = false;
+                shared.core().set_footprint(done);
+            }
+            _ = footprint_timer.tick() => {
+                let now = shared.now_s();
+                let job = if footprinting { None } else { shared.core().footprint_job(now) };
+                if let Some(job) = job {
+                    footprinting = true;
+                    let tx = footprint_tx.clone();
                     tokio::task::spawn_blocking(move || {
                         let _ = tx.blocking_send(job.run());
                     });
