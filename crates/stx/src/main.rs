@@ -15,6 +15,7 @@ mod import;
 mod inputs;
 mod logging;
 mod montecarlo;
+mod plan;
 mod record;
 mod replay;
 mod serve;
@@ -65,6 +66,9 @@ enum Command {
     Import(import::ImportArgs),
     /// Play a recording through a station into the dashboard (pause, seek, speed; no commands).
     Replay(replay::ReplayArgs),
+    /// Pre-flight plan: burst, deploy and landing regions and the target's reachability from a
+    /// forecast (and an earlier recording's measured ascent wind).
+    Plan(plan::PlanArgs),
     /// Station tokens: `stx token new` prints a strong random one as a `[[tokens]]` entry.
     Token(token::TokenArgs),
 }
@@ -107,6 +111,7 @@ fn main() -> ExitCode {
         Command::Import(args) => import::run(args),
         Command::Replay(args) => replay::run(args),
         Command::Token(args) => token::run(args),
+        Command::Plan(args) => plan::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -136,6 +141,7 @@ impl Command {
                 | Command::Export(_)
                 | Command::Import(_)
                 | Command::Token(_)
+                | Command::Plan(_)
         )
     }
 }

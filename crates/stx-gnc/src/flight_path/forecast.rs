@@ -23,6 +23,8 @@
 use serde::{Deserialize, Serialize};
 use stx_dynamics::wind::{ProfileRow, WindError, WindProfile};
 
+use crate::ascent_wind::WindBand;
+
 /// One forecast level.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
@@ -155,6 +157,38 @@ impl Forecast {
             })
             .collect()
     }
+}
+
+/// The `forecast` rows (possibly none) with the wind measured during an earlier ascent
+/// (`bands` above an origin `origin_msl_m` above sea level, lowest first, as
+/// [`crate::ascent_wind::AscentWindEstimator::profile`] gives them) in place of the forecast
+/// rows over the span the measurement covers — the rule of
+/// [`crate::ascent_wind::merge_with_forecast`] — each band's sigma the larger of its two
+/// components'.
+pub fn merge_measured(
+    forecast: &[ForecastRow],
+    bands: &[WindBand],
+    origin_msl_m: f64,
+) -> Result<Forecast, ForecastError> {
+    let (Some(lowest), Some(highest)) = (bands.first(), bands.last()) else {
+        return Forecast::new(forecast.to_vec());
+    };
+    let low = lowest.altitude_min_m + origin_msl_m;
+    let high = highest.altitude_max_m + origin_msl_m;
+    let measured = bands.iter().map(|b| ForecastRow {
+        alt_msl_m: b.altitude_m + origin_msl_m,
+        speed_mps: b.speed_mps(),
+        from_deg: b.from_deg(),
+        sigma_mps: Some(b.sigma_north_mps.max(b.sigma_east_mps)),
+    });
+    let rows = forecast
+        .iter()
+        .filter(|r| r.alt_msl_m < low)
+        .copied()
+        .chain(measured)
+        .chain(forecast.iter().filter(|r| r.alt_msl_m > high).copied())
+        .collect();
+    Forecast::new(rows)
 }
 
 const CSV_COLUMNS: [&str; 4] = ["alt_msl_m", "speed_mps", "from_deg", "sigma_mps"];

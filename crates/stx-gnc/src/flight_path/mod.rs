@@ -41,7 +41,7 @@ use stx_dynamics::wind::WindField;
 
 use crate::performance::GlidePerformance;
 use crate::pointmass::{Conditions, PointMass};
-pub use forecast::{Forecast, ForecastError, ForecastRow};
+pub use forecast::{Forecast, ForecastError, ForecastRow, merge_measured};
 pub use models::{Balloon, RoundChute};
 pub use plan::{PlanError, PlanReport, PlanRequest, plan};
 pub use reach::ReachDisc;

@@ -1,0 +1,198 @@
+//! `stx plan --launch LAT,LON[,ALT] --forecast FILE …`: the pre-flight plan (burst, deploy
+//! and landing regions, the target's reachability) from a forecast file and, if given, the
+//! wind an earlier recording measured on its ascent. Argument parsing and files only; the plan
+//! is `stx_gnc::flight_path::plan`.
+
+use std::path::PathBuf;
+
+use anyhow::Context;
+use clap::Args;
+use stx_gnc::flight_path::plan::{MAX_RUNS, PlannedPoint, measured_ascent};
+use stx_gnc::flight_path::{Forecast, PlanRequest, merge_measured, plan};
+use stx_gnc::geo::LocalFrame;
+use stx_record::Recording;
+use stx_record::export::track::track;
+
+use crate::BadInput;
+
+#[derive(Args, Debug)]
+pub struct PlanArgs {
+    /// Launch site: latitude and longitude in degrees, and the ground's altitude above mean
+    /// sea level in metres (default 0).
+    #[arg(long, value_name = "LAT,LON[,ALT]", value_parser = parse_launch)]
+    launch: LocalFrame,
+    /// Forecast wind file, TOML or CSV (format: README, "Pre-flight planning").
+    #[arg(long, value_name = "FILE", required_unless_present = "from_recording")]
+    forecast: Option<PathBuf>,
+    /// An earlier recording (MCAP) whose measured ascent wind replaces the forecast where it
+    /// reaches.
+    #[arg(long, value_name = "FILE.mcap")]
+    from_recording: Option<PathBuf>,
+    /// Mean ascent rate from launch to burst, m/s.
+    #[arg(long, default_value_t = 5.0, value_name = "M/S")]
+    ascent_rate: f64,
+    /// 1-σ of the ascent rate, m/s.
+    #[arg(long, default_value_t = 0.5, value_name = "M/S")]
+    ascent_rate_sigma: f64,
+    /// Burst altitude above mean sea level, m.
+    #[arg(long, default_value_t = 35_000.0, value_name = "M")]
+    burst_alt: f64,
+    /// 1-σ of the burst altitude, m.
+    #[arg(long, default_value_t = 1500.0, value_name = "M")]
+    burst_alt_sigma: f64,
+    /// Height above the launch site at which the parafoil deploys, m (onboard MIS_DEPLOY_M).
+    #[arg(long, value_name = "M")]
+    deploy_height: Option<f64>,
+    /// 1-σ of each wind component where the forecast gives none, m/s.
+    #[arg(long, default_value_t = 1.5, value_name = "M/S")]
+    wind_sigma: f64,
+    /// Landing target: latitude and longitude, degrees.
+    #[arg(long, value_name = "LAT,LON", value_parser = parse_target)]
+    target: Option<[f64; 2]>,
+    /// Monte Carlo samples.
+    #[arg(long, default_value_t = 500, value_parser = clap::value_parser!(u32).range(1..=MAX_RUNS as i64))]
+    runs: u32,
+    /// Seed of the samples.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Print the plan as JSON (the station's POST /api/plan answer) instead of text.
+    #[arg(long)]
+    json: bool,
+}
+
+fn numbers(text: &str, counts: &[usize]) -> Result<Vec<f64>, String> {
+    let values: Result<Vec<f64>, _> = text.split(',').map(|v| v.trim().parse::<f64>()).collect();
+    match values {
+        Ok(v) if counts.contains(&v.len()) && v.iter().all(|x| x.is_finite()) => Ok(v),
+        _ => Err(format!(
+            "expected {counts:?} comma-separated numbers, got `{text}`"
+        )),
+    }
+}
+
+fn parse_launch(text: &str) -> Result<LocalFrame, String> {
+    let v = numbers(text, &[2, 3])?;
+    Ok(LocalFrame {
+        lat_deg: v[0],
+        lon_deg: v[1],
+        alt_msl_m: v.get(2).copied().unwrap_or(0.0),
+    })
+}
+
+fn parse_target(text: &str) -> Result<[f64; 2], String> {
+    let v = numbers(text, &[2])?;
+    Ok([v[0], v[1]])
+}
+
+pub fn run(args: PlanArgs) -> anyhow::Result<()> {
+    let mut forecast = match &args.forecast {
+        Some(path) => {
+            let text = std::fs::read_to_string(path)
+                .with_context(|| format!("cannot read the forecast {}", path.display()))
+                .map_err(BadInput)?;
+            Some(
+                Forecast::parse(&text)
+                    .with_context(|| format!("forecast {}", path.display()))
+                    .map_err(BadInput)?,
+            )
+        }
+        None => None,
+    };
+    if let Some(path) = &args.from_recording {
+        let mut recording = Recording::open(path)
+            .with_context(|| format!("cannot read the recording {}", path.display()))
+            .map_err(BadInput)?;
+        let (_, points) = track(&mut recording)
+            .with_context(|| format!("the GPS track of {}", path.display()))
+            .map_err(BadInput)?;
+        let fixes: Vec<_> = points
+            .iter()
+            .map(|p| (p.time_ns as f64 * 1e-9, p.lat_deg, p.lon_deg, p.alt_m))
+            .collect();
+        let (bands, frame) = measured_ascent(&fixes);
+        if bands.is_empty() {
+            return Err(BadInput(anyhow::anyhow!(
+                "{}: no ascent wind could be measured (too few fixes while rising)",
+                path.display()
+            ))
+            .into());
+        }
+        eprintln!(
+            "{}: {} measured wind bands from {:.0} to {:.0} m MSL",
+            path.display(),
+            bands.len(),
+            bands[0].altitude_min_m + frame.alt_msl_m,
+            bands[bands.len() - 1].altitude_max_m + frame.alt_msl_m
+        );
+        let base = forecast.as_ref().map_or(&[][..], Forecast::rows);
+        let merged = merge_measured(base, &bands, frame.alt_msl_m)
+            .with_context(|| format!("the wind measured in {}", path.display()))
+            .map_err(BadInput)?;
+        forecast = Some(merged);
+    }
+    let forecast = forecast.expect("clap requires --forecast or --from-recording");
+    let mut request = PlanRequest::new(args.launch, forecast.rows().to_vec());
+    request.ascent_rate_mps = args.ascent_rate;
+    request.ascent_rate_sigma_mps = args.ascent_rate_sigma;
+    request.burst_altitude_msl_m = args.burst_alt;
+    request.burst_altitude_sigma_m = args.burst_alt_sigma;
+    if let Some(h) = args.deploy_height {
+        request.deploy_height_m = h;
+    }
+    request.default_wind_sigma_mps = args.wind_sigma;
+    request.target_lat_lon_deg = args.target;
+    request.runs = args.runs as usize;
+    request.seed = args.seed;
+    let report = plan(&request).map_err(|e| BadInput(e.into()))?;
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+        return Ok(());
+    }
+    let line = |name: &str, p: &PlannedPoint| {
+        println!(
+            "{name:<26} {:>10.5} {:>10.5} {:>7.0} m MSL  {:>6.0} m N {:>7.0} m E  T+{} ±{:.0} s  1σ {:.0} × {:.0} m at {:.0}°",
+            p.lat_deg,
+            p.lon_deg,
+            p.alt_msl_m,
+            p.north_m,
+            p.east_m,
+            clock(p.time_s),
+            p.time_sigma_s,
+            p.ellipse.semi_major_m,
+            p.ellipse.semi_minor_m,
+            p.ellipse.major_axis_rad.to_degrees().rem_euclid(180.0)
+        );
+    };
+    println!(
+        "plan from {:.5}, {:.5} ({:.0} m MSL): {} samples, seed {}",
+        request.launch_lat_deg,
+        request.launch_lon_deg,
+        request.launch_alt_msl_m,
+        request.runs,
+        request.seed
+    );
+    line("burst", &report.burst);
+    line("parafoil deploy", &report.deploy);
+    line("landing, unsteered", &report.landing_unsteered);
+    line("landing, round chute only", &report.round_chute_landing);
+    println!(
+        "steering reaches {:.0} m around the drifted air mass on average ({})",
+        report.steered_reach_radius_m, report.reach_method
+    );
+    if let Some(t) = &report.target {
+        println!(
+            "target {:.5}, {:.5}: reachable in {:.0} % of the samples, {:.0} m from the unsteered landing",
+            t.lat_deg,
+            t.lon_deg,
+            100.0 * t.reachable_probability,
+            t.from_unsteered_landing_m
+        );
+    }
+    Ok(())
+}
+
+/// `h:mm:ss`.
+fn clock(seconds: f64) -> String {
+    let s = seconds.max(0.0).round() as u64;
+    format!("{}:{:02}:{:02}", s / 3600, s / 60 % 60, s % 60)
+}
