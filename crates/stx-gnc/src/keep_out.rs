@@ -74,6 +74,20 @@ impl KeepOutZone {
             == 1
     }
 
+    /// The boundary's vertices (closing point dropped) as latitude, longitude in degrees, in
+    /// `frame` (for the fence sent to the drone, which has no holes).
+    pub fn boundary_lat_lon(&self, frame: &LocalFrame) -> Vec<[f64; 2]> {
+        self.rings_ne_m.first().map_or_else(Vec::new, |ring| {
+            ring.iter()
+                .map(|ne| {
+                    let (lat, lon, _) =
+                        frame.to_geodetic(&nalgebra::Vector3::new(ne[0], ne[1], 0.0));
+                    [lat, lon]
+                })
+                .collect()
+        })
+    }
+
     /// Whether the straight leg from `a` to `b` (north, east, m) enters the zone: an end in
     /// it, or an edge crossed.
     pub fn crossed_by(&self, a: [f64; 2], b: [f64; 2]) -> bool {

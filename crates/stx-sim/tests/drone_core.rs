@@ -593,8 +593,10 @@ fn the_same_seed_flies_the_same_mission() {
 }
 
 /// Regression (issue 17 item 2): MAVProxy announced "fence breach" on connecting, because
-/// SYS_STATUS left the health bit of the geofence (which the drone does not have) clear. A
+/// SYS_STATUS left the health bit of the geofence (which the drone then did not have) clear. A
 /// subsystem not present is reported healthy; a present one is unhealthy only when it fails.
+/// The geofence (keep-out zones, issue 15) is present, and without zones not enabled and
+/// healthy.
 #[test]
 fn sys_status_reports_absent_subsystems_healthy_and_present_ones_as_they_are() {
     const GEOFENCE: u32 = 0x10_0000; // MAV_SYS_STATUS_GEOFENCE
@@ -613,8 +615,13 @@ fn sys_status_reports_absent_subsystems_healthy_and_present_ones_as_they_are() {
         .collect();
     assert!(!statuses.is_empty(), "SYS_STATUS is sent");
     for s in &statuses {
-        assert_eq!(s.sensors_present & GEOFENCE, 0, "no geofence on board");
-        assert_eq!(s.sensors_health & GEOFENCE, GEOFENCE, "absent: healthy");
+        assert_eq!(
+            s.sensors_present & GEOFENCE,
+            GEOFENCE,
+            "a geofence on board"
+        );
+        assert_eq!(s.sensors_enabled & GEOFENCE, 0, "no zones: not enabled");
+        assert_eq!(s.sensors_health & GEOFENCE, GEOFENCE, "no zones: healthy");
         assert_eq!(
             s.sensors_health | s.sensors_present,
             u32::MAX,

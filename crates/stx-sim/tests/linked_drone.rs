@@ -671,6 +671,120 @@ fn an_uploaded_plan_is_flown_and_downloads_as_the_drone_holds_it() {
     assert_eq!(landing.miss_m.map(|m| (m - miss).abs() < 0.01), Some(true));
 }
 
+/// MAV_SYS_STATUS_GEOFENCE.
+const GEOFENCE: u32 = 1 << 20;
+
+/// The last SYS_STATUS's (present, enabled, health) bitmaps.
+fn last_sys_status(bench: &Bench) -> (u32, u32, u32) {
+    bench
+        .ground_events
+        .iter()
+        .rev()
+        .find_map(|(_, e)| match e {
+            GroundEvent::Telemetry {
+                telemetry: Telemetry::System(s),
+                ..
+            } => Some((s.sensors_present, s.sensors_enabled, s.sensors_health)),
+            _ => None,
+        })
+        .expect("a SYS_STATUS")
+}
+
+#[test]
+fn an_uploaded_fence_becomes_the_onboard_zones_and_sys_status_says_when_the_landing_is_in_one() {
+    use stx_gnc::keep_out::{KeepOutZone, KeepOutZones};
+    use stx_link::plan::{FenceEvent, zones_to_fence};
+    let mut bench = Bench::new("rehearsal", |_| {});
+    assert!(bench.run_until(30.0, |b| b.stage() == FlightStage::Parafoil));
+    bench.run_for(5.0);
+    let (present, enabled, health) = last_sys_status(&bench);
+    assert_eq!(
+        (present & GEOFENCE, enabled & GEOFENCE, health & GEOFENCE),
+        (GEOFENCE, 0, GEOFENCE),
+        "no zones: present, not enabled, healthy"
+    );
+    // A zone over where the drone predicts it lands.
+    let landing = bench
+        .drone
+        .drone()
+        .predicted_landing_ne_m()
+        .expect("a prediction");
+    let square = |c: [f64; 2], h: f64| {
+        vec![
+            [c[0] - h, c[1] - h],
+            [c[0] + h, c[1] - h],
+            [c[0] + h, c[1] + h],
+            [c[0] - h, c[1] + h],
+        ]
+    };
+    let zones = KeepOutZones {
+        zones: vec![KeepOutZone {
+            name: "pond".into(),
+            rings_ne_m: vec![square(landing, 60.0)],
+        }],
+    };
+    let site = bench.drone.drone().config().site;
+    let fence = zones_to_fence(&zones, &site).unwrap();
+    let now = bench.now();
+    bench
+        .ground
+        .fence_upload(now, fence.clone())
+        .expect("upload");
+    assert!(bench.run_until(bench.time_s() + 10.0, |b| {
+        b.ground_events
+            .iter()
+            .any(|(_, e)| matches!(e, GroundEvent::Fence(FenceEvent::UploadDone { items: 4 })))
+    }));
+    assert_eq!(bench.drone.counters().fences, 1);
+    let onboard = bench.drone.drone().onboard().guidance().keep_out();
+    assert_eq!(onboard.zones.len(), 1);
+    for (a, b) in onboard.zones[0].rings_ne_m[0]
+        .iter()
+        .zip(&zones.zones[0].rings_ne_m[0])
+    {
+        assert!(
+            (a[0] - b[0]).abs() < 0.05 && (a[1] - b[1]).abs() < 0.05,
+            "{a:?} {b:?}"
+        );
+    }
+    bench.run_for(3.0);
+    let (_, enabled, health) = last_sys_status(&bench);
+    assert_eq!(enabled & GEOFENCE, GEOFENCE, "zones loaded: enabled");
+    let in_zone = bench
+        .drone
+        .drone()
+        .predicted_landing_ne_m()
+        .is_some_and(|p| onboard_zone_at(&bench, p));
+    assert!(
+        in_zone,
+        "the zone is 120 m across the landing predicted 3 s before"
+    );
+    assert_eq!(
+        health & GEOFENCE == 0,
+        in_zone,
+        "health clear exactly when the landing is in a zone"
+    );
+    // The download returns the fence held.
+    let now = bench.now();
+    bench.ground.fence_download(now).expect("download");
+    assert!(bench.run_until(bench.time_s() + 10.0, |b| {
+        b.ground_events.iter().any(
+            |(_, e)| matches!(e, GroundEvent::Fence(FenceEvent::DownloadDone { items }) if items.len() == 4),
+        )
+    }));
+}
+
+fn onboard_zone_at(bench: &Bench, p: [f64; 2]) -> bool {
+    bench
+        .drone
+        .drone()
+        .onboard()
+        .guidance()
+        .keep_out()
+        .zone_at(p)
+        .is_some()
+}
+
 #[test]
 fn the_automatic_cutdown_cuts_the_balloon_at_mis_cutdown_m_by_the_estimate() {
     let mut bench = Bench::new("mission-short", |c| {

@@ -16,7 +16,10 @@ use crate::command::{
 use crate::frame::Frame;
 use crate::manual::{ManualSender, Sticks};
 use crate::param::{ParamClient, ParamConfig, ParamEvent, ParamRequestError};
-use crate::plan::{PlanClient, PlanConfig, PlanEvent, PlanItem, PlanRequestError};
+use crate::plan::{
+    FenceClient, FenceEvent, FenceItem, PlanClient, PlanConfig, PlanEvent, PlanItem,
+    PlanRequestError,
+};
 use crate::signing::SigningConfig;
 use crate::telemetry::{Severity, StatusTextAssembler, Telemetry};
 
@@ -72,6 +75,8 @@ pub enum GroundEvent {
     Param(ParamEvent),
     /// Outcome of a plan transfer.
     Plan(PlanEvent),
+    /// Outcome of a keep-out fence transfer.
+    Fence(FenceEvent),
     /// Any other message from the drone, and every message from another system (for
     /// recording and other tools).
     Other(Box<Frame>),
@@ -85,6 +90,7 @@ pub struct GroundEndpoint {
     commands: CommandClient,
     params: ParamClient,
     plan: PlanClient,
+    fence: FenceClient,
     manual: ManualSender,
     texts: StatusTextAssembler,
     events: VecDeque<GroundEvent>,
@@ -99,6 +105,7 @@ impl GroundEndpoint {
             commands: CommandClient::new(config.command),
             params: ParamClient::new(config.param),
             plan: PlanClient::new(config.plan),
+            fence: FenceClient::new(config.plan),
             manual: ManualSender::new(config.manual_period),
             texts: StatusTextAssembler::default(),
             events: VecDeque::new(),
@@ -176,6 +183,7 @@ impl GroundEndpoint {
         self.commands.handle_message(now, from.0, our, msg);
         self.params.handle_message(now, from.0, msg);
         self.plan.handle_message(now, from.0, msg);
+        self.fence.handle_message(now, from.0, msg);
         match Telemetry::from_mavlink(msg) {
             Some(telemetry) => {
                 if let Telemetry::StatusText(chunk) = &telemetry
@@ -251,6 +259,20 @@ impl GroundEndpoint {
         self.plan.download(now, self.vehicle)
     }
 
+    /// Uploads the keep-out fence ([`zones_to_fence`](crate::plan::zones_to_fence)).
+    pub fn fence_upload(
+        &mut self,
+        now: Duration,
+        items: Vec<FenceItem>,
+    ) -> Result<(), PlanRequestError> {
+        self.fence.upload(now, self.vehicle, items)
+    }
+
+    /// Downloads the fence the drone holds.
+    pub fn fence_download(&mut self, now: Duration) -> Result<(), PlanRequestError> {
+        self.fence.download(now, self.vehicle)
+    }
+
     /// Holds the stick at `sticks` (streamed until released).
     pub fn manual_hold(&mut self, now: Duration, sticks: Sticks) {
         self.manual.hold(now, sticks);
@@ -282,6 +304,7 @@ impl GroundEndpoint {
         self.commands.handle_timeout(now);
         self.params.handle_timeout(now);
         self.plan.handle_timeout(now);
+        self.fence.handle_timeout(now);
         self.manual.handle_timeout(now);
     }
 
@@ -292,6 +315,7 @@ impl GroundEndpoint {
             self.commands.poll_timeout(),
             self.params.poll_timeout(),
             self.plan.poll_timeout(),
+            self.fence.poll_timeout(),
             self.manual.poll_timeout(),
         ]
         .into_iter()
@@ -308,6 +332,9 @@ impl GroundEndpoint {
             self.core.send(now, &m);
         }
         while let Some(m) = self.plan.poll_transmit() {
+            self.core.send(now, &m);
+        }
+        while let Some(m) = self.fence.poll_transmit() {
             self.core.send(now, &m);
         }
         while let Some(m) = self.manual.poll_transmit(now, target) {
@@ -334,6 +361,9 @@ impl GroundEndpoint {
         }
         while let Some(e) = self.plan.poll_event() {
             self.events.push_back(GroundEvent::Plan(e));
+        }
+        while let Some(e) = self.fence.poll_event() {
+            self.events.push_back(GroundEvent::Fence(e));
         }
         self.events.pop_front()
     }

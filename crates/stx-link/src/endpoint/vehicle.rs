@@ -16,7 +16,7 @@ use crate::manual::{ManualEvent, ManualReceiver, Sticks};
 use crate::param::{
     ParamChange, ParamRefusal, ParamSpec, ParamTable, ParamTableError, ParamValidator, RangeOnly,
 };
-use crate::plan::{PlanConfig, PlanItem, PlanServer};
+use crate::plan::{FenceItem, FenceServer, PlanConfig, PlanItem, PlanServer};
 use crate::signing::SigningConfig;
 use crate::telemetry::{Severity, SystemState, Telemetry, VehicleStatus, split_status_text};
 
@@ -70,6 +70,8 @@ pub enum VehicleEvent {
     ParamRefused(ParamRefusal),
     /// A new plan was uploaded.
     PlanReceived(Vec<PlanItem>),
+    /// A new keep-out fence was uploaded (its polygons checked whole).
+    FenceReceived(Vec<FenceItem>),
     /// Stick values, or their going stale.
     Manual(ManualEvent),
     /// Any other message.
@@ -84,6 +86,7 @@ pub struct VehicleEndpoint {
     commands: CommandServer,
     params: ParamTable,
     plan: PlanServer,
+    fence: FenceServer,
     manual: ManualReceiver,
     next_text_id: u16,
     events: VecDeque<VehicleEvent>,
@@ -98,6 +101,7 @@ impl VehicleEndpoint {
         Ok(Self {
             params: ParamTable::new(sys, comp, config.params)?,
             plan: PlanServer::new(sys, comp, config.plan),
+            fence: FenceServer::new(sys, comp, config.plan),
             manual: ManualReceiver::new(sys, config.manual_timeout),
             commands,
             status: config.initial_status,
@@ -228,6 +232,7 @@ impl VehicleEndpoint {
                     self.commands.handle_message(now, from, msg)
                         || self.params.handle_message_with(msg, validator)
                         || self.plan.handle_message(now, from, msg)
+                        || self.fence.handle_message(now, from, msg)
                         || self.manual.handle_message(now, msg)
                 }
             };
@@ -288,6 +293,11 @@ impl VehicleEndpoint {
         self.plan.set_plan(plan);
     }
 
+    /// The keep-out fence held.
+    pub fn fence(&self) -> &[FenceItem] {
+        self.fence.plan()
+    }
+
     /// Changes how long sticks stay fresh without a MANUAL_CONTROL (a parameter the station
     /// may edit).
     pub fn set_manual_timeout(&mut self, timeout: Duration) {
@@ -306,6 +316,7 @@ impl VehicleEndpoint {
             self.core.send(now, &hb);
         }
         self.plan.handle_timeout(now);
+        self.fence.handle_timeout(now);
         self.manual.handle_timeout(now);
     }
 
@@ -314,6 +325,7 @@ impl VehicleEndpoint {
         [
             Some(self.core.poll_timeout()),
             self.plan.poll_timeout(),
+            self.fence.poll_timeout(),
             self.manual.poll_timeout(),
         ]
         .into_iter()
@@ -335,6 +347,9 @@ impl VehicleEndpoint {
         while let Some(m) = self.plan.poll_transmit() {
             self.core.send(now, &m);
         }
+        while let Some(m) = self.fence.poll_transmit() {
+            self.core.send(now, &m);
+        }
         self.core.out.pop_front()
     }
 
@@ -354,6 +369,9 @@ impl VehicleEndpoint {
         }
         while let Some(p) = self.plan.poll_plan() {
             self.events.push_back(VehicleEvent::PlanReceived(p));
+        }
+        while let Some(f) = self.fence.poll_plan() {
+            self.events.push_back(VehicleEvent::FenceReceived(f));
         }
         while let Some(m) = self.manual.poll_event() {
             self.events.push_back(VehicleEvent::Manual(m));

@@ -1,6 +1,7 @@
-//! Ground side of the plan transfer: [`PlanClient`] uploads a plan or downloads the one the
+//! Ground side of a list transfer: [`MissionClient`] uploads a list or downloads the one the
 //! vehicle holds, re-sending its last message after a quiet timeout, and reports each
-//! outcome as a [`PlanEvent`].
+//! outcome as a [`TransferEvent`]. One client per mission type: [`PlanClient`] for the
+//! guidance plan, [`FenceClient`](super::FenceClient) for the keep-out fence.
 
 use std::collections::VecDeque;
 use std::time::Duration;
@@ -11,20 +12,25 @@ use serde::{Deserialize, Serialize};
 
 use super::item::PlanItem;
 use super::mission::{
-    MAX_PLAN_ITEMS, PlanConfig, is_mission, mission_ack, mission_count, mission_request,
+    MAX_PLAN_ITEMS, MissionItem, PlanConfig, mission_ack, mission_count, mission_request,
 };
 
 /// Outcome of a plan transfer on the ground side.
+pub type PlanEvent = TransferEvent<PlanItem>;
+/// Ground side of the plan transfer.
+pub type PlanClient = MissionClient<PlanItem>;
+
+/// Outcome of a list transfer on the ground side.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case")]
-pub enum PlanEvent {
-    /// The vehicle acknowledged the whole plan.
+pub enum TransferEvent<I> {
+    /// The vehicle acknowledged the whole list.
     UploadDone { items: usize },
-    /// The vehicle refused the plan (`result` is the MAV_MISSION_RESULT code) or stopped
+    /// The vehicle refused the list (`result` is the MAV_MISSION_RESULT code) or stopped
     /// answering (`result: None`).
     UploadFailed { result: Option<u8>, reason: String },
-    /// The plan the vehicle holds.
-    DownloadDone { items: Vec<PlanItem> },
+    /// The list the vehicle holds.
+    DownloadDone { items: Vec<I> },
     /// Download failed.
     DownloadFailed { reason: String },
 }
@@ -41,42 +47,50 @@ pub enum PlanRequestError {
 }
 
 #[derive(Debug)]
-enum ClientOp {
+enum ClientOp<I> {
     Upload {
-        items: Vec<PlanItem>,
+        items: Vec<I>,
         acked_through: Option<u16>,
     },
     Download {
         count: Option<u16>,
-        items: Vec<PlanItem>,
+        items: Vec<I>,
     },
 }
 
 #[derive(Debug)]
-struct ClientState {
+struct ClientState<I> {
     target: (u8, u8),
-    op: ClientOp,
+    op: ClientOp<I>,
     last_sent: MavMessage,
     attempts: u8,
     deadline: Duration,
 }
 
-/// Ground side of the plan transfer (sans-io).
-#[derive(Debug, Default)]
-pub struct PlanClient {
+/// Ground side of the transfer of one mission type's list (sans-io).
+#[derive(Debug)]
+pub struct MissionClient<I: MissionItem> {
     /// Timing.
     pub config: PlanConfig,
-    state: Option<ClientState>,
+    state: Option<ClientState<I>>,
     transmit: VecDeque<MavMessage>,
-    events: VecDeque<PlanEvent>,
+    events: VecDeque<TransferEvent<I>>,
 }
 
-impl PlanClient {
+impl<I: MissionItem> Default for MissionClient<I> {
+    fn default() -> Self {
+        Self::new(PlanConfig::default())
+    }
+}
+
+impl<I: MissionItem> MissionClient<I> {
     /// A client with the given timing.
     pub fn new(config: PlanConfig) -> Self {
         Self {
             config,
-            ..Default::default()
+            state: None,
+            transmit: VecDeque::new(),
+            events: VecDeque::new(),
         }
     }
 
@@ -101,7 +115,7 @@ impl PlanClient {
         &mut self,
         now: Duration,
         target: (u8, u8),
-        items: Vec<PlanItem>,
+        items: Vec<I>,
     ) -> Result<(), PlanRequestError> {
         if self.state.is_some() {
             return Err(PlanRequestError::Busy);
@@ -113,7 +127,7 @@ impl PlanClient {
                 count: items.len(),
                 max: MAX_PLAN_ITEMS,
             })?;
-        let msg = mission_count(target, count);
+        let msg = mission_count(target, count, I::MISSION_TYPE);
         self.state = Some(ClientState {
             target,
             op: ClientOp::Upload {
@@ -136,7 +150,7 @@ impl PlanClient {
         let msg = MavMessage::MISSION_REQUEST_LIST(mc::MISSION_REQUEST_LIST_DATA {
             target_system: target.0,
             target_component: target.1,
-            mission_type: mc::MavMissionType::MAV_MISSION_TYPE_MISSION,
+            mission_type: I::MISSION_TYPE,
         });
         self.state = Some(ClientState {
             target,
@@ -185,7 +199,7 @@ impl PlanClient {
                     seq, mission_type, ..
                 }),
             ) => {
-                if !is_mission(*mission_type) {
+                if *mission_type != I::MISSION_TYPE {
                     return;
                 }
                 let Some(item) = items.get(usize::from(*seq)) else {
@@ -200,29 +214,29 @@ impl PlanClient {
                 self.send(now, m, progress);
             }
             (ClientOp::Upload { items, .. }, MavMessage::MISSION_ACK(a))
-                if is_mission(a.mission_type) =>
+                if a.mission_type == I::MISSION_TYPE =>
             {
                 let n = items.len();
                 self.state = None;
                 self.events
                     .push_back(if a.mavtype == MavMissionResult::MAV_MISSION_ACCEPTED {
-                        PlanEvent::UploadDone { items: n }
+                        TransferEvent::UploadDone { items: n }
                     } else {
-                        PlanEvent::UploadFailed {
+                        TransferEvent::UploadFailed {
                             result: Some(a.mavtype as u8),
                             reason: format!("vehicle answered {:?}", a.mavtype),
                         }
                     });
             }
             (ClientOp::Download { count, items }, MavMessage::MISSION_COUNT(c))
-                if is_mission(c.mission_type) =>
+                if c.mission_type == I::MISSION_TYPE =>
             {
                 if count.is_some() {
                     return; // a duplicate COUNT; our request for the next item is out already
                 }
                 if c.count > MAX_PLAN_ITEMS {
                     self.state = None;
-                    self.events.push_back(PlanEvent::DownloadFailed {
+                    self.events.push_back(TransferEvent::DownloadFailed {
                         reason: format!("plan of {} items exceeds {MAX_PLAN_ITEMS}", c.count),
                     });
                     return;
@@ -230,14 +244,17 @@ impl PlanClient {
                 *count = Some(c.count);
                 if c.count == 0 {
                     self.state = None;
-                    self.transmit
-                        .push_back(mission_ack(target, MavMissionResult::MAV_MISSION_ACCEPTED));
+                    self.transmit.push_back(mission_ack(
+                        target,
+                        MavMissionResult::MAV_MISSION_ACCEPTED,
+                        I::MISSION_TYPE,
+                    ));
                     self.events
-                        .push_back(PlanEvent::DownloadDone { items: Vec::new() });
+                        .push_back(TransferEvent::DownloadDone { items: Vec::new() });
                     return;
                 }
                 items.clear();
-                self.send(now, mission_request(target, 0), true);
+                self.send(now, mission_request(target, 0, I::MISSION_TYPE), true);
             }
             (
                 ClientOp::Download {
@@ -245,16 +262,20 @@ impl PlanClient {
                     items,
                 },
                 MavMessage::MISSION_ITEM_INT(m),
-            ) if is_mission(m.mission_type) => {
+            ) if m.mission_type == I::MISSION_TYPE => {
                 if usize::from(m.seq) != items.len() {
                     return; // late duplicate; the current request is re-sent on timeout
                 }
-                match PlanItem::from_mavlink(m) {
+                match I::from_mavlink(m) {
                     Ok(item) => items.push(item),
                     Err(e) => {
                         self.state = None;
-                        self.transmit.push_back(mission_ack(target, e.result()));
-                        self.events.push_back(PlanEvent::DownloadFailed {
+                        self.transmit.push_back(mission_ack(
+                            target,
+                            I::refusal(&e),
+                            I::MISSION_TYPE,
+                        ));
+                        self.events.push_back(TransferEvent::DownloadFailed {
                             reason: format!("item {}: {e}", m.seq),
                         });
                         return;
@@ -264,12 +285,25 @@ impl PlanClient {
                 if items.len() >= usize::from(count) {
                     let items = std::mem::take(items);
                     self.state = None;
-                    self.transmit
-                        .push_back(mission_ack(target, MavMissionResult::MAV_MISSION_ACCEPTED));
-                    self.events.push_back(PlanEvent::DownloadDone { items });
+                    if let Err(reason) = I::check_list(&items) {
+                        self.transmit.push_back(mission_ack(
+                            target,
+                            MavMissionResult::MAV_MISSION_INVALID,
+                            I::MISSION_TYPE,
+                        ));
+                        self.events
+                            .push_back(TransferEvent::DownloadFailed { reason });
+                        return;
+                    }
+                    self.transmit.push_back(mission_ack(
+                        target,
+                        MavMissionResult::MAV_MISSION_ACCEPTED,
+                        I::MISSION_TYPE,
+                    ));
+                    self.events.push_back(TransferEvent::DownloadDone { items });
                 } else {
                     let next = items.len() as u16;
-                    self.send(now, mission_request(target, next), true);
+                    self.send(now, mission_request(target, next, I::MISSION_TYPE), true);
                 }
             }
             _ => {}
@@ -290,12 +324,12 @@ impl PlanClient {
             self.state = None;
             tracing::warn!(%reason, upload, "plan transfer failed");
             self.events.push_back(if upload {
-                PlanEvent::UploadFailed {
+                TransferEvent::UploadFailed {
                     result: None,
                     reason,
                 }
             } else {
-                PlanEvent::DownloadFailed { reason }
+                TransferEvent::DownloadFailed { reason }
             });
             return;
         }
@@ -315,7 +349,7 @@ impl PlanClient {
     }
 
     /// Next outcome.
-    pub fn poll_event(&mut self) -> Option<PlanEvent> {
+    pub fn poll_event(&mut self) -> Option<TransferEvent<I>> {
         self.events.pop_front()
     }
 }

@@ -174,3 +174,20 @@ impl PlanItem {
         })
     }
 }
+
+impl super::mission::MissionItem for PlanItem {
+    const MISSION_TYPE: mc::MavMissionType = mc::MavMissionType::MAV_MISSION_TYPE_MISSION;
+    type Error = PlanItemError;
+
+    fn to_mavlink(&self, target: (u8, u8), seq: u16) -> MavMessage {
+        PlanItem::to_mavlink(self, target, seq)
+    }
+
+    fn from_mavlink(m: &mc::MISSION_ITEM_INT_DATA) -> Result<Self, PlanItemError> {
+        PlanItem::from_mavlink(m)
+    }
+
+    fn refusal(error: &PlanItemError) -> MavMissionResult {
+        error.result()
+    }
+}

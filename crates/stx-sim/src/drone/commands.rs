@@ -5,7 +5,7 @@
 use stx_gnc::params::ParamError;
 use stx_link::command::{Command, CommandResult};
 use stx_link::manual::Sticks;
-use stx_link::plan::PlanItem;
+use stx_link::plan::{FenceItem, PlanItem};
 use stx_link::telemetry::Severity;
 
 use super::Drone;
@@ -46,6 +46,12 @@ impl Drone {
     /// An uploaded plan.
     pub fn handle_plan(&mut self, items: &[PlanItem]) {
         self.onboard.handle_plan(self.time_s(), items);
+        self.drain_onboard_texts();
+    }
+
+    /// An uploaded keep-out fence (checked whole by the link): the onboard guidance's zones.
+    pub fn handle_fence(&mut self, items: &[FenceItem]) {
+        self.onboard.handle_fence(items);
         self.drain_onboard_texts();
     }
 

@@ -98,6 +98,8 @@ pub struct LinkCounters {
     pub params_refused: u64,
     /// Plans uploaded.
     pub plans: u64,
+    /// Keep-out fences uploaded.
+    pub fences: u64,
     /// Datagrams in and frames out dropped because the link was down (injected).
     pub dropped_link_down: u64,
     /// Datagrams in and frames out dropped at random (injected packet loss).
@@ -394,6 +396,10 @@ impl LinkedDrone {
                         time_s,
                         items: items.len(),
                     });
+                }
+                VehicleEvent::FenceReceived(items) => {
+                    self.drone.handle_fence(&items);
+                    self.counters.fences += 1;
                 }
                 VehicleEvent::Manual(_) => {}
                 VehicleEvent::Other(_) => self.counters.ignored_frames += 1,

@@ -21,10 +21,11 @@ mod sensor_bits {
     pub const DIFFERENTIAL_PRESSURE: u32 = 16;
     pub const GPS: u32 = 32;
     pub const SERVOS: u32 = 32_768;
+    pub const GEOFENCE: u32 = 1_048_576;
     pub const AHRS: u32 = 2_097_152;
     pub const BATTERY: u32 = 33_554_432;
     pub const ALL: u32 =
-        MAG | ABSOLUTE_PRESSURE | DIFFERENTIAL_PRESSURE | GPS | SERVOS | AHRS | BATTERY;
+        MAG | ABSOLUTE_PRESSURE | DIFFERENTIAL_PRESSURE | GPS | SERVOS | AHRS | BATTERY | GEOFENCE;
 }
 
 impl Drone {
@@ -121,6 +122,20 @@ impl Drone {
         if self.servo_fault.active_at(t) {
             health &= !sensor_bits::SERVOS;
         }
+        // The geofence (keep-out zones): present always (the drone keeps out of a fence
+        // uploaded to it), enabled while it holds zones, and unhealthy when the payload is
+        // headed into one: the onboard landing prediction (or, landed, the stack itself) lies
+        // in a zone. Flying over a zone high up is not a breach: zones are places not to land.
+        let zones = self.onboard.guidance().keep_out();
+        let mut enabled = sensor_bits::ALL;
+        if zones.zones.is_empty() {
+            enabled &= !sensor_bits::GEOFENCE;
+        } else if self
+            .touchdown_ne_m()
+            .is_some_and(|p| zones.zone_at(p).is_some())
+        {
+            health &= !sensor_bits::GEOFENCE;
+        }
         SystemStatus {
             battery_voltage_v: Some(self.battery.voltage_v()),
             battery_current_a: Some(self.battery.current_a()),
@@ -129,11 +144,20 @@ impl Drone {
             comm_drop_rate_pct: 0.0,
             comm_errors: 0,
             sensors_present: sensor_bits::ALL,
-            sensors_enabled: sensor_bits::ALL,
+            sensors_enabled: enabled,
             // A subsystem the drone does not have is reported healthy, as ArduPilot and PX4
             // do: ground stations read a clear health bit as a fault whatever `present`
             // says (MAVProxy announced "fence breach" for the geofence the drone lacks).
             sensors_health: health | !sensor_bits::ALL,
+        }
+    }
+
+    /// Where the payload comes down (north, east), m: where it lies once landed, else where
+    /// the onboard prediction puts it.
+    fn touchdown_ne_m(&self) -> Option<[f64; 2]> {
+        match self.landing() {
+            Some(l) => Some(l.position_ne_m),
+            None => self.predicted_landing_ne_m(),
         }
     }
 

@@ -342,6 +342,29 @@ impl StationCore {
                     self.after_command_result(now_s, &msg);
                 }
             }
+            // The keep-out fence's transfers: the station does not send one yet (issue 15
+            // item 2, station side still to do); a tool's outcome goes to the log.
+            GroundEvent::Fence(e) => {
+                let (level, text) = match e {
+                    stx_link::plan::FenceEvent::UploadDone { items } => (
+                        Level::Info,
+                        format!("keep-out fence acknowledged ({items} vertices)"),
+                    ),
+                    stx_link::plan::FenceEvent::UploadFailed { reason, .. } => (
+                        Level::Warning,
+                        format!("keep-out fence upload failed: {reason}"),
+                    ),
+                    stx_link::plan::FenceEvent::DownloadDone { items } => (
+                        Level::Info,
+                        format!("keep-out fence held by the drone: {} vertices", items.len()),
+                    ),
+                    stx_link::plan::FenceEvent::DownloadFailed { reason } => (
+                        Level::Warning,
+                        format!("keep-out fence download failed: {reason}"),
+                    ),
+                };
+                self.log(now_s, level, "link", text);
+            }
             GroundEvent::Link(LinkEvent::FrameError(e)) => {
                 tracing::debug!(error = %e, "frame dropped (counted in the link statistics)");
             }

@@ -6,7 +6,7 @@ use stx_dynamics::rotation::wrap_pi;
 use stx_gnc::control::Localizer;
 use stx_gnc::mission::FlightMode;
 use stx_link::command::{Command, CommandResult};
-use stx_link::plan::PlanItem;
+use stx_link::plan::{FenceItem, PlanItem, fence_to_zones};
 use stx_link::telemetry::Severity;
 
 use super::{Onboard, mode_name};
@@ -76,7 +76,10 @@ impl Onboard {
                 let mut plan = *self.guidance.plan();
                 plan.target_ned_m = target;
                 plan.approach_course_rad = approach_heading_deg.map(|d| wrap_pi(d.to_radians()));
-                self.guidance.set_plan(plan, time_s);
+                if let Err(e) = self.guidance.try_set_plan(plan, time_s) {
+                    self.say(Severity::Warning, format!("landing target refused: {e}"));
+                    return CommandResult::Denied;
+                }
                 self.has_target = true;
                 self.say(
                     Severity::Info,
@@ -126,6 +129,14 @@ impl Onboard {
         let points: Vec<_> = items.iter().map(|i| i.to_local(&self.frame)).collect();
         let update = apply(self.guidance.plan(), &points);
         let plan = update.plan;
+        if update.target_set
+            && let Err(e) = plan.check_keep_out(self.guidance.keep_out())
+        {
+            // The upload is acknowledged (the protocol checks items, not their sense); the
+            // plan in force is kept, and a download shows it.
+            self.say(Severity::Warning, format!("plan refused: {e}"));
+            return;
+        }
         let mut said = Vec::new();
         if update.target_set {
             self.has_target = true;
@@ -150,6 +161,32 @@ impl Onboard {
             Severity::Info,
             format!("plan received ({} items): {}", items.len(), said.join(", ")),
         );
+    }
+
+    /// An uploaded keep-out fence: its polygons become guidance's zones in the mission's
+    /// frame. A target already in force that now lies in a zone is kept (the operator is told
+    /// and chooses another): dropping it would leave the drone without one.
+    pub fn handle_fence(&mut self, items: &[FenceItem]) {
+        let zones = match fence_to_zones(items, &self.frame) {
+            Ok(zones) => zones,
+            Err(e) => {
+                self.say(Severity::Warning, format!("keep-out fence refused: {e}"));
+                return;
+            }
+        };
+        let n = zones.zones.len();
+        let clash = self
+            .has_target
+            .then(|| self.guidance.plan().check_keep_out(&zones).err())
+            .flatten();
+        self.guidance.set_keep_out(zones);
+        self.say(
+            Severity::Info,
+            format!("keep-out fence received: {n} zones"),
+        );
+        if let Some(e) = clash {
+            self.say(Severity::Warning, format!("keep-out: {e}"));
+        }
     }
 
     /// The plan held, as mission items (what a station's download returns).
