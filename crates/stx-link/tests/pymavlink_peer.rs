@@ -4,7 +4,8 @@
 //! frames and corrupted CRCs; a signed variant with refused frames) and a manifest of every
 //! valid frame. The decoder must recover exactly those frames, in order, with the same header,
 //! payload and field values, and count the corrupt ones. Conversely `verify_stream.py` lets
-//! pymavlink check frames that stx-link signed.
+//! pymavlink check frames that stx-link signed, and `fence_upload.py` encodes a keep-out
+//! fence upload (MAV_MISSION_TYPE_FENCE, exclusion polygons) for the vehicle side to take.
 //!
 //! Python: `$STX_PYTHON`, or `.venv/bin/python` at the workspace root. To create it:
 //! `python3 -m venv .venv && .venv/bin/pip install pymavlink==2.4.50`.
@@ -380,4 +381,38 @@ fn pymavlink_verifies_frames_signed_by_stx_link() {
     let v: Value = serde_json::from_str(out.trim()).expect("json summary");
     assert_eq!(v["goodsig"].as_u64(), Some(0), "{v}");
     assert_eq!(v["messages"].as_array().map(Vec::len), Some(0), "{v}");
+}
+
+/// A fence upload encoded by pymavlink (`fence_upload.py`) is taken by the vehicle side's
+/// [`FenceServer`](stx_link::plan::FenceServer), acknowledged, and read as the polygons sent.
+#[test]
+fn a_fence_uploaded_by_pymavlink_is_accepted_as_its_polygons() {
+    use mavlink::dialects::common::{MavMissionResult, MavMissionType};
+    use stx_link::plan::{FenceServer, PlanConfig, fence_polygons};
+    let file = Path::new(env!("CARGO_TARGET_TMPDIR")).join("pymavlink-fence-upload.bin");
+    let printed = run_py("fence_upload.py", &[file.to_str().expect("utf-8 path")]);
+    let vertices: Vec<[i64; 3]> = serde_json::from_str(printed.trim()).expect("json");
+    let bytes = std::fs::read(&file).expect("frames");
+    let (frames, _) = decode(&bytes, bytes.len(), FrameDecoder::default());
+    assert_eq!(frames.len(), 1 + vertices.len());
+    let mut server = FenceServer::new(1, 1, PlanConfig::default());
+    let mut answers = Vec::new();
+    for f in &frames {
+        assert!(server.handle_message(Duration::ZERO, (255, 190), &f.message));
+        while let Some(m) = server.poll_transmit() {
+            answers.push(m);
+        }
+    }
+    let Some(MavMessage::MISSION_ACK(ack)) = answers.last() else {
+        panic!("no ack: {answers:?}")
+    };
+    assert_eq!(ack.mavtype, MavMissionResult::MAV_MISSION_ACCEPTED);
+    assert_eq!(ack.mission_type, MavMissionType::MAV_MISSION_TYPE_FENCE);
+    let fence = server.poll_plan().expect("a fence");
+    let polygons = fence_polygons(&fence).expect("well formed");
+    assert_eq!(polygons.iter().map(Vec::len).collect::<Vec<_>>(), [4, 3]);
+    for (got, [_, lat, lon]) in polygons.iter().flatten().zip(&vertices) {
+        assert!((got[0] * 1e7 - *lat as f64).abs() < 0.5, "{got:?}");
+        assert!((got[1] * 1e7 - *lon as f64).abs() < 0.5, "{got:?}");
+    }
 }
