@@ -185,6 +185,14 @@ pub struct StationConfig {
     /// shown on the map, which then draws its metric grid; the station runs on.
     #[serde(default)]
     pub tile_pack: Option<PathBuf>,
+    /// Keep-out zones (water, borders, forest, roads, people), a GeoJSON (RFC 7946) file of
+    /// Polygon and MultiPolygon features, each with a `name` property, relative to the working
+    /// directory. Read at start: a missing or invalid file stops the station with the reason
+    /// (it would otherwise guide and predict as if the zones were not there). Operators' edits
+    /// on the dashboard are written back to it. Absent: no zones until an operator draws some
+    /// (which are then not kept across a restart).
+    #[serde(default)]
+    pub keep_out: Option<PathBuf>,
     /// Origin of the mission's local frame (launch site).
     pub origin: LocalFrame,
     /// The drone link.
@@ -355,6 +363,13 @@ impl StationConfig {
             }) {
                 return invalid("tile_pack", "an .mbtiles or .pmtiles file");
             }
+        }
+        if self
+            .keep_out
+            .as_ref()
+            .is_some_and(|p| p.as_os_str().is_empty())
+        {
+            return invalid("keep_out", "a GeoJSON file");
         }
         if let Err((field, rule)) = self.recording.check() {
             return invalid(field, rule);

@@ -16,6 +16,7 @@ use serde_json::{Map, Value, json};
 use thiserror::Error;
 
 use crate::core::CutdownArm;
+use crate::keep_out::{KeepOutBody, KeepOutMsg};
 use crate::messages::{
     AscentWindMsg, CommandResultMsg, ErrorBody, EventMsg, ParamsMsg, ReplayView, Session, StateMsg,
 };
@@ -54,6 +55,8 @@ pub enum ServerMessage {
     Lagged(LaggedMsg),
     /// The answer to `ping`.
     Pong(PongMsg),
+    /// When the keep-out zones change.
+    KeepOut(KeepOutMsg),
 }
 
 /// Why the contract could not be assembled (a bug in the types, caught by the tests).
@@ -102,6 +105,7 @@ pub fn schema() -> Result<Value, ContractError> {
         sent.subschema_for::<ReplayView>(),
         sent.subschema_for::<RecordingsBody>(),
         sent.subschema_for::<ReplayOpened>(),
+        sent.subschema_for::<KeepOutMsg>(),
         read.subschema_for::<ClientMessage>(),
         read.subschema_for::<ModeBody>(),
         read.subschema_for::<HeadingBody>(),
@@ -112,6 +116,7 @@ pub fn schema() -> Result<Value, ContractError> {
         read.subschema_for::<ParamBody>(),
         read.subschema_for::<ConfirmBody>(),
         read.subschema_for::<ReplayBody>(),
+        read.subschema_for::<KeepOutBody>(),
     ];
     let mut definitions: Map<String, Value> = sent.take_definitions(true);
     // A type both sent and read must be described the same way both times.
@@ -126,7 +131,7 @@ pub fn schema() -> Result<Value, ContractError> {
     Ok(json!({
         "$schema": "http://json-schema.org/draft-07/schema#",
         "title": "stx station API",
-        "description": "Every message of the stx station's HTTP and WebSocket API (crates/stx-station/API.md), generated from the daemon's Rust types by `cargo run -p stx-station --example api_schema`: do not edit. The root is any one of them: on the WebSocket ServerMessage (station to page) and ClientMessage (page to station); over REST the bodies the station answers (Session, StateMsg, ParamsMsg, AscentWindMsg, EventsBody, TrackBody, ClientsBody, CommandResultMsg, CommandAccepted, CutdownArm, ErrorBody, ReplayView, RecordingsBody, ReplayOpened) and the bodies of the commands (*Body).",
+        "description": "Every message of the stx station's HTTP and WebSocket API (crates/stx-station/API.md), generated from the daemon's Rust types by `cargo run -p stx-station --example api_schema`: do not edit. The root is any one of them: on the WebSocket ServerMessage (station to page) and ClientMessage (page to station); over REST the bodies the station answers (Session, StateMsg, ParamsMsg, AscentWindMsg, EventsBody, TrackBody, ClientsBody, CommandResultMsg, CommandAccepted, CutdownArm, ErrorBody, ReplayView, RecordingsBody, ReplayOpened, KeepOutMsg) and the bodies of the commands (*Body).",
         "anyOf": messages,
         "definitions": definitions,
     }))

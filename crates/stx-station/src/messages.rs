@@ -406,6 +406,8 @@ pub struct StateMsg {
     pub forecast_wind: Vec<ForecastRow>,
     /// Mission.
     pub mission: MissionView,
+    /// Predicted landings inside a keep-out zone, one per prediction at most.
+    pub keep_out_alarms: Vec<crate::keep_out::KeepOutAlarmView>,
     /// The station's recording of this run; `null` where no daemon records (tests of the
     /// core, replays).
     pub recording: Option<RecordingView>,
@@ -589,7 +591,7 @@ pub struct TrackPoint {
 #[derive(Debug, Clone, Serialize, JsonSchema)]
 pub struct ErrorBody {
     /// Machine-readable kind.
-    #[schemars(extend("enum" = ["unauthorized", "forbidden", "bad_request", "not_found", "not_armed", "too_many_requests", "replay"]))]
+    #[schemars(extend("enum" = ["unauthorized", "forbidden", "bad_request", "not_found", "not_armed", "too_many_requests", "replay", "not_saved"]))]
     pub error: &'static str,
     /// For people: what is wrong.
     pub reason: String,

@@ -113,6 +113,8 @@ impl Recording {
                 // measures it again.
                 Outbound::AscentWind(_) => Vec::new(),
                 Outbound::Command(c) => vec![r.channels.command(c)],
+                // The change is in the event log, which is recorded.
+                Outbound::KeepOut(_) => Vec::new(),
             };
             for (ch, payload) in records {
                 r.handle.write(ch, now, now, payload);

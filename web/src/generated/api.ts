@@ -2,7 +2,7 @@
 // the daemon's Rust types by `cargo run -p stx-station --example api_schema`): do not edit.
 
 /**
- * Every message of the stx station's HTTP and WebSocket API (crates/stx-station/API.md), generated from the daemon's Rust types by `cargo run -p stx-station --example api_schema`: do not edit. The root is any one of them: on the WebSocket ServerMessage (station to page) and ClientMessage (page to station); over REST the bodies the station answers (Session, StateMsg, ParamsMsg, AscentWindMsg, EventsBody, TrackBody, ClientsBody, CommandResultMsg, CommandAccepted, CutdownArm, ErrorBody, ReplayView, RecordingsBody, ReplayOpened) and the bodies of the commands (*Body).
+ * Every message of the stx station's HTTP and WebSocket API (crates/stx-station/API.md), generated from the daemon's Rust types by `cargo run -p stx-station --example api_schema`: do not edit. The root is any one of them: on the WebSocket ServerMessage (station to page) and ClientMessage (page to station); over REST the bodies the station answers (Session, StateMsg, ParamsMsg, AscentWindMsg, EventsBody, TrackBody, ClientsBody, CommandResultMsg, CommandAccepted, CutdownArm, ErrorBody, ReplayView, RecordingsBody, ReplayOpened, KeepOutMsg) and the bodies of the commands (*Body).
  */
 export type StxStationAPI =
   | ServerMessage
@@ -18,6 +18,7 @@ export type StxStationAPI =
   | ReplayView
   | RecordingsBody
   | ReplayOpened
+  | KeepOutMsg
   | ClientMessage
   | ModeBody
   | HeadingBody
@@ -27,12 +28,22 @@ export type StxStationAPI =
   | PlanBody
   | ParamBody
   | ConfirmBody
-  | ReplayBody;
+  | ReplayBody
+  | KeepOutBody;
 /**
  * Every message the station sends on the WebSocket, told apart by `type`.
  */
 export type ServerMessage =
-  HelloMsg | StateMsg | EventMsg | CommandResultMsg | ParamsMsg | AscentWindMsg | HistoryMsg | LaggedMsg | PongMsg;
+  | HelloMsg
+  | StateMsg
+  | EventMsg
+  | CommandResultMsg
+  | ParamsMsg
+  | AscentWindMsg
+  | HistoryMsg
+  | LaggedMsg
+  | PongMsg
+  | KeepOutMsg;
 /**
  * Who may do what.
  */
@@ -54,6 +65,10 @@ export type GuidancePhase =
   | "flare"
   | "best_reachable"
   | "landed";
+/**
+ * Which of the station's landing predictions.
+ */
+export type PredictionKind = "planned" | "uncontrolled";
 /**
  * Stage of a STRAPLEX mission, from the launch pad to the landing field (gnc.md, "Flight
  * stages").
@@ -283,6 +298,10 @@ export interface StateMsg {
    * Guidance.
    */
   guidance: GuidanceView | null;
+  /**
+   * Predicted landings inside a keep-out zone, one per prediction at most.
+   */
+  keep_out_alarms: KeepOutAlarmView[];
   /**
    * Link.
    */
@@ -583,6 +602,23 @@ export interface PatternView {
    * The target is within the glide's reach.
    */
   target_reachable: boolean;
+}
+/**
+ * A predicted landing inside a keep-out zone.
+ */
+export interface KeepOutAlarmView {
+  /**
+   * Which prediction.
+   */
+  prediction: PredictionKind;
+  /**
+   * Mission time the prediction entered the zone, s.
+   */
+  since_s: number;
+  /**
+   * The zone's name.
+   */
+  zone: string;
 }
 /**
  * Link quality.
@@ -1274,6 +1310,44 @@ export interface PongMsg {
   type: "pong";
 }
 /**
+ * The keep-out zones now in force.
+ */
+export interface KeepOutMsg {
+  /**
+   * Areas in force (a MultiPolygon feature counts each of its polygons).
+   */
+  areas: number;
+  /**
+   * Who set them last; `null`: as read from the file.
+   */
+  changed_by: string | null;
+  /**
+   * The file they are kept in (`keep_out` of the station config); `null`: none, edits are
+   * lost at a restart.
+   */
+  file: string | null;
+  /**
+   * Why the configured file could not be read at start (the station then runs without
+   * its zones until an operator sets them); `null` when it was read.
+   */
+  load_error: string | null;
+  /**
+   * Mission clock, s.
+   */
+  time_s: number;
+  /**
+   * Always `keep_out`.
+   */
+  type: "keep_out";
+  /**
+   * The zones, a GeoJSON FeatureCollection (longitude, latitude in degrees); empty when
+   * there are none.
+   */
+  zones: {
+    [k: string]: unknown | undefined;
+  };
+}
+/**
  * `GET /api/events`.
  */
 export interface EventsBody {
@@ -1380,7 +1454,15 @@ export interface ErrorBody {
   /**
    * Machine-readable kind.
    */
-  error: "unauthorized" | "forbidden" | "bad_request" | "not_found" | "not_armed" | "too_many_requests" | "replay";
+  error:
+    | "unauthorized"
+    | "forbidden"
+    | "bad_request"
+    | "not_found"
+    | "not_armed"
+    | "too_many_requests"
+    | "replay"
+    | "not_saved";
   /**
    * For people: what is wrong.
    */
@@ -1615,4 +1697,11 @@ export interface ReplayBody {
    * × real time, 0.25–64.
    */
   speed?: number | null;
+}
+/**
+ * `PUT /api/keep-out`: every zone, as a GeoJSON FeatureCollection of Polygon and
+ * MultiPolygon features, each with a non-empty `name` property. It replaces the zones.
+ */
+export interface KeepOutBody {
+  [k: string]: unknown | undefined;
 }

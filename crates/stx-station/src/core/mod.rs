@@ -14,13 +14,15 @@
 //!   holds and releases the sticks);
 //! - `ascent`: the wind measured from the balloon's drift during the ascent, by altitude
 //!   band, and the profile ([`StationCore::wind_profile`]) the predictions fly in;
-//! - `params`: the drone's parameter table; `views`: the `state` and `params` messages.
+//! - `params`: the drone's parameter table; `views`: the `state` and `params` messages;
+//! - `keep_out`: the keep-out zones, the targets they refuse and the alarms they raise.
 
 mod actions;
 mod ascent;
 mod commands;
 mod cutdown;
 mod footprint;
+mod keep_out;
 mod manual;
 mod navigation;
 mod operator;
@@ -48,6 +50,7 @@ pub use ascent::REFIT_EVERY_S;
 pub use commands::{ANSWER_PER_PLAN_ITEM_S, ANSWER_WITHIN_S, UPLOAD_RETRY_S, UPLOAD_TRIES};
 pub use cutdown::CutdownArm;
 pub use footprint::{FootprintDone, FootprintJob};
+pub use keep_out::{CLEAR_AFTER_S, CheckedZones};
 pub use manual::MANUAL_SILENCE_S;
 pub use navigation::{Predicted, PredictionJob};
 pub use requests::{ApiError, CommandRequest};
@@ -89,6 +92,8 @@ pub enum Outbound {
     AscentWind(crate::messages::AscentWindMsg),
     /// An operator's request, accepted: for the recording (pages see its event).
     Command(crate::recording::station::CommandRecord),
+    /// The keep-out zones, changed.
+    KeepOut(crate::keep_out::KeepOutMsg),
 }
 
 /// The station.
@@ -135,6 +140,8 @@ pub struct StationCore {
     pub(crate) replica_command: stx_dynamics::state::Controls,
     /// The vehicle's main-line servo travel, m: telemetry reports the servo in −1…1 of it.
     pub(crate) main_line_travel_m: f64,
+    /// The keep-out zones and the alarms they raised.
+    pub(crate) keep_out: keep_out::KeepOut,
 }
 
 impl StationCore {
@@ -173,6 +180,7 @@ impl StationCore {
             last_connected: None,
             replica_command: stx_dynamics::state::Controls::default(),
             main_line_travel_m: stx_dynamics::vehicle::Vehicle::straplex().main_line_travel_m,
+            keep_out: keep_out::KeepOut::default(),
             config,
         }
     }

@@ -290,6 +290,7 @@ impl StationCore {
         }
         self.refit_ascent_winds(now_s);
         self.handle_timeout(now_s);
+        self.watch_keep_out(now_s);
         let state = self.state_msg_now(now_s);
         if now_s >= self.next_history_s {
             self.next_history_s = now_s + 1.0;

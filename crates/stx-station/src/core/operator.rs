@@ -30,7 +30,7 @@ impl StationCore {
             payload,
             change,
             text,
-        } = check(&self.frame, &self.params, request)?;
+        } = check(&self.frame, &self.keep_out.zones, &self.params, request)?;
         let id = self
             .commands
             .open(now_s, &mut self.outbox, command, payload, change);

@@ -6,6 +6,7 @@
 use nalgebra::Vector3;
 use stx_gnc::control::Localizer;
 use stx_gnc::geo::LocalFrame;
+use stx_gnc::keep_out::KeepOutZones;
 use stx_gnc::mission::FlightMode;
 use stx_gnc::plan_upload::PlanPoint;
 use stx_link::command::Command;
@@ -129,9 +130,28 @@ fn mode_name(mode: FlightMode) -> String {
         .unwrap_or_else(|| format!("{mode:?}"))
 }
 
-/// Checks `request` against the frame and the drone's parameter table.
+/// A landing point inside a keep-out zone is refused, naming the zone.
+fn check_clear(
+    zones: &KeepOutZones,
+    what: &str,
+    frame: &LocalFrame,
+    lat_deg: f64,
+    lon_deg: f64,
+) -> Result<(), ApiError> {
+    let p = frame.to_ned(lat_deg, lon_deg, frame.alt_msl_m);
+    match zones.zone_at([p.x, p.y]) {
+        Some(zone) => Err(ApiError::bad_request(format!(
+            "{what} inside keep-out zone '{}'",
+            zone.name
+        ))),
+        None => Ok(()),
+    }
+}
+
+/// Checks `request` against the frame, the keep-out zones and the drone's parameter table.
 pub(crate) fn check(
     frame: &LocalFrame,
+    zones: &KeepOutZones,
     table: &Table,
     request: CommandRequest,
 ) -> Result<Checked, ApiError> {
@@ -143,7 +163,7 @@ pub(crate) fn check(
     };
     Ok(match request {
         CommandRequest::ParamSet { name, value } => check_param_set(table, name, value)?,
-        CommandRequest::Plan(items) => check_plan(frame, items)?,
+        CommandRequest::Plan(items) => check_plan(frame, zones, items)?,
         CommandRequest::Mode(mode) => checked(
             "set_mode",
             Payload::Command(Command::SetMode(mode)),
@@ -211,6 +231,7 @@ pub(crate) fn check(
             if let Some(a) = approach_course_deg {
                 check_finite("approach_course_deg", a)?;
             }
+            check_clear(zones, "target", frame, lat_deg, lon_deg)?;
             checked(
                 "set_target",
                 Payload::Command(Command::SetLandingTarget {
@@ -263,7 +284,11 @@ fn check_param_set(table: &Table, name: String, value: f64) -> Result<Checked, A
     })
 }
 
-fn check_plan(frame: &LocalFrame, items: Vec<PlanItem>) -> Result<Checked, ApiError> {
+fn check_plan(
+    frame: &LocalFrame,
+    zones: &KeepOutZones,
+    items: Vec<PlanItem>,
+) -> Result<Checked, ApiError> {
     if items.is_empty() {
         return Err(ApiError::bad_request("items must not be empty"));
     }
@@ -291,6 +316,10 @@ fn check_plan(frame: &LocalFrame, items: Vec<PlanItem>) -> Result<Checked, ApiEr
         check_finite("alt_msl_m", alt)?;
         if let Some(a) = approach {
             check_finite("approach_course_deg", a)?;
+        }
+        // Flying over a zone is guidance's to avoid where it can; landing in one is refused.
+        if matches!(item, PlanItem::Land { .. }) {
+            check_clear(zones, "the plan's landing point", frame, lat, lon)?;
         }
     }
     Ok(Checked {

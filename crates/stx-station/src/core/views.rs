@@ -253,6 +253,7 @@ impl StationCore {
                 stage: self.latest.status.map(|(s, _)| snake(s.stage)),
                 cutdown_armed_until_s: self.cutdown.armed_until(),
             },
+            keep_out_alarms: self.keep_out_alarms(),
             recording: None,
             replay: None,
         }

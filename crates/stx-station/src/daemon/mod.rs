@@ -218,8 +218,18 @@ async fn run_with(
         }
         Some(_) => (None, None),
     };
+    let mut core = StationCore::new(config.clone(), wall_origin_ms);
+    if let Some(path) = &config.keep_out {
+        // Missing or invalid, the station runs on with the reason on every page and in the
+        // log: a station that does not start loses the drone's telemetry and commands, worse
+        // than flying without the zones with everyone told so.
+        let text = tokio::fs::read_to_string(path)
+            .await
+            .map_err(|e| e.to_string());
+        core.load_keep_out(0.0, &path.display().to_string(), text);
+    }
     let shared = Arc::new(Shared {
-        core: Mutex::new(StationCore::new(config.clone(), wall_origin_ms)),
+        core: Mutex::new(core),
         config: config.clone(),
         started: start,
         link_due: Notify::new(),
@@ -234,6 +244,7 @@ async fn run_with(
         recording_summaries: Default::default(),
         tiles: LoadedPack::load(config.tile_pack.as_deref()).await,
         replay_requests,
+        keep_out_edit: Default::default(),
     });
     let (stop_tx, stop_rx) = watch::channel(false);
     let sessions_task = replay_requests_rx.map(|rx| {

@@ -227,6 +227,7 @@ fn send_outbound(shared: &Shared, outbound: Vec<Outbound>) {
             Outbound::CommandResult(r) => serde_json::to_string(&r),
             Outbound::Params(p) => serde_json::to_string(&p),
             Outbound::AscentWind(a) => serde_json::to_string(&a),
+            Outbound::KeepOut(k) => serde_json::to_string(&k),
             // Recorded only: pages see the request's event.
             Outbound::Command(_) => continue,
         };

@@ -4,6 +4,7 @@
 //! - `shared`: what every handler shares ([`Shared`]) and the `{error, reason}` answers;
 //! - `auth`: tokens, names and roles;
 //! - `rest`: the reading endpoints; `commands`: the commanding ones (operators only);
+//! - `keep_out`: the keep-out zones, read by anyone, edited by operators;
 //! - `ws`: the WebSocket (state, events, command results; operators' sticks);
 //! - `kml`: the Google Earth feed; `replay`: the replay's pause, seek and speed;
 //! - `recordings`: the past recordings: list, download, open in a replay;
@@ -15,6 +16,7 @@
 
 mod auth;
 mod commands;
+mod keep_out;
 mod kml;
 mod recordings;
 mod replay;
@@ -57,6 +59,10 @@ pub fn router(state: std::sync::Arc<Shared>) -> Router {
         .route("/api/commands/localizer", post(command::<LocalizerBody>))
         .route("/api/commands/target", post(command::<TargetBody>))
         .route("/api/commands/plan", post(command::<PlanBody>))
+        .route(
+            "/api/keep-out",
+            get(keep_out::keep_out).put(keep_out::set_keep_out),
+        )
         .route("/api/cutdown/arm", post(arm_cutdown))
         .route("/api/cutdown/confirm", post(confirm_cutdown))
         .route("/api/clients", get(clients))

@@ -55,6 +55,8 @@ pub struct Shared {
     /// Where `POST /api/recordings/{name}/replay` asks the daemon for a replay station;
     /// `None` in a replay station (replays are opened from the live one).
     pub replay_requests: Option<tokio::sync::mpsc::Sender<ReplayRequest>>,
+    /// Held while an edit of the keep-out zones is written and applied.
+    pub keep_out_edit: tokio::sync::Mutex<()>,
 }
 
 /// Why a replay could not be opened: `(status, error, reason)` of the answer.
@@ -155,7 +157,10 @@ impl Shared {
     pub fn reset_core(&self) {
         let mut core = self.core();
         let wall_origin_ms = core.wall_origin_ms();
+        // The zones are the station's, not what it heard.
+        let keep_out = core.keep_out.clone();
         *core = StationCore::new(self.config.clone(), wall_origin_ms);
+        core.keep_out = keep_out;
     }
 }
 

@@ -55,6 +55,11 @@ pub fn config(edit: impl FnOnce(&mut StationConfig)) -> StationConfig {
     c.web_dir = std::env::temp_dir().join("stx-station-test-no-web");
     // Tests that record say where.
     c.recording.enabled = false;
+    // The shipped zones, wherever the test runs (read only: no test here edits them).
+    c.keep_out = Some(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../config/keep-out/sample.geojson"),
+    );
     edit(&mut c);
     c.validate().expect("valid test config");
     c
