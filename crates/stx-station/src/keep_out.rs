@@ -24,7 +24,7 @@ pub struct KeepOutMsg {
     /// there are none.
     pub zones: serde_json::Value,
     /// Areas in force (a MultiPolygon feature counts each of its polygons).
-    pub areas: usize,
+    pub areas: u32,
     /// The file they are kept in (`keep_out` of the station config); `null`: none, edits are
     /// lost at a restart.
     pub file: Option<String>,

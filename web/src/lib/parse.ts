@@ -588,6 +588,8 @@ const DECODERS = {
   },
   lagged: (v, wrap) => wrap(parseLagged(v)),
   pong: () => ({ ok: true, msg: { type: "pong" }, dropped: 0 }),
+  // The page does not show the keep-out zones yet: passed on as a message it does not use.
+  keep_out: () => ({ ok: true, msg: { type: "unknown", raw_type: "keep_out" }, dropped: 0 }),
 } satisfies Record<WireServerType, (v: Obj, wrap: Wrap) => Decoded>;
 
 /** Counts what arrived, so loss and garbage are shown rather than hidden (style.md, lesson 9). */

@@ -108,7 +108,7 @@ export type Replay = Lenient<Wire.ReplayView, "file" | "mode">;
 
 export type State = Omit<
   Lenient<Wire.StateMsg, "type" | "time_s" | "link" | "forecast_wind" | "mission">,
-  "link" | "vehicle" | "guidance" | "prediction" | "forecast_wind" | "recording" | "replay" | "footprint"
+  "link" | "vehicle" | "guidance" | "prediction" | "forecast_wind" | "recording" | "replay" | "footprint" | "keep_out_alarms"
 > & {
   recording: Recording | null;
   replay: Replay | null;

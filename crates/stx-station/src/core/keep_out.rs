@@ -250,7 +250,7 @@ impl StationCore {
         KeepOutMsg {
             kind: "keep_out",
             zones: self.keep_out.geojson.clone(),
-            areas: self.keep_out.zones.zones.len(),
+            areas: u32::try_from(self.keep_out.zones.zones.len()).unwrap_or(u32::MAX),
             file: self
                 .config
                 .keep_out
