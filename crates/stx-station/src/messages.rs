@@ -491,8 +491,9 @@ pub struct EventMsg {
     pub wall_ms: u64,
     /// Level.
     pub level: Level,
-    /// Where it comes from: guidance, link, command, station, vehicle.
-    #[schemars(extend("enum" = ["guidance", "link", "command", "station", "vehicle"]))]
+    /// Where it comes from: guidance, link, command, station, vehicle, keep_out (the keep-out
+    /// zones: loaded, edited, a landing predicted in one).
+    #[schemars(extend("enum" = ["guidance", "link", "command", "station", "vehicle", "keep_out"]))]
     pub source: &'static str,
     /// Text.
     pub text: String,

@@ -1033,9 +1033,10 @@ export interface EventMsg {
    */
   level: Level;
   /**
-   * Where it comes from: guidance, link, command, station, vehicle.
+   * Where it comes from: guidance, link, command, station, vehicle, keep_out (the keep-out
+   * zones: loaded, edited, a landing predicted in one).
    */
-  source: "guidance" | "link" | "command" | "station" | "vehicle";
+  source: "guidance" | "link" | "command" | "station" | "vehicle" | "keep_out";
   /**
    * Text.
    */

@@ -33,7 +33,7 @@ const STATE = {
   footprint: { computed_s: 800.0, age_s: 1.5, stale: false, height_m: 567.4, draws: 200, contours: [{ level: 0.5, polygons: [[[[38.52, -7.9], [38.54, -7.9], [38.54, -7.87], [38.52, -7.9]]]] }, { level: 0.95, polygons: [] }] },
   forecast_wind: [{ alt_msl_m: 300, speed_mps: 2.0, from_deg: 270 }, { alt_msl_m: 1000, speed_mps: 4, from_deg: 280 }],
   mission: { stage: "parafoil", cutdown_armed_until_s: null },
-  keep_out_alarms: [],
+  keep_out_alarms: [{ prediction: "uncontrolled", zone: "Pond", since_s: 790.5 }],
   recording: { state: "on", file: "/var/lib/stx/recordings/stx-20261124T100000Z-001.mcap", bytes_written: 1200000, messages_written: 9000, messages_lost: 0, problem: null },
   replay: null,
 };
@@ -60,9 +60,7 @@ describe("the fixtures are messages of the contract", () => {
 describe("decodeMessage: the API.md example", () => {
   it("reads a message of the contract as it is: nothing lost, nothing invented", () => {
     const d = decodeMessage(j(STATE));
-    // Nothing the page reads: it does not show keep-out alarms yet.
-    const { keep_out_alarms: _unread, ...read } = STATE;
-    expect(d).toEqual({ ok: true, msg: read, dropped: 0 });
+    expect(d).toEqual({ ok: true, msg: STATE, dropped: 0 });
     expect(decodeMessage(j({ type: "hello", session: SESSION, role: "operator", name: "ops-1" }))).toEqual({ ok: true, msg: { type: "hello", session: SESSION }, dropped: 0 });
   });
   it("parses a full state", () => {
@@ -233,5 +231,25 @@ describe("the reachable footprint in a state", () => {
   it("is null when absent or without its time", () => {
     expect(parsed(null)).toBeNull();
     expect(parsed({ contours: [] })).toBeNull();
+  });
+});
+
+describe("keep-out zones", () => {
+  const square = [[-7.89, 38.53], [-7.88, 38.53], [-7.88, 38.54], [-7.89, 38.53]];
+  const msg = (features: unknown[]) => decodeMessage(j({ type: "keep_out", time_s: 12, areas: features.length, changed_by: null, file: null, load_error: null, zones: { type: "FeatureCollection", features } }));
+  it("reads named Polygons and each polygon of a MultiPolygon, as the map's [lat, lon]", () => {
+    const d = msg([
+      { type: "Feature", properties: { name: "Pond" }, geometry: { type: "Polygon", coordinates: [square] } },
+      { type: "Feature", properties: { name: "Woods" }, geometry: { type: "MultiPolygon", coordinates: [[square], [square, square]] } },
+    ]);
+    expect(d.ok && d.msg.type === "keep_out" ? d.msg.areas.map((a) => [a.name, a.rings.length]) : null).toEqual([["Pond", 1], ["Woods", 1], ["Woods", 2]]);
+    expect(d.ok && d.msg.type === "keep_out" ? d.msg.areas[0]?.rings[0]?.[1] : null).toEqual([38.53, -7.88]);
+  });
+  it("leaves out a geometry it cannot draw (a point, a ring off the globe)", () => {
+    const d = msg([
+      { type: "Feature", properties: { name: "Mast" }, geometry: { type: "Point", coordinates: [-7.89, 38.53] } },
+      { type: "Feature", properties: { name: "Bad" }, geometry: { type: "Polygon", coordinates: [[[0, 95], [1, 1], [2, 2]]] } },
+    ]);
+    expect(d.ok && d.msg.type === "keep_out" ? d.msg.areas : null).toEqual([]);
   });
 });

@@ -15,6 +15,9 @@ import type {
   FlightMode,
   FlightStage,
   Footprint,
+  KeepOutAlarm,
+  KeepOutArea,
+  KeepOutMsg,
   ForecastWind,
   Gps,
   GpsFix,
@@ -110,7 +113,7 @@ const PHASES = {
 } as const satisfies Record<GuidancePhase, true>;
 const FIXES = { no_gps: true, no_fix: true, fix2d: true, fix3d: true, dgps: true, rtk_float: true, rtk_fixed: true, static: true, ppp: true } as const satisfies Record<GpsFix, true>;
 const GROUPS = { gains: true, spiral: true, failsafe: true, mission: true } as const satisfies Record<ParamGroup, true>;
-const SOURCES = { guidance: true, link: true, command: true, station: true, vehicle: true } as const satisfies Record<WireServerMessageOf<"event">["source"], true>;
+const SOURCES = { guidance: true, link: true, command: true, station: true, vehicle: true, keep_out: true } as const satisfies Record<WireServerMessageOf<"event">["source"], true>;
 const METHODS = { gps_velocity: true, position_differences: true } as const satisfies Record<BandMethod, true>;
 const TARGET_SOURCES = { drone_plan: true, drone_telemetry: true, operator: true } as const satisfies Record<NonNullable<Guidance["target_source"]>, true>;
 
@@ -348,6 +351,49 @@ export function parseFootprint(o: Obj): Footprint | null {
   };
 }
 
+/** GeoJSON `[lon, lat]` rings as the map's `[lat, lon]`; `null` when any is not a ring. */
+function geoRings(v: unknown): Ring[] | null {
+  if (!Array.isArray(v) || v.length === 0) return null;
+  const rings = v.map((r) => (Array.isArray(r) ? parseRing(r.map((p) => (Array.isArray(p) ? [p[1], p[0]] : p))) : null));
+  return rings.every((r): r is Ring => r !== null) ? rings : null;
+}
+
+/** The zones of a `keep_out` message (a GeoJSON FeatureCollection of named Polygons and MultiPolygons). */
+export function parseKeepOut(v: Obj): Parsed<KeepOutMsg> {
+  const time_s = num(v, "time_s");
+  if (time_s === null) return bad("keep_out without a numeric time_s");
+  const zones = obj(v, "zones");
+  const areas: KeepOutArea[] = [];
+  const features = zones !== null && Array.isArray(zones.features) ? zones.features : [];
+  for (const f of features) {
+    if (!isObj(f)) continue;
+    const props = obj(f, "properties");
+    const name = (props && str(props, "name")) ?? "unnamed zone";
+    const g = obj(f, "geometry");
+    if (g === null || !Array.isArray(g.coordinates)) continue;
+    const polygons = g.type === "Polygon" ? [g.coordinates] : g.type === "MultiPolygon" ? g.coordinates : [];
+    for (const p of polygons) {
+      const rings = geoRings(p);
+      if (rings !== null) areas.push({ name, rings });
+    }
+  }
+  return ok({ type: "keep_out", time_s, load_error: str(v, "load_error"), changed_by: str(v, "changed_by"), file: str(v, "file"), areas });
+}
+
+const PREDICTION_KINDS = { planned: true, uncontrolled: true } as const satisfies Record<KeepOutAlarm["prediction"], true>;
+
+function parseAlarms(v: unknown): KeepOutAlarm[] {
+  if (!Array.isArray(v)) return [];
+  const out: KeepOutAlarm[] = [];
+  for (const a of v) {
+    if (!isObj(a)) continue;
+    const prediction = oneOf(a, "prediction", PREDICTION_KINDS);
+    const zone = str(a, "zone");
+    if (prediction !== null && zone !== null) out.push({ prediction, zone, since_s: num(a, "since_s") ?? 0 });
+  }
+  return out;
+}
+
 function parseForecast(v: unknown): ForecastWind[] {
   if (!Array.isArray(v)) return [];
   const out: ForecastWind[] = [];
@@ -375,6 +421,7 @@ export function parseState(v: Obj): Parsed<State> {
     guidance: sub(v, "guidance", parseGuidance),
     prediction: sub(v, "prediction", parsePrediction),
     footprint: sub(v, "footprint", parseFootprint),
+    keep_out_alarms: parseAlarms(v.keep_out_alarms),
     forecast_wind: parseForecast(v.forecast_wind),
     mission: m,
     recording: sub(v, "recording", parseRecording),
@@ -588,8 +635,7 @@ const DECODERS = {
   },
   lagged: (v, wrap) => wrap(parseLagged(v)),
   pong: () => ({ ok: true, msg: { type: "pong" }, dropped: 0 }),
-  // The page does not show the keep-out zones yet: passed on as a message it does not use.
-  keep_out: () => ({ ok: true, msg: { type: "unknown", raw_type: "keep_out" }, dropped: 0 }),
+  keep_out: (v, wrap) => wrap(parseKeepOut(v)),
 } satisfies Record<WireServerType, (v: Obj, wrap: Wrap) => Decoded>;
 
 /** Counts what arrived, so loss and garbage are shown rather than hidden (style.md, lesson 9). */

@@ -117,8 +117,19 @@ export type State = Omit<
   guidance: Guidance | null;
   prediction: Prediction | null;
   footprint: Footprint | null;
+  keep_out_alarms: KeepOutAlarm[];
   forecast_wind: ForecastWind[];
 };
+
+/** A predicted landing inside a keep-out zone. */
+export type KeepOutAlarm = Wire.KeepOutAlarmView;
+/** One keep-out area as the map draws it: its outer ring then its holes, `[lat, lon]`. */
+export interface KeepOutArea {
+  name: string;
+  rings: Ring[];
+}
+/** The keep-out zones in force, as the map draws them. */
+export type KeepOutMsg = Pick<Wire.KeepOutMsg, "type" | "time_s" | "load_error" | "changed_by" | "file"> & { areas: KeepOutArea[] };
 
 /** A ring of `[lat_deg, lon_deg]` points, Leaflet's own order. */
 export type Ring = [number, number][];
@@ -164,6 +175,7 @@ export type ServerMessage =
   | CommandResult
   | ParamsMsg
   | AscentWindMsg
+  | KeepOutMsg
   | History
   | Lagged
   | Wire.PongMsg

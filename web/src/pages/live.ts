@@ -7,7 +7,7 @@ import "../styles/live.css";
 import { Api, ApiError, type CommandBodies, type CommandPath } from "../lib/api";
 import { CommandTracker, type CommandEntry } from "../lib/commands";
 import { fmt, fmtMissionTime, label } from "../lib/format";
-import { parseAscentWind, parseParams, parseSession, isObj } from "../lib/parse";
+import { parseAscentWind, parseKeepOut, parseParams, parseSession, isObj } from "../lib/parse";
 import { LiveSocket, type SocketStatus } from "../lib/socket";
 import { landingBadge, phaseLabel } from "../lib/recovery";
 import { judgeStaleness, type StaleVerdict } from "../lib/staleness";
@@ -133,6 +133,7 @@ function build(session: Session): void {
           applyRoleEverywhere();
           // `ascent_wind` comes only when the bands change: (re)connected, the page reads them.
           loadAscentWind();
+          loadKeepOut();
           break;
         case "state":
           onState(m);
@@ -151,6 +152,9 @@ function build(session: Session): void {
           break;
         case "ascent_wind":
           wind.setAscent(m);
+          break;
+        case "keep_out":
+          map.setZones(m);
           break;
         case "lagged":
           // The station dropped messages for this page: say so rather than show a silent gap.
@@ -342,6 +346,18 @@ function build(session: Session): void {
       receivedAtMs = now - SILENT_SOCKET_S * 1000; // one kick per silence, not one per tick
       socket.kick();
     }
+  }
+
+  function loadKeepOut(): void {
+    api.get("/api/keep-out").then(
+      (r) => {
+        const k = isObj(r) ? parseKeepOut(r) : null;
+        if (!k?.ok) return;
+        map.setZones(k.value);
+        if (k.value.load_error) localEvent("error", `keep-out zones NOT loaded: ${k.value.load_error}`);
+      },
+      (e: unknown) => localEvent("warning", `keep-out zones not loaded: ${e instanceof Error ? e.message : String(e)}`),
+    );
   }
 
   function loadAscentWind(): void {

@@ -15,7 +15,7 @@ import { fmt, fmtDir, fmtDistance } from "../lib/format";
 import { boxAround, keyPoints, needsFraming, type Box } from "../lib/framing";
 import { isLanded } from "../lib/recovery";
 import { packNote, tilesBadge } from "../lib/tiles";
-import type { Footprint, LandingPrediction, LatLon, Ring, State, Station, TrackPoint } from "../lib/types";
+import type { Footprint, KeepOutAlarm, KeepOutMsg, LandingPrediction, LatLon, Ring, State, Station, TrackPoint } from "../lib/types";
 
 const ll = (p: LatLon): L.LatLngExpression => [p.lat_deg, p.lon_deg];
 const MAX_TRACK = 20_000;
@@ -36,6 +36,9 @@ export class MapView {
   private readonly reach95 = L.polygon([], { color: "#2a7ab0", weight: 1, fillColor: "#2a7ab0", fillOpacity: 0.1, interactive: false, className: "map-footprint-95" });
   private readonly reach50 = L.polygon([], { color: "#2a7ab0", weight: 2, fillColor: "#2a7ab0", fillOpacity: 0.22, interactive: false, className: "map-footprint-50" });
   private readonly reachText: HTMLElement;
+  /** Keep-out zones, drawn under everything else, each named on hover. */
+  private readonly zones = L.layerGroup();
+  private readonly alarmText: HTMLElement;
   private readonly ellPlanned = L.polygon([], { color: "#006400", weight: 2, fillOpacity: 0.12 });
   private readonly ellUncontrolled = L.polygon([], { color: "#c05800", weight: 2, fillOpacity: 0.08, dashArray: "4 4" });
   private readonly planned: L.Marker;
@@ -86,6 +89,7 @@ export class MapView {
     this.uncontrolled = L.marker(ll(this.origin), { icon: icon("mk-uncontrolled", DOT_SVG("#c05800"), 18, "map-pred-uncontrolled"), interactive: false });
     this.vehicle = L.marker(ll(this.origin), { icon: icon("mk-vehicle", VEHICLE_SVG, 40, "map-vehicle"), zIndexOffset: 1000, interactive: false });
     this.draftTarget = L.marker(ll(this.origin), { icon: icon("mk-draft", TARGET_SVG, 34, "map-draft-target"), interactive: false, opacity: 0.6 });
+    this.zones.addTo(this.map);
     for (const layer of [this.reach95, this.reach50, this.pattern, this.final, this.ellUncontrolled, this.ellPlanned, this.track, this.draftPlan, this.draftLocalizer]) layer.addTo(this.map);
 
     // Badges drawn on top of the map: tiles status, wind, final approach, landing, follow toggle.
@@ -98,10 +102,11 @@ export class MapView {
     this.windText = h("span", { "data-testid": "map-wind" }, "wind —");
     this.finalText = h("div", { class: "map-badge final", "data-testid": "map-final", hidden: true });
     this.landedText = h("div", { class: "map-badge landed", "data-testid": "map-landed", hidden: true });
+    this.alarmText = h("div", { class: "map-badge alarm", role: "alert", "data-testid": "map-keep-out-alarm", hidden: true });
     this.reachText = h("div", { class: "map-badge reach", "data-testid": "map-footprint", hidden: true, title: "ground the stack can still reach: darker in at least half of the dispersed draws, lighter in 95 %" });
     this.followBtn = h("button", { type: "button", class: "small on", "data-testid": "map-follow", "aria-pressed": "true", title: "keep the vehicle, target, pattern and predicted landings in view (off when you drag or zoom)" }, "Follow");
     this.followBtn.addEventListener("click", () => this.setFollow(!this.follow));
-    const overlay = h("div", { class: "map-overlay", "data-testid": "map-overlay" }, this.tilesStatus, packNoteEl, h("div", { class: "map-badge wind" }, this.windArrow, this.windText), this.finalText, this.reachText, this.landedText, this.followBtn);
+    const overlay = h("div", { class: "map-overlay", "data-testid": "map-overlay" }, this.tilesStatus, packNoteEl, h("div", { class: "map-badge wind" }, this.windArrow, this.windText), this.alarmText, this.finalText, this.reachText, this.landedText, this.followBtn);
     L.DomEvent.disableClickPropagation(overlay);
     L.DomEvent.disableScrollPropagation(overlay);
     el.append(overlay);
@@ -170,11 +175,28 @@ export class MapView {
     this.track.setLatLngs(points.slice(-MAX_TRACK).map((p) => [p.lat_deg, p.lon_deg] as L.LatLngTuple));
   }
 
+  /** Draws the keep-out zones in force (replacing the previous set). */
+  setZones(k: KeepOutMsg): void {
+    this.zones.clearLayers();
+    for (const a of k.areas) {
+      L.polygon(a.rings, { color: "#b00020", weight: 2, fillColor: "#b00020", fillOpacity: 0.18, dashArray: "4 3", className: "map-keep-out" })
+        .bindTooltip(`keep out: ${a.name}`, { sticky: true })
+        .addTo(this.zones);
+    }
+    this.root.dataset.keepOutAreas = String(k.areas.length);
+  }
+
+  private showAlarms(alarms: KeepOutAlarm[]): void {
+    this.alarmText.hidden = alarms.length === 0;
+    setText(this.alarmText, alarms.map((a) => `${a.prediction} landing in keep-out zone "${a.zone}"`).join(" · "));
+  }
+
   private showFootprint(f: Footprint | null, stale: boolean): void {
     const level = (p: number): Ring[][] => f?.contours.find((c) => Math.abs(c.level - p) < 1e-6)?.polygons ?? [];
     this.reach95.setLatLngs(level(0.95));
     this.reach50.setLatLngs(level(0.5));
     const old = stale || (f?.stale ?? false);
+    this.zones.addTo(this.map);
     for (const layer of [this.reach95, this.reach50]) layer.setStyle({ color: old ? "#888" : "#2a7ab0", fillColor: old ? "#888" : "#2a7ab0" });
     this.reachText.hidden = f === null;
     if (f !== null) {
@@ -223,6 +245,7 @@ export class MapView {
     }
     const pred = landed ? null : s.prediction;
     this.showFootprint(landed ? null : s.footprint, stale);
+    this.showAlarms(landed ? [] : s.keep_out_alarms);
     this.showPrediction(this.planned, this.ellPlanned, pred?.planned ?? null, "planned", stale);
     this.showPrediction(this.uncontrolled, this.ellUncontrolled, pred?.uncontrolled ?? null, "uncontrolled", stale);
     for (const [layer, color] of [[this.pattern, "#c000c0"], [this.final, "#c000c0"]] as const) layer.setStyle({ color: stale ? "#888" : color });
