@@ -8,8 +8,10 @@
 //
 // Usage: node tests/browser/footprint.mjs [path/to/stx]   (default target/release/stx)
 
+import { copyFile, mkdtemp, readFile, writeFile } from "node:fs/promises";
+import { tmpdir } from "node:os";
 import { join } from "node:path";
-import { OPERATOR, VIEWER, out, speed, check, newContext, startStation, apiOf, until, attr, text, watchErrors, runFlights, registerRest, fromNorthEast } from "./harness.mjs";
+import { OPERATOR, VIEWER, root, out, speed, check, newContext, startStation, apiOf, until, attr, text, watchErrors, runFlights, registerRest, fromNorthEast } from "./harness.mjs";
 
 registerRest("PUT", /^\/api\/keep-out$/, "KeepOutBody", "KeepOutMsg");
 
@@ -25,8 +27,26 @@ function inRing(ring, p) {
 }
 const inPolygons = (polys, p) => polys.some(([outer, ...holes]) => inRing(outer, p) && !holes.some((h) => inRing(h, p)));
 
+/**
+ * The shipped station config with its sample zones copied aside: an operator's edit is written to
+ * the configured file, and the test's edits must not land in the repository's sample.
+ */
+async function configWithZoneCopy() {
+  const dir = await mkdtemp(join(tmpdir(), "stx-browser-zones-"));
+  const zones = join(dir, "zones.geojson");
+  await copyFile(join(root, "config/keep-out/sample.geojson"), zones);
+  const toml = await readFile(join(root, "config/station.toml"), "utf8");
+  const edited = toml.replace(/^keep_out = .*$/m, `keep_out = ${JSON.stringify(zones)}`);
+  if (edited === toml) throw new Error("config/station.toml has no keep_out line to point at the copy");
+  const file = join(dir, "station.toml");
+  await writeFile(file, edited);
+  return { file, zones };
+}
+
 async function flight() {
-  const { base } = await startStation(["--sim", "--sim-scenario", "rehearsal", "--sim-speed", String(speed), "--link", "udpin:127.0.0.1:0"]);
+  const copy = await configWithZoneCopy();
+  const sampleBefore = await readFile(join(root, "config/keep-out/sample.geojson"), "utf8");
+  const { base } = await startStation(["--config", copy.file, "--sim", "--sim-scenario", "rehearsal", "--sim-speed", String(speed), "--link", "udpin:127.0.0.1:0"]);
   const api = apiOf(base);
   const ctx = await newContext("footprint", { viewport: { width: 1440, height: 900 } });
   const page = await ctx.newPage();
@@ -42,6 +62,10 @@ async function flight() {
   check("footprint: the state carries the 50 % and 95 % regions, and the 95 % region holds the planned landing",
     f && level(f, 0.5).length > 0 && level(f, 0.95).length > 0 && holds,
     `${f?.draws} draws from ${f?.height_m?.toFixed(0)} m; 50 %: ${level(f, 0.5).length} polygon(s), 95 %: ${level(f, 0.95).length}; planned landing ${holds ? "inside" : "OUTSIDE"}`);
+  const hits = f?.zone_hits ?? [];
+  const hitBadge = await until(() => text(page, "map-footprint").catch(() => ""), (t) => /keep-out within reach: .*Pond/.test(t), 10000);
+  check("footprint: the sample zones within reach are marked (the pond by the target), on the map too",
+    hits.some((h) => h.zone === "Pond" && h.level >= 0.5) && /Pond/.test(hitBadge), `${JSON.stringify(hits)}; badge "${hitBadge}"`);
   const drawn = await until(() => page.locator("path.map-footprint-95, path.map-footprint-50").count(), (n) => n >= 2, 10000);
   const badge = await text(page, "map-footprint").catch(() => "");
   check("footprint: the map draws both regions with the age of the refresh", drawn >= 2 && /reach 50 % \/ 95 %/.test(badge), `${drawn} paths, badge "${badge}"`);
@@ -82,6 +106,11 @@ async function flight() {
   const events = (await api("/api/events")).body?.events ?? [];
   const logged = events.some((e) => e.level === "warning" && /Test field/.test(e.text));
   check("keep-out: a landing predicted in a zone raises the alarm on the map and a warning in the log", /Test field/.test(alarm) && logged, `map "${alarm}", log ${logged ? "has" : "lacks"} the warning`);
+  const onDisk = JSON.parse(await readFile(copy.zones, "utf8"));
+  const sampleAfter = await readFile(join(root, "config/keep-out/sample.geojson"), "utf8");
+  check("keep-out: the edit is kept in the configured file (a restart keeps it), and only there",
+    onDisk.features?.some((z) => z.properties?.name === "Test field") && sampleAfter === sampleBefore,
+    `${onDisk.features?.length} zones in the file; the repository's sample ${sampleAfter === sampleBefore ? "untouched" : "CHANGED"}`);
   await page.screenshot({ path: join(out, "footprint.png") });
   await ctx.close();
 }

@@ -14,7 +14,7 @@ use crate::config::{ForecastRow, Role};
 
 pub use crate::ascent_wind_msg::{AscentBandView, AscentWindMsg};
 mod footprint;
-pub use footprint::{FootprintContourView, FootprintView};
+pub use footprint::{FootprintContourView, FootprintView, FootprintZoneHit};
 
 /// `GET /api/session` and the WebSocket's `hello`.
 #[derive(Debug, Clone, Serialize, JsonSchema)]

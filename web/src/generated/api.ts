@@ -463,6 +463,10 @@ export interface FootprintView {
    * Old (no refresh for several periods): show it as stale.
    */
   stale: boolean;
+  /**
+   * The keep-out zones the regions overlap: ground the stack could land on and must not.
+   */
+  zone_hits: FootprintZoneHit[];
 }
 /**
  * The ground reached with at least `level` probability.
@@ -476,6 +480,19 @@ export interface FootprintContourView {
    * Polygons, each its outer ring then its holes; a ring is `[lat_deg, lon_deg]` points.
    */
   polygons: [number, number][][][];
+}
+/**
+ * A keep-out zone inside the reachable ground.
+ */
+export interface FootprintZoneHit {
+  /**
+   * The highest probability level whose region overlaps it, 0…1 (0.5 or 0.95).
+   */
+  level: number;
+  /**
+   * The zone's name.
+   */
+  zone: string;
 }
 /**
  * A row of the forecast wind profile.

@@ -30,7 +30,7 @@ const STATE = {
     commands: { main_line: 0.35, brake: 0.0 }, age_s: 0.05, stale: false },
   prediction: { planned: { lat_deg: 38.5334, lon_deg: -7.8888, time_to_land_s: 187.0, semi_major_m: 12.1, semi_minor_m: 6.0, major_axis_deg: 40.0 },
     uncontrolled: { lat_deg: 38.52, lon_deg: -7.87, time_to_land_s: 190.0, semi_major_m: 80, semi_minor_m: 40, major_axis_deg: 100 }, age_s: 0.6, stale: false },
-  footprint: { computed_s: 800.0, age_s: 1.5, stale: false, height_m: 567.4, draws: 200, contours: [{ level: 0.5, polygons: [[[[38.52, -7.9], [38.54, -7.9], [38.54, -7.87], [38.52, -7.9]]]] }, { level: 0.95, polygons: [] }] },
+  footprint: { computed_s: 800.0, age_s: 1.5, stale: false, height_m: 567.4, draws: 200, contours: [{ level: 0.5, polygons: [[[[38.52, -7.9], [38.54, -7.9], [38.54, -7.87], [38.52, -7.9]]]] }, { level: 0.95, polygons: [] }], zone_hits: [{ zone: "Pond", level: 0.95 }] },
   forecast_wind: [{ alt_msl_m: 300, speed_mps: 2.0, from_deg: 270 }, { alt_msl_m: 1000, speed_mps: 4, from_deg: 280 }],
   mission: { stage: "parafoil", cutdown_armed_until_s: null },
   keep_out_alarms: [{ prediction: "uncontrolled", zone: "Pond", since_s: 790.5 }],
@@ -210,7 +210,7 @@ describe("MessageStats", () => {
 
 describe("the reachable footprint in a state", () => {
   const ring = [[38.53, -7.89], [38.54, -7.89], [38.54, -7.88], [38.53, -7.89]];
-  const fp = (contours: unknown) => ({ computed_s: 812.5, age_s: 1.2, stale: false, height_m: 640, draws: 200, contours });
+  const fp = (contours: unknown) => ({ computed_s: 812.5, age_s: 1.2, stale: false, height_m: 640, draws: 200, contours, zone_hits: [{ zone: "Pond", level: 0.5 }, { level: 0.95 }] });
   const parsed = (footprint: unknown) => {
     const d = decodeMessage(j({ ...STATE, footprint }));
     return d.ok && d.msg.type === "state" ? d.msg.footprint : undefined;
@@ -219,6 +219,8 @@ describe("the reachable footprint in a state", () => {
   it("keeps each level's polygons, outer ring then holes, as Leaflet's [lat, lon]", () => {
     const f = parsed(fp([{ level: 0.5, polygons: [[ring]] }, { level: 0.95, polygons: [[ring, ring], [ring]] }]));
     expect(f?.computed_s).toBe(812.5);
+    // A hit without its zone's name says nothing: left out.
+    expect(f?.zone_hits).toEqual([{ zone: "Pond", level: 0.5 }]);
     expect(f?.contours.map((c) => [c.level, c.polygons.length, c.polygons[0]?.length])).toEqual([[0.5, 1, 1], [0.95, 2, 2]]);
     expect(f?.contours[0]?.polygons[0]?.[0]?.[1]).toEqual([38.54, -7.89]);
   });

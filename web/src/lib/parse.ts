@@ -341,8 +341,15 @@ export function parseFootprint(o: Obj): Footprint | null {
     }
     contours.push({ level, polygons });
   }
+  const zone_hits: Footprint["zone_hits"] = [];
+  for (const h of Array.isArray(o.zone_hits) ? o.zone_hits : []) {
+    const zone = isObj(h) ? str(h, "zone") : null;
+    const level = isObj(h) ? num(h, "level") : null;
+    if (zone !== null && level !== null) zone_hits.push({ zone, level });
+  }
   return {
     computed_s,
+    zone_hits,
     age_s: num(o, "age_s") ?? 0,
     stale: bool(o, "stale") ?? false,
     height_m: num(o, "height_m") ?? 0,

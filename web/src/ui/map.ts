@@ -202,7 +202,8 @@ export class MapView {
     if (f !== null) {
       this.reachText.dataset.computed = f.computed_s.toFixed(1);
       this.reachText.classList.toggle("stale", old);
-      setText(this.reachText, `reach 50 % / 95 % from ${fmt(f.height_m, "m", 0)} · ${fmt(f.age_s, "s", 0)} ago`);
+      const hits = f.zone_hits.map((z) => `${z.zone} (${Math.round(z.level * 100)} %)`).join(", ");
+      setText(this.reachText, `reach 50 % / 95 % from ${fmt(f.height_m, "m", 0)} · ${fmt(f.age_s, "s", 0)} ago${hits ? ` · keep-out within reach: ${hits}` : ""}`);
     }
   }
 

@@ -16,7 +16,7 @@ use stx_gnc::mission::FlightStage;
 use stx_gnc::performance::GlidePerformance;
 
 use super::StationCore;
-use crate::messages::{FootprintContourView, FootprintView};
+use crate::messages::{FootprintContourView, FootprintView, FootprintZoneHit};
 
 /// A footprint older than this is shown as stale, s: two refreshes missed at the longest
 /// period the issue allows (5 s).
@@ -112,14 +112,17 @@ impl StationCore {
     /// footprint, which then ages into stale.
     pub fn set_footprint(&mut self, done: FootprintDone) {
         match done.footprint {
-            Ok(f) => self.footprint = Some((f, done.computed_s)),
+            Ok(f) => {
+                let hits = f.zone_hits(self.keep_out_zones());
+                self.footprint = Some((f, done.computed_s, hits));
+            }
             Err(e) => tracing::debug!("no footprint: {e}"),
         }
     }
 
     /// The footprint as the dashboard draws it; `null` off the parafoil.
     pub(crate) fn footprint_view(&self, now_s: f64) -> Option<FootprintView> {
-        let (f, computed_s) = self.footprint.as_ref().filter(|_| self.under_parafoil())?;
+        let (f, computed_s, hits) = self.footprint.as_ref().filter(|_| self.under_parafoil())?;
         let geodetic = |ne: &[f64; 2]| {
             let (lat, lon, _) = self
                 .frame
@@ -155,6 +158,13 @@ impl StationCore {
                                 .collect()
                         })
                         .collect(),
+                })
+                .collect(),
+            zone_hits: hits
+                .iter()
+                .map(|h| FootprintZoneHit {
+                    zone: h.name.clone(),
+                    level: h.level,
                 })
                 .collect(),
         })

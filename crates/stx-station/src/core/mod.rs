@@ -114,8 +114,13 @@ pub struct StationCore {
     pub(crate) prediction: Option<LandingPrediction>,
     /// When the sensor data the prediction started from arrived (mission time, s).
     pub(crate) prediction_data_s: Option<f64>,
-    /// The latest reachable footprint and the mission time it was computed at, s.
-    pub(crate) footprint: Option<(stx_gnc::footprint::Footprint, f64)>,
+    /// The latest reachable footprint, the mission time it was computed at (s), and the
+    /// keep-out zones it overlaps (found once per footprint, not per state message).
+    pub(crate) footprint: Option<(
+        stx_gnc::footprint::Footprint,
+        f64,
+        Vec<stx_gnc::footprint::ZoneHit>,
+    )>,
     /// The plan download and where the replica's plan comes from.
     pub(crate) sync: sync::PlanSync,
     /// The drone's clock of the estimate guidance last ran on, s.

@@ -19,6 +19,17 @@ pub struct FootprintView {
     pub draws: u32,
     /// The regions, by ascending probability level (0.5, then 0.95).
     pub contours: Vec<FootprintContourView>,
+    /// The keep-out zones the regions overlap: ground the stack could land on and must not.
+    pub zone_hits: Vec<FootprintZoneHit>,
+}
+
+/// A keep-out zone inside the reachable ground.
+#[derive(Debug, Clone, Serialize, JsonSchema)]
+pub struct FootprintZoneHit {
+    /// The zone's name.
+    pub zone: String,
+    /// The highest probability level whose region overlaps it, 0…1 (0.5 or 0.95).
+    pub level: f64,
 }
 
 /// The ground reached with at least `level` probability.
