@@ -33,8 +33,35 @@ pub struct KeepOutMsg {
     pub load_error: Option<String>,
     /// Who set them last; `null`: as read from the file.
     pub changed_by: Option<String>,
+    /// Whether the drone holds them as its fence.
+    pub fence: FenceView,
     /// Mission clock, s.
     pub time_s: f64,
+}
+
+/// The drone's copy of the zones in force (sent as MAVLink's fence).
+#[derive(Debug, Clone, PartialEq, Serialize, JsonSchema)]
+pub struct FenceView {
+    /// Where the transfer stands.
+    pub state: FenceState,
+    /// Why the last transfer failed; `null` after a success.
+    pub last_error: Option<String>,
+}
+
+/// Where the drone's copy of the zones stands.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum FenceState {
+    /// The station was given no zones: it leaves the drone's fence alone.
+    None,
+    /// To be sent when the drone is heard and the link takes it.
+    Waiting,
+    /// Sent; the drone has not answered yet.
+    Sending,
+    /// The drone acknowledged these zones.
+    Held,
+    /// Every try failed: the drone does not have them (until they change or it reconnects).
+    Failed,
 }
 
 /// Which of the station's landing predictions.

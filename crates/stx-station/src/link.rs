@@ -104,6 +104,7 @@ impl StationLink {
             }
             LinkOp::PlanUpload(items) => ep.plan_upload(now, items).map_err(plan_error),
             LinkOp::PlanDownload => ep.plan_download(now).map_err(plan_error),
+            LinkOp::FenceUpload(items) => ep.fence_upload(now, items).map_err(plan_error),
             LinkOp::ParamList => ep.param_list(now).map_err(param_error),
             LinkOp::ManualHold(sticks) => {
                 ep.manual_hold(now, sticks);

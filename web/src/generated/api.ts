@@ -103,6 +103,10 @@ export type ParamGroup = "gains" | "spiral" | "failsafe" | "mission";
  */
 export type BandMethod = "gps_velocity" | "position_differences";
 /**
+ * Where the drone's copy of the zones stands.
+ */
+export type FenceState = "none" | "waiting" | "sending" | "held" | "failed";
+/**
  * A message from the page on the WebSocket.
  */
 export type ClientMessage =
@@ -1340,6 +1344,10 @@ export interface KeepOutMsg {
    */
   changed_by: string | null;
   /**
+   * Whether the drone holds them as its fence.
+   */
+  fence: FenceView;
+  /**
    * The file they are kept in (`keep_out` of the station config); `null`: none, edits are
    * lost at a restart.
    */
@@ -1364,6 +1372,19 @@ export interface KeepOutMsg {
   zones: {
     [k: string]: unknown | undefined;
   };
+}
+/**
+ * The drone's copy of the zones in force (sent as MAVLink's fence).
+ */
+export interface FenceView {
+  /**
+   * Why the last transfer failed; `null` after a success.
+   */
+  last_error: string | null;
+  /**
+   * Where the transfer stands.
+   */
+  state: FenceState;
 }
 /**
  * `GET /api/events`.

@@ -46,6 +46,8 @@ pub enum LinkOp {
     ManualHold(Sticks),
     /// Stop the sticks.
     ManualRelease,
+    /// Send the keep-out zones as the drone's fence (the station's own initiative).
+    FenceUpload(Vec<stx_link::plan::FenceItem>),
 }
 
 /// A [`LinkOp`] for the link driver, with the id its outcome comes back under and the
@@ -88,6 +90,8 @@ pub(crate) enum Purpose {
     ParamList,
     /// Sticks.
     Manual,
+    /// The station's own transfer of the keep-out fence.
+    FenceUpload,
 }
 
 #[derive(Debug)]

@@ -159,6 +159,7 @@ impl StationCore {
                     ..Default::default()
                 };
                 self.log(now_s, Level::Info, "keep_out", text);
+                self.fence_changed(now_s);
             }
             Err(reason) => {
                 let reason = format!("keep-out zones NOT loaded from {file}: {reason}");
@@ -239,6 +240,7 @@ impl StationCore {
             Level::Warning
         };
         self.log(now_s, level, "keep_out", text);
+        self.fence_changed(now_s);
         self.watch_keep_out(now_s);
         let msg = self.keep_out_msg(now_s);
         self.outbound.push(super::Outbound::KeepOut(msg.clone()));
@@ -258,6 +260,7 @@ impl StationCore {
                 .map(|p| p.display().to_string()),
             load_error: self.keep_out.load_error.clone(),
             changed_by: self.keep_out.changed_by.clone(),
+            fence: self.fence.view(),
             time_s: now_s,
         }
     }
@@ -354,4 +357,4 @@ impl StationCore {
 
 #[cfg(test)]
 #[path = "keep_out_tests.rs"]
-mod tests;
+pub(super) mod tests;

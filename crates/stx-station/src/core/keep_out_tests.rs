@@ -38,7 +38,8 @@ fn with_pond(core: &mut StationCore) {
     core.set_keep_out(0.0, "operator", checked, Some("zones.geojson"));
 }
 
-fn events(core: &mut StationCore) -> Vec<(Level, String)> {
+/// The `keep_out` log entries sent since the last call.
+pub(in crate::core) fn events(core: &mut StationCore) -> Vec<(Level, String)> {
     core.drain_outbound()
         .into_iter()
         .filter_map(|o| match o {

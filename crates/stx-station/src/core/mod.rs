@@ -15,12 +15,14 @@
 //! - `ascent`: the wind measured from the balloon's drift during the ascent, by altitude
 //!   band, and the profile ([`StationCore::wind_profile`]) the predictions fly in;
 //! - `params`: the drone's parameter table; `views`: the `state` and `params` messages;
-//! - `keep_out`: the keep-out zones, the targets they refuse and the alarms they raise.
+//! - `keep_out`: the keep-out zones, the targets they refuse and the alarms they raise;
+//!   `fence`: the zones sent to the drone as its fence, until it acknowledges them.
 
 mod actions;
 mod ascent;
 mod commands;
 mod cutdown;
+mod fence;
 mod footprint;
 mod keep_out;
 mod manual;
@@ -49,6 +51,7 @@ pub use actions::{APPLY_WITHIN_S, ActionError, ActionId, LinkAction, LinkOp, OUT
 pub use ascent::REFIT_EVERY_S;
 pub use commands::{ANSWER_PER_PLAN_ITEM_S, ANSWER_WITHIN_S, UPLOAD_RETRY_S, UPLOAD_TRIES};
 pub use cutdown::CutdownArm;
+pub use fence::{FENCE_RETRY_S, FENCE_TRIES};
 pub use footprint::{FootprintDone, FootprintJob};
 pub use keep_out::{CLEAR_AFTER_S, CheckedZones};
 pub use manual::MANUAL_SILENCE_S;
@@ -147,6 +150,8 @@ pub struct StationCore {
     pub(crate) main_line_travel_m: f64,
     /// The keep-out zones and the alarms they raised.
     pub(crate) keep_out: keep_out::KeepOut,
+    /// The drone's copy of the zones.
+    fence: fence::FenceSync,
 }
 
 impl StationCore {
@@ -186,6 +191,7 @@ impl StationCore {
             replica_command: stx_dynamics::state::Controls::default(),
             main_line_travel_m: stx_dynamics::vehicle::Vehicle::straplex().main_line_travel_m,
             keep_out: keep_out::KeepOut::default(),
+            fence: fence::FenceSync::default(),
             config,
         }
     }
@@ -355,29 +361,7 @@ impl StationCore {
                     self.after_command_result(now_s, &msg);
                 }
             }
-            // The keep-out fence's transfers: the station does not send one yet (issue 15
-            // item 2, station side still to do); a tool's outcome goes to the log.
-            GroundEvent::Fence(e) => {
-                let (level, text) = match e {
-                    stx_link::plan::FenceEvent::UploadDone { items } => (
-                        Level::Info,
-                        format!("keep-out fence acknowledged ({items} vertices)"),
-                    ),
-                    stx_link::plan::FenceEvent::UploadFailed { reason, .. } => (
-                        Level::Warning,
-                        format!("keep-out fence upload failed: {reason}"),
-                    ),
-                    stx_link::plan::FenceEvent::DownloadDone { items } => (
-                        Level::Info,
-                        format!("keep-out fence held by the drone: {} vertices", items.len()),
-                    ),
-                    stx_link::plan::FenceEvent::DownloadFailed { reason } => (
-                        Level::Warning,
-                        format!("keep-out fence download failed: {reason}"),
-                    ),
-                };
-                self.log(now_s, level, "link", text);
-            }
+            GroundEvent::Fence(e) => self.on_fence_event(now_s, e),
             GroundEvent::Link(LinkEvent::FrameError(e)) => {
                 tracing::debug!(error = %e, "frame dropped (counted in the link statistics)");
             }
@@ -392,8 +376,9 @@ impl StationCore {
                     APPLY_WITHIN_S,
                 );
                 self.want_plan_download(now_s);
+                self.fence_link(now_s, true);
             }
-            GroundEvent::Link(LinkEvent::Lost { .. }) => {}
+            GroundEvent::Link(LinkEvent::Lost { .. }) => self.fence_link(now_s, false),
             GroundEvent::Link(LinkEvent::PersistSigningTimestamp(_)) => {}
             GroundEvent::Other(_) => {}
         }

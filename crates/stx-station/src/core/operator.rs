@@ -102,6 +102,7 @@ impl StationCore {
             self.log(now_s, Level::Info, "command", expired);
         }
         self.manual_timeout(now_s);
+        self.fence_timeout(now_s);
         let upload_waiting = self.commands.upload_waiting();
         self.schedule_plan_download(now_s, upload_waiting);
     }
@@ -143,6 +144,11 @@ impl StationCore {
             Purpose::Manual => {
                 if let Err(e) = result {
                     tracing::debug!(error = %e, "sticks not sent");
+                }
+            }
+            Purpose::FenceUpload => {
+                if !late {
+                    self.fence_applied(now_s, result);
                 }
             }
         }

@@ -213,6 +213,11 @@ impl Onboard {
         }
     }
 
+    /// The mission's local frame (the site), in which guidance's positions and zones lie.
+    pub fn frame(&self) -> &LocalFrame {
+        &self.frame
+    }
+
     /// Guidance, for its phase, plan, events and spiral status.
     pub fn guidance(&self) -> &Guidance {
         &self.guidance
