@@ -3,14 +3,16 @@
 // pad wait, then a balloon ascent at about 5 m/s to a burst at 3 km MSL), measures the wind from
 // the balloon's drift band by band, and the wind panel draws the bands beside the forecast. The
 // bands must agree with the scenario's mean wind (config/scenarios/mission-short.toml, gusts of
-// 0.2 m/s on top), and the panel must show as many bands as the station measured.
+// 0.2 m/s on top), and the panel must show as many bands as the station measured. During the
+// ascent the map draws the predicted burst, deploy point and unsteered landing flown in those
+// bands; the last burst predicted before the burst must lie where the balloon burst.
 //
 // Usage: node tests/browser/ascent_winds.mjs [path/to/stx]   (default target/release/stx)
 // Env: ASCENT_SIM_SPEED (default 20).
 
 import { readFile } from "node:fs/promises";
 import { join } from "node:path";
-import { VIEWER, root, out, check, newContext, startStation, apiOf, until, text, watchErrors, runFlights } from "./harness.mjs";
+import { VIEWER, root, out, check, newContext, startStation, apiOf, until, text, watchErrors, runFlights, distanceM } from "./harness.mjs";
 
 const SPEED = Number(process.env.ASCENT_SIM_SPEED ?? 20);
 
@@ -49,6 +51,32 @@ async function flight() {
   // During the ascent: the first bands appear while the balloon still rises.
   const during = await until(async () => ({ n: await diamonds(), stage: (await api("/api/state")).body?.mission?.stage }), (x) => x.n >= 1 || x.stage === "round_chute", 120000, 500);
   check("during the ascent the wind panel draws measured bands", during.n >= 1 && during.stage === "ascent", `${during.n} band(s) drawn at stage ${during.stage}`);
+
+  // The flight path on the map while the balloon rises, and the last burst it predicted
+  // against where the balloon burst (the estimate at the first state under the round chute).
+  let lastBurst = null;
+  let marks = null;
+  let burstAt = null;
+  for (const deadline = Date.now() + 120000; Date.now() < deadline; ) {
+    const s = (await api("/api/state")).body;
+    if (s?.mission?.stage === "ascent" && s.flight_path?.burst) {
+      lastBurst = s.flight_path.burst;
+      if (marks === null && (await page.locator('[data-testid="map-burst"]').count()) === 1) {
+        const alt = async (id) => Number(await page.locator(`[data-testid="${id}"]`).getAttribute("data-alt"));
+        marks = { burst: await alt("map-burst"), deploy: await alt("map-deploy"), landing: await page.locator('[data-testid="map-unsteered-landing"]').count(), badge: await text(page, "map-flight-path") };
+      }
+    } else if (s?.mission?.stage === "round_chute" && s.estimate) {
+      burstAt = { lat_deg: s.estimate.lat_deg, lon_deg: s.estimate.lon_deg, alt_msl_m: s.estimate.alt_msl_m };
+      break;
+    }
+    await new Promise((r) => setTimeout(r, 250));
+  }
+  check("during the ascent the map draws the predicted burst (3 km), deploy point (1200 m above the site) and unsteered landing, and says when",
+    marks !== null && Math.abs(marks.burst - 3000) < 5 && Math.abs(marks.deploy - (site + 1200)) < 15 && marks.landing === 1 && /burst in .* · deploy in/.test(marks.badge),
+    JSON.stringify(marks));
+  const miss = lastBurst && burstAt ? distanceM(lastBurst, burstAt) : NaN;
+  check("the last burst predicted during the ascent lies within 60 m of where the balloon burst", miss < 60,
+    `${miss.toFixed(0)} m (predicted ${lastBurst?.in_s?.toFixed(0)} s ahead; burst seen at ${burstAt?.alt_msl_m?.toFixed(0)} m MSL)`);
 
   // After the burst: the whole ascent, and the panel agrees with the station.
   const done = await until(() => api("/api/ascent_wind"), (r) => r.body?.ascent_over === true, 180000, 1000);

@@ -16,7 +16,7 @@
 
 use stx_dynamics::atmosphere::StandardAtmosphere;
 use stx_dynamics::vehicle::Vehicle;
-use stx_gnc::flight_path::{Air, FlightPath, StackConfig, Start, propagate};
+use stx_gnc::flight_path::{Air, FlightPath, Start, propagate};
 use stx_gnc::mission::{FlightMode, FlightStage};
 use stx_gnc::performance::GlidePerformance;
 use stx_sim::drone::{Drone, MissionConfig};
@@ -55,16 +55,7 @@ fn fly(config: &MissionConfig) -> Flown {
 
 fn plan(config: &MissionConfig) -> FlightPath {
     let vehicle = Vehicle::straplex();
-    let stack = StackConfig {
-        mean_ascent_rate_mps: config.balloon.mean_ascent_rate_mps,
-        ascent_density_exponent: config.balloon.ascent_density_exponent,
-        burst_altitude_msl_m: config.balloon.burst_altitude_msl_m,
-        chute_drag_area_m2: config.round_chute.drag_area_m2,
-        chute_mass_kg: vehicle.total_mass_kg() + config.round_chute.extra_mass_kg,
-        gravity_mps2: vehicle.gravity_mps2,
-        deploy_height_m: config.onboard.mission.deploy_height_m,
-        ..StackConfig::default()
-    };
+    let stack = config.stack_config(&vehicle);
     let mut mean = config.wind.clone().expect("the mission has a wind");
     mean.turbulence = None;
     let wind = mean.build().expect("wind builds");

@@ -12,6 +12,7 @@ use subtle::ConstantTimeEq;
 
 use serde::{Deserialize, Serialize};
 use stx_gnc::ascent_wind::AscentWindConfig;
+use stx_gnc::flight_path::StackConfig;
 use stx_gnc::geo::LocalFrame;
 use stx_gnc::guidance::GuidanceConfig;
 use stx_link::signing::{KeyText, SIGNING_KEY_ENV, SigningKey};
@@ -208,6 +209,12 @@ pub struct StationConfig {
     /// [`AscentWindConfig`]); the defaults suit a sounding balloon with a 1–10 Hz GPS.
     #[serde(default)]
     pub ascent_wind: AscentWindConfig,
+    /// The stack's balloon, round chute and deployment as the live flight path flies them
+    /// (`[flight_path]`: mean ascent rate m/s, burst altitude m MSL, chute Cd·A m² and mass kg,
+    /// deploy height m above the origin, …; see [`StackConfig`]). The drone's `MIS_DEPLOY_M`
+    /// and `MIS_CUTDOWN_M` win once its parameters are read.
+    #[serde(default)]
+    pub flight_path: StackConfig,
     /// The guidance replica's settings (the same defaults as onboard).
     #[serde(default)]
     pub guidance: GuidanceConfig,
@@ -383,6 +390,11 @@ impl StationConfig {
         let o = &self.origin;
         if !(o.lat_deg.abs() <= 90.0 && o.lon_deg.abs() <= 180.0 && o.alt_msl_m.is_finite()) {
             return invalid("origin", "latitude within ±90°, longitude within ±180°");
+        }
+        if let Err(stx_gnc::flight_path::FlightPathError::Invalid { field, rule, .. }) =
+            self.flight_path.validate()
+        {
+            return invalid(&format!("flight_path.{field}"), rule);
         }
         if let Err(stx_gnc::ascent_wind::AscentWindConfigError::Invalid { field, rule, .. }) =
             self.ascent_wind.validate()

@@ -7,9 +7,13 @@ use anyhow::{Context, bail};
 use clap::{Args, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 use stx_gnc::estimator::EstimatorConfig;
+use stx_gnc::geo::LocalFrame;
+use stx_gnc::keep_out::KeepOutZones;
 use stx_sim::closed_loop::SensedNavigation;
 use stx_sim::dispersions::Dispersions;
-use stx_sim::montecarlo::{CampaignPart, MonteCarloConfig, MonteCarloReport, Shard, run_all};
+use stx_sim::montecarlo::{
+    CampaignPart, MonteCarloConfig, MonteCarloReport, Shard, ZoneLandings, run_all,
+};
 
 use crate::BadInput;
 
@@ -82,6 +86,15 @@ struct CampaignArgs {
     /// Where `--shard` writes its part (JSON).
     #[arg(long, requires = "shard")]
     out: Option<PathBuf>,
+    /// Keep-out zones (GeoJSON, as the station's `keep_out`) around the target, which lies at
+    /// the default site (38.5333° N, 7.8889° W): guidance keeps out of them and the report
+    /// counts the capsules landed in one, by wind (e.g. config/keep-out/montecarlo.geojson).
+    #[arg(long, value_name = "FILE.geojson")]
+    keep_out: Option<PathBuf>,
+    /// Do not give guidance the `--keep-out` zones; only count the landings in them (what
+    /// keeping out is worth is the difference).
+    #[arg(long, requires = "keep_out")]
+    keep_out_unguided: bool,
 }
 
 pub fn run(args: MonteCarloArgs) -> anyhow::Result<()> {
@@ -170,6 +183,10 @@ fn campaign(args: CampaignArgs) -> anyhow::Result<()> {
     if let Some(path) = &args.gains {
         config.guidance.gains = crate::inputs::load_gains(path)?;
     }
+    if let Some(path) = &args.keep_out {
+        config.keep_out = load_zones(path)?;
+        config.keep_out_guided = !args.keep_out_unguided;
+    }
     let estimator = EstimatorConfig::default();
     // Fail on bad settings before any thread starts.
     SensedNavigation::new(&config.sensors, estimator.clone(), 0).context("navigation settings")?;
@@ -213,6 +230,52 @@ fn campaign(args: CampaignArgs) -> anyhow::Result<()> {
         return Ok(());
     }
     print_report(&report, args.json, args.details)
+}
+
+/// The zones of `path` around the campaign's target, which must lie outside every one.
+fn load_zones(path: &std::path::Path) -> anyhow::Result<KeepOutZones> {
+    let text = std::fs::read_to_string(path)
+        .with_context(|| format!("--keep-out: cannot read {}", path.display()))
+        .map_err(BadInput)?;
+    let zones = KeepOutZones::from_geojson(&text, &LocalFrame::default())
+        .map_err(|e| BadInput(anyhow::anyhow!("--keep-out {}: {e}", path.display())))?;
+    if let Some(zone) = zones.zone_at([0.0, 0.0]) {
+        return Err(BadInput(anyhow::anyhow!(
+            "--keep-out {}: the target (38.5333° N, 7.8889° W) lies in zone '{}'",
+            path.display(),
+            zone.name
+        ))
+        .into());
+    }
+    Ok(zones)
+}
+
+fn print_zone_landings(z: &ZoneLandings) {
+    println!(
+        "capsules landed in a keep-out zone ({}; guidance {}): {} of {} landings ({} failed runs \
+         not counted)",
+        z.zones.join(", "),
+        if z.guided {
+            "kept out"
+        } else {
+            "did not know them"
+        },
+        z.in_zone,
+        z.landings,
+        z.failed
+    );
+    for b in &z.by_wind {
+        println!(
+            "  wind {:.0}–{:.0} m/s: {} of {}",
+            b.wind_from_mps, b.wind_to_mps, b.in_zone, b.landings
+        );
+    }
+    for l in &z.runs {
+        println!(
+            "  run {} in '{}' at {:.0} m N, {:.0} m E of the target, wind {:.1} m/s (--replay {})",
+            l.index, l.zone, l.payload_ne_m[0], l.payload_ne_m[1], l.wind_mps, l.index
+        );
+    }
 }
 
 fn print_table(r: &MonteCarloReport) {
@@ -270,6 +333,9 @@ fn print_table(r: &MonteCarloReport) {
             r.unreachable_from_last_best_m.median,
             r.unreachable_from_last_best_m.max
         );
+    }
+    if let Some(z) = &r.keep_out {
+        print_zone_landings(z);
     }
     if !r.failed_runs.is_empty() {
         println!("{} runs failed: {:?}", r.failed_runs.len(), r.failed_runs);

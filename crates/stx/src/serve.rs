@@ -102,7 +102,13 @@ pub fn run(args: ServeArgs) -> anyhow::Result<()> {
         );
     }
     let sim = if args.sim {
-        Some(sim_options(&config, &args)?)
+        let options = sim_options(&config, &args)?;
+        // The rehearsal's station knows the balloon it flies with: its burst, ascent rate and
+        // round chute are the scenario's (the drone's parameters give the deploy height).
+        config.flight_path = options
+            .mission
+            .stack_config(&stx_dynamics::vehicle::Vehicle::straplex());
+        Some(options)
     } else {
         None
     };

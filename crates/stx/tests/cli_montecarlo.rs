@@ -1,6 +1,6 @@
 //! `stx montecarlo` over shards and dispersion files, through the real binary: a campaign split
 //! into shards and merged gives the one-machine report; bad parts and bad dispersion files are
-//! refused with a clear message and exit code 2.
+//! refused with a clear message and exit code 2; capsules landed in keep-out zones are counted.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -170,5 +170,92 @@ fn a_bad_dispersion_file_or_shard_is_refused_by_name() {
     ]);
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("K/N"));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A FeatureCollection of one rectangle `name`, north `n0`…`n1` and east `e0`…`e1` of the
+/// campaign's target (the default site), in metres (a flat-earth conversion, metre-accurate
+/// over these distances).
+fn rectangle(name: &str, [n0, n1]: [f64; 2], [e0, e1]: [f64; 2]) -> String {
+    let (lat0, lon0) = (38.5333_f64, -7.8889_f64);
+    let m_per_deg_lat = 111_000.0;
+    let m_per_deg_lon = m_per_deg_lat * lat0.to_radians().cos();
+    let at = |n: f64, e: f64| {
+        format!(
+            "[{}, {}]",
+            lon0 + e / m_per_deg_lon,
+            lat0 + n / m_per_deg_lat
+        )
+    };
+    format!(
+        r#"{{"type": "FeatureCollection", "features": [{{"type": "Feature",
+        "properties": {{"name": "{name}"}}, "geometry": {{"type": "Polygon", "coordinates": [[
+        {}, {}, {}, {}, {}]]}}}}]}}"#,
+        at(n0, e0),
+        at(n0, e1),
+        at(n1, e1),
+        at(n1, e0),
+        at(n0, e0)
+    )
+}
+
+#[test]
+fn capsules_landed_in_keep_out_zones_are_counted_by_wind_and_bad_zones_are_refused() {
+    let dir = temp_dir("zones");
+    // Everything more than 3 m north of the target is a zone guidance does not know of: the
+    // capsules landed there are exactly those counted.
+    let north = dir.join("north.geojson");
+    std::fs::write(&north, rectangle("North", [3.0, 3000.0], [-3000.0, 3000.0])).expect("write");
+    let mut args = CAMPAIGN.to_vec();
+    args.extend([
+        "--json",
+        "--details",
+        "--keep-out",
+        north.to_str().expect("path"),
+        "--keep-out-unguided",
+    ]);
+    let report = json(&stx(&args));
+    let z = &report["keep_out"];
+    assert_eq!(z["zones"], serde_json::json!(["North"]));
+    assert_eq!(z["guided"], false);
+    let results = report["results"].as_array().expect("results");
+    let north_of = |r: &serde_json::Value| r["payload_touchdown_ne_m"][0].as_f64().expect("n");
+    // Well clear of the edge (the conversions differ by centimetres), so the test is sharp.
+    assert!(results.iter().all(|r| (north_of(r) - 3.0).abs() > 0.5));
+    let expected = results.iter().filter(|r| north_of(r) > 3.0).count();
+    assert!(
+        expected > 0 && expected < results.len(),
+        "both kinds of landing: {expected}"
+    );
+    assert_eq!(z["in_zone"].as_u64(), Some(expected as u64), "{z}");
+    assert_eq!(z["landings"].as_u64(), Some(results.len() as u64));
+    let by_wind = z["by_wind"].as_array().expect("bins");
+    let sum = |key: &str| {
+        by_wind
+            .iter()
+            .map(|b| b[key].as_u64().unwrap_or(0))
+            .sum::<u64>()
+    };
+    assert_eq!(sum("landings"), results.len() as u64);
+    assert_eq!(sum("in_zone"), expected as u64);
+    for run in z["runs"].as_array().expect("runs") {
+        assert_eq!(run["zone"], "North");
+    }
+
+    // A target inside a zone, a file that is not zones, a missing file: refused by name.
+    let over = dir.join("over.geojson");
+    std::fs::write(&over, rectangle("Field", [-50.0, 50.0], [-50.0, 50.0])).expect("write");
+    let not_zones = dir.join("bad.geojson");
+    std::fs::write(&not_zones, r#"{"type": "Point", "coordinates": [0, 0]}"#).expect("write");
+    for (file, says) in [
+        (over.to_str().expect("path"), "lies in zone 'Field'"),
+        (not_zones.to_str().expect("path"), "bad.geojson"),
+        ("/nonexistent.geojson", "cannot read"),
+    ] {
+        let out = stx(&["montecarlo", "--runs", "1", "--keep-out", file]);
+        assert_eq!(out.status.code(), Some(2), "{file}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains(says), "{file}: {err}");
+    }
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -291,6 +291,12 @@ export interface StateMsg {
    */
   estimate: EstimateView | null;
   /**
+   * The unsteered flight path from the balloon or the round chute (burst, deploy and
+   * landing points, in the ascent's measured winds); `null` under the parafoil, on the
+   * ground, and without a 3-D fix or any wind (no band, no forecast).
+   */
+  flight_path: FlightPathView | null;
+  /**
    * The ground still reachable under the parafoil; `null` before the first footprint.
    */
   footprint: FootprintView | null;
@@ -438,6 +444,78 @@ export interface EstimateView {
    * Wind speed, m/s.
    */
   wind_speed_mps: number;
+}
+/**
+ * The latest flight-path prediction.
+ */
+export interface FlightPathView {
+  /**
+   * Where the balloon bursts (or the drone cuts it away at `MIS_CUTDOWN_M`); `null` under
+   * the round chute.
+   */
+  burst: PathPointView | null;
+  /**
+   * Mission clock when it was computed, s.
+   */
+  computed_s: number;
+  /**
+   * Where the round chute is released and the parafoil deploys (`MIS_DEPLOY_M`).
+   */
+  deploy: PathPointView;
+  /**
+   * Where the parafoil lands with its servos neutral.
+   */
+  landing: PathPointView;
+  /**
+   * Bands of the ascent's measured wind it flew in (the forecast above the highest and
+   * below the lowest); 0: the forecast alone.
+   */
+  measured_bands: number;
+  /**
+   * Altitude of the highest measured band's top, m above mean sea level: above it the
+   * path flies the forecast; `null` without bands.
+   */
+  measured_to_msl_m: number | null;
+  /**
+   * The ground steering could reach from the deploy point: a disc's centre, degrees.
+   *
+   * @minItems 2
+   * @maxItems 2
+   */
+  reach_centre_lat_lon_deg: [number, number];
+  /**
+   * The disc's radius, m.
+   */
+  reach_radius_m: number;
+  /**
+   * Where the stack would land if the round chute were never released.
+   */
+  round_chute_landing: PathPointView;
+  /**
+   * The stage it was computed in: `ascent` (or `pre_launch`) or `round_chute`.
+   */
+  stage: string;
+}
+/**
+ * A point of the flight path.
+ */
+export interface PathPointView {
+  /**
+   * Altitude above mean sea level, m.
+   */
+  alt_msl_m: number;
+  /**
+   * Time from when it was computed, s.
+   */
+  in_s: number;
+  /**
+   * Latitude, degrees.
+   */
+  lat_deg: number;
+  /**
+   * Longitude, degrees.
+   */
+  lon_deg: number;
 }
 /**
  * The latest reachable footprint.

@@ -33,6 +33,7 @@ const STATE = {
   footprint: { computed_s: 800.0, age_s: 1.5, stale: false, height_m: 567.4, draws: 200, contours: [{ level: 0.5, polygons: [[[[38.52, -7.9], [38.54, -7.9], [38.54, -7.87], [38.52, -7.9]]]] }, { level: 0.95, polygons: [] }], zone_hits: [{ zone: "Pond", level: 0.95 }] },
   forecast_wind: [{ alt_msl_m: 300, speed_mps: 2.0, from_deg: 270 }, { alt_msl_m: 1000, speed_mps: 4, from_deg: 280 }],
   mission: { stage: "parafoil", cutdown_armed_until_s: null },
+  flight_path: null,
   keep_out_alarms: [{ prediction: "uncontrolled", zone: "Pond", since_s: 790.5 }],
   recording: { state: "on", file: "/var/lib/stx/recordings/stx-20261124T100000Z-001.mcap", bytes_written: 1200000, messages_written: 9000, messages_lost: 0, problem: null },
   replay: null,

@@ -5,6 +5,7 @@
 // the contract does not list; a message without what makes it meaningful (a state without time_s,
 // an event without text) is rejected with a reason, so the caller can count and show it.
 
+import { parseFlightPath } from "./flightPath";
 import type {
   AscentBand,
   AscentWindMsg,
@@ -428,6 +429,7 @@ export function parseState(v: Obj): Parsed<State> {
     guidance: sub(v, "guidance", parseGuidance),
     prediction: sub(v, "prediction", parsePrediction),
     footprint: sub(v, "footprint", parseFootprint),
+    flight_path: sub(v, "flight_path", parseFlightPath),
     keep_out_alarms: parseAlarms(v.keep_out_alarms),
     forecast_wind: parseForecast(v.forecast_wind),
     mission: m,

@@ -1,3 +1,4 @@
+import type { FlightPath } from "./flightPath";
 // The API's messages as the page holds them. Their shapes are not written here: they come from the
 // station's contract, ../generated/api.ts (generated from api.schema.json, itself generated from
 // the daemon's Rust types; see crates/stx-station/API.md). What this file adds is the page's
@@ -108,7 +109,7 @@ export type Replay = Lenient<Wire.ReplayView, "file" | "mode">;
 
 export type State = Omit<
   Lenient<Wire.StateMsg, "type" | "time_s" | "link" | "forecast_wind" | "mission">,
-  "link" | "vehicle" | "guidance" | "prediction" | "forecast_wind" | "recording" | "replay" | "footprint" | "keep_out_alarms"
+  "link" | "vehicle" | "guidance" | "prediction" | "forecast_wind" | "recording" | "replay" | "footprint" | "keep_out_alarms" | "flight_path"
 > & {
   recording: Recording | null;
   replay: Replay | null;
@@ -117,6 +118,7 @@ export type State = Omit<
   guidance: Guidance | null;
   prediction: Prediction | null;
   footprint: Footprint | null;
+  flight_path: FlightPath | null;
   keep_out_alarms: KeepOutAlarm[];
   forecast_wind: ForecastWind[];
 };

@@ -10,6 +10,7 @@ import L from "leaflet";
 import "leaflet/dist/leaflet.css";
 import { h, setText } from "./dom";
 import { stationTileLayer } from "./tileLayer";
+import { FlightPathLayer } from "./flightPathLayer";
 import { distanceM, ellipsePoints, fromLocal, gridValues, niceStep, toLocal } from "../lib/geo";
 import { fmt, fmtDir, fmtDistance } from "../lib/format";
 import { boxAround, keyPoints, needsFraming, type Box } from "../lib/framing";
@@ -39,6 +40,7 @@ export class MapView {
   /** Keep-out zones, drawn under everything else, each named on hover. */
   private readonly zones = L.layerGroup();
   private readonly alarmText: HTMLElement;
+  private readonly flightPath: FlightPathLayer;
   private readonly ellPlanned = L.polygon([], { color: "#006400", weight: 2, fillOpacity: 0.12 });
   private readonly ellUncontrolled = L.polygon([], { color: "#c05800", weight: 2, fillOpacity: 0.08, dashArray: "4 4" });
   private readonly planned: L.Marker;
@@ -90,6 +92,7 @@ export class MapView {
     this.vehicle = L.marker(ll(this.origin), { icon: icon("mk-vehicle", VEHICLE_SVG, 40, "map-vehicle"), zIndexOffset: 1000, interactive: false });
     this.draftTarget = L.marker(ll(this.origin), { icon: icon("mk-draft", TARGET_SVG, 34, "map-draft-target"), interactive: false, opacity: 0.6 });
     this.zones.addTo(this.map);
+    this.flightPath = new FlightPathLayer(this.map);
     for (const layer of [this.reach95, this.reach50, this.pattern, this.final, this.ellUncontrolled, this.ellPlanned, this.track, this.draftPlan, this.draftLocalizer]) layer.addTo(this.map);
 
     // Badges drawn on top of the map: tiles status, wind, final approach, landing, follow toggle.
@@ -106,7 +109,7 @@ export class MapView {
     this.reachText = h("div", { class: "map-badge reach", "data-testid": "map-footprint", hidden: true, title: "ground the stack can still reach: darker in at least half of the dispersed draws, lighter in 95 %" });
     this.followBtn = h("button", { type: "button", class: "small on", "data-testid": "map-follow", "aria-pressed": "true", title: "keep the vehicle, target, pattern and predicted landings in view (off when you drag or zoom)" }, "Follow");
     this.followBtn.addEventListener("click", () => this.setFollow(!this.follow));
-    const overlay = h("div", { class: "map-overlay", "data-testid": "map-overlay" }, this.tilesStatus, packNoteEl, h("div", { class: "map-badge wind" }, this.windArrow, this.windText), this.alarmText, this.finalText, this.reachText, this.landedText, this.followBtn);
+    const overlay = h("div", { class: "map-overlay", "data-testid": "map-overlay" }, this.tilesStatus, packNoteEl, h("div", { class: "map-badge wind" }, this.windArrow, this.windText), this.alarmText, this.finalText, this.reachText, this.flightPath.badge, this.landedText, this.followBtn);
     L.DomEvent.disableClickPropagation(overlay);
     L.DomEvent.disableScrollPropagation(overlay);
     el.append(overlay);
@@ -246,6 +249,7 @@ export class MapView {
     }
     const pred = landed ? null : s.prediction;
     this.showFootprint(landed ? null : s.footprint, stale);
+    this.flightPath.update(landed ? null : s.flight_path, lat !== null && lon !== null ? { lat_deg: lat, lon_deg: lon } : null, stale);
     this.showAlarms(landed ? [] : s.keep_out_alarms);
     this.showPrediction(this.planned, this.ellPlanned, pred?.planned ?? null, "planned", stale);
     this.showPrediction(this.uncontrolled, this.ellUncontrolled, pred?.uncontrolled ?? null, "uncontrolled", stale);

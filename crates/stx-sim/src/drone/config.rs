@@ -12,6 +12,7 @@
 use serde::Deserialize;
 use stx_dynamics::wind::WindConfig;
 use stx_gnc::estimator::EstimatorConfig;
+use stx_gnc::flight_path::StackConfig;
 use stx_gnc::geo::LocalFrame;
 use stx_gnc::mission::{FlightMode, FlightStage};
 use stx_gnc::params::OnboardSettings;
@@ -280,6 +281,21 @@ fn default_max_duration_s() -> f64 {
 }
 
 impl MissionConfig {
+    /// The stack as the flight-path planner models it: this mission's balloon, round chute
+    /// and deploy height, with `vehicle`'s mass and gravity.
+    pub fn stack_config(&self, vehicle: &stx_dynamics::vehicle::Vehicle) -> StackConfig {
+        StackConfig {
+            mean_ascent_rate_mps: self.balloon.mean_ascent_rate_mps,
+            ascent_density_exponent: self.balloon.ascent_density_exponent,
+            burst_altitude_msl_m: self.balloon.burst_altitude_msl_m,
+            chute_drag_area_m2: self.round_chute.drag_area_m2,
+            chute_mass_kg: vehicle.total_mass_kg() + self.round_chute.extra_mass_kg,
+            gravity_mps2: vehicle.gravity_mps2,
+            deploy_height_m: self.onboard.mission.deploy_height_m,
+            ..StackConfig::default()
+        }
+    }
+
     /// Parses and validates a mission; `name` is used in errors.
     pub fn from_toml_str(name: &str, text: &str) -> Result<Self, MissionError> {
         let mut config: MissionConfig =

@@ -2,6 +2,7 @@
 
 use serde::Serialize;
 use stx_gnc::guidance::GuidanceConfig;
+use stx_gnc::keep_out::KeepOutZones;
 
 use crate::dispersions::Dispersions;
 use crate::sensors::SensorConfig;
@@ -36,6 +37,13 @@ pub struct MonteCarloConfig {
     /// Guidance settings.
     #[serde(skip)]
     pub guidance: GuidanceConfig,
+    /// Keep-out zones in the target's frame (`LocalFrame::default()`): guidance keeps out of
+    /// them, and the report counts the capsules that land in one.
+    #[serde(skip)]
+    pub keep_out: KeepOutZones,
+    /// Whether guidance is given [`Self::keep_out`] (false: the zones only count the landings
+    /// in them, to measure what keeping out of them is worth).
+    pub keep_out_guided: bool,
 }
 
 impl Default for MonteCarloConfig {
@@ -53,6 +61,8 @@ impl Default for MonteCarloConfig {
             dispersions: Dispersions::nominal(),
             sensors: SensorConfig::default(),
             guidance: GuidanceConfig::default(),
+            keep_out: KeepOutZones::default(),
+            keep_out_guided: true,
         }
     }
 }

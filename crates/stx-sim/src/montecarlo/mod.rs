@@ -7,11 +7,15 @@
 //! report depends only on the seed and the run count, never on how the runs were spread over
 //! threads or machines: a campaign split into shards ([`Shard`], one [`CampaignPart`] each)
 //! and [`merge`]d gives the one-machine report.
+//!
+//! With keep-out zones ([`MonteCarloConfig::keep_out`]) guidance flies every run with them and
+//! the report counts the capsules that came down in one ([`ZoneLandings`]).
 
 mod config;
 mod report;
 mod run;
 mod shard;
+mod zones;
 
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
@@ -31,6 +35,7 @@ pub use run::{
     wind_field, wind_shape,
 };
 pub use shard::{CampaignPart, MergeError, merge};
+pub use zones::{WIND_BIN_MPS, ZoneCount, ZoneLanding, ZoneLandings};
 
 /// Flies every run on `config.threads` threads, calling `progress(done)` as runs finish.
 pub fn run_all<N: Navigator>(

@@ -5,6 +5,7 @@ use serde::{Deserialize, Serialize};
 
 use super::config::MonteCarloConfig;
 use super::run::{RunConditions, RunResult};
+use super::zones::ZoneLandings;
 use crate::dispersions::Dispersions;
 
 /// A run among the worst of a campaign, enough to replay it (`only_run`).
@@ -77,6 +78,16 @@ pub struct CampaignHeader {
     pub flare: bool,
     /// The dispersion set every run drew from.
     pub dispersions: Dispersions,
+    /// The keep-out zones guidance kept out of, by name (none: flown without).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub keep_out_zones: Vec<String>,
+    /// Whether guidance knew the zones (false: they only counted the landings).
+    #[serde(default = "yes")]
+    pub keep_out_guided: bool,
+}
+
+fn yes() -> bool {
+    true
 }
 
 impl CampaignHeader {
@@ -90,6 +101,13 @@ impl CampaignHeader {
             release_radius_m: config.release_radius_m,
             flare: config.flare,
             dispersions: config.dispersions.clone(),
+            keep_out_zones: config
+                .keep_out
+                .zones
+                .iter()
+                .map(|z| z.name.clone())
+                .collect(),
+            keep_out_guided: config.keep_out_guided,
         }
     }
 }
@@ -132,6 +150,9 @@ pub struct MonteCarloReport {
     pub unreachable_from_best_m: Stats,
     /// The same from the best reachable point announced last, m.
     pub unreachable_from_last_best_m: Stats,
+    /// Capsules landed in keep-out zones, overall and by wind (campaigns with zones only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub keep_out: Option<ZoneLandings>,
     /// Runs that failed to fly (integration error, time-out, a refused draw), with their index
     /// and reason.
     pub failed_runs: Vec<(usize, String)>,
@@ -186,7 +207,17 @@ impl MonteCarloReport {
         let announced = |f: fn(&RunResult) -> Option<f64>| {
             Stats::of(&results.iter().filter_map(f).collect::<Vec<_>>())
         };
+        let keep_out = (!campaign.keep_out_zones.is_empty()).then(|| {
+            ZoneLandings::of(
+                &campaign.keep_out_zones,
+                campaign.keep_out_guided,
+                &results,
+                failed_runs.len(),
+                campaign.wind_max_mps,
+            )
+        });
         Self {
+            keep_out,
             campaign,
             runs: results.len() + failed_runs.len(),
             miss_m: miss(|r| r.miss_m),
@@ -250,6 +281,8 @@ mod tests {
             touchdown_vertical_speed_mps: 2.5,
             payload_miss_m: 1.0,
             payload_touchdown_vertical_speed_mps: 2.0,
+            payload_touchdown_ne_m: [1.0, 0.0],
+            payload_zone: None,
             payload_after_first_contact_s: 2.0,
             wind_estimate_rmse_mps: 0.2,
             unreachable: false,
@@ -263,6 +296,46 @@ mod tests {
             events: Vec::new(),
             track: Vec::new(),
         }
+    }
+
+    #[test]
+    fn zone_landings_are_counted_by_wind_with_failed_runs_apart() {
+        let run = |index: usize, wind: f64, zone: Option<&str>| {
+            let mut r = landed(0.0, false);
+            r.index = index;
+            r.conditions.wind_speed_mps = wind;
+            r.payload_zone = zone.map(str::to_string);
+            r
+        };
+        let results = vec![
+            run(3, 0.5, None),
+            run(1, 1.9, Some("Pond")),
+            run(2, 2.0, None),
+            run(4, 5.5, Some("Road")),
+        ];
+        let mut header = CampaignHeader::of(&MonteCarloConfig {
+            wind_max_mps: 6.0,
+            ..MonteCarloConfig::default()
+        });
+        header.keep_out_zones = vec!["Pond".into(), "Road".into()];
+        let report = MonteCarloReport::assemble(header, results, vec![(0, "x".into())], 1.0);
+        let z = report.keep_out.expect("zones counted");
+        assert_eq!((z.landings, z.in_zone, z.failed), (4, 2, 1));
+        let bins: Vec<(f64, usize, usize)> = z
+            .by_wind
+            .iter()
+            .map(|b| (b.wind_from_mps, b.landings, b.in_zone))
+            .collect();
+        assert_eq!(bins, vec![(0.0, 2, 1), (2.0, 1, 0), (4.0, 1, 1)]);
+        let named: Vec<(usize, &str)> = z.runs.iter().map(|l| (l.index, l.zone.as_str())).collect();
+        assert_eq!(named, vec![(1, "Pond"), (4, "Road")]);
+        // Without zones, no count at all.
+        let plain = CampaignHeader::of(&MonteCarloConfig::default());
+        assert!(
+            MonteCarloReport::assemble(plain, vec![], vec![], 0.0)
+                .keep_out
+                .is_none()
+        );
     }
 
     #[test]

@@ -66,6 +66,12 @@ pub struct RunResult {
     pub payload_miss_m: f64,
     /// The capsule's vertical speed at its touchdown, m/s.
     pub payload_touchdown_vertical_speed_mps: f64,
+    /// Where the capsule touched down, north and east of the target, m.
+    #[serde(default)]
+    pub payload_touchdown_ne_m: [f64; 2],
+    /// The keep-out zone the capsule came down in, by name (campaigns with zones only).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub payload_zone: Option<String>,
     /// Time from the first contact to the capsule's, s.
     pub payload_after_first_contact_s: f64,
     /// RMS of the horizontal wind-estimate error from 30 s after release on, m/s.
@@ -281,6 +287,9 @@ pub fn run_one<N: Navigator>(
     let mut guidance_config = config.guidance;
     guidance_config.spiral.flare = config.flare;
     let mut guidance = Guidance::new(guidance_config);
+    if config.keep_out_guided {
+        guidance.set_keep_out(config.keep_out.clone());
+    }
     guidance.set_plan(
         Plan {
             target_ned_m: Vector3::zeros(),
@@ -368,6 +377,11 @@ pub fn run_one<N: Navigator>(
         touchdown_vertical_speed_mps: touchdown.vertical_speed_mps,
         payload_miss_m: payload.position_ne_m[0].hypot(payload.position_ne_m[1]),
         payload_touchdown_vertical_speed_mps: payload.vertical_speed_mps,
+        payload_touchdown_ne_m: payload.position_ne_m,
+        payload_zone: config
+            .keep_out
+            .zone_at(payload.position_ne_m)
+            .map(|z| z.name.clone()),
         payload_after_first_contact_s: payload.time_s - touchdown.time_s,
         wind_estimate_rmse_mps: if wind_samples > 0 {
             (wind_error_sq / wind_samples as f64).sqrt()

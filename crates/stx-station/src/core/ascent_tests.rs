@@ -5,7 +5,7 @@
 use stx_dynamics::wind::WindField;
 use stx_link::telemetry::{GlobalPosition, Telemetry};
 
-use super::tests::{core, gps_raw};
+use super::tests::{core, gps_raw, level_attitude};
 use super::*;
 
 /// The air's velocity (north, east), m/s, at `altitude_m` above the origin: 4 m/s east
@@ -65,15 +65,7 @@ impl Balloon {
                 v_down_mps: -climb_mps,
                 heading_deg: None,
             }),
-            Telemetry::Attitude(stx_link::telemetry::Attitude {
-                time_boot_ms: ms,
-                roll_rad: 0.0,
-                pitch_rad: 0.0,
-                yaw_rad: 0.0,
-                roll_rate_radps: 0.0,
-                pitch_rate_radps: 0.0,
-                yaw_rate_radps: 0.0,
-            }),
+            level_attitude(ms),
             Telemetry::GpsRaw(gps_raw(ms, [lat, lon, alt], [n, e])),
         ] {
             core.on_link_event(

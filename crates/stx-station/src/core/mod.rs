@@ -14,6 +14,8 @@
 //!   holds and releases the sticks);
 //! - `ascent`: the wind measured from the balloon's drift during the ascent, by altitude
 //!   band, and the profile ([`StationCore::wind_profile`]) the predictions fly in;
+//!   `flight_path`: the burst, deploy and unsteered landing points flown in it while the
+//!   balloon rises and the round chute falls;
 //! - `params`: the drone's parameter table; `views`: the `state` and `params` messages;
 //! - `keep_out`: the keep-out zones, the targets they refuse and the alarms they raise;
 //!   `fence`: the zones sent to the drone as its fence, until it acknowledges them.
@@ -23,6 +25,7 @@ mod ascent;
 mod commands;
 mod cutdown;
 mod fence;
+mod flight_path;
 mod footprint;
 mod keep_out;
 mod manual;
@@ -52,6 +55,7 @@ pub use ascent::REFIT_EVERY_S;
 pub use commands::{ANSWER_PER_PLAN_ITEM_S, ANSWER_WITHIN_S, UPLOAD_RETRY_S, UPLOAD_TRIES};
 pub use cutdown::CutdownArm;
 pub use fence::{FENCE_RETRY_S, FENCE_TRIES};
+pub use flight_path::FLIGHT_PATH_EVERY_S;
 pub use footprint::{FootprintDone, FootprintJob};
 pub use keep_out::{CLEAR_AFTER_S, CheckedZones};
 pub use manual::MANUAL_SILENCE_S;
@@ -152,6 +156,8 @@ pub struct StationCore {
     pub(crate) keep_out: keep_out::KeepOut,
     /// The drone's copy of the zones.
     fence: fence::FenceSync,
+    /// The unsteered flight path from the balloon or the round chute.
+    live_path: flight_path::LivePath,
 }
 
 impl StationCore {
@@ -192,6 +198,7 @@ impl StationCore {
             main_line_travel_m: stx_dynamics::vehicle::Vehicle::straplex().main_line_travel_m,
             keep_out: keep_out::KeepOut::default(),
             fence: fence::FenceSync::default(),
+            live_path: flight_path::LivePath::default(),
             config,
         }
     }

@@ -289,6 +289,7 @@ impl StationCore {
             self.estimate = None;
         }
         self.refit_ascent_winds(now_s);
+        self.update_flight_path(now_s);
         self.handle_timeout(now_s);
         self.watch_keep_out(now_s);
         let state = self.state_msg_now(now_s);

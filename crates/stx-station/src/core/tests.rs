@@ -28,6 +28,19 @@ pub(super) fn sent_ops(core: &mut StationCore, now_s: f64) -> Vec<LinkOp> {
         .collect()
 }
 
+/// A level, still attitude at `ms` on the drone's clock (it moves the drone's clock on).
+pub(super) fn level_attitude(ms: u32) -> Telemetry {
+    Telemetry::Attitude(Attitude {
+        time_boot_ms: ms,
+        roll_rad: 0.0,
+        pitch_rad: 0.0,
+        yaw_rad: 0.0,
+        roll_rate_radps: 0.0,
+        pitch_rate_radps: 0.0,
+        yaw_rate_radps: 0.0,
+    })
+}
+
 /// A 3-D GPS fix at `ms` on the drone's clock, at latitude, longitude (degrees) and altitude
 /// (m MSL), moving at `[north, east]` m/s.
 pub(super) fn gps_raw(ms: u32, [lat, lon, alt]: [f64; 3], [north, east]: [f64; 2]) -> GpsRaw {

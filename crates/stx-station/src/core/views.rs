@@ -248,6 +248,7 @@ impl StationCore {
             guidance,
             prediction,
             footprint: self.footprint_view(now_s),
+            flight_path: self.flight_path_view_now(),
             forecast_wind: self.config.forecast_wind.clone(),
             mission: MissionView {
                 stage: self.latest.status.map(|(s, _)| snake(s.stage)),
