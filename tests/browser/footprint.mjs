@@ -8,10 +8,9 @@
 //
 // Usage: node tests/browser/footprint.mjs [path/to/stx]   (default target/release/stx)
 
-import { copyFile, mkdtemp, readFile, writeFile } from "node:fs/promises";
-import { tmpdir } from "node:os";
+import { readFile } from "node:fs/promises";
 import { join } from "node:path";
-import { OPERATOR, VIEWER, root, out, speed, check, newContext, startStation, apiOf, until, attr, text, watchErrors, runFlights, registerRest, fromNorthEast } from "./harness.mjs";
+import { OPERATOR, VIEWER, root, out, speed, check, newContext, startStation, apiOf, until, attr, text, watchErrors, runFlights, registerRest, fromNorthEast, configWithZoneCopy } from "./harness.mjs";
 
 registerRest("PUT", /^\/api\/keep-out$/, "KeepOutBody", "KeepOutMsg");
 
@@ -26,22 +25,6 @@ function inRing(ring, p) {
   return inside;
 }
 const inPolygons = (polys, p) => polys.some(([outer, ...holes]) => inRing(outer, p) && !holes.some((h) => inRing(h, p)));
-
-/**
- * The shipped station config with its sample zones copied aside: an operator's edit is written to
- * the configured file, and the test's edits must not land in the repository's sample.
- */
-async function configWithZoneCopy() {
-  const dir = await mkdtemp(join(tmpdir(), "stx-browser-zones-"));
-  const zones = join(dir, "zones.geojson");
-  await copyFile(join(root, "config/keep-out/sample.geojson"), zones);
-  const toml = await readFile(join(root, "config/station.toml"), "utf8");
-  const edited = toml.replace(/^keep_out = .*$/m, `keep_out = ${JSON.stringify(zones)}`);
-  if (edited === toml) throw new Error("config/station.toml has no keep_out line to point at the copy");
-  const file = join(dir, "station.toml");
-  await writeFile(file, edited);
-  return { file, zones };
-}
 
 async function flight() {
   const copy = await configWithZoneCopy();

@@ -8,7 +8,7 @@
 
 import { spawn } from "node:child_process";
 import { createSocket } from "node:dgram";
-import { mkdir, mkdtemp } from "node:fs/promises";
+import { copyFile, mkdir, mkdtemp, readFile, writeFile } from "node:fs/promises";
 import { tmpdir } from "node:os";
 import { createRequire } from "node:module";
 import { dirname, join, resolve } from "node:path";
@@ -191,6 +191,23 @@ export async function startStation(args) {
   if (!found) throw new Error(`stx serve did not start:\n${io.out}\n${io.err}`);
   return { io, base: found[1] };
 }
+
+/**
+ * The shipped station config with its sample zones copied aside: an operator's edit is written to
+ * the configured file, and the test's edits must not land in the repository's sample.
+ */
+export async function configWithZoneCopy() {
+  const dir = await mkdtemp(join(tmpdir(), "stx-browser-zones-"));
+  const zones = join(dir, "zones.geojson");
+  await copyFile(join(root, "config/keep-out/sample.geojson"), zones);
+  const toml = await readFile(join(root, "config/station.toml"), "utf8");
+  const edited = toml.replace(/^keep_out = .*$/m, `keep_out = ${JSON.stringify(zones)}`);
+  if (edited === toml) throw new Error("config/station.toml has no keep_out line to point at the copy");
+  const file = join(dir, "station.toml");
+  await writeFile(file, edited);
+  return { file, zones };
+}
+
 /** A free loopback UDP port for the station's link (the drone must know it before it starts). */
 export async function freeUdpPort() {
   const s = createSocket("udp4");

@@ -43,6 +43,10 @@ export class Api {
     return this.request<T>("POST", path, body);
   }
 
+  put<T = unknown>(path: string, body: unknown): Promise<T> {
+    return this.request<T>("PUT", path, body);
+  }
+
   /** POST of a command: resolves to the request id of the 202. */
   async command<P extends CommandPath>(path: P, body: CommandBodies[P]): Promise<string> {
     const r = await this.post(path, body);

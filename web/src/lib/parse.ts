@@ -55,6 +55,7 @@ import type {
   Vehicle,
 } from "./types";
 import type { ServerMessage as WireServerMessage } from "../generated/api";
+import { zonesOf } from "./zones";
 
 type WireServerType = WireServerMessage["type"];
 type WireServerMessageOf<T extends WireServerType> = Extract<WireServerMessage, { type: T }>;
@@ -385,7 +386,7 @@ export function parseKeepOut(v: Obj): Parsed<KeepOutMsg> {
       if (rings !== null) areas.push({ name, rings });
     }
   }
-  return ok({ type: "keep_out", time_s, load_error: str(v, "load_error"), changed_by: str(v, "changed_by"), file: str(v, "file"), areas });
+  return ok({ type: "keep_out", time_s, load_error: str(v, "load_error"), changed_by: str(v, "changed_by"), file: str(v, "file"), areas, zones: zonesOf(zones) });
 }
 
 const PREDICTION_KINDS = { planned: true, uncontrolled: true } as const satisfies Record<KeepOutAlarm["prediction"], true>;

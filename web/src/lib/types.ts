@@ -130,8 +130,19 @@ export interface KeepOutArea {
   name: string;
   rings: Ring[];
 }
-/** The keep-out zones in force, as the map draws them. */
-export type KeepOutMsg = Pick<Wire.KeepOutMsg, "type" | "time_s" | "load_error" | "changed_by" | "file"> & { areas: KeepOutArea[] };
+/**
+ * One keep-out feature as the map edits it: its name, its kind (`""`: none), its other GeoJSON
+ * properties kept as they came, and its polygons (outer ring then holes), each ring `[lat, lon]`
+ * without the closing point.
+ */
+export interface Zone {
+  name: string;
+  kind: string;
+  extra: Record<string, unknown>;
+  polygons: Ring[][];
+}
+/** The keep-out zones in force: each area as the map draws it, each feature as it edits it. */
+export type KeepOutMsg = Pick<Wire.KeepOutMsg, "type" | "time_s" | "load_error" | "changed_by" | "file"> & { areas: KeepOutArea[]; zones: Zone[] };
 
 /** A ring of `[lat_deg, lon_deg]` points, Leaflet's own order. */
 export type Ring = [number, number][];

@@ -80,7 +80,7 @@ function build(session: Session): void {
   const station = session.station;
 
   // ---- panels
-  const map = new MapView(station, token);
+  const map = new MapView(station, token, (zones) => api.put("/api/keep-out", zones));
   const picks = new PickGroup((p) => map.setPicker(p));
   const attitude = new AttitudeIndicator();
   const compass = new Compass();

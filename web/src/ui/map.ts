@@ -16,6 +16,7 @@ import { fmt, fmtDir, fmtDistance } from "../lib/format";
 import { boxAround, keyPoints, needsFraming, type Box } from "../lib/framing";
 import { isLanded } from "../lib/recovery";
 import { packNote, tilesBadge } from "../lib/tiles";
+import { ZoneEditor } from "./zoneEditor";
 import type { Footprint, KeepOutAlarm, KeepOutMsg, LandingPrediction, LatLon, Ring, State, Station, TrackPoint } from "../lib/types";
 
 const ll = (p: LatLon): L.LatLngExpression => [p.lat_deg, p.lon_deg];
@@ -37,8 +38,8 @@ export class MapView {
   private readonly reach95 = L.polygon([], { color: "#2a7ab0", weight: 1, fillColor: "#2a7ab0", fillOpacity: 0.1, interactive: false, className: "map-footprint-95" });
   private readonly reach50 = L.polygon([], { color: "#2a7ab0", weight: 2, fillColor: "#2a7ab0", fillOpacity: 0.22, interactive: false, className: "map-footprint-50" });
   private readonly reachText: HTMLElement;
-  /** Keep-out zones, drawn under everything else, each named on hover. */
-  private readonly zones = L.layerGroup();
+  /** Keep-out zones, drawn under everything else, each named on hover; edited by operators. */
+  private readonly zones: ZoneEditor;
   private readonly alarmText: HTMLElement;
   private readonly flightPath: FlightPathLayer;
   private readonly ellPlanned = L.polygon([], { color: "#006400", weight: 2, fillOpacity: 0.12 });
@@ -71,7 +72,8 @@ export class MapView {
   /** Why the station's tile pack gives no map, as it said. */
   private readonly packError: string | null;
 
-  constructor(station: Station, tileToken: string | null) {
+  /** `saveZones`: sends an operator's edit of the keep-out zones (`PUT /api/keep-out`). */
+  constructor(station: Station, tileToken: string | null, saveZones: (collection: unknown) => Promise<unknown>) {
     this.origin = station.origin;
     const el = h("div", { class: "map", "data-testid": "map", role: "application", "aria-label": "map" });
     this.root = el;
@@ -91,7 +93,7 @@ export class MapView {
     this.uncontrolled = L.marker(ll(this.origin), { icon: icon("mk-uncontrolled", DOT_SVG("#c05800"), 18, "map-pred-uncontrolled"), interactive: false });
     this.vehicle = L.marker(ll(this.origin), { icon: icon("mk-vehicle", VEHICLE_SVG, 40, "map-vehicle"), zIndexOffset: 1000, interactive: false });
     this.draftTarget = L.marker(ll(this.origin), { icon: icon("mk-draft", TARGET_SVG, 34, "map-draft-target"), interactive: false, opacity: 0.6 });
-    this.zones.addTo(this.map);
+    this.zones = new ZoneEditor(this.map, { save: saveZones, onEditing: (on) => on && this.setFollow(false) });
     this.flightPath = new FlightPathLayer(this.map);
     for (const layer of [this.reach95, this.reach50, this.pattern, this.final, this.ellUncontrolled, this.ellPlanned, this.track, this.draftPlan, this.draftLocalizer]) layer.addTo(this.map);
 
@@ -112,7 +114,7 @@ export class MapView {
     const overlay = h("div", { class: "map-overlay", "data-testid": "map-overlay" }, this.tilesStatus, packNoteEl, h("div", { class: "map-badge wind" }, this.windArrow, this.windText), this.alarmText, this.finalText, this.reachText, this.flightPath.badge, this.landedText, this.followBtn);
     L.DomEvent.disableClickPropagation(overlay);
     L.DomEvent.disableScrollPropagation(overlay);
-    el.append(overlay);
+    el.append(overlay, this.zones.root);
     this.overlay = overlay;
 
     this.map.on("moveend zoomend", () => this.drawGrid());
@@ -178,14 +180,9 @@ export class MapView {
     this.track.setLatLngs(points.slice(-MAX_TRACK).map((p) => [p.lat_deg, p.lon_deg] as L.LatLngTuple));
   }
 
-  /** Draws the keep-out zones in force (replacing the previous set). */
+  /** The keep-out zones in force (drawn at once unless an operator is editing them). */
   setZones(k: KeepOutMsg): void {
-    this.zones.clearLayers();
-    for (const a of k.areas) {
-      L.polygon(a.rings, { color: "#b00020", weight: 2, fillColor: "#b00020", fillOpacity: 0.18, dashArray: "4 3", className: "map-keep-out" })
-        .bindTooltip(`keep out: ${a.name}`, { sticky: true })
-        .addTo(this.zones);
-    }
+    this.zones.show(k);
     this.root.dataset.keepOutAreas = String(k.areas.length);
   }
 
@@ -199,7 +196,6 @@ export class MapView {
     this.reach95.setLatLngs(level(0.95));
     this.reach50.setLatLngs(level(0.5));
     const old = stale || (f?.stale ?? false);
-    this.zones.addTo(this.map);
     for (const layer of [this.reach95, this.reach50]) layer.setStyle({ color: old ? "#888" : "#2a7ab0", fillColor: old ? "#888" : "#2a7ab0" });
     this.reachText.hidden = f === null;
     if (f !== null) {
@@ -328,6 +324,11 @@ export class MapView {
   /** Grid lines every 1/2/5×10^k m east and north of the origin, labelled in metres. */
   private drawGrid(): void {
     this.grid.clearLayers();
+    // The view, for tests and for people reading the DOM: with the container's size it gives
+    // every pixel's position (Web Mercator), as where a zone's corner was clicked.
+    const c = this.map.getCenter();
+    this.root.dataset.center = `${c.lat.toFixed(7)},${c.lng.toFixed(7)}`;
+    this.root.dataset.zoom = String(this.map.getZoom());
     const b = this.map.getBounds();
     const sw = toLocal(this.origin, { lat_deg: b.getSouth(), lon_deg: b.getWest() });
     const ne = toLocal(this.origin, { lat_deg: b.getNorth(), lon_deg: b.getEast() });
