@@ -5,7 +5,8 @@
 // landing is saved where it was clicked (in the API and in the file) and raises the landing
 // alarm on the map and in the log; a corner dragged moves; a name the station refuses (and one
 // this page refuses) is shown and the edit is kept; a change by another operator is announced
-// during an edit and drawn after it; a deleted zone is gone; a viewer has no edit controls.
+// during an edit and drawn after it; a deleted zone is gone; Cancel forgets an edit; a viewer has
+// no edit controls.
 //
 // Where a click lands is computed here from the map's view (its centre and zoom, which the page
 // writes on the map element) with Web Mercator's formulas, independently of Leaflet's code.
@@ -61,6 +62,8 @@ async function drag(page, from, to) {
   await page.mouse.down();
   for (let i = 1; i <= 8; i++) await page.mouse.move(from.x + ((to.x - from.x) * i) / 8, from.y + ((to.y - from.y) * i) / 8);
   await page.mouse.up();
+  // Leaflet swallows a click that comes right after a drag (it takes it for the drag's end).
+  await sleep(300);
 }
 
 async function flight() {
@@ -96,8 +99,10 @@ async function flight() {
   const v = await viewOf(page);
   const u = (await api("/api/state")).body.prediction.uncontrolled;
   const pu = pixelOf(v, u);
-  // A square of ±90 px around the landing, kept clear of the badges (top) and of the bar (bottom left).
-  const top = (await page.locator('[data-testid="map-overlay"]').boundingBox()).y + 80;
+  // A square of ±90 px around the landing, kept clear of the badges along the top (with room for
+  // a row more: the alarm comes) and of the bar (bottom left).
+  const badges = await page.locator('[data-testid="map-overlay"]').boundingBox();
+  const top = badges.y + badges.height + 60;
   const barTop = (await bar.boundingBox()).y - 20;
   const side = 90;
   const cx = Math.min(Math.max(pu.x, v.box.x + side + 60), v.box.x + v.box.width - side - 20);
@@ -131,26 +136,36 @@ async function flight() {
   check("zones: the landing predicted in the drawn zone raises the alarm on the map and in the log (station and page)", /Test field/.test(alarm) && logged && onPage, `map "${alarm}"; station log ${logged}; page log ${onPage}`);
   await page.screenshot({ path: join(out, "zones-drawn.png") });
 
-  // ---- drag one corner
+  // ---- drag one corner, add one at a midpoint and drag it out, delete one by a right-click
   await tb("zones-edit").click();
   await until(() => bar.getAttribute("data-editing"), (e) => e === "true", 3000);
   const v2 = await viewOf(page);
+  const px = corners(got).map((p) => pixelOf(v2, p));
+  const whole = (p) => ({ x: Math.round(p.x), y: Math.round(p.y) });
   // Leaflet drags a corner by the mouse's travel from where it was pressed: the corner should
   // end 40 px right and 30 px down of where it was (to its marker's whole pixel).
-  const corner = pixelOf(v2, corners(got)[2]);
-  const from = { x: Math.round(corner.x), y: Math.round(corner.y) };
+  const from = whole(px[2]);
   await drag(page, from, { x: from.x + 40, y: from.y + 30 });
+  // The handle halfway along the first edge becomes a corner when clicked; then it is dragged out.
+  const mid = { x: (px[0].x + px[1].x) / 2, y: (px[0].y + px[1].y) / 2 };
+  await page.mouse.click(whole(mid).x, whole(mid).y);
+  await sleep(200);
+  await drag(page, whole(mid), { x: whole(mid).x, y: whole(mid).y - 30 });
+  await page.mouse.click(whole(px[3]).x, whole(px[3]).y, { button: "right" });
+  await sleep(100);
   await tb("zones-save").click();
   await until(() => bar.getAttribute("data-editing"), (e) => e === "false", 5000);
   const moved = corners(feature((await api("/api/keep-out")).body, "Test field"));
-  const movedWanted = [wanted[0], wanted[1], positionAt(v2, { x: corner.x + 40, y: corner.y + 30 }), wanted[3]];
+  const movedWanted = [wanted[0], positionAt(v2, { x: mid.x, y: mid.y - 30 }), wanted[1], positionAt(v2, { x: px[2].x + 40, y: px[2].y + 30 })];
   const err2 = worstM(moved, movedWanted);
-  check("zones: a corner dragged on the map moves there, the others stay", err2 <= tol, `corners within ${err2.toFixed(2)} m of where they should be; the dragged one moved ${distanceM(corners(got)[2] ?? u, moved[2] ?? u).toFixed(0)} m`);
+  check("zones: a corner dragged, one added at a midpoint and dragged out, one deleted by a right-click: saved so, the others unchanged", err2 <= tol,
+    `${moved.length} corners (4 wanted) at ${JSON.stringify(moved.map((p) => whole(pixelOf(v2, p))))} px (clicked ${JSON.stringify(px.map(whole))}), within ${err2.toFixed(2)} m of where they should be; the dragged one moved ${distanceM(corners(got)[2] ?? u, moved[3] ?? u).toFixed(0)} m`);
 
   // ---- a refused edit is shown and kept
   await tb("zones-edit").click();
   await until(() => bar.getAttribute("data-editing"), (e) => e === "true", 3000);
-  const inside = pixelOf(v2, { lat_deg: (wanted[0].lat_deg + wanted[2].lat_deg) / 2, lon_deg: (wanted[0].lon_deg + wanted[2].lon_deg) / 2 });
+  // Inside the zone (convex): the mean of its corners.
+  const inside = moved.map((p) => pixelOf(v2, p)).reduce((a, p) => ({ x: a.x + p.x / moved.length, y: a.y + p.y / moved.length }), { x: 0, y: 0 });
   await page.mouse.click(inside.x, inside.y);
   const selected = await until(() => tb("zones-name").inputValue(), (n) => n === "Test field", 3000);
   const long = "Long ".repeat(17); // 85 characters: the station takes at most 80
@@ -189,6 +204,24 @@ async function flight() {
   const putAgain = await api("/api/keep-out", OPERATOR, { method: "PUT", body: JSON.stringify({ type: "FeatureCollection", features: [...after.zones.features, other] }) });
   const follows = await until(() => page.locator("path.map-keep-out").count(), (n) => n === zonesAtStart.areas + 1, 5000);
   check("zones: out of editing, the map follows another operator's change", putAgain.status === 200 && follows === zonesAtStart.areas + 1, `${follows} zones drawn`);
+
+  // ---- Cancel forgets an edit: a zone drawn, then cancelled
+  const beforeCancel = (await api("/api/keep-out")).body;
+  await tb("zones-edit").click();
+  await until(() => bar.getAttribute("data-editing"), (e) => e === "true", 3000);
+  await tb("zones-draw").click();
+  const tri = [[0, -60], [60, 40], [-60, 40], [0, -60]].map(([dx, dy]) => ({ x: Math.round(cx + dx), y: Math.round(cy + dy) }));
+  for (const p of tri) {
+    await page.mouse.click(p.x, p.y);
+    await sleep(80);
+  }
+  const drawnEditing = await until(() => page.locator("path.map-keep-out").count(), (n) => n === zonesAtStart.areas + 2, 3000);
+  await tb("zones-cancel").click();
+  const drawnCancelled = await until(() => page.locator("path.map-keep-out").count(), (n) => n === zonesAtStart.areas + 1, 3000);
+  const afterCancel = (await api("/api/keep-out")).body;
+  check("zones: Cancel forgets the edit (a zone drawn is gone) and sends nothing",
+    drawnEditing === zonesAtStart.areas + 2 && drawnCancelled === zonesAtStart.areas + 1 && JSON.stringify(afterCancel.zones) === JSON.stringify(beforeCancel.zones),
+    `${drawnEditing} zones drawn while editing, ${drawnCancelled} after Cancel; in force ${afterCancel.areas}`);
   await page.screenshot({ path: join(out, "zones-final.png") });
   await ctx.close();
 }
