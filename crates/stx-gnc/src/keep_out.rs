@@ -7,8 +7,8 @@
 //! centimetres at these sizes) and every later question is plane geometry: the even–odd rule
 //! for inside (holes in a polygon are outside its zone), segment intersection for a leg. The
 //! `geojson` crate parses and checks the text's structure; what it leaves to its users (rings
-//! closed and long enough, coordinates finite and on the globe) is checked here, and a bad file
-//! is refused with the feature and the rule it breaks.
+//! closed, long enough and not crossing themselves, coordinates finite and on the globe) is
+//! checked here, and a bad file is refused with the feature and the rule it breaks.
 
 use geojson::{GeoJson, GeometryValue, PolygonType};
 use thiserror::Error;
@@ -217,6 +217,11 @@ fn flatten(
                 ));
             }
             points.pop();
+            if crosses_itself(&points) {
+                return Err(bad(
+                    "crosses itself (two of its edges meet): it bounds no single area",
+                ));
+            }
             Ok(points)
         })
         .collect()
@@ -241,6 +246,36 @@ fn ring_contains(ring: &[[f64; 2]], p: [f64; 2]) -> bool {
         }
     }
     inside
+}
+
+/// Whether two edges of an open ring that share no corner meet. Inside-or-out by the even–odd
+/// rule is then no longer what the operator drew (a bow tie's middle, a loop pulled through),
+/// so such a ring is refused. Repeated consecutive points (some GIS exports have them) are
+/// skipped first: their zero-length edge would touch its neighbours' neighbours. The check is
+/// quadratic in the corners, which a zone drawn or traced by hand keeps in the hundreds.
+fn crosses_itself(ring: &[[f64; 2]]) -> bool {
+    let mut corners: Vec<[f64; 2]> = Vec::with_capacity(ring.len());
+    for p in ring {
+        if corners.last() != Some(p) {
+            corners.push(*p);
+        }
+    }
+    while corners.len() > 1 && corners.first() == corners.last() {
+        corners.pop();
+    }
+    let n = corners.len();
+    (0..n).any(|i| {
+        // Edge i and its neighbours share a corner; the last edge neighbours the first.
+        let last = if i == 0 { n.saturating_sub(1) } else { n };
+        (i + 2..last).any(|j| {
+            segments_cross(
+                corners[i],
+                corners[(i + 1) % n],
+                corners[j],
+                corners[(j + 1) % n],
+            )
+        })
+    })
 }
 
 /// Whether segments `ab` and `cd` cross or touch.

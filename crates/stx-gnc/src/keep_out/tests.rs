@@ -112,6 +112,14 @@ fn a_bare_geometry_is_a_zone_named_by_its_place_in_the_file() {
 }
 
 #[test]
+fn a_simple_ring_with_a_repeated_corner_or_a_concave_notch_is_an_area() {
+    // A notch (concave) and a corner given twice in a row, as some GIS exports write them.
+    let notched = r#"{"type": "Polygon", "coordinates": [[[17.0, 48.0], [17.02, 48.0], [17.02, 48.0], [17.02, 48.02], [17.01, 48.005], [17.0, 48.02], [17.0, 48.0]]]}"#;
+    let zones = KeepOutZones::from_geojson(notched, &frame()).expect("a simple ring");
+    assert_eq!(zones.zones.len(), 1);
+}
+
+#[test]
 fn files_that_are_not_areas_on_the_globe_are_refused_with_the_rule_broken() {
     let f = frame();
     let err = |text: &str| KeepOutZones::from_geojson(text, &f).expect_err(text);
@@ -131,6 +139,16 @@ fn files_that_are_not_areas_on_the_globe_are_refused_with_the_rule_broken() {
     let short_ring =
         r#"{"type": "Polygon", "coordinates": [[[17.0, 48.0], [17.01, 48.0], [17.0, 48.0]]]}"#;
     assert!(matches!(err(short_ring), KeepOutError::Ring { .. }));
+    // A bow tie (two corners swapped) and a ring whose edge runs back onto another's corner.
+    let bow_tie = r#"{"type": "Polygon", "coordinates": [[[17.0, 48.0], [17.01, 48.01], [17.0, 48.01], [17.01, 48.0], [17.0, 48.0]]]}"#;
+    assert!(matches!(
+        err(bow_tie),
+        KeepOutError::Ring { ring: 0, reason, .. } if reason.contains("crosses itself")
+    ));
+    let touching = r#"{"type": "Polygon", "coordinates": [[[17.0, 48.0], [17.02, 48.0], [17.01, 48.0], [17.01, 48.01], [17.0, 48.0]]]}"#;
+    assert!(
+        matches!(err(touching), KeepOutError::Ring { reason, .. } if reason.contains("crosses itself"))
+    );
     let off_globe = r#"{"type": "Polygon", "coordinates": [[[17.0, 48.0], [17.01, 95.0], [17.01, 48.01], [17.0, 48.0]]]}"#;
     assert!(matches!(err(off_globe), KeepOutError::Position { lat, .. } if lat == 95.0));
     let message = err(off_globe).to_string();

@@ -151,6 +151,18 @@ fn an_edit_is_checked_named_logged_with_who_and_what_and_sent_to_the_pages() {
             },
             "ring 0",
         ),
+        (
+            {
+                // Two corners swapped: a bow tie, as an edit on the map can leave it.
+                let mut f = square(&c, "Bow tie", 0.0, 0.0, 10.0);
+                let ring = f["geometry"]["coordinates"][0]
+                    .as_array_mut()
+                    .expect("ring");
+                ring.swap(1, 2);
+                collection(vec![f])
+            },
+            "keep-out feature 0: ring 0 crosses itself",
+        ),
     ] {
         let err = c.check_keep_out(body).unwrap_err();
         assert_eq!(err.status, 400);
