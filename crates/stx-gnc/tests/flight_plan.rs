@@ -96,7 +96,28 @@ fn bad_requests_are_refused_with_the_field_named() {
         ),
         (
             Box::new(|r| r.ascent_rate_mps = -1.0),
-            "mean_ascent_rate_mps",
+            "`ascent_rate_mps` = -1",
+        ),
+        (
+            Box::new(|r| r.ascent_rate_mps = 1e-300),
+            "`ascent_rate_mps`",
+        ),
+        (
+            Box::new(|r| r.burst_altitude_msl_m = 1e9),
+            "`burst_altitude_msl_m` = 1000000000",
+        ),
+        (
+            Box::new(|r| r.deploy_height_m = 40_000.0),
+            "`deploy_height_m`",
+        ),
+        (Box::new(|r| r.deploy_height_m = -1.0), "`deploy_height_m`"),
+        (
+            Box::new(|r| r.burst_altitude_sigma_m = f64::INFINITY),
+            "`burst_altitude_sigma_m`",
+        ),
+        (
+            Box::new(|r| r.default_wind_sigma_mps = 1e6),
+            "`default_wind_sigma_mps`",
         ),
         (Box::new(|r| r.forecast.clear()), "no rows"),
         (

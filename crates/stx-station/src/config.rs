@@ -12,6 +12,7 @@ use subtle::ConstantTimeEq;
 
 use serde::{Deserialize, Serialize};
 use stx_gnc::ascent_wind::AscentWindConfig;
+pub use stx_gnc::flight_path::ForecastRow;
 use stx_gnc::flight_path::StackConfig;
 use stx_gnc::geo::LocalFrame;
 use stx_gnc::guidance::GuidanceConfig;
@@ -143,18 +144,6 @@ impl LinkSettings {
     }
 }
 
-/// A row of the forecast wind profile.
-#[derive(Debug, Clone, Copy, Serialize, Deserialize, schemars::JsonSchema)]
-#[serde(deny_unknown_fields)]
-pub struct ForecastRow {
-    /// Altitude above mean sea level, m.
-    pub alt_msl_m: f64,
-    /// Wind speed, m/s.
-    pub speed_mps: f64,
-    /// Direction the wind blows from, degrees from north.
-    pub from_deg: f64,
-}
-
 /// The station.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -200,8 +189,10 @@ pub struct StationConfig {
     pub link: LinkSettings,
     /// Access tokens.
     pub tokens: Vec<TokenConfig>,
-    /// The forecast wind, for comparison with the estimate, and for the landing predictions
-    /// above and below the altitudes the ascent measured.
+    /// The forecast wind, for comparison with the estimate, for the landing predictions
+    /// above and below the altitudes the ascent measured, and to start the Plan page's plans
+    /// from (the rows of a forecast file, `stx_gnc::flight_path::forecast`; a row's
+    /// `sigma_mps` is used by plans only).
     #[serde(default)]
     pub forecast_wind: Vec<ForecastRow>,
     /// How the wind is measured from the balloon's drift during the ascent (`[ascent_wind]`:
@@ -402,8 +393,13 @@ impl StationConfig {
             return invalid(&format!("ascent_wind.{field}"), rule);
         }
         for (i, r) in self.forecast_wind.iter().enumerate() {
-            if !(r.speed_mps >= 0.0 && r.alt_msl_m.is_finite() && r.from_deg.is_finite()) {
-                return invalid(&format!("forecast_wind[{i}]"), "finite, speed ≥ 0");
+            let sigma_ok = r.sigma_mps.is_none_or(|s| s.is_finite() && s >= 0.0);
+            let finite = r.alt_msl_m.is_finite() && r.from_deg.is_finite();
+            if !(r.speed_mps >= 0.0 && finite && sigma_ok) {
+                return invalid(
+                    &format!("forecast_wind[{i}]"),
+                    "finite, speed and sigma ≥ 0",
+                );
             }
         }
         Ok(())

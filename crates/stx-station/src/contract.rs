@@ -20,6 +20,7 @@ use crate::keep_out::{KeepOutBody, KeepOutMsg};
 use crate::messages::{
     AscentWindMsg, CommandResultMsg, ErrorBody, EventMsg, ParamsMsg, ReplayView, Session, StateMsg,
 };
+use crate::preflight::{PreflightBody, PreflightDefaults};
 use crate::replies::{
     ClientsBody, CommandAccepted, EventsBody, HelloMsg, HistoryMsg, LaggedMsg, PongMsg,
     RecordingsBody, ReplayOpened, TrackBody,
@@ -28,6 +29,7 @@ use crate::requests::{
     ClientMessage, ConfirmBody, CourseBody, HeadingBody, LocalizerBody, ModeBody, ParamBody,
     PlanBody, ReplayBody, TargetBody,
 };
+use stx_gnc::flight_path::PlanReport;
 
 /// Where the schema is committed, from the workspace root.
 pub const SCHEMA_PATH: &str = "web/src/generated/api.schema.json";
@@ -86,12 +88,49 @@ fn generator(contract: Contract) -> SchemaGenerator {
     }
 }
 
+/// `read` is `sent` with fewer fields required: those it fills in with defaults.
+fn only_defaults_differ(sent: &Value, read: &Value) -> bool {
+    let required =
+        |v: &Value| -> Vec<Value> { v["required"].as_array().cloned().unwrap_or_default() };
+    let without_required = |v: &Value| {
+        let mut v = v.clone();
+        if let Some(o) = v.as_object_mut() {
+            o.remove("required");
+        }
+        v
+    };
+    let sent_required = required(sent);
+    without_required(sent) == without_required(read)
+        && required(read).iter().all(|r| sent_required.contains(r))
+}
+
+/// Points the references of a read schema to the `…Input` names of `inputs`.
+fn refer_to_inputs(schema: &mut Value, inputs: &[String]) {
+    match schema {
+        Value::Object(o) => {
+            for (key, value) in o.iter_mut() {
+                let target = value
+                    .as_str()
+                    .and_then(|r| r.strip_prefix("#/definitions/"));
+                match target {
+                    Some(name) if key == "$ref" && inputs.iter().any(|i| i == name) => {
+                        *value = Value::String(format!("#/definitions/{name}Input"));
+                    }
+                    _ => refer_to_inputs(value, inputs),
+                }
+            }
+        }
+        Value::Array(items) => items.iter_mut().for_each(|v| refer_to_inputs(v, inputs)),
+        _ => {}
+    }
+}
+
 /// The whole contract: a schema whose `definitions` name every message.
 pub fn schema() -> Result<Value, ContractError> {
     let mut sent = generator(Contract::Serialize);
     let mut read = generator(Contract::Deserialize);
     // The root names each message once: what the station sends, then what it reads.
-    let messages = [
+    let sent_messages = [
         sent.subschema_for::<ServerMessage>(),
         sent.subschema_for::<Session>(),
         sent.subschema_for::<ParamsMsg>(),
@@ -106,6 +145,10 @@ pub fn schema() -> Result<Value, ContractError> {
         sent.subschema_for::<RecordingsBody>(),
         sent.subschema_for::<ReplayOpened>(),
         sent.subschema_for::<KeepOutMsg>(),
+        sent.subschema_for::<PlanReport>(),
+        sent.subschema_for::<PreflightDefaults>(),
+    ];
+    let read_messages = [
         read.subschema_for::<ClientMessage>(),
         read.subschema_for::<ModeBody>(),
         read.subschema_for::<HeadingBody>(),
@@ -117,11 +160,37 @@ pub fn schema() -> Result<Value, ContractError> {
         read.subschema_for::<ConfirmBody>(),
         read.subschema_for::<ReplayBody>(),
         read.subschema_for::<KeepOutBody>(),
+        read.subschema_for::<PreflightBody>(),
     ];
     let mut definitions: Map<String, Value> = sent.take_definitions(true);
-    // A type both sent and read must be described the same way both times.
-    for (name, schema) in read.take_definitions(true) {
+    let read_definitions = read.take_definitions(true);
+    // A type both sent and read must be described the same way both times, but for one
+    // difference: a field the station fills in when it is left out (a serde default) is
+    // required as sent and optional as read. Such a type is read under its own name, `…Input`.
+    let mut inputs = Vec::new();
+    for (name, schema) in &read_definitions {
+        match definitions.get(name) {
+            Some(other) if other == schema => {}
+            Some(other) if only_defaults_differ(other, schema) => inputs.push(name.clone()),
+            Some(_) => return Err(ContractError::Conflict(name.clone())),
+            None => {}
+        }
+    }
+    let mut messages: Vec<Value> = sent_messages.into_iter().map(Value::from).collect();
+    for schema in read_messages {
+        let mut schema = Value::from(schema);
+        refer_to_inputs(&mut schema, &inputs);
+        messages.push(schema);
+    }
+    for (name, mut schema) in read_definitions {
+        refer_to_inputs(&mut schema, &inputs);
+        let name = if inputs.contains(&name) {
+            format!("{name}Input")
+        } else {
+            name
+        };
         match definitions.get(&name) {
+            // A type that holds an input type now differs from its sent self as well.
             Some(other) if *other != schema => return Err(ContractError::Conflict(name)),
             _ => {
                 definitions.insert(name, schema);
@@ -131,7 +200,7 @@ pub fn schema() -> Result<Value, ContractError> {
     Ok(json!({
         "$schema": "http://json-schema.org/draft-07/schema#",
         "title": "stx station API",
-        "description": "Every message of the stx station's HTTP and WebSocket API (crates/stx-station/API.md), generated from the daemon's Rust types by `cargo run -p stx-station --example api_schema`: do not edit. The root is any one of them: on the WebSocket ServerMessage (station to page) and ClientMessage (page to station); over REST the bodies the station answers (Session, StateMsg, ParamsMsg, AscentWindMsg, EventsBody, TrackBody, ClientsBody, CommandResultMsg, CommandAccepted, CutdownArm, ErrorBody, ReplayView, RecordingsBody, ReplayOpened, KeepOutMsg) and the bodies of the commands (*Body).",
+        "description": "Every message of the stx station's HTTP and WebSocket API (crates/stx-station/API.md), generated from the daemon's Rust types by `cargo run -p stx-station --example api_schema`: do not edit. The root is any one of them: on the WebSocket ServerMessage (station to page) and ClientMessage (page to station); over REST the bodies the station answers (Session, StateMsg, ParamsMsg, AscentWindMsg, EventsBody, TrackBody, ClientsBody, CommandResultMsg, CommandAccepted, CutdownArm, ErrorBody, ReplayView, RecordingsBody, ReplayOpened, KeepOutMsg, PlanReport, PreflightDefaults) and the bodies of the commands (*Body).",
         "anyOf": messages,
         "definitions": definitions,
     }))

@@ -16,7 +16,8 @@
 //!   `stx_gnc::params`, shared with the drone); [`contract`]: all of them as one JSON Schema,
 //!   the contract the dashboard's TypeScript types are generated from; [`kml`]: the Google
 //!   Earth feed; [`keep_out`]: the keep-out zones' messages; [`limits`]: requests per token, wrong tokens per address and pages at once,
-//!   as token buckets on the station's clock; [`recording`]: what a flight's MCAP recording
+//!   as token buckets on the station's clock; [`preflight`]: the Plan page's pre-flight plans
+//!   (`POST /api/plan`); [`recording`]: what a flight's MCAP recording
 //!   holds, under which topics; [`replay`]: a recording played back through the station.
 //!
 //! With the default feature `daemon`, the adapters:
@@ -40,6 +41,7 @@ pub mod kml;
 pub mod limits;
 pub mod link;
 pub mod messages;
+pub mod preflight;
 #[cfg(feature = "daemon")]
 pub mod recorder;
 pub mod recording;

@@ -9,7 +9,7 @@ use std::time::Duration;
 
 use common::*;
 use serde_json::json;
-use stx_record::{CoreOptions, Output, RecorderCore, RecordingInfo, foxglove};
+use stx_record::{CoreOptions, RecorderCore, RecordingInfo, foxglove};
 use stx_station::daemon::MAX_SESSIONS;
 
 const T0: u64 = 1_767_225_600_000_000_000;
@@ -28,19 +28,12 @@ fn write_recording(path: &Path) {
     let ch = core
         .add_channel(Duration::ZERO, foxglove::log_channel("/events").unwrap())
         .unwrap();
-    let mut bytes = Vec::new();
     for i in 0..50u64 {
         let t = T0 + i * 100_000_000;
         core.write(Duration::from_millis(100 * i), ch, t, t, br#"{"i":1}"#)
             .unwrap();
     }
-    core.finish().unwrap();
-    while let Some(out) = core.poll_output() {
-        if let Output::Bytes { data, .. } = out {
-            bytes.extend(data);
-        }
-    }
-    std::fs::write(path, bytes).unwrap();
+    std::fs::write(path, finished_recording(core)).unwrap();
 }
 
 fn with_dir(dir: &Path) -> stx_station::config::StationConfig {

@@ -1,17 +1,18 @@
 //! `stx plan --launch LAT,LON[,ALT] --forecast FILE …`: the pre-flight plan (burst, deploy
 //! and landing regions, the target's reachability) from a forecast file and, if given, the
 //! wind an earlier recording measured on its ascent. Argument parsing and files only; the plan
-//! is `stx_gnc::flight_path::plan`.
+//! is `stx_gnc::flight_path::plan`, the recording's wind
+//! `stx_station::recording::ascent::measured_forecast` (as the station's `POST /api/plan`).
 
 use std::path::PathBuf;
 
 use anyhow::Context;
 use clap::Args;
-use stx_gnc::flight_path::plan::{MAX_RUNS, PlannedPoint, measured_ascent};
-use stx_gnc::flight_path::{Forecast, PlanRequest, merge_measured, plan};
+use stx_gnc::flight_path::plan::{MAX_RUNS, PlannedPoint};
+use stx_gnc::flight_path::{Forecast, PlanRequest, plan};
 use stx_gnc::geo::LocalFrame;
 use stx_record::Recording;
-use stx_record::export::track::track;
+use stx_station::recording::ascent::measured_forecast;
 
 use crate::BadInput;
 
@@ -50,7 +51,7 @@ pub struct PlanArgs {
     #[arg(long, value_name = "LAT,LON", value_parser = parse_target)]
     target: Option<[f64; 2]>,
     /// Monte Carlo samples.
-    #[arg(long, default_value_t = 500, value_parser = clap::value_parser!(u32).range(1..=MAX_RUNS as i64))]
+    #[arg(long, default_value_t = 500, value_parser = clap::value_parser!(u32).range(1..=i64::from(MAX_RUNS)))]
     runs: u32,
     /// Seed of the samples.
     #[arg(long, default_value_t = 1)]
@@ -102,33 +103,18 @@ pub fn run(args: PlanArgs) -> anyhow::Result<()> {
         let mut recording = Recording::open(path)
             .with_context(|| format!("cannot read the recording {}", path.display()))
             .map_err(BadInput)?;
-        let (_, points) = track(&mut recording)
-            .with_context(|| format!("the GPS track of {}", path.display()))
+        let base = forecast.as_ref().map_or(&[][..], Forecast::rows);
+        let measured = measured_forecast(&mut recording, base)
+            .with_context(|| format!("the recording {}", path.display()))
             .map_err(BadInput)?;
-        let fixes: Vec<_> = points
-            .iter()
-            .map(|p| (p.time_ns as f64 * 1e-9, p.lat_deg, p.lon_deg, p.alt_m))
-            .collect();
-        let (bands, frame) = measured_ascent(&fixes);
-        if bands.is_empty() {
-            return Err(BadInput(anyhow::anyhow!(
-                "{}: no ascent wind could be measured (too few fixes while rising)",
-                path.display()
-            ))
-            .into());
-        }
         eprintln!(
             "{}: {} measured wind bands from {:.0} to {:.0} m MSL",
             path.display(),
-            bands.len(),
-            bands[0].altitude_min_m + frame.alt_msl_m,
-            bands[bands.len() - 1].altitude_max_m + frame.alt_msl_m
+            measured.bands,
+            measured.lowest_msl_m,
+            measured.highest_msl_m
         );
-        let base = forecast.as_ref().map_or(&[][..], Forecast::rows);
-        let merged = merge_measured(base, &bands, frame.alt_msl_m)
-            .with_context(|| format!("the wind measured in {}", path.display()))
-            .map_err(BadInput)?;
-        forecast = Some(merged);
+        forecast = Some(measured.forecast);
     }
     let forecast = forecast.expect("clap requires --forecast or --from-recording");
     let mut request = PlanRequest::new(args.launch, forecast.rows().to_vec());
@@ -141,7 +127,7 @@ pub fn run(args: PlanArgs) -> anyhow::Result<()> {
     }
     request.default_wind_sigma_mps = args.wind_sigma;
     request.target_lat_lon_deg = args.target;
-    request.runs = args.runs as usize;
+    request.runs = args.runs;
     request.seed = args.seed;
     let report = plan(&request).map_err(|e| BadInput(e.into()))?;
     if args.json {

@@ -2,7 +2,7 @@
 // the daemon's Rust types by `cargo run -p stx-station --example api_schema`): do not edit.
 
 /**
- * Every message of the stx station's HTTP and WebSocket API (crates/stx-station/API.md), generated from the daemon's Rust types by `cargo run -p stx-station --example api_schema`: do not edit. The root is any one of them: on the WebSocket ServerMessage (station to page) and ClientMessage (page to station); over REST the bodies the station answers (Session, StateMsg, ParamsMsg, AscentWindMsg, EventsBody, TrackBody, ClientsBody, CommandResultMsg, CommandAccepted, CutdownArm, ErrorBody, ReplayView, RecordingsBody, ReplayOpened, KeepOutMsg) and the bodies of the commands (*Body).
+ * Every message of the stx station's HTTP and WebSocket API (crates/stx-station/API.md), generated from the daemon's Rust types by `cargo run -p stx-station --example api_schema`: do not edit. The root is any one of them: on the WebSocket ServerMessage (station to page) and ClientMessage (page to station); over REST the bodies the station answers (Session, StateMsg, ParamsMsg, AscentWindMsg, EventsBody, TrackBody, ClientsBody, CommandResultMsg, CommandAccepted, CutdownArm, ErrorBody, ReplayView, RecordingsBody, ReplayOpened, KeepOutMsg, PlanReport, PreflightDefaults) and the bodies of the commands (*Body).
  */
 export type StxStationAPI =
   | ServerMessage
@@ -19,6 +19,8 @@ export type StxStationAPI =
   | RecordingsBody
   | ReplayOpened
   | KeepOutMsg
+  | PlanReport
+  | PreflightDefaults
   | ClientMessage
   | ModeBody
   | HeadingBody
@@ -29,7 +31,8 @@ export type StxStationAPI =
   | ParamBody
   | ConfirmBody
   | ReplayBody
-  | KeepOutBody;
+  | KeepOutBody
+  | PreflightBody;
 /**
  * Every message the station sends on the WebSocket, told apart by `type`.
  */
@@ -577,7 +580,7 @@ export interface FootprintZoneHit {
   zone: string;
 }
 /**
- * A row of the forecast wind profile.
+ * One forecast level.
  */
 export interface ForecastRow {
   /**
@@ -585,11 +588,15 @@ export interface ForecastRow {
    */
   alt_msl_m: number;
   /**
-   * Direction the wind blows from, degrees from north.
+   * Direction the wind blows from, degrees clockwise from true north.
    */
   from_deg: number;
   /**
-   * Wind speed, m/s.
+   * 1-σ error of each horizontal wind component, m/s (≥ 0); `None`: the planner's default.
+   */
+  sigma_mps?: number | null;
+  /**
+   * Wind speed, m/s (≥ 0).
    */
   speed_mps: number;
 }
@@ -1702,6 +1709,212 @@ export interface ReplayOpened {
   scheme: string;
 }
 /**
+ * The plan.
+ */
+export interface PlanReport {
+  /**
+   * Where the balloon bursts.
+   */
+  burst: PlannedPoint;
+  /**
+   * Where the round chute is released and the parafoil deploys.
+   */
+  deploy: PlannedPoint;
+  /**
+   * Unsteered landings of up to 300 samples, `[lat, lon]` degrees, for a scatter.
+   */
+  landing_samples_lat_lon_deg: [number, number][];
+  /**
+   * Where the parafoil lands unsteered (servos neutral).
+   */
+  landing_unsteered: PlannedPoint;
+  /**
+   * How steering's reach is computed.
+   */
+  reach_method: string;
+  /**
+   * The request it answers (with its defaults filled in).
+   */
+  request: PlanRequest;
+  /**
+   * Where the stack would land had the round chute never been released.
+   */
+  round_chute_landing: PlannedPoint;
+  /**
+   * Mean radius of the glide disc steering reaches from the deploy point, m.
+   */
+  steered_reach_radius_m: number;
+  /**
+   * Outline of the region steering reaches with that probability, `[lat, lon]` degrees.
+   */
+  steered_region_lat_lon_deg: [number, number][];
+  /**
+   * Probability the steered region stands for.
+   */
+  steered_region_probability: number;
+  /**
+   * The target's reachability, if a target was given.
+   */
+  target: TargetReach | null;
+}
+/**
+ * A point of the plan: the mean over the samples, where it is, and how it spreads.
+ */
+export interface PlannedPoint {
+  /**
+   * Altitude above mean sea level, m.
+   */
+  alt_msl_m: number;
+  /**
+   * East of the launch site, m.
+   */
+  east_m: number;
+  /**
+   * 1-σ ellipse of the position.
+   */
+  ellipse: Ellipse;
+  /**
+   * Latitude, degrees north.
+   */
+  lat_deg: number;
+  /**
+   * Longitude, degrees east.
+   */
+  lon_deg: number;
+  /**
+   * North of the launch site, m.
+   */
+  north_m: number;
+  /**
+   * Mean time after launch, s.
+   */
+  time_s: number;
+  /**
+   * 1-σ of the time, s.
+   */
+  time_sigma_s: number;
+}
+/**
+ * A 1-σ ellipse.
+ */
+export interface Ellipse {
+  /**
+   * Direction of the major axis from north, rad.
+   */
+  major_axis_rad: number;
+  /**
+   * Semi-major axis, m.
+   */
+  semi_major_m: number;
+  /**
+   * Semi-minor axis, m.
+   */
+  semi_minor_m: number;
+}
+/**
+ * What the plan is asked for. Every field but the launch site and the forecast has a default.
+ */
+export interface PlanRequest {
+  /**
+   * Mean ascent rate from launch to burst, m/s.
+   */
+  ascent_rate_mps: number;
+  /**
+   * Its 1-σ, m/s.
+   */
+  ascent_rate_sigma_mps: number;
+  /**
+   * Burst altitude above mean sea level, m.
+   */
+  burst_altitude_msl_m: number;
+  /**
+   * Its 1-σ, m.
+   */
+  burst_altitude_sigma_m: number;
+  /**
+   * 1-σ of each wind component where the forecast gives none, m/s.
+   */
+  default_wind_sigma_mps: number;
+  /**
+   * Height above the launch site at which the parafoil deploys, m (the onboard
+   * `MIS_DEPLOY_M`).
+   */
+  deploy_height_m: number;
+  /**
+   * The forecast wind, lowest level first (see [`super::forecast`]).
+   */
+  forecast: ForecastRow[];
+  /**
+   * Launch site ground altitude above mean sea level, m.
+   */
+  launch_alt_msl_m: number;
+  /**
+   * Launch site latitude, degrees north.
+   */
+  launch_lat_deg: number;
+  /**
+   * Launch site longitude, degrees east.
+   */
+  launch_lon_deg: number;
+  /**
+   * Monte Carlo samples, 1…[`MAX_RUNS`] (a u32: the API's contract and JavaScript know no
+   * usize).
+   */
+  runs: number;
+  /**
+   * Seed of the samples: the same request gives the same plan.
+   */
+  seed: number;
+  /**
+   * The landing target, `[latitude, longitude]` in degrees.
+   *
+   * @minItems 2
+   * @maxItems 2
+   */
+  target_lat_lon_deg: [number, number] | null;
+}
+/**
+ * The target and whether steering reaches it.
+ */
+export interface TargetReach {
+  /**
+   * Distance from the mean unsteered landing, m.
+   */
+  from_unsteered_landing_m: number;
+  /**
+   * Latitude, degrees north.
+   */
+  lat_deg: number;
+  /**
+   * Longitude, degrees east.
+   */
+  lon_deg: number;
+  /**
+   * Fraction of the samples from whose deploy point steering reaches it, 0…1.
+   */
+  reachable_probability: number;
+}
+/**
+ * `GET /api/plan/defaults`: the station's own settings, to start a plan from.
+ */
+export interface PreflightDefaults {
+  /**
+   * Most Monte Carlo samples a plan may fly.
+   */
+  max_runs: number;
+  /**
+   * A request from the station's launch site (the mission frame's origin) over its
+   * configured forecast (`forecast_wind`, empty if it has none), to the drone's target
+   * when the station knows it, with `stx plan`'s defaults for the rest.
+   */
+  request: PlanRequest;
+  /**
+   * Where the target comes from (as the state's `guidance.target_source`); `null`: the
+   * station knows no target.
+   */
+  target_source: string | null;
+}
+/**
  * `POST /api/commands/mode`.
  */
 export interface ModeBody {
@@ -1821,4 +2034,81 @@ export interface ReplayBody {
  */
 export interface KeepOutBody {
   [k: string]: unknown | undefined;
+}
+/**
+ * `POST /api/plan`.
+ */
+export interface PreflightBody {
+  /**
+   * A recording of the station (a name `GET /api/recordings` lists) whose measured ascent
+   * wind replaces `request.forecast` over the altitudes it measured; `null`: the forecast
+   * alone.
+   */
+  from_recording?: string | null;
+  /**
+   * What to plan (as `stx plan` takes it; fields left out take its defaults).
+   */
+  request: PlanRequestInput;
+}
+/**
+ * What the plan is asked for. Every field but the launch site and the forecast has a default.
+ */
+export interface PlanRequestInput {
+  /**
+   * Mean ascent rate from launch to burst, m/s.
+   */
+  ascent_rate_mps?: number;
+  /**
+   * Its 1-σ, m/s.
+   */
+  ascent_rate_sigma_mps?: number;
+  /**
+   * Burst altitude above mean sea level, m.
+   */
+  burst_altitude_msl_m?: number;
+  /**
+   * Its 1-σ, m.
+   */
+  burst_altitude_sigma_m?: number;
+  /**
+   * 1-σ of each wind component where the forecast gives none, m/s.
+   */
+  default_wind_sigma_mps?: number;
+  /**
+   * Height above the launch site at which the parafoil deploys, m (the onboard
+   * `MIS_DEPLOY_M`).
+   */
+  deploy_height_m?: number;
+  /**
+   * The forecast wind, lowest level first (see [`super::forecast`]).
+   */
+  forecast: ForecastRow[];
+  /**
+   * Launch site ground altitude above mean sea level, m.
+   */
+  launch_alt_msl_m?: number;
+  /**
+   * Launch site latitude, degrees north.
+   */
+  launch_lat_deg: number;
+  /**
+   * Launch site longitude, degrees east.
+   */
+  launch_lon_deg: number;
+  /**
+   * Monte Carlo samples, 1…[`MAX_RUNS`] (a u32: the API's contract and JavaScript know no
+   * usize).
+   */
+  runs?: number;
+  /**
+   * Seed of the samples: the same request gives the same plan.
+   */
+  seed?: number;
+  /**
+   * The landing target, `[latitude, longitude]` in degrees.
+   *
+   * @minItems 2
+   * @maxItems 2
+   */
+  target_lat_lon_deg?: [number, number] | null;
 }

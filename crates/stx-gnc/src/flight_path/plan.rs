@@ -19,7 +19,7 @@ use crate::geo::LocalFrame;
 use crate::performance::GlidePerformance;
 
 /// Most Monte Carlo samples one plan may fly (a plan of that size takes about a second).
-pub const MAX_RUNS: usize = 5000;
+pub const MAX_RUNS: u32 = 5000;
 
 /// What the plan is asked for. Every field but the launch site and the forecast has a default.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -57,9 +57,10 @@ pub struct PlanRequest {
     /// The landing target, `[latitude, longitude]` in degrees.
     #[serde(default)]
     pub target_lat_lon_deg: Option<[f64; 2]>,
-    /// Monte Carlo samples, 1…[`MAX_RUNS`].
+    /// Monte Carlo samples, 1…[`MAX_RUNS`] (a u32: the API's contract and JavaScript know no
+    /// usize).
     #[serde(default = "defaults::runs")]
-    pub runs: usize,
+    pub runs: u32,
     /// Seed of the samples: the same request gives the same plan.
     #[serde(default = "defaults::seed")]
     pub seed: u64,
@@ -85,7 +86,7 @@ mod defaults {
     pub fn wind_sigma() -> f64 {
         1.5
     }
-    pub fn runs() -> usize {
+    pub fn runs() -> u32 {
         500
     }
     pub fn seed() -> u64 {
@@ -210,36 +211,84 @@ fn check(field: &'static str, value: f64, ok: bool, rule: &'static str) -> Resul
 /// Makes the plan `request` asks for (see the module doc).
 pub fn plan(request: &PlanRequest) -> Result<PlanReport, PlanError> {
     let r = request;
-    check(
-        "launch_lat_deg",
-        r.launch_lat_deg,
-        r.launch_lat_deg.abs() <= 89.0,
-        "within ±89°",
-    )?;
-    check(
-        "launch_lon_deg",
-        r.launch_lon_deg,
-        r.launch_lon_deg.abs() <= 180.0,
-        "within ±180°",
-    )?;
     let alt = r.launch_alt_msl_m;
-    check(
-        "launch_alt_msl_m",
-        alt,
-        (-500.0..=9000.0).contains(&alt),
-        "in −500…9000",
-    )?;
-    let runs = r.runs as f64;
-    check("runs", runs, (1..=MAX_RUNS).contains(&r.runs), "in 1…5000")?;
-    let burst = r.burst_altitude_msl_m;
-    check(
-        "burst_altitude_msl_m",
-        burst,
-        burst > alt + 100.0,
-        "over 100 m above the launch site",
-    )?;
+    let (rate, burst, deploy) = (r.ascent_rate_mps, r.burst_altitude_msl_m, r.deploy_height_m);
+    let (rate_sigma, burst_sigma) = (r.ascent_rate_sigma_mps, r.burst_altitude_sigma_m);
     let sigma = r.default_wind_sigma_mps;
-    check("default_wind_sigma_mps", sigma, sigma >= 0.0, "≥ 0")?;
+    // The request's own names and a balloon's plausible ranges, before the flight path's
+    // checks (which know the settings by other names, and accept any finite rate), in the
+    // order a form shows them. Each is also checked to be finite.
+    let rules: [(&'static str, f64, bool, &'static str); 11] = [
+        (
+            "launch_lat_deg",
+            r.launch_lat_deg,
+            r.launch_lat_deg.abs() <= 89.0,
+            "within ±89°",
+        ),
+        (
+            "launch_lon_deg",
+            r.launch_lon_deg,
+            r.launch_lon_deg.abs() <= 180.0,
+            "within ±180°",
+        ),
+        (
+            "launch_alt_msl_m",
+            alt,
+            (-500.0..=9000.0).contains(&alt),
+            "in −500…9000",
+        ),
+        (
+            "runs",
+            f64::from(r.runs),
+            (1..=MAX_RUNS).contains(&r.runs),
+            "in 1…5000",
+        ),
+        (
+            "ascent_rate_mps",
+            rate,
+            rate > 0.1 && rate <= 50.0,
+            "in (0.1, 50]",
+        ),
+        (
+            "ascent_rate_sigma_mps",
+            rate_sigma,
+            (0.0..=rate).contains(&rate_sigma),
+            "in 0…ascent_rate_mps",
+        ),
+        (
+            "burst_altitude_msl_m",
+            burst,
+            burst > alt + 100.0,
+            "over 100 m above the launch site",
+        ),
+        (
+            "burst_altitude_msl_m",
+            burst,
+            burst < 60_000.0,
+            "below 60 000 (a balloon's ceiling)",
+        ),
+        (
+            "burst_altitude_sigma_m",
+            burst_sigma,
+            (0.0..=10_000.0).contains(&burst_sigma),
+            "in 0…10 000",
+        ),
+        (
+            "deploy_height_m",
+            deploy,
+            deploy >= 0.0 && alt + deploy < burst,
+            "≥ 0 and below the burst altitude",
+        ),
+        (
+            "default_wind_sigma_mps",
+            sigma,
+            (0.0..=50.0).contains(&sigma),
+            "in 0…50",
+        ),
+    ];
+    for (field, value, ok, rule) in rules {
+        check(field, value, ok, rule)?;
+    }
     let frame = LocalFrame {
         lat_deg: r.launch_lat_deg,
         lon_deg: r.launch_lon_deg,
@@ -276,7 +325,7 @@ pub fn plan(request: &PlanRequest) -> Result<PlanReport, PlanError> {
             burst_altitude_sigma_m: r.burst_altitude_sigma_m,
             wind_sigma: forecast.sigma_rows(alt, sigma),
         },
-        runs: r.runs,
+        runs: r.runs as usize,
         target_ne_m,
         region_probability: 0.5,
     };

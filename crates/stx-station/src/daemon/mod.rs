@@ -245,6 +245,7 @@ async fn run_with(
         tiles: LoadedPack::load(config.tile_pack.as_deref()).await,
         replay_requests,
         keep_out_edit: Default::default(),
+        planning: Default::default(),
     });
     let (stop_tx, stop_rx) = watch::channel(false);
     let sessions_task = replay_requests_rx.map(|rx| {

@@ -5,6 +5,8 @@
 //! - `auth`: tokens, names and roles;
 //! - `rest`: the reading endpoints; `commands`: the commanding ones (operators only);
 //! - `keep_out`: the keep-out zones, read by anyone, edited by operators;
+//! - `plan`: the Plan page's pre-flight plans, for anyone, one at a time, off the async
+//!   workers;
 //! - `ws`: the WebSocket (state, events, command results; operators' sticks);
 //! - `kml`: the Google Earth feed; `replay`: the replay's pause, seek and speed;
 //! - `recordings`: the past recordings: list, download, open in a replay;
@@ -18,6 +20,7 @@ mod auth;
 mod commands;
 mod keep_out;
 mod kml;
+mod plan;
 mod recordings;
 mod replay;
 mod rest;
@@ -63,6 +66,8 @@ pub fn router(state: std::sync::Arc<Shared>) -> Router {
             "/api/keep-out",
             get(keep_out::keep_out).put(keep_out::set_keep_out),
         )
+        .route("/api/plan", post(plan::make_plan))
+        .route("/api/plan/defaults", get(plan::plan_defaults))
         .route("/api/cutdown/arm", post(arm_cutdown))
         .route("/api/cutdown/confirm", post(confirm_cutdown))
         .route("/api/clients", get(clients))

@@ -43,7 +43,7 @@ fn directory(state: &AppState) -> Result<PathBuf, HttpError> {
 }
 
 /// The path of the recording `name`, which must exist.
-fn recording_path(state: &AppState, name: &str) -> Result<PathBuf, HttpError> {
+pub(crate) fn recording_path(state: &AppState, name: &str) -> Result<PathBuf, HttpError> {
     let not_found = || {
         error(
             StatusCode::NOT_FOUND,

@@ -57,6 +57,9 @@ pub struct Shared {
     pub replay_requests: Option<tokio::sync::mpsc::Sender<ReplayRequest>>,
     /// Held while an edit of the keep-out zones is written and applied.
     pub keep_out_edit: tokio::sync::Mutex<()>,
+    /// Held while a pre-flight plan is computed (up to a second of a core): one at a time,
+    /// so pages cannot take the cores the link and the telemetry need.
+    pub planning: Arc<tokio::sync::Mutex<()>>,
 }
 
 /// Why a replay could not be opened: `(status, error, reason)` of the answer.
@@ -189,6 +192,14 @@ impl HttpError {
             "replay",
             "this station is replaying a recording: there is no drone to command",
         )
+    }
+
+    /// 429 Too Many Requests, with `Retry-After`: what is done one at a time is being done
+    /// for another caller.
+    pub(crate) fn busy(reason: impl Into<String>, retry: RetryAfter) -> Self {
+        let mut e = error(StatusCode::TOO_MANY_REQUESTS, "busy", reason);
+        e.2 = Some(retry);
+        e
     }
 
     /// 429 Too Many Requests, with `Retry-After`.

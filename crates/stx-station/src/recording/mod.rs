@@ -25,6 +25,7 @@
 //! - [`CONFIG`]: the station's configuration at start, without secrets (token names and roles
 //!   only, never a token or the signing key).
 
+pub mod ascent;
 pub mod settings;
 pub mod station;
 pub mod summary;

@@ -359,3 +359,15 @@ impl SimDrone {
         self.handle.query(f).await.expect("the drone answers")
     }
 }
+
+/// The bytes of the recording `core` wrote, closed.
+pub fn finished_recording(mut core: stx_record::RecorderCore) -> Vec<u8> {
+    core.finish().expect("recording closed");
+    let mut bytes = Vec::new();
+    while let Some(out) = core.poll_output() {
+        if let stx_record::Output::Bytes { data, .. } = out {
+            bytes.extend(data);
+        }
+    }
+    bytes
+}
