@@ -205,10 +205,11 @@ function build(session: Session): void {
   // The recovery page opens in a new tab, which does not share this tab's sessionStorage: the
   // token goes in its address (the page takes it out of the address bar at once, as this one does).
   const recovery = h("a", { href: withToken("recovery.html", token), target: "_blank", rel: "noopener", "data-testid": "recovery-link", class: "linkbtn", title: "the recovery team's page for phones (new tab)" }, "Recovery");
+  const planLink = h("a", { href: withToken("plan.html", token), target: "_blank", rel: "noopener", "data-testid": "plan-link", class: "linkbtn", title: "pre-flight plan: burst, deploy and landing regions from a forecast (new tab)" }, "Plan");
   const header = h("header", { class: "top" },
     h("strong", { class: "station" }, station.name), clock, conn, roleBadge,
     h("span", { class: "hdr-group" }, h("small", {}, "mode "), hdrMode, h("small", {}, " stage "), hdrStage, h("small", {}, " phase "), hdrPhase),
-    hdrLink, hdrLanding, h("span", { class: "spacer" }), kml, recovery);
+    hdrLink, hdrLanding, h("span", { class: "spacer" }), kml, recovery, planLink);
   const banner = h("div", { class: "banner", role: "alert", "data-testid": "banner", hidden: true });
   const viewerNote = h("div", { class: "viewer-note", "data-testid": "viewer-note" }, `Viewer: you can watch everything; commanding needs the operator role (${OPERATOR_REQUIRED}).`);
 

@@ -1,0 +1,155 @@
+// The Plan page: a pre-flight plan from the launch site, the balloon's settings and their spread,
+// and a forecast (or the ascent wind an earlier recording measured), computed by the station
+// (`POST /api/plan`, the same plan as `stx plan`). The form starts from the station's own launch
+// site, forecast and target (`GET /api/plan/defaults`); the result is the burst, deploy and
+// landing points with their 1-σ ellipses on the station's map, the unsteered landings, the region
+// steering likely reaches and the target's reachability. Errors, the page's or the station's,
+// are shown beside the form.
+
+import "../styles/common.css";
+import "../styles/plan.css";
+import type * as Wire from "../generated/api";
+import { Api, ApiError } from "../lib/api";
+import { parseSession } from "../lib/parse";
+import { type PlanForm, buildRequest, formOf } from "../lib/preflight";
+import { resolveToken, searchWithoutToken } from "../lib/token";
+import { h, setText } from "../ui/dom";
+import { PreflightMap } from "../ui/preflightMap";
+
+const token = resolveToken(location.search, sessionStorage);
+if (new URLSearchParams(location.search).has("token")) history.replaceState(null, "", `${location.pathname}${searchWithoutToken(location.search)}`);
+const api = new Api(token);
+
+/** Each box: its field, label and what it takes. */
+const BOXES: [Exclude<keyof PlanForm, "forecast" | "from_recording">, string, string][] = [
+  ["launch_lat_deg", "Launch latitude", "degrees north"],
+  ["launch_lon_deg", "Launch longitude", "degrees east"],
+  ["launch_alt_msl_m", "Launch altitude", "m above sea level"],
+  ["ascent_rate_mps", "Ascent rate", "m/s, mean to burst"],
+  ["ascent_rate_sigma_mps", "± ascent rate", "1-σ, m/s"],
+  ["burst_altitude_msl_m", "Burst altitude", "m above sea level"],
+  ["burst_altitude_sigma_m", "± burst altitude", "1-σ, m"],
+  ["deploy_height_m", "Deploy height", "m above the launch site"],
+  ["default_wind_sigma_mps", "Wind σ", "m/s, for rows without a sigma"],
+  ["runs", "Runs", "Monte Carlo samples"],
+  ["seed", "Seed", "same seed, same plan"],
+  ["target_lat_deg", "Target latitude", "degrees north; empty: none"],
+  ["target_lon_deg", "Target longitude", "degrees east"],
+];
+
+const inputs = new Map<keyof PlanForm, HTMLInputElement | HTMLTextAreaElement | HTMLSelectElement>();
+for (const [field, , title] of BOXES) inputs.set(field, h("input", { type: "text", inputmode: "decimal", id: `plan-${field}`, "data-testid": `plan-in-${field}`, title }));
+const forecastBox = h("textarea", { id: "plan-forecast", "data-testid": "plan-in-forecast", spellcheck: "false", title: "one row a line: alt_msl_m,speed_mps,from_deg[,sigma_mps]" });
+inputs.set("forecast", forecastBox);
+const recordingBox = h("select", { id: "plan-from_recording", "data-testid": "plan-in-from_recording" }, h("option", { value: "" }, "none: the forecast alone"));
+inputs.set("from_recording", recordingBox);
+const submit = h("button", { type: "submit", "data-testid": "plan-submit" }, "Plan");
+const error = h("div", { class: "plan-error", role: "alert", "data-testid": "plan-error", hidden: true });
+const status = h("div", { class: "small muted wide", role: "status", "data-testid": "plan-status" });
+
+const form = h("form", { class: "plan-form", "data-testid": "plan-form", novalidate: true });
+for (const [field, label] of BOXES) form.append(h("label", { for: `plan-${field}` }, label), inputs.get(field)!);
+form.append(
+  h("label", { for: "plan-forecast", class: "wide" }, "Forecast (alt_msl_m,speed_mps,from_deg[,sigma_mps]; from: where the wind blows from)"),
+  forecastBox,
+  h("label", { for: "plan-from_recording" }, "Measured ascent"),
+  recordingBox,
+  h("div", { class: "wide" }, submit),
+  status,
+  error,
+);
+
+const out = {
+  burst: h("div", { class: "line", "data-testid": "plan-burst" }),
+  deploy: h("div", { class: "line", "data-testid": "plan-deploy" }),
+  landing: h("div", { class: "line", "data-testid": "plan-landing" }),
+  round: h("div", { class: "line", "data-testid": "plan-round" }),
+  reach: h("div", { class: "line", "data-testid": "plan-reach" }),
+  target: h("div", { class: "line", "data-testid": "plan-target" }),
+};
+const result = h("section", { class: "plan-result", "data-testid": "plan-result", hidden: true }, ...Object.values(out));
+const mapSlot = h("div", {});
+const app = document.getElementById("app")!;
+app.replaceChildren(
+  h("header", {}, h("strong", {}, "STRAPLEX pre-flight plan"), h("a", { href: "index.html", class: "small" }, "live page")),
+  h("main", { class: "plan-main" }, form, h("div", { class: "plan-result" }, result, mapSlot)),
+);
+
+let map: PreflightMap | null = null;
+
+const clock = (s: number): string => {
+  const t = Math.max(0, Math.round(s));
+  return `${Math.floor(t / 3600)}:${String(Math.floor(t / 60) % 60).padStart(2, "0")}:${String(t % 60).padStart(2, "0")}`;
+};
+
+function pointLine(name: string, p: Wire.PlannedPoint): string {
+  const e = p.ellipse;
+  const axis = (((e.major_axis_rad * 180) / Math.PI) % 180 + 180) % 180;
+  return `${name}: ${p.lat_deg.toFixed(5)}, ${p.lon_deg.toFixed(5)}, ${p.alt_msl_m.toFixed(0)} m MSL · N ${p.north_m.toFixed(0)} m, E ${p.east_m.toFixed(0)} m of launch · T+${clock(p.time_s)} ±${p.time_sigma_s.toFixed(0)} s · 1σ ${e.semi_major_m.toFixed(0)} × ${e.semi_minor_m.toFixed(0)} m at ${axis.toFixed(0)}°`;
+}
+
+function showPlan(plan: Wire.PlanReport): void {
+  setText(out.burst, pointLine("Burst", plan.burst));
+  setText(out.deploy, pointLine("Parafoil deploy", plan.deploy));
+  setText(out.landing, pointLine("Landing, unsteered", plan.landing_unsteered));
+  setText(out.round, pointLine("Landing, round chute only", plan.round_chute_landing));
+  setText(out.reach, `Steering reaches ${plan.steered_reach_radius_m.toFixed(0)} m around the drifted air mass on average; the green region is reached in ${(100 * plan.steered_region_probability).toFixed(0)} % of the samples (${plan.landing_samples_lat_lon_deg.length} landings drawn)`);
+  const t = plan.target;
+  setText(out.target, t ? `Target ${t.lat_deg.toFixed(5)}, ${t.lon_deg.toFixed(5)}: reachable in ${(100 * t.reachable_probability).toFixed(0)} % of the samples, ${t.from_unsteered_landing_m.toFixed(0)} m from the unsteered landing` : "No target given");
+  result.hidden = false;
+  map?.show(plan);
+}
+
+function showError(text: string, field: keyof PlanForm | null): void {
+  for (const [f, el] of inputs) el.setAttribute("aria-invalid", String(f === field));
+  error.hidden = text === "";
+  setText(error, text);
+}
+
+form.addEventListener("submit", (ev) => {
+  ev.preventDefault();
+  void plan();
+});
+
+async function plan(): Promise<void> {
+  const values = Object.fromEntries([...inputs].map(([f, el]) => [f, el.value])) as unknown as PlanForm;
+  const built = buildRequest(values);
+  if (!built.ok) {
+    showError(built.error, built.field);
+    return;
+  }
+  showError("", null);
+  submit.disabled = true;
+  setText(status, "computing…");
+  const started = performance.now();
+  try {
+    const report = await api.post<Wire.PlanReport>("/api/plan", built.body);
+    showPlan(report);
+    setText(status, `planned ${report.request.runs} samples in ${((performance.now() - started) / 1000).toFixed(1)} s`);
+  } catch (e) {
+    // The station's reason names the field; it is shown as given.
+    showError(e instanceof ApiError ? `${e.status} ${e.error}: ${e.reason}` : String(e), null);
+    setText(status, "");
+  } finally {
+    submit.disabled = false;
+  }
+}
+
+async function start(): Promise<void> {
+  try {
+    const session = parseSession(await api.get("/api/session"));
+    if (!session.ok) throw new Error(session.error);
+    map = new PreflightMap(session.value.station, token);
+    mapSlot.replaceChildren(map.root);
+    const defaults = await api.get<Wire.PreflightDefaults>("/api/plan/defaults");
+    const filled = formOf(defaults.request);
+    for (const [f, el] of inputs) if (f !== "from_recording") el.value = filled[f];
+    setText(status, `from the station: launch site${defaults.request.forecast.length ? ", forecast" : " (no forecast configured)"}${defaults.target_source ? `, target (${defaults.target_source})` : ""}; at most ${defaults.max_runs} runs`);
+    const list = await api.get<Wire.RecordingsBody>("/api/recordings");
+    for (const r of list.recordings) recordingBox.append(h("option", { value: r.name }, r.name));
+  } catch (e) {
+    showError(e instanceof ApiError ? `${e.status} ${e.error}: ${e.reason}` : `cannot start: ${String(e)}`, null);
+  }
+}
+
+void start();
