@@ -67,7 +67,7 @@ const out = {
   reach: h("div", { class: "line", "data-testid": "plan-reach" }),
   target: h("div", { class: "line", "data-testid": "plan-target" }),
 };
-const result = h("section", { class: "plan-result", "data-testid": "plan-result", hidden: true }, ...Object.values(out));
+const result = h("section", { class: "plan-lines", "data-testid": "plan-result", hidden: true }, ...Object.values(out));
 const mapSlot = h("div", {});
 const app = document.getElementById("app")!;
 app.replaceChildren(
