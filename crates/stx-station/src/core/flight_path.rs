@@ -189,6 +189,7 @@ mod tests {
                 alt_msl_m: origin_msl + h,
                 speed_mps: 10.0,
                 from_deg: 270.0,
+                sigma_mps: None,
             })
             .collect();
         config.flight_path.ascent_density_exponent = 0.0;
