@@ -17,6 +17,12 @@ use thiserror::Error;
 
 use crate::core::CutdownArm;
 use crate::keep_out::{KeepOutBody, KeepOutMsg};
+use crate::lab::LabJobBody;
+use crate::lab::bodies::{
+    LabGainsBody, LabGainsListBody, LabSavedBody, LabStartedBody, LabVehicleBody,
+};
+use crate::lab::jobs::LabStatusBody;
+use crate::lab::vehicle_fields::VehicleFieldsBody;
 use crate::messages::{
     AscentWindMsg, CommandResultMsg, ErrorBody, EventMsg, ParamsMsg, ReplayView, Session, StateMsg,
 };
@@ -129,8 +135,9 @@ fn refer_to_inputs(schema: &mut Value, inputs: &[String]) {
 pub fn schema() -> Result<Value, ContractError> {
     let mut sent = generator(Contract::Serialize);
     let mut read = generator(Contract::Deserialize);
-    // The root names each message once: what the station sends, then what it reads.
-    let sent_messages = [
+    // The root names each message once: what the station sends, then what it reads (Vecs:
+    // serde serializes arrays of at most 32).
+    let sent_messages = vec![
         sent.subschema_for::<ServerMessage>(),
         sent.subschema_for::<Session>(),
         sent.subschema_for::<ParamsMsg>(),
@@ -147,8 +154,13 @@ pub fn schema() -> Result<Value, ContractError> {
         sent.subschema_for::<KeepOutMsg>(),
         sent.subschema_for::<PlanReport>(),
         sent.subschema_for::<PreflightDefaults>(),
+        sent.subschema_for::<LabStatusBody>(),
+        sent.subschema_for::<LabStartedBody>(),
+        sent.subschema_for::<VehicleFieldsBody>(),
+        sent.subschema_for::<LabGainsListBody>(),
+        sent.subschema_for::<LabSavedBody>(),
     ];
-    let read_messages = [
+    let read_messages = vec![
         read.subschema_for::<ClientMessage>(),
         read.subschema_for::<ModeBody>(),
         read.subschema_for::<HeadingBody>(),
@@ -161,6 +173,9 @@ pub fn schema() -> Result<Value, ContractError> {
         read.subschema_for::<ReplayBody>(),
         read.subschema_for::<KeepOutBody>(),
         read.subschema_for::<PreflightBody>(),
+        read.subschema_for::<LabJobBody>(),
+        read.subschema_for::<LabVehicleBody>(),
+        read.subschema_for::<LabGainsBody>(),
     ];
     let mut definitions: Map<String, Value> = sent.take_definitions(true);
     let read_definitions = read.take_definitions(true);
@@ -200,7 +215,7 @@ pub fn schema() -> Result<Value, ContractError> {
     Ok(json!({
         "$schema": "http://json-schema.org/draft-07/schema#",
         "title": "stx station API",
-        "description": "Every message of the stx station's HTTP and WebSocket API (crates/stx-station/API.md), generated from the daemon's Rust types by `cargo run -p stx-station --example api_schema`: do not edit. The root is any one of them: on the WebSocket ServerMessage (station to page) and ClientMessage (page to station); over REST the bodies the station answers (Session, StateMsg, ParamsMsg, AscentWindMsg, EventsBody, TrackBody, ClientsBody, CommandResultMsg, CommandAccepted, CutdownArm, ErrorBody, ReplayView, RecordingsBody, ReplayOpened, KeepOutMsg, PlanReport, PreflightDefaults) and the bodies of the commands (*Body).",
+        "description": "Every message of the stx station's HTTP and WebSocket API (crates/stx-station/API.md), generated from the daemon's Rust types by `cargo run -p stx-station --example api_schema`: do not edit. The root is any one of them: on the WebSocket ServerMessage (station to page) and ClientMessage (page to station); over REST the bodies the station answers (Session, StateMsg, ParamsMsg, AscentWindMsg, EventsBody, TrackBody, ClientsBody, CommandResultMsg, CommandAccepted, CutdownArm, ErrorBody, ReplayView, RecordingsBody, ReplayOpened, KeepOutMsg, PlanReport, PreflightDefaults, the Lab's Lab*Body and VehicleFieldsBody) and the bodies of the commands (*Body).",
         "anyOf": messages,
         "definitions": definitions,
     }))

@@ -2,7 +2,7 @@
 // the daemon's Rust types by `cargo run -p stx-station --example api_schema`): do not edit.
 
 /**
- * Every message of the stx station's HTTP and WebSocket API (crates/stx-station/API.md), generated from the daemon's Rust types by `cargo run -p stx-station --example api_schema`: do not edit. The root is any one of them: on the WebSocket ServerMessage (station to page) and ClientMessage (page to station); over REST the bodies the station answers (Session, StateMsg, ParamsMsg, AscentWindMsg, EventsBody, TrackBody, ClientsBody, CommandResultMsg, CommandAccepted, CutdownArm, ErrorBody, ReplayView, RecordingsBody, ReplayOpened, KeepOutMsg, PlanReport, PreflightDefaults) and the bodies of the commands (*Body).
+ * Every message of the stx station's HTTP and WebSocket API (crates/stx-station/API.md), generated from the daemon's Rust types by `cargo run -p stx-station --example api_schema`: do not edit. The root is any one of them: on the WebSocket ServerMessage (station to page) and ClientMessage (page to station); over REST the bodies the station answers (Session, StateMsg, ParamsMsg, AscentWindMsg, EventsBody, TrackBody, ClientsBody, CommandResultMsg, CommandAccepted, CutdownArm, ErrorBody, ReplayView, RecordingsBody, ReplayOpened, KeepOutMsg, PlanReport, PreflightDefaults, the Lab's Lab*Body and VehicleFieldsBody) and the bodies of the commands (*Body).
  */
 export type StxStationAPI =
   | ServerMessage
@@ -21,6 +21,11 @@ export type StxStationAPI =
   | KeepOutMsg
   | PlanReport
   | PreflightDefaults
+  | LabStatusBody
+  | LabStartedBody
+  | VehicleFieldsBody
+  | LabGainsListBody
+  | LabSavedBody
   | ClientMessage
   | ModeBody
   | HeadingBody
@@ -32,7 +37,10 @@ export type StxStationAPI =
   | ConfirmBody
   | ReplayBody
   | KeepOutBody
-  | PreflightBody;
+  | PreflightBody
+  | LabJobBody
+  | LabVehicleBody
+  | LabGainsBody;
 /**
  * Every message the station sends on the WebSocket, told apart by `type`.
  */
@@ -110,6 +118,22 @@ export type BandMethod = "gps_velocity" | "position_differences";
  */
 export type FenceState = "none" | "waiting" | "sending" | "held" | "failed";
 /**
+ * A finished job's result, by kind.
+ */
+export type LabResult =
+  | (ScenarioSeries & {
+      kind: "scenario";
+    })
+  | (MonteCarloSummary & {
+      kind: "monte_carlo";
+    })
+  | (StabilitySummary & {
+      kind: "stability";
+    })
+  | (TuneSummary & {
+      kind: "tune";
+    });
+/**
  * A message from the page on the WebSocket.
  */
 export type ClientMessage =
@@ -179,6 +203,66 @@ export type PlanItemBody =
        * Longitude, degrees.
        */
       lon_deg: number;
+    };
+/**
+ * What an operator asks the Lab to run (`POST /api/lab/jobs`).
+ */
+export type LabJobBody =
+  | {
+      kind: "scenario";
+      /**
+       * A built-in scenario's name (`uncontrolled`, `spiral-exit`, …).
+       */
+      scenario: string;
+      /**
+       * Parameters changed from the seed's vehicle.
+       */
+      vehicle?: {
+        [k: string]: number | undefined;
+      };
+    }
+  | {
+      /**
+       * Release height above the target, m (50 … 3000).
+       */
+      altitude_m: number;
+      kind: "monte_carlo";
+      /**
+       * Number of runs (1 … 500).
+       */
+      runs: number;
+      /**
+       * Seed of the batch: the same seed gives the same landings.
+       */
+      seed: number;
+      /**
+       * Largest mean wind drawn, m/s (0 … 15).
+       */
+      wind_max_mps: number;
+    }
+  | {
+      /**
+       * Altitude of the trim, m above sea level (−5000 … 86000).
+       */
+      altitude_m: number;
+      kind: "stability";
+      /**
+       * Parameters changed from the seed's vehicle.
+       */
+      vehicle?: {
+        [k: string]: number | undefined;
+      };
+    }
+  | {
+      /**
+       * Altitude of the trim, m above sea level (−5000 … 86000).
+       */
+      altitude_m: number;
+      /**
+       * `heading`, `course`, `localizer` or `vertical`.
+       */
+      controller: string;
+      kind: "tune";
     };
 
 /**
@@ -1915,6 +1999,362 @@ export interface PreflightDefaults {
   target_source: string | null;
 }
 /**
+ * `GET /api/lab`: the Lab's state for every page.
+ */
+export interface LabStatusBody {
+  /**
+   * The station runs Lab jobs (only `stx serve` does; a replay does not).
+   */
+  available: boolean;
+  /**
+   * The running job.
+   */
+  job: LabJobView | null;
+  /**
+   * The last job's outcome.
+   */
+  last: LabOutcomeView | null;
+  /**
+   * A job's longest run, s.
+   */
+  time_cap_s: number;
+}
+/**
+ * The running job, as `GET /api/lab` shows it.
+ */
+export interface LabJobView {
+  /**
+   * A cancel was asked; the job stops at its next step.
+   */
+  cancelling: boolean;
+  /**
+   * Steps done (runs of a batch, iterations of a tuning).
+   */
+  done: number;
+  /**
+   * Time since it started, s.
+   */
+  elapsed_s: number;
+  /**
+   * Job number (1, 2, … since the station started).
+   */
+  id: number;
+  /**
+   * `scenario`, `monte_carlo`, `stability` or `tune`.
+   */
+  kind: string;
+  /**
+   * Who started it (token name).
+   */
+  started_by: string;
+  /**
+   * Steps in all (0 when the job cannot tell).
+   */
+  total: number;
+}
+/**
+ * How the last job ended, with its result.
+ */
+export interface LabOutcomeView {
+  /**
+   * How long it ran, s.
+   */
+  elapsed_s: number;
+  /**
+   * Job number.
+   */
+  id: number;
+  /**
+   * Its kind.
+   */
+  kind: string;
+  /**
+   * `done`, `cancelled` (a batch keeps the runs it flew), `timed_out` or `failed`.
+   */
+  outcome: string;
+  /**
+   * Why it failed or stopped.
+   */
+  reason: string | null;
+  /**
+   * The result (partial when cancelled or timed out; none when failed).
+   */
+  result: LabResult | null;
+  /**
+   * Who started it.
+   */
+  started_by: string;
+}
+/**
+ * A scenario's flight as series for the plots (one entry per recorded sample).
+ */
+export interface ScenarioSeries {
+  /**
+   * Airspeed, m/s.
+   */
+  airspeed_mps: number[];
+  /**
+   * The canopy's position east of the release, m.
+   */
+  east_m: number[];
+  /**
+   * The canopy's height above the release, m.
+   */
+  height_m: number[];
+  /**
+   * The canopy's position north of the release, m.
+   */
+  north_m: number[];
+  /**
+   * The canopy's pitch, deg.
+   */
+  pitch_deg: number[];
+  /**
+   * The canopy's roll, deg.
+   */
+  roll_deg: number[];
+  /**
+   * The scenario's name.
+   */
+  scenario: string;
+  /**
+   * The canopy's sink rate (downward speed), m/s.
+   */
+  sink_mps: number[];
+  /**
+   * Time, s.
+   */
+  time_s: number[];
+  /**
+   * The canopy's yaw, deg.
+   */
+  yaw_deg: number[];
+}
+/**
+ * A Monte Carlo batch's landing statistics.
+ */
+export interface MonteCarloSummary {
+  /**
+   * Runs that failed (counted as misses).
+   */
+  failed_runs: number;
+  /**
+   * Share of landings within 30° of upwind (0 … 1).
+   */
+  into_wind_fraction: number;
+  /**
+   * Each landing from the target `[long, right]`, m: along the upwind direction
+   * (positive beyond the target) and across it (positive to the right).
+   */
+  landings_long_right_m: [number, number][];
+  /**
+   * … largest, m.
+   */
+  miss_max_m: number;
+  /**
+   * Distance from the target at first ground contact: median, m.
+   */
+  miss_median_m: number;
+  /**
+   * … 95th percentile, m.
+   */
+  miss_p95_m: number;
+  /**
+   * Runs asked for.
+   */
+  runs_asked: number;
+  /**
+   * Runs flown (fewer when cancelled or stopped by the time cap).
+   */
+  runs_flown: number;
+  /**
+   * Median vertical speed of the payload at touchdown, m/s.
+   */
+  touchdown_vertical_speed_median_mps: number;
+}
+/**
+ * The stability analysis beside the seed's figures.
+ */
+export interface StabilitySummary {
+  /**
+   * Trim airspeed, m/s.
+   */
+  airspeed_mps: number;
+  /**
+   * Altitude of the trim, m.
+   */
+  altitude_m: number;
+  /**
+   * Controllability rank (both inputs).
+   */
+  controllability_rank: number;
+  /**
+   * Every eigenvalue `[re, im]`, 1/s.
+   */
+  eigenvalues: [number, number][];
+  /**
+   * Trim glide ratio.
+   */
+  glide_ratio: number;
+  /**
+   * Number of states of the linear model.
+   */
+  n_states: number;
+  /**
+   * Observability rank.
+   */
+  observability_rank: number;
+  /**
+   * The seed's.
+   */
+  seed_controllability_rank: number;
+  /**
+   * The seed's eigenvalues `[re, im]` (§6.2.1), 1/s.
+   */
+  seed_eigenvalues: [number, number][];
+  /**
+   * The seed's.
+   */
+  seed_observability_rank: number;
+  /**
+   * The seed's count.
+   */
+  seed_zero_eigenvalues: number;
+  /**
+   * Trim sink rate, m/s.
+   */
+  sink_rate_mps: number;
+  /**
+   * Decisions close to their thresholds.
+   */
+  warnings: string[];
+  /**
+   * Eigenvalues counted as zero.
+   */
+  zero_eigenvalues: number;
+}
+/**
+ * A tuning run's outcome.
+ */
+export interface TuneSummary {
+  /**
+   * The controller tuned.
+   */
+  controller: string;
+  /**
+   * Nonlinear step cost with the gains before.
+   */
+  cost_before: number;
+  /**
+   * … with the seed's (A.13) gains.
+   */
+  cost_seed: number;
+  /**
+   * … with the tuned gains.
+   */
+  cost_tuned: number;
+  /**
+   * The tuned gains by parameter name.
+   */
+  gains: {
+    [k: string]: number | undefined;
+  };
+  /**
+   * The gains file (TOML) with every controller's gains.
+   */
+  gains_toml: string;
+}
+/**
+ * `POST /api/lab/jobs`' answer: the job started.
+ */
+export interface LabStartedBody {
+  /**
+   * The job's number.
+   */
+  id: number;
+  /**
+   * Its kind.
+   */
+  kind: string;
+}
+/**
+ * `GET /api/lab/vehicle`: the fields of the vehicle editor.
+ */
+export interface VehicleFieldsBody {
+  /**
+   * Every number of the vehicle file, in the file's order.
+   */
+  fields: VehicleField[];
+}
+/**
+ * One editable number of the vehicle.
+ */
+export interface VehicleField {
+  /**
+   * Dotted name, as the vehicle file nests it.
+   */
+  name: string;
+  /**
+   * The seed's (STRAPLEX, config/vehicle/straplex.toml) value.
+   */
+  seed: number;
+  /**
+   * Unit (`kg`, `m`, `m/s²`, …; `1` when dimensionless or per radian as the name says).
+   */
+  unit: string;
+}
+/**
+ * `GET /api/lab/gains`: the control gains and their built-in values.
+ */
+export interface LabGainsListBody {
+  /**
+   * Every `GN_` parameter.
+   */
+  gains: LabGain[];
+}
+/**
+ * One control gain of `GET /api/lab/gains`.
+ */
+export interface LabGain {
+  /**
+   * What it does.
+   */
+  description: string;
+  /**
+   * Largest accepted.
+   */
+  max: number;
+  /**
+   * Smallest accepted.
+   */
+  min: number;
+  /**
+   * Parameter name on the drone.
+   */
+  name: string;
+  /**
+   * Units.
+   */
+  units: string;
+  /**
+   * Built-in value.
+   */
+  value: number;
+}
+/**
+ * A file the Lab saved, or the gains it sent.
+ */
+export interface LabSavedBody {
+  /**
+   * The file written (`save`), else empty.
+   */
+  path: string;
+  /**
+   * The parameter requests sent (`send`), one id each as `GET /api/commands/{id}` knows it.
+   */
+  request_ids: string[];
+}
+/**
  * `POST /api/commands/mode`.
  */
 export interface ModeBody {
@@ -2111,4 +2551,47 @@ export interface PlanRequestInput {
    * @maxItems 2
    */
   target_lat_lon_deg?: [number, number] | null;
+}
+/**
+ * `POST /api/lab/vehicle/check` and `/save`: a vehicle as edited.
+ */
+export interface LabVehicleBody {
+  /**
+   * File name to save as (letters, digits, `-`, `_`; `.toml` is added), in the Lab's
+   * directory; ignored by `check`.
+   */
+  name?: string | null;
+  /**
+   * Replace a file of that name.
+   */
+  overwrite?: boolean;
+  /**
+   * Parameters changed from the seed's vehicle.
+   */
+  vehicle?: {
+    [k: string]: number | undefined;
+  };
+}
+/**
+ * `POST /api/lab/gains/save` and `/send`: control gains by parameter name (`GN_…`).
+ */
+export interface LabGainsBody {
+  /**
+   * `send` only: the operator confirmed sending these gains to the drone.
+   */
+  confirm?: boolean;
+  /**
+   * Gains by parameter name; those left out keep their built-in value.
+   */
+  gains: {
+    [k: string]: number | undefined;
+  };
+  /**
+   * File name for `save` (as for a vehicle).
+   */
+  name?: string | null;
+  /**
+   * Replace a file of that name.
+   */
+  overwrite?: boolean;
 }

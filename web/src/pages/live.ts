@@ -204,12 +204,13 @@ function build(session: Session): void {
   const kml = h("a", { href: withToken("/kml", token), "data-testid": "kml-link", class: "linkbtn", title: "open in Google Earth: a network link that refreshes every 2 s" }, "KML");
   // The recovery page opens in a new tab, which does not share this tab's sessionStorage: the
   // token goes in its address (the page takes it out of the address bar at once, as this one does).
+  const lab = h("a", { href: withToken("lab.html", token), target: "_blank", rel: "noopener", "data-testid": "lab-link", class: "linkbtn", title: "scenarios, Monte Carlo, stability, tuning (new tab)" }, "Lab");
   const recovery = h("a", { href: withToken("recovery.html", token), target: "_blank", rel: "noopener", "data-testid": "recovery-link", class: "linkbtn", title: "the recovery team's page for phones (new tab)" }, "Recovery");
   const planLink = h("a", { href: withToken("plan.html", token), target: "_blank", rel: "noopener", "data-testid": "plan-link", class: "linkbtn", title: "pre-flight plan: burst, deploy and landing regions from a forecast (new tab)" }, "Plan");
   const header = h("header", { class: "top" },
     h("strong", { class: "station" }, station.name), clock, conn, roleBadge,
     h("span", { class: "hdr-group" }, h("small", {}, "mode "), hdrMode, h("small", {}, " stage "), hdrStage, h("small", {}, " phase "), hdrPhase),
-    hdrLink, hdrLanding, h("span", { class: "spacer" }), kml, recovery, planLink);
+    hdrLink, hdrLanding, h("span", { class: "spacer" }), kml, recovery, planLink, lab);
   const banner = h("div", { class: "banner", role: "alert", "data-testid": "banner", hidden: true });
   const viewerNote = h("div", { class: "viewer-note", "data-testid": "viewer-note" }, `Viewer: you can watch everything; commanding needs the operator role (${OPERATOR_REQUIRED}).`);
 

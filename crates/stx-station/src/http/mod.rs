@@ -10,7 +10,8 @@
 //! - `ws`: the WebSocket (state, events, command results; operators' sticks);
 //! - `kml`: the Google Earth feed; `replay`: the replay's pause, seek and speed;
 //! - `recordings`: the past recordings: list, download, open in a replay;
-//! - `tiles`: the offline map's tiles, from the tile pack and the tiles directory.
+//! - `tiles`: the offline map's tiles, from the tile pack and the tiles directory;
+//! - `lab`: the Lab's jobs, vehicle and gains files.
 //!
 //! Handlers only lock the core for a moment, build their answer, and wake the daemon when they
 //! gave the core something for the link ([`Shared::link_due`]); nothing here waits on the
@@ -20,6 +21,7 @@ mod auth;
 mod commands;
 mod keep_out;
 mod kml;
+mod lab;
 mod plan;
 mod recordings;
 mod replay;
@@ -81,6 +83,15 @@ pub fn router(state: std::sync::Arc<Shared>) -> Router {
             "/api/recordings/{name}/replay",
             post(recordings::open_replay),
         )
+        .route("/api/lab", get(lab::status))
+        .route("/api/lab/jobs", post(lab::start))
+        .route("/api/lab/cancel", post(lab::cancel))
+        .route("/api/lab/vehicle", get(lab::vehicle_fields))
+        .route("/api/lab/vehicle/check", post(lab::vehicle_check))
+        .route("/api/lab/vehicle/save", post(lab::vehicle_save))
+        .route("/api/lab/gains", get(lab::gains))
+        .route("/api/lab/gains/save", post(lab::gains_save))
+        .route("/api/lab/gains/send", post(lab::gains_send))
         .route("/api/ws", get(ws::websocket))
         // An API path that does not exist is an API error, never the dashboard's page.
         .route("/api", any(api_not_found))

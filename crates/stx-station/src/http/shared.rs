@@ -60,6 +60,9 @@ pub struct Shared {
     /// Held while a pre-flight plan is computed (up to a second of a core): one at a time,
     /// so pages cannot take the cores the link and the telemetry need.
     pub planning: Arc<tokio::sync::Mutex<()>>,
+    /// The Lab, set once by the binary that can run its jobs (`stx serve`); unset, the Lab's
+    /// endpoints answer that there is none.
+    pub lab: std::sync::OnceLock<Arc<crate::lab::LabService>>,
 }
 
 /// Why a replay could not be opened: `(status, error, reason)` of the answer.

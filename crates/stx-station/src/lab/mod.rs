@@ -1,0 +1,290 @@
+//! The Lab: the engineering tools (a scenario, a Monte Carlo batch, the stability analysis, a
+//! tuning run) run from the dashboard on the station's machine, one at a time, in the
+//! background, never on the telemetry path.
+//!
+//! The station cannot fly a scenario itself (stx-sim and stx-analysis sit above it in the
+//! crates' order), so the work is a [`LabWorker`] the binary hands over when it starts the
+//! daemon; the station owns what the pages see and send: the requests ([`LabJobBody`]), the
+//! results ([`LabResult`]), the job's life ([`jobs::LabJobs`]: one at a time, a time cap,
+//! progress, cancel, the last outcome kept) and the vehicle editor ([`vehicle_fields`]).
+
+pub mod bodies;
+pub mod jobs;
+pub mod vehicle_fields;
+
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+use std::sync::{Arc, Mutex, MutexGuard};
+
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
+use stx_dynamics::vehicle::Vehicle;
+
+pub use jobs::{LabBusy, LabJobs, StopReason};
+
+/// Largest Monte Carlo batch the Lab flies (a bigger campaign is `stx montecarlo`'s).
+pub const MAX_LAB_RUNS: u32 = 500;
+
+/// Vehicle parameters changed from the seed's (STRAPLEX) vehicle, by their dotted name as
+/// `GET /api/lab/vehicle` lists them (`canopy.mass_kg`), in that field's unit.
+pub type VehicleEdits = BTreeMap<String, f64>;
+
+/// What an operator asks the Lab to run (`POST /api/lab/jobs`).
+#[derive(Debug, Clone, Deserialize, JsonSchema)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum LabJobBody {
+    /// Fly a scenario (`stx sim`) with the vehicle as edited.
+    Scenario {
+        /// A built-in scenario's name (`uncontrolled`, `spiral-exit`, …).
+        scenario: String,
+        /// Parameters changed from the seed's vehicle.
+        #[serde(default)]
+        vehicle: VehicleEdits,
+    },
+    /// A Monte Carlo batch of guided landings (`stx montecarlo`), on one thread.
+    MonteCarlo {
+        /// Number of runs (1 … 500).
+        runs: u32,
+        /// Seed of the batch: the same seed gives the same landings.
+        seed: u64,
+        /// Largest mean wind drawn, m/s (0 … 15).
+        wind_max_mps: f64,
+        /// Release height above the target, m (50 … 3000).
+        altitude_m: f64,
+    },
+    /// Trim, linearise, eigenvalues and ranks beside the seed's (`stx analyze`).
+    Stability {
+        /// Altitude of the trim, m above sea level (−5000 … 86000).
+        altitude_m: f64,
+        /// Parameters changed from the seed's vehicle.
+        #[serde(default)]
+        vehicle: VehicleEdits,
+    },
+    /// Tune one controller's gains on its step experiment (`stx tune`; the optimiser's
+    /// evaluations are bounded by the library, the job by the Lab's time cap).
+    Tune {
+        /// `heading`, `course`, `localizer` or `vertical`.
+        controller: String,
+        /// Altitude of the trim, m above sea level (−5000 … 86000).
+        altitude_m: f64,
+    },
+}
+
+impl LabJobBody {
+    /// The job's kind as the status names it.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Self::Scenario { .. } => "scenario",
+            Self::MonteCarlo { .. } => "monte_carlo",
+            Self::Stability { .. } => "stability",
+            Self::Tune { .. } => "tune",
+        }
+    }
+
+    /// The vehicle edits the job flies with (none for the others).
+    pub fn vehicle_edits(&self) -> Option<&VehicleEdits> {
+        match self {
+            Self::Scenario { vehicle, .. } | Self::Stability { vehicle, .. } => Some(vehicle),
+            _ => None,
+        }
+    }
+
+    /// Refuses a job out of the Lab's bounds: `(field, reason)`.
+    pub fn check(&self) -> Result<(), (String, String)> {
+        let range = |field: &str, v: f64, lo: f64, hi: f64| {
+            if v.is_finite() && (lo..=hi).contains(&v) {
+                Ok(())
+            } else {
+                Err((
+                    field.to_string(),
+                    format!("must be within {lo} … {hi}, not {v}"),
+                ))
+            }
+        };
+        match self {
+            Self::Scenario { scenario, .. } if scenario.trim().is_empty() => {
+                Err(("scenario".into(), "a scenario name is required".into()))
+            }
+            Self::Scenario { .. } => Ok(()),
+            Self::MonteCarlo {
+                runs,
+                wind_max_mps,
+                altitude_m,
+                ..
+            } => {
+                range("runs", *runs as f64, 1.0, MAX_LAB_RUNS as f64)?;
+                range("wind_max_mps", *wind_max_mps, 0.0, 15.0)?;
+                range("altitude_m", *altitude_m, 50.0, 3000.0)
+            }
+            Self::Stability { altitude_m, .. } | Self::Tune { altitude_m, .. } => {
+                range("altitude_m", *altitude_m, -5000.0, 86000.0)
+            }
+        }
+    }
+}
+
+/// A finished job's result, by kind.
+#[derive(Debug, Clone, Serialize, JsonSchema)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum LabResult {
+    /// A scenario's flight.
+    Scenario(ScenarioSeries),
+    /// A Monte Carlo batch's landings.
+    MonteCarlo(MonteCarloSummary),
+    /// The stability analysis.
+    Stability(StabilitySummary),
+    /// A tuning run.
+    Tune(TuneSummary),
+}
+
+/// A scenario's flight as series for the plots (one entry per recorded sample).
+#[derive(Debug, Clone, Default, Serialize, JsonSchema)]
+pub struct ScenarioSeries {
+    /// The scenario's name.
+    pub scenario: String,
+    /// Time, s.
+    pub time_s: Vec<f64>,
+    /// The canopy's position north of the release, m.
+    pub north_m: Vec<f64>,
+    /// The canopy's position east of the release, m.
+    pub east_m: Vec<f64>,
+    /// The canopy's height above the release, m.
+    pub height_m: Vec<f64>,
+    /// The canopy's roll, deg.
+    pub roll_deg: Vec<f64>,
+    /// The canopy's pitch, deg.
+    pub pitch_deg: Vec<f64>,
+    /// The canopy's yaw, deg.
+    pub yaw_deg: Vec<f64>,
+    /// Airspeed, m/s.
+    pub airspeed_mps: Vec<f64>,
+    /// The canopy's sink rate (downward speed), m/s.
+    pub sink_mps: Vec<f64>,
+}
+
+/// A Monte Carlo batch's landing statistics.
+#[derive(Debug, Clone, Default, Serialize, JsonSchema)]
+pub struct MonteCarloSummary {
+    /// Runs asked for.
+    pub runs_asked: u64,
+    /// Runs flown (fewer when cancelled or stopped by the time cap).
+    pub runs_flown: u64,
+    /// Runs that failed (counted as misses).
+    pub failed_runs: u64,
+    /// Distance from the target at first ground contact: median, m.
+    pub miss_median_m: f64,
+    /// … 95th percentile, m.
+    pub miss_p95_m: f64,
+    /// … largest, m.
+    pub miss_max_m: f64,
+    /// Share of landings within 30° of upwind (0 … 1).
+    pub into_wind_fraction: f64,
+    /// Median vertical speed of the payload at touchdown, m/s.
+    pub touchdown_vertical_speed_median_mps: f64,
+    /// Each landing from the target `[long, right]`, m: along the upwind direction
+    /// (positive beyond the target) and across it (positive to the right).
+    pub landings_long_right_m: Vec<[f64; 2]>,
+}
+
+/// The stability analysis beside the seed's figures.
+#[derive(Debug, Clone, Default, Serialize, JsonSchema)]
+pub struct StabilitySummary {
+    /// Altitude of the trim, m.
+    pub altitude_m: f64,
+    /// Trim airspeed, m/s.
+    pub airspeed_mps: f64,
+    /// Trim sink rate, m/s.
+    pub sink_rate_mps: f64,
+    /// Trim glide ratio.
+    pub glide_ratio: f64,
+    /// Number of states of the linear model.
+    pub n_states: u64,
+    /// Every eigenvalue `[re, im]`, 1/s.
+    pub eigenvalues: Vec<[f64; 2]>,
+    /// The seed's eigenvalues `[re, im]` (§6.2.1), 1/s.
+    pub seed_eigenvalues: Vec<[f64; 2]>,
+    /// Eigenvalues counted as zero.
+    pub zero_eigenvalues: u64,
+    /// The seed's count.
+    pub seed_zero_eigenvalues: u64,
+    /// Controllability rank (both inputs).
+    pub controllability_rank: u64,
+    /// The seed's.
+    pub seed_controllability_rank: u64,
+    /// Observability rank.
+    pub observability_rank: u64,
+    /// The seed's.
+    pub seed_observability_rank: u64,
+    /// Decisions close to their thresholds.
+    pub warnings: Vec<String>,
+}
+
+/// A tuning run's outcome.
+#[derive(Debug, Clone, Default, Serialize, JsonSchema)]
+pub struct TuneSummary {
+    /// The controller tuned.
+    pub controller: String,
+    /// Nonlinear step cost with the gains before.
+    pub cost_before: f64,
+    /// … with the tuned gains.
+    pub cost_tuned: f64,
+    /// … with the seed's (A.13) gains.
+    pub cost_seed: f64,
+    /// The tuned gains by parameter name.
+    pub gains: BTreeMap<String, f64>,
+    /// The gains file (TOML) with every controller's gains.
+    pub gains_toml: String,
+}
+
+/// What a running job reports and asks: the adapter's side of [`jobs::LabJobs`].
+pub trait JobControl: Sync {
+    /// `done` of `total` steps finished.
+    fn progress(&self, done: usize, total: usize);
+    /// The job should stop now (cancelled or over its time cap).
+    fn should_stop(&self) -> bool;
+}
+
+/// The work behind the Lab, supplied by the binary (it alone links the simulator and the
+/// analysis). Called on a blocking thread of its own.
+pub trait LabWorker: Send + Sync {
+    /// Runs `job` (already checked) on `vehicle`; `Err` is the reason it failed.
+    fn run(
+        &self,
+        job: &LabJobBody,
+        vehicle: &Vehicle,
+        control: &dyn JobControl,
+    ) -> Result<LabResult, String>;
+}
+
+/// The Lab as a live station runs it: the runner, the work, where files are saved.
+pub struct LabService {
+    jobs: Mutex<LabJobs>,
+    worker: Arc<dyn LabWorker>,
+    dir: PathBuf,
+}
+
+impl LabService {
+    /// A Lab doing `worker`'s jobs, each for at most `time_cap_s`, saving files in `dir`.
+    pub fn new(worker: Arc<dyn LabWorker>, dir: PathBuf, time_cap_s: f64) -> Self {
+        Self {
+            jobs: Mutex::new(LabJobs::new(time_cap_s)),
+            worker,
+            dir,
+        }
+    }
+
+    /// The work.
+    pub fn worker(&self) -> Arc<dyn LabWorker> {
+        self.worker.clone()
+    }
+
+    /// Where files are saved.
+    pub fn dir(&self) -> &std::path::Path {
+        &self.dir
+    }
+
+    /// The runner, for a moment.
+    pub fn jobs(&self) -> MutexGuard<'_, LabJobs> {
+        self.jobs.lock().unwrap_or_else(|e| e.into_inner())
+    }
+}

@@ -1,0 +1,325 @@
+// The Lab page: edit the vehicle (units and the seed's values beside each field, checked by the
+// station with the model's own rules), run a scenario, a Monte Carlo batch, the stability
+// analysis or a tuning run in the station's background, follow its progress (cancel a batch),
+// and see the plots; save a vehicle or gains file, send tuned gains to the drone after a
+// confirmation. Operators run and save; viewers see the results only (the station refuses them
+// anyway). The status is polled: twice a second while a job runs, every 3 s otherwise.
+
+import "../styles/common.css";
+import "../styles/lab.css";
+import uPlot from "uplot";
+import "uplot/dist/uPlot.min.css";
+import { Api, ApiError } from "../lib/api";
+import { complexPlane, metres, outcomeLine, progressOf, vehicleEdits } from "../lib/lab";
+import { isObj } from "../lib/parse";
+import { resolveToken, searchWithoutToken, withToken } from "../lib/token";
+import type * as Wire from "../generated/api";
+import { h, s, setText } from "../ui/dom";
+import { applyRole } from "../ui/role";
+
+const SCENARIOS = ["uncontrolled", "spiral-exit", "spiral-landing", "vertical", "localizer", "stratospheric"];
+const CONTROLLERS = ["heading", "course", "localizer", "vertical"];
+
+const token = resolveToken(location.search, sessionStorage);
+if (new URLSearchParams(location.search).has("token")) history.replaceState(null, "", `${location.pathname}${searchWithoutToken(location.search)}`);
+const api = new Api(token);
+
+let operator = false;
+let fields: Wire.VehicleField[] = [];
+const typed = new Map<string, string>();
+let shownResult = -1;
+let lastGains: Record<string, number> | null = null;
+
+const num = (id: string, value: string, min: string, max: string, step = "any") =>
+  h("input", { type: "number", "data-testid": id, value, min, max, step });
+
+const el = {
+  role: h("span", { "data-testid": "lab-role" }),
+  vehicleRows: h("tbody"),
+  vehicleMsg: h("div", { "data-testid": "vehicle-msg", role: "status" }),
+  vehicleName: h("input", { type: "text", "data-testid": "vehicle-name", placeholder: "file name" }),
+  kind: h("select", { "data-testid": "job-kind" }, ...["scenario", "monte_carlo", "stability", "tune"].map((k) => h("option", { value: k }, k.replace("_", " ")))),
+  scenario: h("select", { "data-testid": "job-scenario" }, ...SCENARIOS.map((n) => h("option", { value: n }, n))),
+  runs: num("mc-runs", "20", "1", "500", "1"),
+  seed: num("mc-seed", "1", "0", "1000000000", "1"),
+  wind: num("mc-wind", "4", "0", "15"),
+  releaseAlt: num("mc-altitude", "600", "50", "3000"),
+  trimAlt: num("trim-altitude", "100", "-5000", "86000"),
+  controller: h("select", { "data-testid": "tune-controller" }, ...CONTROLLERS.map((n) => h("option", { value: n }, n))),
+  start: h("button", { type: "button", "data-testid": "job-start", "data-role": "operator" }, "Run"),
+  cancel: h("button", { type: "button", "data-testid": "job-cancel", "data-role": "operator" }, "Cancel"),
+  progress: h("progress", { "data-testid": "job-progress", max: "1" }),
+  progressLabel: h("div", { "data-testid": "job-progress-label", role: "status" }),
+  jobMsg: h("div", { "data-testid": "job-msg", class: "error", role: "alert" }),
+  outcome: h("div", { "data-testid": "job-outcome" }),
+  results: h("div", { class: "plots", "data-testid": "lab-results" }),
+};
+
+function jobBody(): Wire.LabJobBody {
+  const edits = vehicleEdits(fields, typed).edits;
+  const n = (i: HTMLInputElement) => Number(i.value);
+  switch (el.kind.value) {
+    case "monte_carlo":
+      return { kind: "monte_carlo", runs: n(el.runs), seed: n(el.seed), wind_max_mps: n(el.wind), altitude_m: n(el.releaseAlt) };
+    case "stability":
+      return { kind: "stability", altitude_m: n(el.trimAlt), vehicle: edits };
+    case "tune":
+      return { kind: "tune", controller: el.controller.value, altitude_m: n(el.trimAlt) };
+    default:
+      return { kind: "scenario", scenario: el.scenario.value, vehicle: edits };
+  }
+}
+
+/** Shows why a request was refused. */
+function showError(e: unknown, where: HTMLElement): void {
+  if (e instanceof ApiError) setText(where, `${e.error}: ${e.reason}`);
+  else setText(where, String(e));
+}
+
+/** The vehicle field a refusal names: its reason starts with the field's dotted name. */
+function fieldOf(e: ApiError): string | null {
+  const head = e.reason.split(": ")[0] ?? "";
+  return fields.some((f) => f.name === head) ? head : null;
+}
+
+function vehicleTable(): void {
+  el.vehicleRows.replaceChildren(
+    ...fields.map((f) => {
+      const input = h("input", { type: "text", "data-testid": `vehicle-${f.name}`, value: String(f.seed), "data-role": "operator" });
+      input.addEventListener("input", () => typed.set(f.name, input.value));
+      return h("tr", { "data-field": f.name }, h("td", {}, f.name), h("td", {}, input), h("td", {}, f.unit), h("td", { class: "note" }, String(f.seed)), h("td", { class: "field-error", "data-testid": `vehicle-error-${f.name}` }));
+    }),
+  );
+}
+
+function vehicleRequest(): { vehicle: Record<string, number> } | null {
+  const { edits, errors } = vehicleEdits(fields, typed);
+  const bad = Object.entries(errors)[0];
+  if (bad !== undefined) {
+    setText(el.vehicleMsg, `${bad[0]}: ${bad[1]}`);
+    return null;
+  }
+  return { vehicle: edits };
+}
+
+async function checkVehicle(): Promise<void> {
+  const body = vehicleRequest();
+  if (!body) return;
+  setText(el.vehicleMsg, "");
+  if ((await post(api, "/api/lab/vehicle/check", body, el.vehicleMsg)) !== null) setText(el.vehicleMsg, `valid (${Object.keys(body.vehicle).length} changed from the seed)`);
+}
+
+async function saveVehicle(): Promise<void> {
+  const body = vehicleRequest();
+  if (!body) return;
+  const saved = await post(api, "/api/lab/vehicle/save", { ...body, name: el.vehicleName.value }, el.vehicleMsg);
+  if (isObj(saved) && typeof saved.path === "string") setText(el.vehicleMsg, `saved ${saved.path}`);
+}
+
+/** POSTs; a refusal is shown in `where` and, naming a vehicle field, on its row. */
+async function post(a: Api, path: string, body: unknown, where: HTMLElement): Promise<unknown> {
+  for (const row of el.vehicleRows.querySelectorAll("tr.invalid")) row.classList.remove("invalid");
+  for (const cell of el.vehicleRows.querySelectorAll(".field-error")) cell.textContent = "";
+  try {
+    return await a.post(path, body);
+  } catch (e) {
+    showError(e, where);
+    const field = e instanceof ApiError ? fieldOf(e) : null;
+    if (e instanceof ApiError && field !== null) {
+      const row = el.vehicleRows.querySelector<HTMLElement>(`tr[data-field="${CSS.escape(field)}"]`);
+      if (row) {
+        row.classList.add("invalid");
+        const cell = row.querySelector(".field-error");
+        if (cell) cell.textContent = e.reason.slice(field.length + 2);
+      }
+    }
+    return null;
+  }
+}
+
+async function start(): Promise<void> {
+  setText(el.jobMsg, "");
+  const r = await post(api, "/api/lab/jobs", jobBody(), el.jobMsg);
+  if (r !== null) void poll();
+}
+
+async function cancel(): Promise<void> {
+  try {
+    await api.post("/api/lab/cancel", {});
+  } catch (e) {
+    showError(e, el.jobMsg);
+  }
+  void poll();
+}
+
+function timeChart(title: string, x: number[], series: { label: string; data: number[]; color: string }[], testid: string): HTMLElement {
+  const box = h("div", { "data-testid": testid }, h("h2", {}, title));
+  const width = Math.max(320, Math.min(900, (el.results.clientWidth || 700) - 20));
+  const opts: uPlot.Options = {
+    width,
+    height: 180,
+    scales: { x: { time: false } },
+    series: [{ label: "t s" }, ...series.map((s) => ({ label: s.label, stroke: s.color }))],
+  };
+  new uPlot(opts, [x, ...series.map((s) => s.data)], box);
+  return box;
+}
+
+function svgPlot(testid: string, title: string, points: [number, number][], seed: [number, number][], xLabel: string, yLabel: string): HTMLElement {
+  const box = { width: 420, height: 260, margin: 24 };
+  const p = complexPlane([...points, ...seed], box);
+  const svg = s("svg", { width: box.width, height: box.height, "data-testid": testid });
+  svg.append(s("line", { x1: 0, x2: box.width, y1: p.y(0), y2: p.y(0), stroke: "#999" }));
+  svg.append(s("line", { x1: p.x(0), x2: p.x(0), y1: 0, y2: box.height, stroke: "#999" }));
+  for (const [re, im] of seed) svg.append(s("circle", { cx: p.x(re), cy: p.y(im), r: 5, fill: "none", stroke: "#c05800", class: "seed-point" }));
+  for (const [re, im] of points) if (Number.isFinite(re) && Number.isFinite(im)) svg.append(s("circle", { cx: p.x(re), cy: p.y(im), r: 3, fill: "#0b2f8a", class: "point" }));
+  svg.append(s("text", { x: box.width - 4, y: p.y(0) - 4, "text-anchor": "end", "font-size": 11 }, xLabel));
+  svg.append(s("text", { x: p.x(0) + 4, y: 12, "font-size": 11 }, yLabel));
+  return h("div", {}, h("h2", {}, title), svg);
+}
+
+function table(testid: string, rows: [string, string, string?][]): HTMLElement {
+  return h("table", { "data-testid": testid }, h("tr", {}, h("th", {}, ""), h("th", {}, "stx"), h("th", {}, "seed")), ...rows.map(([k, v, seed]) => h("tr", {}, h("td", {}, k), h("td", {}, v), h("td", { class: "note" }, seed ?? ""))));
+}
+
+function gainsPanel(t: Wire.TuneSummary): HTMLElement {
+  const gains: Record<string, number> = {};
+  for (const [k, v] of Object.entries(t.gains)) if (v !== undefined) gains[k] = v;
+  lastGains = gains;
+  const name = h("input", { type: "text", "data-testid": "gains-name", placeholder: "file name", "data-role": "operator" });
+  const msg = h("div", { "data-testid": "gains-msg", role: "status" });
+  const save = h("button", { type: "button", "data-testid": "gains-save", "data-role": "operator" }, "Save gains file");
+  const send = h("button", { type: "button", "data-testid": "gains-send", "data-role": "operator" }, "Send gains to the drone…");
+  const confirm = h("button", { type: "button", "data-testid": "gains-confirm", "data-role": "operator", hidden: true }, "Confirm: set these parameters on the drone");
+  save.addEventListener("click", async () => {
+    const r = await post(api, "/api/lab/gains/save", { gains: lastGains, name: name.value }, msg);
+    if (isObj(r) && typeof r.path === "string") setText(msg, `saved ${r.path}`);
+  });
+  send.addEventListener("click", () => {
+    confirm.hidden = false;
+    setText(msg, `${Object.keys(gains).length} parameters will change the drone's guidance in flight.`);
+  });
+  confirm.addEventListener("click", async () => {
+    confirm.hidden = true;
+    const r = await post(api, "/api/lab/gains/send", { gains: lastGains, confirm: true }, msg);
+    if (isObj(r) && Array.isArray(r.request_ids)) setText(msg, `sent: ${r.request_ids.length} parameter requests (see the dashboard's command list)`);
+  });
+  const rows = Object.entries(gains).map(([k, v]) => [k, v.toPrecision(4)] as [string, string]);
+  const panel = h("div", { "data-testid": "tune-result" }, h("h2", {}, `Tuned ${t.controller}: cost ${t.cost_before.toFixed(3)} → ${t.cost_tuned.toFixed(3)} (seed's gains ${t.cost_seed.toFixed(3)})`), table("tune-gains", rows), h("div", { class: "row" }, name, save, send, confirm), msg);
+  applyRole(panel, operator);
+  return panel;
+}
+
+function showResult(r: Wire.LabResult): void {
+  const parts: HTMLElement[] = [];
+  if (r.kind === "scenario") {
+    parts.push(timeChart(`Height above release — ${r.scenario}`, r.time_s, [{ label: "height m", data: r.height_m, color: "#0b2f8a" }], "plot-height"));
+    parts.push(timeChart("Attitude", r.time_s, [{ label: "roll °", data: r.roll_deg, color: "#0b2f8a" }, { label: "pitch °", data: r.pitch_deg, color: "#c05800" }, { label: "yaw °", data: r.yaw_deg, color: "#006400" }], "plot-attitude"));
+    parts.push(timeChart("Airspeed, sink rate", r.time_s, [{ label: "airspeed m/s", data: r.airspeed_mps, color: "#0b2f8a" }, { label: "sink m/s", data: r.sink_mps, color: "#c05800" }], "plot-speeds"));
+    parts.push(timeChart("Position", r.time_s, [{ label: "north m", data: r.north_m, color: "#0b2f8a" }, { label: "east m", data: r.east_m, color: "#c000c0" }], "plot-position"));
+  } else if (r.kind === "monte_carlo") {
+    parts.push(
+      h("div", { "data-testid": "mc-result" }, h("h2", {}, `Monte Carlo: ${r.runs_flown} of ${r.runs_asked} runs flown, ${r.failed_runs} failed`),
+        table("mc-stats", [
+          ["miss median", metres(r.miss_median_m)],
+          ["miss p95", metres(r.miss_p95_m)],
+          ["miss max", metres(r.miss_max_m)],
+          ["into the wind", `${(100 * r.into_wind_fraction).toFixed(0)} %`],
+          ["payload touchdown vertical speed (median)", `${r.touchdown_vertical_speed_median_mps.toFixed(2)} m/s`],
+        ])),
+    );
+    parts.push(svgPlot("mc-landings", "Landings from the target (long along the upwind direction, right across it)", r.landings_long_right_m.map(([l, rr]) => [rr, l]), [], "right m", "long m"));
+  } else if (r.kind === "stability") {
+    parts.push(svgPlot("eigen-plot", "Eigenvalues (● stx, ○ seed §6.2.1)", r.eigenvalues, r.seed_eigenvalues, "Re 1/s", "Im 1/s"));
+    parts.push(table("stability-ranks", [
+      ["trim airspeed", `${r.airspeed_mps.toFixed(2)} m/s`],
+      ["trim sink rate", `${r.sink_rate_mps.toFixed(2)} m/s`, "3.1"],
+      ["glide ratio", r.glide_ratio.toFixed(2), "≈2"],
+      ["zero eigenvalues", String(r.zero_eigenvalues), String(r.seed_zero_eigenvalues)],
+      ["controllability rank", String(r.controllability_rank), String(r.seed_controllability_rank)],
+      ["observability rank", String(r.observability_rank), String(r.seed_observability_rank)],
+    ]));
+    for (const w of r.warnings) parts.push(h("div", { class: "note" }, `warning: ${w}`));
+  } else if (r.kind === "tune") {
+    parts.push(gainsPanel(r));
+  }
+  el.results.replaceChildren(...parts);
+}
+
+let timer: ReturnType<typeof setTimeout> | null = null;
+
+async function poll(): Promise<void> {
+  if (timer !== null) clearTimeout(timer);
+  let status: Wire.LabStatusBody | null = null;
+  try {
+    status = await api.get<Wire.LabStatusBody>("/api/lab");
+  } catch (e) {
+    showError(e, el.jobMsg);
+  }
+  if (status) render(status);
+  timer = setTimeout(() => void poll(), status?.job ? 500 : 3000);
+}
+
+function render(st: Wire.LabStatusBody): void {
+  if (!st.available) setText(el.jobMsg, "this station runs no Lab");
+  const job = st.job;
+  el.start.disabled = !operator || job !== null || !st.available;
+  el.cancel.disabled = !operator || job === null;
+  if (job) {
+    const p = progressOf(job);
+    if (p.fraction === null) el.progress.removeAttribute("value");
+    else el.progress.value = p.fraction;
+    setText(el.progressLabel, p.label);
+  } else {
+    el.progress.value = 0;
+    setText(el.progressLabel, "idle");
+  }
+  const last = st.last;
+  setText(el.outcome, last ? outcomeLine(last) : "no job yet");
+  if (last && last.id !== shownResult) {
+    shownResult = last.id;
+    if (last.result) showResult(last.result);
+    else el.results.replaceChildren();
+  }
+}
+
+async function main(): Promise<void> {
+  const app = document.getElementById("app");
+  if (!app) return;
+  const session = await api.get<Wire.Session>("/api/session").catch((e: unknown) => {
+    app.replaceChildren(h("p", { class: "error" }, e instanceof ApiError ? e.message : String(e)));
+    return null;
+  });
+  if (!session) return;
+  operator = session.role === "operator";
+  setText(el.role, `${session.name} (${session.role}${operator ? "" : ": results only"})`);
+  fields = (await api.get<Wire.VehicleFieldsBody>("/api/lab/vehicle")).fields;
+  vehicleTable();
+  const check = h("button", { type: "button", "data-testid": "vehicle-check" }, "Check");
+  const save = h("button", { type: "button", "data-testid": "vehicle-save", "data-role": "operator" }, "Save vehicle file");
+  check.addEventListener("click", () => void checkVehicle());
+  save.addEventListener("click", () => void saveVehicle());
+  el.start.addEventListener("click", () => void start());
+  el.cancel.addEventListener("click", () => void cancel());
+  const dashboard = h("a", { href: withToken("index.html", token), "data-testid": "dashboard-link" }, "Dashboard");
+  const page = h("div", {},
+    h("header", {}, h("strong", {}, "stx — Lab"), el.role, dashboard),
+    h("main", {},
+      h("div", {},
+        h("section", {}, h("h2", {}, "Vehicle (seed: STRAPLEX, config/vehicle/straplex.toml)"),
+          h("table", { class: "vehicle-table" }, h("thead", {}, h("tr", {}, h("th", {}, "parameter"), h("th", {}, "value"), h("th", {}, "unit"), h("th", {}, "seed"), h("th", {}, ""))), el.vehicleRows),
+          h("div", { class: "row" }, check, el.vehicleName, save), el.vehicleMsg),
+        h("section", {}, h("h2", {}, "Run"),
+          h("div", { class: "row" }, h("label", {}, "job ", el.kind)),
+          h("div", { class: "row" }, h("label", {}, "scenario ", el.scenario)),
+          h("div", { class: "row" }, h("label", {}, "runs ", el.runs), h("label", {}, "seed ", el.seed), h("label", {}, "wind max m/s ", el.wind), h("label", {}, "release height m ", el.releaseAlt)),
+          h("div", { class: "row" }, h("label", {}, "trim altitude m ", el.trimAlt), h("label", {}, "controller ", el.controller)),
+          h("div", { class: "row" }, el.start, el.cancel),
+          el.progress, el.progressLabel, el.jobMsg, el.outcome)),
+      h("section", {}, h("h2", {}, "Results"), el.results)));
+  app.replaceChildren(page);
+  applyRole(page, operator);
+  await poll();
+}
+
+void main();
