@@ -63,6 +63,10 @@ enum BenchWhat {
         /// wrong-token requests and 200 WebSocket connects and disconnects a second.
         #[arg(long)]
         abuse: bool,
+        /// While telemetry is timed, run a Lab Monte Carlo batch of N runs (started over the
+        /// API as the Lab page does; cancelled after the window).
+        #[arg(long, value_name = "N")]
+        lab_montecarlo: Option<u32>,
     },
 }
 
@@ -122,6 +126,7 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
             commands,
             record_dir,
             abuse,
+            lab_montecarlo,
         } => {
             let report = crate::bench_station::run(&crate::bench_station::StationBenchOptions {
                 clients,
@@ -130,6 +135,7 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
                 commands,
                 record_dir,
                 abuse,
+                lab_montecarlo,
             })?;
             if json {
                 println!("{}", serde_json::to_string_pretty(&report)?);
@@ -163,6 +169,18 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
                         a.websockets_opened,
                         a.rss_before_mb,
                         a.rss_after_mb
+                    );
+                }
+                if let Some(l) = &report.lab {
+                    println!(
+                        "Lab Monte Carlo during it: {} of {} runs flown in the window{}",
+                        l.runs_done_in_window,
+                        l.runs_asked,
+                        if l.running_at_window_end {
+                            " (still running at its end, then cancelled)"
+                        } else {
+                            " (finished before the window ended)"
+                        }
                     );
                 }
                 let r = &report.recording;

@@ -29,8 +29,6 @@ use std::time::{Duration, Instant};
 
 use anyhow::{Context, bail};
 use futures_util::StreamExt;
-use http_body_util::{BodyExt, Full};
-use hyper::body::Bytes;
 use serde::Serialize;
 use stx_link_tokio::DriverEvent;
 use stx_sim::drone::MissionConfig;
@@ -55,6 +53,8 @@ pub struct StationBenchOptions {
     pub record_dir: Option<std::path::PathBuf>,
     /// Flood the station from other addresses while telemetry is timed (`bench_abuse`).
     pub abuse: bool,
+    /// Run a Lab Monte Carlo batch of this many runs while telemetry is timed (`bench_lab`).
+    pub lab_montecarlo: Option<u32>,
 }
 
 /// Latency distribution, ms.
@@ -115,6 +115,8 @@ pub struct StationReport {
     pub recording: stx_station::messages::RecordingView,
     /// The flood during the telemetry window, with `--abuse`.
     pub abuse: Option<crate::bench_abuse::AbuseReport>,
+    /// The Lab batch during the telemetry window, with `--lab-montecarlo`.
+    pub lab: Option<crate::bench_lab::LabLoadReport>,
 }
 
 /// Starts the station on its own runtime; returns its addresses and the stop switch.
@@ -234,25 +236,6 @@ fn attitude_stamp(text: &str) -> Option<u32> {
     digits.parse().ok()
 }
 
-/// One HTTP/1.1 POST on the kept-alive connection; the status.
-async fn post(
-    sender: &mut hyper::client::conn::http1::SendRequest<Full<Bytes>>,
-    http: SocketAddr,
-    path: &str,
-    token: &str,
-    body: String,
-) -> anyhow::Result<u16> {
-    let request = hyper::Request::post(format!("http://{http}{path}"))
-        .header("authorization", format!("Bearer {token}"))
-        .header("content-type", "application/json")
-        .header("host", http.to_string())
-        .body(Full::new(Bytes::from(body)))?;
-    let response = sender.send_request(request).await?;
-    let status = response.status().as_u16();
-    response.into_body().collect().await?;
-    Ok(status)
-}
-
 /// The size of the station's `state` now, and what of the pipeline did not run (empty when
 /// the estimate, the guidance pattern, the station's and the drone's predictions are there).
 fn station_view(running: &stx_station::daemon::Running) -> (usize, String) {
@@ -366,12 +349,20 @@ pub fn run(options: &StationBenchOptions) -> anyhow::Result<StationReport> {
         } else {
             None
         };
+        let lab = match options.lab_montecarlo {
+            Some(runs) => Some(crate::bench_lab::LabLoad::start(&running, &token, runs).await?),
+            None => None,
+        };
         let timed_from = Instant::now();
         let window = Duration::from_secs_f64(options.frames as f64 / options.frame_rate_hz);
         tokio::time::sleep(window).await;
         let timed_to = Instant::now();
         let abuse = match flood {
             Some(f) => Some(f.stop().await?),
+            None => None,
+        };
+        let lab = match lab {
+            Some(l) => Some(l.stop(&running).await?),
             None => None,
         };
         if landed.load(Ordering::Relaxed) {
@@ -423,7 +414,7 @@ pub fn run(options: &StationBenchOptions) -> anyhow::Result<StationReport> {
             // A new heading each time, so the drone never takes it for a retry.
             let body = format!(r#"{{"heading_deg":{}}}"#, (k % 3600) as f64 * 0.1);
             let started = Instant::now();
-            let status = post(
+            let status = crate::bench_http::post(
                 &mut sender,
                 running.http,
                 "/api/commands/heading",
@@ -460,6 +451,7 @@ pub fn run(options: &StationBenchOptions) -> anyhow::Result<StationReport> {
             },
             recording: shared.recording.view(),
             abuse,
+            lab,
         })
     });
     let _ = stop_station.send(());

@@ -7,12 +7,15 @@
 mod analyze;
 mod bench;
 mod bench_abuse;
+mod bench_http;
+mod bench_lab;
 mod bench_memory;
 mod bench_station;
 mod drone;
 mod export;
 mod import;
 mod inputs;
+mod lab;
 mod logging;
 mod montecarlo;
 mod plan;

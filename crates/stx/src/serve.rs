@@ -55,6 +55,10 @@ pub struct ServeArgs {
     /// Do not record this run.
     #[arg(long)]
     no_record: bool,
+    /// Where the Lab saves vehicle and gains files (default: `lab/` in the state directory,
+    /// else `./lab`); never config/ unless named here.
+    #[arg(long, value_name = "DIR")]
+    lab_dir: Option<PathBuf>,
 }
 
 /// Reads and validates the station configuration.
@@ -101,6 +105,12 @@ pub fn run(args: ServeArgs) -> anyhow::Result<()> {
             "the dashboard is not built here: run `cd web && npm ci && npm run build` (the API works without it)"
         );
     }
+    let lab_dir = args.lab_dir.clone().unwrap_or_else(|| {
+        stx_link::signing::persist::default_state_dir(|k| std::env::var_os(k))
+            .unwrap_or_default()
+            .join("lab")
+    });
+    let lab = crate::lab::service(lab_dir);
     let sim = if args.sim {
         let options = sim_options(&config, &args)?;
         // The rehearsal's station knows the balloon it flies with: its burst, ascent rate and
@@ -125,6 +135,8 @@ pub fn run(args: ServeArgs) -> anyhow::Result<()> {
         });
         let mut drone_task = None;
         let station = stx_station::daemon::run(config, stopped(stop_rx.clone()), |running| {
+            // Set once, on a station just started: it cannot have one already.
+            let _ = running.shared.lab.set(lab);
             let mut banner = format!(
                 "stx station: open {}://{}/?token={operator}\n",
                 running.scheme, running.http
