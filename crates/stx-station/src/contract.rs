@@ -212,6 +212,7 @@ pub fn schema() -> Result<Value, ContractError> {
             }
         }
     }
+    inline_tagged_variants(&mut definitions);
     Ok(json!({
         "$schema": "http://json-schema.org/draft-07/schema#",
         "title": "stx station API",
@@ -219,6 +220,50 @@ pub fn schema() -> Result<Value, ContractError> {
         "anyOf": messages,
         "definitions": definitions,
     }))
+}
+
+/// An internally tagged enum's newtype variant (`{"kind":"scenario", ...the struct's fields}`)
+/// comes out of schemars as the tag's properties plus `allOf: [$ref struct]`; with every object
+/// closed, neither half would accept the other's fields. The struct's properties are copied in
+/// beside the tag instead, so the variant is one closed object.
+fn inline_tagged_variants(definitions: &mut Map<String, Value>) {
+    let structs = definitions.clone();
+    let mut visit = |variant: &mut Value| {
+        let Some(object) = variant.as_object_mut() else {
+            return;
+        };
+        let target = match object.get("allOf").and_then(Value::as_array) {
+            Some(all) if all.len() == 1 && object.contains_key("properties") => all[0]
+                .get("$ref")
+                .and_then(Value::as_str)
+                .and_then(|r| r.strip_prefix("#/definitions/"))
+                .and_then(|name| structs.get(name))
+                .cloned(),
+            _ => None,
+        };
+        let Some(target) = target else { return };
+        for key in ["properties", "required"] {
+            let Some(theirs) = target.get(key).cloned() else {
+                continue;
+            };
+            match (object.get_mut(key), theirs) {
+                (Some(Value::Object(ours)), Value::Object(theirs)) => ours.extend(theirs),
+                (Some(Value::Array(ours)), Value::Array(theirs)) => ours.extend(theirs),
+                (None, theirs) => {
+                    object.insert(key.into(), theirs);
+                }
+                _ => {}
+            }
+        }
+        object.remove("allOf");
+    };
+    for definition in definitions.values_mut() {
+        for key in ["oneOf", "anyOf"] {
+            if let Some(Value::Array(variants)) = definition.get_mut(key) {
+                variants.iter_mut().for_each(&mut visit);
+            }
+        }
+    }
 }
 
 /// The schema as committed: pretty JSON, one trailing newline.

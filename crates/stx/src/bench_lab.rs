@@ -9,6 +9,7 @@ use http_body_util::Full;
 use hyper::body::Bytes;
 use serde::Serialize;
 use stx_station::daemon::Running;
+use stx_station::lab::LabResult;
 
 /// What the Lab job did during the telemetry window.
 #[derive(Debug, Serialize)]
@@ -65,9 +66,19 @@ impl LabLoad {
             .context("the Lab")?
             .jobs()
             .status(running.shared.now_s());
+        // A batch that ended within the window (done, failed or stopped by the time cap) flew
+        // the runs its outcome counts, not necessarily all those asked.
+        let runs_done_in_window = match (&status.job, &status.last) {
+            (Some(job), _) => job.done,
+            (None, Some(last)) => match &last.result {
+                Some(LabResult::MonteCarlo(summary)) => summary.runs_flown,
+                _ => bail!("the Lab batch ended without its runs: {}", last.outcome),
+            },
+            (None, None) => bail!("the Lab has neither the batch nor its outcome"),
+        };
         let report = LabLoadReport {
             runs_asked: self.runs,
-            runs_done_in_window: status.job.as_ref().map_or(u64::from(self.runs), |j| j.done),
+            runs_done_in_window,
             running_at_window_end: status.job.is_some(),
         };
         if report.running_at_window_end {

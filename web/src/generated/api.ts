@@ -121,18 +121,177 @@ export type FenceState = "none" | "waiting" | "sending" | "held" | "failed";
  * A finished job's result, by kind.
  */
 export type LabResult =
-  | (ScenarioSeries & {
+  | {
+      /**
+       * Airspeed, m/s.
+       */
+      airspeed_mps: number[];
+      /**
+       * The canopy's position east of the release, m.
+       */
+      east_m: number[];
+      /**
+       * The canopy's height above the release, m.
+       */
+      height_m: number[];
       kind: "scenario";
-    })
-  | (MonteCarloSummary & {
+      /**
+       * The canopy's position north of the release, m.
+       */
+      north_m: number[];
+      /**
+       * The canopy's pitch, deg.
+       */
+      pitch_deg: number[];
+      /**
+       * The canopy's roll, deg.
+       */
+      roll_deg: number[];
+      /**
+       * The scenario's name.
+       */
+      scenario: string;
+      /**
+       * The canopy's sink rate (downward speed), m/s.
+       */
+      sink_mps: number[];
+      /**
+       * Time, s.
+       */
+      time_s: number[];
+      /**
+       * The canopy's yaw, deg.
+       */
+      yaw_deg: number[];
+    }
+  | {
+      /**
+       * Runs that failed (counted as misses).
+       */
+      failed_runs: number;
+      /**
+       * Share of landings within 30° of upwind (0 … 1).
+       */
+      into_wind_fraction: number;
       kind: "monte_carlo";
-    })
-  | (StabilitySummary & {
+      /**
+       * Each landing from the target `[long, right]`, m: along the upwind direction
+       * (positive beyond the target) and across it (positive to the right).
+       */
+      landings_long_right_m: [number, number][];
+      /**
+       * … largest, m.
+       */
+      miss_max_m: number;
+      /**
+       * Distance from the target at first ground contact: median, m.
+       */
+      miss_median_m: number;
+      /**
+       * … 95th percentile, m.
+       */
+      miss_p95_m: number;
+      /**
+       * Runs asked for.
+       */
+      runs_asked: number;
+      /**
+       * Runs flown (fewer when cancelled or stopped by the time cap).
+       */
+      runs_flown: number;
+      /**
+       * Median vertical speed of the payload at touchdown, m/s.
+       */
+      touchdown_vertical_speed_median_mps: number;
+    }
+  | {
+      /**
+       * Trim airspeed, m/s.
+       */
+      airspeed_mps: number;
+      /**
+       * Altitude of the trim, m.
+       */
+      altitude_m: number;
+      /**
+       * Controllability rank (both inputs).
+       */
+      controllability_rank: number;
+      /**
+       * Every eigenvalue `[re, im]`, 1/s.
+       */
+      eigenvalues: [number, number][];
+      /**
+       * Trim glide ratio.
+       */
+      glide_ratio: number;
       kind: "stability";
-    })
-  | (TuneSummary & {
+      /**
+       * Number of states of the linear model.
+       */
+      n_states: number;
+      /**
+       * Observability rank.
+       */
+      observability_rank: number;
+      /**
+       * The seed's.
+       */
+      seed_controllability_rank: number;
+      /**
+       * The seed's eigenvalues `[re, im]` (§6.2.1), 1/s.
+       */
+      seed_eigenvalues: [number, number][];
+      /**
+       * The seed's.
+       */
+      seed_observability_rank: number;
+      /**
+       * The seed's count.
+       */
+      seed_zero_eigenvalues: number;
+      /**
+       * Trim sink rate, m/s.
+       */
+      sink_rate_mps: number;
+      /**
+       * Decisions close to their thresholds.
+       */
+      warnings: string[];
+      /**
+       * Eigenvalues counted as zero.
+       */
+      zero_eigenvalues: number;
+    }
+  | {
+      /**
+       * The controller tuned.
+       */
+      controller: string;
+      /**
+       * Nonlinear step cost with the gains before.
+       */
+      cost_before: number;
+      /**
+       * … with the seed's (A.13) gains.
+       */
+      cost_seed: number;
+      /**
+       * … with the tuned gains.
+       */
+      cost_tuned: number;
+      /**
+       * The tuned gains by parameter name.
+       */
+      gains: {
+        [k: string]: number | undefined;
+      };
+      /**
+       * The gains file (TOML) with every controller's gains.
+       */
+      gains_toml: string;
       kind: "tune";
-    });
+    };
 /**
  * A message from the page on the WebSocket.
  */
@@ -1660,7 +1819,7 @@ export interface CutdownArm {
  */
 export interface ErrorBody {
   /**
-   * Machine-readable kind.
+   * Machine-readable kind; every kind the station answers is listed (a new one must be).
    */
   error:
     | "unauthorized"
@@ -1670,7 +1829,24 @@ export interface ErrorBody {
     | "not_armed"
     | "too_many_requests"
     | "replay"
-    | "not_saved";
+    | "replay_failed"
+    | "unreadable"
+    | "unavailable"
+    | "busy"
+    | "internal"
+    | "io"
+    | "tile_pack"
+    | "not_saved"
+    | "lab_unavailable"
+    | "invalid_job"
+    | "invalid_vehicle"
+    | "invalid_gains"
+    | "no_job"
+    | "no_thread"
+    | "bad_name"
+    | "exists"
+    | "write_failed"
+    | "confirmation_required";
   /**
    * For people: what is wrong.
    */
@@ -2084,185 +2260,6 @@ export interface LabOutcomeView {
    * Who started it.
    */
   started_by: string;
-}
-/**
- * A scenario's flight as series for the plots (one entry per recorded sample).
- */
-export interface ScenarioSeries {
-  /**
-   * Airspeed, m/s.
-   */
-  airspeed_mps: number[];
-  /**
-   * The canopy's position east of the release, m.
-   */
-  east_m: number[];
-  /**
-   * The canopy's height above the release, m.
-   */
-  height_m: number[];
-  /**
-   * The canopy's position north of the release, m.
-   */
-  north_m: number[];
-  /**
-   * The canopy's pitch, deg.
-   */
-  pitch_deg: number[];
-  /**
-   * The canopy's roll, deg.
-   */
-  roll_deg: number[];
-  /**
-   * The scenario's name.
-   */
-  scenario: string;
-  /**
-   * The canopy's sink rate (downward speed), m/s.
-   */
-  sink_mps: number[];
-  /**
-   * Time, s.
-   */
-  time_s: number[];
-  /**
-   * The canopy's yaw, deg.
-   */
-  yaw_deg: number[];
-}
-/**
- * A Monte Carlo batch's landing statistics.
- */
-export interface MonteCarloSummary {
-  /**
-   * Runs that failed (counted as misses).
-   */
-  failed_runs: number;
-  /**
-   * Share of landings within 30° of upwind (0 … 1).
-   */
-  into_wind_fraction: number;
-  /**
-   * Each landing from the target `[long, right]`, m: along the upwind direction
-   * (positive beyond the target) and across it (positive to the right).
-   */
-  landings_long_right_m: [number, number][];
-  /**
-   * … largest, m.
-   */
-  miss_max_m: number;
-  /**
-   * Distance from the target at first ground contact: median, m.
-   */
-  miss_median_m: number;
-  /**
-   * … 95th percentile, m.
-   */
-  miss_p95_m: number;
-  /**
-   * Runs asked for.
-   */
-  runs_asked: number;
-  /**
-   * Runs flown (fewer when cancelled or stopped by the time cap).
-   */
-  runs_flown: number;
-  /**
-   * Median vertical speed of the payload at touchdown, m/s.
-   */
-  touchdown_vertical_speed_median_mps: number;
-}
-/**
- * The stability analysis beside the seed's figures.
- */
-export interface StabilitySummary {
-  /**
-   * Trim airspeed, m/s.
-   */
-  airspeed_mps: number;
-  /**
-   * Altitude of the trim, m.
-   */
-  altitude_m: number;
-  /**
-   * Controllability rank (both inputs).
-   */
-  controllability_rank: number;
-  /**
-   * Every eigenvalue `[re, im]`, 1/s.
-   */
-  eigenvalues: [number, number][];
-  /**
-   * Trim glide ratio.
-   */
-  glide_ratio: number;
-  /**
-   * Number of states of the linear model.
-   */
-  n_states: number;
-  /**
-   * Observability rank.
-   */
-  observability_rank: number;
-  /**
-   * The seed's.
-   */
-  seed_controllability_rank: number;
-  /**
-   * The seed's eigenvalues `[re, im]` (§6.2.1), 1/s.
-   */
-  seed_eigenvalues: [number, number][];
-  /**
-   * The seed's.
-   */
-  seed_observability_rank: number;
-  /**
-   * The seed's count.
-   */
-  seed_zero_eigenvalues: number;
-  /**
-   * Trim sink rate, m/s.
-   */
-  sink_rate_mps: number;
-  /**
-   * Decisions close to their thresholds.
-   */
-  warnings: string[];
-  /**
-   * Eigenvalues counted as zero.
-   */
-  zero_eigenvalues: number;
-}
-/**
- * A tuning run's outcome.
- */
-export interface TuneSummary {
-  /**
-   * The controller tuned.
-   */
-  controller: string;
-  /**
-   * Nonlinear step cost with the gains before.
-   */
-  cost_before: number;
-  /**
-   * … with the seed's (A.13) gains.
-   */
-  cost_seed: number;
-  /**
-   * … with the tuned gains.
-   */
-  cost_tuned: number;
-  /**
-   * The tuned gains by parameter name.
-   */
-  gains: {
-    [k: string]: number | undefined;
-  };
-  /**
-   * The gains file (TOML) with every controller's gains.
-   */
-  gains_toml: string;
 }
 /**
  * `POST /api/lab/jobs`' answer: the job started.

@@ -182,7 +182,10 @@ function table(testid: string, rows: [string, string, string?][]): HTMLElement {
   return h("table", { "data-testid": testid }, h("tr", {}, h("th", {}, ""), h("th", {}, "stx"), h("th", {}, "seed")), ...rows.map(([k, v, seed]) => h("tr", {}, h("td", {}, k), h("td", {}, v), h("td", { class: "note" }, seed ?? ""))));
 }
 
-function gainsPanel(t: Wire.TuneSummary): HTMLElement {
+/** A tuning run's result (the contract inlines each kind of result in `LabResult`). */
+type TuneResult = Extract<Wire.LabResult, { kind: "tune" }>;
+
+function gainsPanel(t: TuneResult): HTMLElement {
   const gains: Record<string, number> = {};
   for (const [k, v] of Object.entries(t.gains)) if (v !== undefined) gains[k] = v;
   lastGains = gains;

@@ -258,18 +258,12 @@ pub(crate) async fn gains(_caller: Caller) -> Response {
 }
 
 /// The built-in settings with `gains` applied, each checked as the drone checks it.
-fn settings_with(gains: &BTreeMap<String, f64>) -> Result<OnboardSettings, Response> {
+fn settings_with(gains: &BTreeMap<String, f64>) -> Result<OnboardSettings, FieldError> {
     let mut settings = OnboardSettings::default();
     for (name, value) in gains {
-        let refused = |reason: String| {
-            field_error(
-                StatusCode::BAD_REQUEST,
-                "invalid_gains",
-                FieldError {
-                    field: name.clone(),
-                    reason,
-                },
-            )
+        let refused = |reason: String| FieldError {
+            field: name.clone(),
+            reason,
         };
         if !is_gain(name) {
             return Err(refused("not a control gain (GN_…)".into()));
@@ -291,7 +285,7 @@ pub(crate) async fn gains_save(
     let b = json_body(body)?;
     let settings = match settings_with(&b.gains) {
         Ok(s) => s,
-        Err(r) => return Ok(r),
+        Err(e) => return Ok(field_error(StatusCode::BAD_REQUEST, "invalid_gains", e)),
     };
     let path = file_in(lab.dir(), b.name.as_deref(), b.overwrite)?;
     write_file(
@@ -311,8 +305,8 @@ pub(crate) async fn gains_send(
 ) -> Result<Response, HttpError> {
     caller.operator()?;
     let b = json_body(body)?;
-    if let Err(r) = settings_with(&b.gains) {
-        return Ok(r);
+    if let Err(e) = settings_with(&b.gains) {
+        return Ok(field_error(StatusCode::BAD_REQUEST, "invalid_gains", e));
     }
     if !b.confirm {
         return Err(error(
