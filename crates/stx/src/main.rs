@@ -11,6 +11,7 @@ mod bench_http;
 mod bench_lab;
 mod bench_memory;
 mod bench_station;
+mod compare;
 mod drone;
 mod export;
 mod import;
@@ -72,6 +73,8 @@ enum Command {
     /// Pre-flight plan: burst, deploy and landing regions and the target's reachability from a
     /// forecast (and an earlier recording's measured ascent wind).
     Plan(plan::PlanArgs),
+    /// A flight (recording or flight-log CSV) against the model: per-channel errors.
+    Compare(compare::CompareArgs),
     /// Station tokens: `stx token new` prints a strong random one as a `[[tokens]]` entry.
     Token(token::TokenArgs),
 }
@@ -115,6 +118,7 @@ fn main() -> ExitCode {
         Command::Replay(args) => replay::run(args),
         Command::Token(args) => token::run(args),
         Command::Plan(args) => plan::run(args),
+        Command::Compare(args) => compare::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -145,6 +149,7 @@ impl Command {
                 | Command::Import(_)
                 | Command::Token(_)
                 | Command::Plan(_)
+                | Command::Compare(_)
         )
     }
 }

@@ -1,0 +1,90 @@
+//! `stx compare FILE [--vehicle FILE] [--json]`: a flight against the model (issue 16 item 1).
+//! Reads a station recording (MCAP) or a flight-log CSV (format: `stx_analysis::flight_log::csv`,
+//! README "Flight versus model"), flies the vehicle through it with the recorded commands and
+//! wind (`stx_analysis::compare`) and prints the error of each channel. Files and printing only.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::Context;
+use clap::Args;
+use stx_analysis::compare::{CompareOptions, CompareReport, compare};
+use stx_analysis::flight_log::recording::LogBuilder;
+use stx_analysis::flight_log::{FlightLog, csv::from_csv};
+use stx_record::Recording;
+
+use crate::BadInput;
+use crate::inputs::load_vehicle;
+
+#[derive(Args, Debug)]
+pub struct CompareArgs {
+    /// The flight: a station recording (`.mcap`) or a flight-log CSV (`.csv`).
+    #[arg(value_name = "FILE")]
+    file: PathBuf,
+    /// Vehicle file to fly (default: the shipped STRAPLEX vehicle).
+    #[arg(long, value_name = "FILE")]
+    vehicle: Option<PathBuf>,
+    /// Print the whole report (series and error figures) as JSON instead of the table.
+    #[arg(long)]
+    json: bool,
+}
+
+/// The flight log of a recording or a CSV file; what cannot be read is bad input.
+pub fn read_log(path: &Path) -> anyhow::Result<FlightLog> {
+    let is_csv = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("csv"));
+    if is_csv {
+        let text = std::fs::read_to_string(path)
+            .with_context(|| format!("reading {}", path.display()))
+            .map_err(BadInput)?;
+        return from_csv(&text)
+            .with_context(|| format!("flight log {}", path.display()))
+            .map_err(|e| BadInput(e).into());
+    }
+    let bad = |e: anyhow::Error| BadInput(e.context(format!("recording {}", path.display())));
+    let mut recording = Recording::open(path).map_err(|e| bad(e.into()))?;
+    let mut builder = LogBuilder::default();
+    for message in recording.messages().map_err(|e| bad(e.into()))? {
+        let message = message.map_err(|e| bad(e.into()))?;
+        builder
+            .add(&message.topic, message.log_time, &message.data)
+            .map_err(|e| bad(e.into()))?;
+    }
+    builder.finish().map_err(|e| bad(e.into()).into())
+}
+
+/// The per-channel error table.
+pub fn table(report: &CompareReport) -> String {
+    let mut out = format!(
+        "flight of {:.1} s, {} samples; simulated − recorded:\n{:<16} {:>5} {:>10} {:>10} {:>10} {:>7}\n",
+        report.duration_s,
+        report.time_s.len(),
+        "channel",
+        "unit",
+        "rms",
+        "max |e|",
+        "bias",
+        "samples"
+    );
+    for c in &report.channels {
+        out.push_str(&format!(
+            "{:<16} {:>5} {:>10.3} {:>10.3} {:>10.3} {:>7}\n",
+            c.name, c.unit, c.error.rms, c.error.max_abs, c.error.bias, c.error.count
+        ));
+    }
+    out
+}
+
+pub fn run(args: CompareArgs) -> anyhow::Result<()> {
+    let log = read_log(&args.file)?;
+    let vehicle = load_vehicle(args.vehicle.as_deref())?;
+    let report = compare(&log, &vehicle, &CompareOptions::default())
+        .with_context(|| format!("flying the model through {}", args.file.display()))
+        .map_err(BadInput)?;
+    if args.json {
+        println!("{}", serde_json::to_string(&report)?);
+    } else {
+        print!("{}", table(&report));
+    }
+    Ok(())
+}
