@@ -288,8 +288,9 @@ impl Spiral {
 
         let wind = self.wind.update(est, sc.wind_filter_s);
         let reorient = self.machine.take_reorient();
-        let approach_course_rad = if self.keep_out.zones.is_empty() {
-            plan.approach_course_rad
+        let keep_clear_rad = if self.keep_out.zones.is_empty() || plan.approach_course_rad.is_some()
+        {
+            None
         } else {
             // Into the wind, or in calm air along the axis held (the final is flown upwind,
             // against the axis).
@@ -298,25 +299,31 @@ impl Spiral {
             } else {
                 self.axis.downwind_rad().map(|d| d + std::f64::consts::PI)
             };
-            let may_turn = reorient
+            // Chosen where the pattern is placed (the approximation, a loop's start), not on
+            // the turn onto the final: the vehicle is already on the base leg of the course
+            // chosen at the loop's start, and that course was checked clear for it.
+            let may_turn = (reorient && phase != GuidancePhase::FinalApproach)
                 || matches!(
                     phase,
                     GuidancePhase::Approximation | GuidancePhase::BestReachable
                 );
-            let (course, note) = self.clear_approach.course(
-                &self.keep_out,
-                plan.approach_course_rad,
-                into_wind,
-                target_ne,
-                sc,
-                may_turn,
-            );
+            let (course, note) =
+                self.clear_approach
+                    .course(&self.keep_out, into_wind, target_ne, sc, may_turn);
             self.notes.extend(note);
             course
         };
-        let (downwind, frozen) =
-            self.axis
-                .orient(phase, reorient, approach_course_rad, &wind, sc, rel);
+        let (downwind, frozen) = self.axis.orient(
+            phase,
+            reorient,
+            pattern::Courses {
+                operator_rad: plan.approach_course_rad,
+                keep_clear_rad,
+            },
+            &wind,
+            sc,
+            rel,
+        );
         let frame = WindFrame::new(target_ne, downwind);
         let [x, y] = frame.to_wind(rel);
         let turn_rate = self

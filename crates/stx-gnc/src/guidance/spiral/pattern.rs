@@ -37,6 +37,16 @@ pub(super) fn corner_xy(branch: usize, ax: f64, ay: f64) -> [f64; 2] {
     }
 }
 
+/// Final-approach courses asked for instead of into the wind, rad.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Courses {
+    /// The operator's: the axis is set to it at once and kept.
+    pub(super) operator_rad: Option<f64>,
+    /// The one keep-out zones ask for (see `keep_clear`): the axis turns towards it as it
+    /// would towards the wind, within the same limits. The operator's wins over it.
+    pub(super) keep_clear_rad: Option<f64>,
+}
+
 /// The pattern's axis and half-length, held between the moments they may follow the wind.
 #[derive(Debug, Clone, Copy, Default)]
 pub(super) struct Axis {
@@ -55,17 +65,22 @@ impl Axis {
     /// The pattern's downwind direction for this update, rad, and whether the axis (and the
     /// half-length with it) is held. `reorient` says the phase machine lets the axis follow
     /// the wind at this update (the start of a loop, the turn onto the final); in the
-    /// approximation and on the way to the best reachable point it always may. `rel` is the
+    /// approximation and on the way to the best reachable point it always may.
+    /// `courses` are the final-approach courses asked for instead of into the wind. `rel` is the
     /// vehicle's place from the target (north, east), m.
     pub(super) fn orient(
         &mut self,
         phase: GuidancePhase,
         reorient: bool,
-        approach_course_rad: Option<f64>,
+        courses: Courses,
         wind: &WindNow,
         sc: &SpiralConfig,
         rel: [f64; 2],
     ) -> (f64, bool) {
+        let Courses {
+            operator_rad: approach_course_rad,
+            keep_clear_rad,
+        } = courses;
         let wind_speed = wind.speed_mps;
         let wind = wind.ne_mps;
         // The pattern's axis: downwind, unless the operator fixed the approach course; in calm
@@ -83,15 +98,22 @@ impl Axis {
             GuidancePhase::FinalApproach => FINAL_REORIENT_MAX_RAD,
             _ => LOOP_REORIENT_MAX_RAD,
         };
-        let downwind = match (approach_course_rad, self.downwind_rad) {
-            (Some(course), _) => wrap_pi(course + std::f64::consts::PI),
-            (None, Some(previous)) if frozen || wind_speed < sc.calm_wind_mps => previous,
-            (None, Some(previous)) => {
-                let turn = wrap_pi(wind[1].atan2(wind[0]) - previous);
+        // Where the axis would go: a keep-out course (see `keep_clear`) in place of the
+        // wind's direction, turned to within the same limits as the wind, since the vehicle is
+        // placed for the axis it had whatever made the axis turn.
+        let toward = keep_clear_rad
+            .map(|course| wrap_pi(course + std::f64::consts::PI))
+            .or_else(|| (wind_speed >= sc.calm_wind_mps).then(|| wind[1].atan2(wind[0])));
+        let downwind = match (approach_course_rad, self.downwind_rad, toward) {
+            (Some(course), _, _) => wrap_pi(course + std::f64::consts::PI),
+            (None, Some(previous), None) => previous,
+            (None, Some(previous), Some(_)) if frozen => previous,
+            (None, Some(previous), Some(toward)) => {
+                let turn = wrap_pi(toward - previous);
                 wrap_pi(previous + turn.clamp(-largest_turn, largest_turn))
             }
-            (None, None) if wind_speed >= sc.calm_wind_mps => wind[1].atan2(wind[0]),
-            (None, None) => rel[1].atan2(rel[0]),
+            (None, None, Some(toward)) => toward,
+            (None, None, None) => rel[1].atan2(rel[0]),
         };
         self.downwind_rad = Some(downwind);
         (downwind, frozen)
