@@ -95,7 +95,8 @@ fn low_track_enters(f: &Flight, zones: &KeepOutZones, height_m: f64) -> bool {
 #[test]
 fn a_pond_on_the_final_into_the_wind_is_cleared_by_landing_off_the_wind() {
     let target = [200.0, 100.0];
-    for (speed, from_deg) in [(2.0, 135.0), (4.0, 250.0)] {
+    // Light winds: turning the final off the wind costs at most 1 m/s of crosswind.
+    for (speed, from_deg) in [(1.0, 135.0), (0.8, 250.0)] {
         let wind = wind_from(speed, from_deg);
         // A pond on the final approach into the wind, 15–45 m downwind of the target.
         let downwind = (from_deg + 180.0_f64).to_radians();
@@ -177,4 +178,33 @@ fn a_target_in_a_zone_is_refused_naming_the_zone_and_the_plan_in_force_kept() {
     assert!(err.to_string().contains("'road'"), "{err}");
     assert_eq!(*guidance.plan(), outside);
     assert_eq!(guidance.phase(), GuidancePhase::Idle);
+}
+
+/// In a 4 m/s wind the turn that clears the pond would bring more crosswind than the energy
+/// sums hold (Monte Carlo: such finals ended out of reach, in the zones): the nominal final is
+/// flown, said once, and its accuracy keeps the landing out of the pond.
+#[test]
+fn in_a_strong_wind_the_final_stays_into_the_wind_and_lands_beside_the_pond() {
+    let target = [200.0, 100.0];
+    let (speed, from_deg) = (4.0, 250.0);
+    let wind = wind_from(speed, from_deg);
+    let downwind = (from_deg + 180.0_f64).to_radians();
+    let centre = [
+        target[0] + 30.0 * downwind.cos(),
+        target[1] + 30.0 * downwind.sin(),
+    ];
+    let zones = KeepOutZones {
+        zones: vec![rectangle("pond", centre, downwind, 15.0, 8.0)],
+    };
+    let f = land(target, 700.0, wind, &zones);
+    assert!(zones.zone_at(f.touchdown).is_none(), "landed in the pond");
+    let miss = (f.touchdown[0] - target[0]).hypot(f.touchdown[1] - target[1]);
+    assert!(miss < 20.0, "missed by {miss:.1} m");
+    assert!(
+        f.reasons
+            .iter()
+            .any(|r| r.contains("'pond'") && r.contains("crosswind") && r.contains("nominal")),
+        "{:?}",
+        f.reasons
+    );
 }

@@ -26,12 +26,15 @@
 //! same limits as towards the wind (`pattern.rs`), since the vehicle is placed for the axis
 //! it had whatever the reason for the turn.
 //!
-//! That is not the whole cost: with these fixed, guidance with zones still lands in them
-//! more often than without. In the runs replayed, a final turned 20–50° off the wind ends
-//! out of reach soon after the turn onto it (the energy sums plan with the wind along the
-//! axis only, not the crab a crosswind costs), and the flight to the best reachable point
-//! lands beside the target, in a zone. Limiting the offset by the crosswind, or planning
-//! the energy along the turned final, is the next step.
+//! That was not the whole cost: with these fixed, guidance with zones still landed in them
+//! more often than without. In the runs replayed, a final turned 20–50° off a 3–4 m/s wind
+//! ended out of reach soon after the turn onto it (the energy sums plan with the wind along
+//! the axis only, not the crab a crosswind costs), and the flight to the best reachable point
+//! landed beside the target, in a zone. So the turn is also limited by the crosswind it
+//! brings, [`MAX_CROSSWIND_MPS`] (in calm air the full [`MAX_OFFSET_RAD`]); past that the
+//! nominal into-wind final is flown, whose few metres of scatter keep it out of a zone tens of
+//! metres away better than a crosswind final does. Planning the energy along the turned final
+//! would allow larger turns in stronger winds.
 //!
 //! With the target out of reach the best reachable point is the point of the glide's circle
 //! nearest the target; when that lies in a zone (or within [`POINT_MARGIN_M`] of one), the
@@ -47,6 +50,23 @@ const COURSE_STEP_RAD: f64 = 0.174_532_925_199_432_95;
 /// wind the crosswind at touchdown costs more than the zone saves, and the energy sums
 /// (planned along the wind) no longer hold.
 const MAX_OFFSET_RAD: f64 = 6.0 * COURSE_STEP_RAD;
+/// Largest crosswind a turned final may take, m/s: the energy sums plan the final along the
+/// wind, and a crab into more than this puts the stack short of the target (Monte Carlo with
+/// zones next to the target: finals 20–50° off a 3–4 m/s wind ended out of reach, 50 m from
+/// the target, in the zones they were turned away from).
+const MAX_CROSSWIND_MPS: f64 = 1.0;
+
+/// The largest turn off the wind at `wind_speed_mps`: [`MAX_OFFSET_RAD`], less in a wind whose
+/// crosswind on such a final would exceed [`MAX_CROSSWIND_MPS`].
+fn max_offset_rad(wind_speed_mps: f64) -> f64 {
+    if wind_speed_mps <= MAX_CROSSWIND_MPS {
+        MAX_OFFSET_RAD
+    } else {
+        (MAX_CROSSWIND_MPS / wind_speed_mps)
+            .asin()
+            .min(MAX_OFFSET_RAD)
+    }
+}
 /// Half-angle of the wedge about the final approach kept clear, rad (8°): after the base leg
 /// the stack converges onto the final line from its side, near the target (where a zone
 /// matters) in the point-mass flights up to about 6° off it.
@@ -110,14 +130,16 @@ impl ClearApproach {
         target_ne: [f64; 2],
         sc: &SpiralConfig,
         may_turn: bool,
+        wind_speed_mps: f64,
     ) -> (Option<f64>, Option<String>) {
+        let limit = max_offset_rad(wind_speed_mps);
         let Some(into_wind) = into_wind_rad.filter(|_| may_turn) else {
             return (self.chosen_rad, None);
         };
         let clear =
             |legs: &[[[f64; 2]; 2]]| legs.iter().all(|[a, b]| zones.crossed_by(*a, *b).is_none());
         if let Some(held) = self.chosen_rad
-            && stx_dynamics::rotation::wrap_pi(held - into_wind).abs() <= MAX_OFFSET_RAD + 1e-9
+            && stx_dynamics::rotation::wrap_pi(held - into_wind).abs() <= limit + 1e-9
             && clear(&low_legs(target_ne, held, sc))
         {
             return (Some(held), None);
@@ -127,7 +149,7 @@ impl ClearApproach {
             [o, -o]
         }));
         let candidates: Vec<f64> = offsets
-            .filter(|o| o.abs() <= MAX_OFFSET_RAD + 1e-9)
+            .filter(|o| o.abs() <= limit + 1e-9)
             .map(|o| into_wind + o)
             .collect();
         let low_clear = |c: f64| clear(&low_legs(target_ne, c, sc));
@@ -173,8 +195,9 @@ impl ClearApproach {
                 let note = (!self.none_clear).then(|| {
                     format!(
                         "keep-out: no final approach within {:.0}° of the wind clears the zones \
-                         (into the wind crosses '{}'); flying the nominal approach",
-                        MAX_OFFSET_RAD.to_degrees(),
+                         (into the wind crosses '{}'; more would take over {MAX_CROSSWIND_MPS:.0} m/s \
+                         of crosswind); flying the nominal approach",
+                        limit.to_degrees(),
                         blocking.unwrap_or_else(|| "?".into())
                     )
                 });
@@ -240,13 +263,37 @@ mod tests {
     }
 
     #[test]
+    fn the_turn_off_the_wind_is_limited_by_the_crosswind_it_brings() {
+        assert_eq!(max_offset_rad(0.5), MAX_OFFSET_RAD);
+        assert_eq!(max_offset_rad(MAX_CROSSWIND_MPS), MAX_OFFSET_RAD);
+        // 4 m/s: a turn of asin(1/4) = 14.5° at most, so a zone needing 20° is not avoided
+        // by turning: the nominal final is flown.
+        let limit = max_offset_rad(4.0);
+        assert!(
+            (limit.to_degrees() - 14.48).abs() < 0.01,
+            "{}",
+            limit.to_degrees()
+        );
+        assert!((4.0 * limit.sin() - MAX_CROSSWIND_MPS).abs() < 1e-12);
+        let sc = SpiralConfig::default();
+        // A pond across the final from the south, wide enough that 10° does not clear it.
+        let zones = square_zone("Pond", -120.0, -60.0, -40.0, 40.0);
+        let mut calm = ClearApproach::default();
+        let (turned, _) = calm.course(&zones, Some(0.0), [0.0, 0.0], &sc, true, 0.5);
+        assert!(turned.is_some_and(|c| c.abs() > 0.15), "{turned:?}");
+        let mut windy = ClearApproach::default();
+        let (kept, _) = windy.course(&zones, Some(0.0), [0.0, 0.0], &sc, true, 4.0);
+        assert_eq!(kept, None, "into the wind, not {kept:?}");
+    }
+
+    #[test]
     fn a_zone_on_the_final_into_the_wind_turns_the_approach_by_the_least_clear_step() {
         let sc = SpiralConfig::default();
         // Into the wind is north (course 0): the final comes from the south, over a pond
         // 40–80 m south of the target.
         let zones = square_zone("pond", -80.0, -40.0, -10.0, 10.0);
         let mut clear = ClearApproach::default();
-        let (course, note) = clear.course(&zones, Some(0.0), [0.0, 0.0], &sc, true);
+        let (course, note) = clear.course(&zones, Some(0.0), [0.0, 0.0], &sc, true, 0.0);
         let course = course.expect("a turned approach");
         assert!(course.abs() > 0.0 && course.abs() <= MAX_OFFSET_RAD + 1e-9);
         assert!(note.unwrap().contains("'pond'"));
@@ -254,7 +301,7 @@ mod tests {
             assert!(zones.crossed_by(a, b).is_none());
         }
         // Held while the axis may not turn, whatever the wind.
-        let (held, note) = clear.course(&zones, Some(1.0), [0.0, 0.0], &sc, false);
+        let (held, note) = clear.course(&zones, Some(1.0), [0.0, 0.0], &sc, false, 0.0);
         assert_eq!((held, note), (Some(course), None));
     }
 
@@ -264,7 +311,7 @@ mod tests {
         let zones = square_zone("far", 500.0, 600.0, 500.0, 600.0);
         let mut clear = ClearApproach::default();
         assert_eq!(
-            clear.course(&zones, Some(0.3), [0.0, 0.0], &sc, true),
+            clear.course(&zones, Some(0.3), [0.0, 0.0], &sc, true, 0.0),
             (None, None)
         );
     }
@@ -274,20 +321,22 @@ mod tests {
         let sc = SpiralConfig::default();
         let zones = square_zone("pond", -80.0, -40.0, -10.0, 10.0);
         let mut clear = ClearApproach::default();
-        let (course, _) = clear.course(&zones, Some(0.0), [0.0, 0.0], &sc, true);
+        let (course, _) = clear.course(&zones, Some(0.0), [0.0, 0.0], &sc, true, 0.0);
         let course = course.expect("a turned approach");
         // The wind veers so that into the wind is clear now, and back: the course stays, and
         // nothing is said.
         for wind in [0.5, -0.2, 0.3] {
             assert_eq!(
-                clear.course(&zones, Some(wind), [0.0, 0.0], &sc, true),
+                clear.course(&zones, Some(wind), [0.0, 0.0], &sc, true, 0.0),
                 (Some(course), None)
             );
         }
         // Further than the largest offset from the wind it is chosen again.
         let far = course + MAX_OFFSET_RAD + 0.3;
         assert_ne!(
-            clear.course(&zones, Some(far), [0.0, 0.0], &sc, true).0,
+            clear
+                .course(&zones, Some(far), [0.0, 0.0], &sc, true, 0.0)
+                .0,
             Some(course)
         );
     }
@@ -304,12 +353,12 @@ mod tests {
             [-20.0, 20.0],
         ]);
         let mut clear = ClearApproach::default();
-        let (course, note) = clear.course(&zones, Some(0.0), [0.0, 0.0], &sc, true);
+        let (course, note) = clear.course(&zones, Some(0.0), [0.0, 0.0], &sc, true, 0.0);
         assert_eq!(course, None);
         assert!(note.unwrap().contains("flying the nominal approach"));
         // Said once.
         assert_eq!(
-            clear.course(&zones, Some(0.0), [0.0, 0.0], &sc, true),
+            clear.course(&zones, Some(0.0), [0.0, 0.0], &sc, true, 0.0),
             (None, None)
         );
     }

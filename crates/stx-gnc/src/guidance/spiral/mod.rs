@@ -307,9 +307,14 @@ impl Spiral {
                     phase,
                     GuidancePhase::Approximation | GuidancePhase::BestReachable
                 );
-            let (course, note) =
-                self.clear_approach
-                    .course(&self.keep_out, into_wind, target_ne, sc, may_turn);
+            let (course, note) = self.clear_approach.course(
+                &self.keep_out,
+                into_wind,
+                target_ne,
+                sc,
+                may_turn,
+                wind.speed_mps,
+            );
             self.notes.extend(note);
             course
         };
