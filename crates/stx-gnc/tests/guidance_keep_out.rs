@@ -92,21 +92,25 @@ fn low_track_enters(f: &Flight, zones: &KeepOutZones, height_m: f64) -> bool {
     })
 }
 
+/// A pond on the final approach into a wind from `from_deg`, 15–45 m downwind of `target`.
+fn pond_on_final(target: [f64; 2], from_deg: f64) -> KeepOutZones {
+    let downwind = (from_deg + 180.0_f64).to_radians();
+    let centre = [
+        target[0] + 30.0 * downwind.cos(),
+        target[1] + 30.0 * downwind.sin(),
+    ];
+    KeepOutZones {
+        zones: vec![rectangle("pond", centre, downwind, 15.0, 8.0)],
+    }
+}
+
 #[test]
 fn a_pond_on_the_final_into_the_wind_is_cleared_by_landing_off_the_wind() {
     let target = [200.0, 100.0];
     // Light winds: turning the final off the wind costs at most 1 m/s of crosswind.
     for (speed, from_deg) in [(1.0, 135.0), (0.8, 250.0)] {
         let wind = wind_from(speed, from_deg);
-        // A pond on the final approach into the wind, 15–45 m downwind of the target.
-        let downwind = (from_deg + 180.0_f64).to_radians();
-        let centre = [
-            target[0] + 30.0 * downwind.cos(),
-            target[1] + 30.0 * downwind.sin(),
-        ];
-        let zones = KeepOutZones {
-            zones: vec![rectangle("pond", centre, downwind, 15.0, 8.0)],
-        };
+        let zones = pond_on_final(target, from_deg);
         let nominal = land(target, 700.0, wind, &KeepOutZones::default());
         assert!(
             low_track_enters(&nominal, &zones, 100.0),
@@ -188,14 +192,7 @@ fn in_a_strong_wind_the_final_stays_into_the_wind_and_lands_beside_the_pond() {
     let target = [200.0, 100.0];
     let (speed, from_deg) = (4.0, 250.0);
     let wind = wind_from(speed, from_deg);
-    let downwind = (from_deg + 180.0_f64).to_radians();
-    let centre = [
-        target[0] + 30.0 * downwind.cos(),
-        target[1] + 30.0 * downwind.sin(),
-    ];
-    let zones = KeepOutZones {
-        zones: vec![rectangle("pond", centre, downwind, 15.0, 8.0)],
-    };
+    let zones = pond_on_final(target, from_deg);
     let f = land(target, 700.0, wind, &zones);
     assert!(zones.zone_at(f.touchdown).is_none(), "landed in the pond");
     let miss = (f.touchdown[0] - target[0]).hypot(f.touchdown[1] - target[1]);

@@ -2,26 +2,19 @@
 //! included), written as the documented flight-log CSV, compares closely with that vehicle and
 //! clearly worse with one whose drag is doubled; bad input exits 2.
 
+mod common;
+
+use common::stx;
+
 use std::path::PathBuf;
-use std::process::Command;
 
 use serde_json::Value;
 use stx_analysis::flight_log::csv::to_csv;
 use stx_analysis::flight_log::synthetic::{SyntheticFlight, simulate};
 use stx_dynamics::vehicle::Vehicle;
 
-fn stx(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_stx"))
-        .args(args)
-        .output()
-        .expect("stx runs")
-}
-
 fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("stx-cli-compare-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).expect("temp dir");
-    dir
+    common::temp_dir("compare", name)
 }
 
 /// The `rms` of each channel of `stx compare --json`.

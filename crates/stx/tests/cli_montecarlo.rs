@@ -2,22 +2,15 @@
 //! into shards and merged gives the one-machine report; bad parts and bad dispersion files are
 //! refused with a clear message and exit code 2; capsules landed in keep-out zones are counted.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod common;
 
-fn stx(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_stx"))
-        .args(args)
-        .output()
-        .expect("stx runs")
-}
+use common::stx;
+
+use std::path::{Path, PathBuf};
+use std::process::Output;
 
 fn temp_dir(name: &str) -> PathBuf {
-    let dir =
-        std::env::temp_dir().join(format!("stx-cli-montecarlo-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).expect("temp dir");
-    dir
+    common::temp_dir("montecarlo", name)
 }
 
 /// A small campaign: short flights, realistic dispersions.

@@ -1,8 +1,11 @@
 //! `stx record recover` from the outside: a cut recording becomes a whole one; bad input
 //! exits 2 without touching anything.
 
+mod common;
+
+use common::stx;
+
 use std::path::{Path, PathBuf};
-use std::process::Command;
 use std::time::Duration;
 
 use stx_record::{
@@ -11,18 +14,8 @@ use stx_record::{
 
 const T0: u64 = 1_767_225_600_000_000_000;
 
-fn stx(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_stx"))
-        .args(args)
-        .output()
-        .expect("stx runs")
-}
-
 fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("stx-cli-record-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).expect("temp dir");
-    dir
+    common::temp_dir("record", name)
 }
 
 /// A recording of 400 events over 4 s (one-second chunks), and the offset halfway through
