@@ -15,6 +15,8 @@
 use nalgebra::{Vector2, Vector3};
 use stx_dynamics::wind::WindField;
 
+use crate::estimate::Estimate;
+
 /// Default height over which the correction of the profile fades out, m: the depth of air a
 /// forecast's error or an hour's change of the weather tends to share (a few hundred metres
 /// to a kilometre in the boundary layer and above).
@@ -78,6 +80,26 @@ impl<'a> DescentWind<'a> {
             profile: Some((profile, correction)),
             start_altitude_m: -start_position_ned_m.z,
             fade_height_m,
+        }
+    }
+
+    /// The wind below the drone of estimate `est`: its wind corrected `profile` when there is
+    /// one (see [`Self::with_profile`]), else its wind everywhere. What the landing
+    /// prediction and the reachable footprint both fly in.
+    pub fn below_estimate(
+        est: &Estimate,
+        profile: Option<&'a dyn WindField>,
+        fade_height_m: f64,
+    ) -> Self {
+        match profile {
+            Some(p) => Self::with_profile(
+                est.wind_ned_mps,
+                p,
+                est.time_s,
+                &est.position_ned_m,
+                fade_height_m,
+            ),
+            None => Self::uniform(est.wind_ned_mps),
         }
     }
 

@@ -159,16 +159,7 @@ pub fn predict_in_wind(
     config: &PredictorConfig,
     profile: Option<&dyn WindField>,
 ) -> LandingPrediction {
-    let wind = match profile {
-        Some(p) => DescentWind::with_profile(
-            est.wind_ned_mps,
-            p,
-            est.time_s,
-            &est.position_ned_m,
-            config.profile_fade_height_m,
-        ),
-        None => DescentWind::uniform(est.wind_ned_mps),
-    };
+    let wind = DescentWind::below_estimate(est, profile, config.profile_fade_height_m);
     let points = sigma_points(est, config);
     let fly = |planned: bool| {
         let outcomes: Vec<(f64, [f64; 2], f64)> = points

@@ -4,9 +4,8 @@
 //! (see `crates/stx-gnc/GNC_NOTES.md`).
 
 use stx_gnc::estimator::EstimatorConfig;
-use stx_sim::closed_loop::SensedNavigation;
 use stx_sim::dispersions::Dispersions;
-use stx_sim::montecarlo::{MonteCarloConfig, run_all};
+use stx_sim::montecarlo::{MonteCarloConfig, run_sensed};
 
 /// Bounds on the payload's (the capsule's) miss, set on 2026-11-25 from this campaign's
 /// figures then (median 6.8 m, p95 41.1 m, no failed run; the first contact's: 9.3 m and 43.2 m)
@@ -25,15 +24,7 @@ fn regression_sixty_realistic_runs_keep_their_payload_miss_and_failures() {
         dispersions: Dispersions::realistic(),
         ..MonteCarloConfig::default()
     };
-    let report = run_all(
-        &config,
-        |c, sensors| {
-            SensedNavigation::new(sensors, EstimatorConfig::default(), c.seed)
-                .map_err(|e| e.to_string())
-        },
-        |_| {},
-    )
-    .expect("the campaign runs");
+    let report = run_sensed(&config, &EstimatorConfig::default()).expect("the campaign runs");
     let m = report.payload_miss_m;
     eprintln!(
         "60 realistic runs, seed 2026: payload miss median {:.1} m, p95 {:.1} m, max {:.1} m; \

@@ -5,7 +5,7 @@
 use stx_dynamics::vehicle::Vehicle;
 use stx_gnc::estimator::EstimatorConfig;
 use stx_sim::closed_loop::SensedNavigation;
-use stx_sim::montecarlo::{MonteCarloConfig, run_all};
+use stx_sim::montecarlo::{MonteCarloConfig, run_all, run_sensed};
 use stx_sim::open_loop::run;
 use stx_sim::scenario::Scenario;
 use stx_sim::summary::Summary;
@@ -148,15 +148,7 @@ fn the_monte_carlo_gives_the_same_result_for_the_same_seed_on_any_thread_count()
             threads,
             ..MonteCarloConfig::default()
         };
-        run_all(
-            &config,
-            |c, sensors| {
-                SensedNavigation::new(sensors, EstimatorConfig::default(), c.seed)
-                    .map_err(|e| e.to_string())
-            },
-            |_| {},
-        )
-        .expect("runs")
+        run_sensed(&config, &EstimatorConfig::default()).expect("runs")
     };
     let (a, b) = (campaign(1), campaign(2));
     assert!(a.failed_runs.is_empty() && b.failed_runs.is_empty());
@@ -321,13 +313,5 @@ fn a_reversal_onto_the_downwind_leg_is_flown_one_way_and_not_chattered() {
 
 /// The campaign `config` flown with the default sensors and estimator.
 fn fly_sensed(config: &MonteCarloConfig) -> stx_sim::montecarlo::MonteCarloReport {
-    run_all(
-        config,
-        |c, sensors| {
-            SensedNavigation::new(sensors, EstimatorConfig::default(), c.seed)
-                .map_err(|e| e.to_string())
-        },
-        |_| {},
-    )
-    .expect("runs")
+    run_sensed(config, &EstimatorConfig::default()).expect("runs")
 }

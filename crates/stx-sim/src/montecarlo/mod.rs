@@ -46,6 +46,22 @@ pub fn run_all<N: Navigator>(
     run_until(config, navigator, progress, || false)
 }
 
+/// [`run_all`] with every run navigated as on the drone: its sensors, and the estimator set
+/// by `estimator`, seeded by the run (what `stx montecarlo` and the regression tests fly).
+pub fn run_sensed(
+    config: &MonteCarloConfig,
+    estimator: &stx_gnc::estimator::EstimatorConfig,
+) -> Result<MonteCarloReport, IntegrateError> {
+    run_all(
+        config,
+        |c, sensors| {
+            crate::closed_loop::SensedNavigation::new(sensors, estimator.clone(), c.seed)
+                .map_err(|e| e.to_string())
+        },
+        |_| {},
+    )
+}
+
 /// [`run_all`] that stops starting runs once `stop()` is true (an operator's cancel, a time
 /// cap): the runs in flight finish and the report holds only the runs flown, so a cancelled
 /// campaign's report is smaller than asked, never padded.

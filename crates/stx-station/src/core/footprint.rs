@@ -49,15 +49,10 @@ impl FootprintJob {
     pub fn run(&self) -> FootprintDone {
         // The measured profile is corrected by the wind the drone measures now, the correction
         // fading below it, as the landing prediction does.
-        let below = self.wind_profile.as_ref().map(|p| {
-            DescentWind::with_profile(
-                self.estimate.wind_ned_mps,
-                p,
-                self.estimate.time_s,
-                &self.estimate.position_ned_m,
-                DEFAULT_FADE_HEIGHT_M,
-            )
-        });
+        let below = self
+            .wind_profile
+            .as_ref()
+            .map(|p| DescentWind::below_estimate(&self.estimate, Some(p), DEFAULT_FADE_HEIGHT_M));
         let input = FootprintInput {
             estimate: &self.estimate,
             performance: &self.performance,

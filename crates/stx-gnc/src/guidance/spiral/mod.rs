@@ -19,13 +19,14 @@
 //! seed's slide spiral, flown on headings, needed one branch longer than the other to come
 //! back over the target; here that is what the ground-referenced localizers do.
 //!
-//! The pattern's axis and its half-length follow the wind during the approximation; after
-//! that they change only at the start of a loop (at most 45°) and onto the final (at most
-//! 20°), so the vehicle's place in the pattern does not move under it while decisions taken
-//! on it are being flown. Corners are started a turn radius early, at the turn rate the
-//! control gains in force actually give ([`corner_turn_rate_rad_s`]), and energy decisions
-//! wait until the wind estimate has been certain for a while. Each phase change is one
-//! decision, and its reason says where, how high, in which loop, what was decided and why.
+//! The pattern's axis and its half-length follow the wind during the approximation; after that
+//! they change only at the start of a loop (at most 45°, but fully at the first loop on a
+//! settled wind if they were laid on an unsettled one) and onto the final (at most 20°), so the
+//! vehicle's place in the pattern does not move under it while decisions taken on it are being
+//! flown. Corners are started a turn radius early, at the turn rate the control gains in force
+//! actually give ([`corner_turn_rate_rad_s`]), and energy decisions wait until the wind
+//! estimate has been certain for a while. Each phase change is one decision, and its reason
+//! says where, how high, in which loop, what was decided and why.
 //!
 //! Leaving the spiral is an energy decision recomputed at every update. The height needed to
 //! turn base at `x` on Branch1 and glide in is `H(x) = hang + s₀·ay/g_cross + s_t·x/g_up +
@@ -36,21 +37,23 @@
 //! upwind, and full brakes below the flare height.
 //!
 //! **Which law flies the final.** The brakes on the final approach are set by
-//! [`FinalLaw::GlideInversion`] by default: every update, the brake whose steady glide over
-//! the ground, into the planned headwind, ends on the aim point (the flare's start) from where
-//! the vehicle is — the glide performance inverted. The seed's glide-slope law (eqs.
-//! 5.12–5.17, [`control::vertical`](crate::control::vertical)) down a straight path whose slope is fixed at the turn onto
-//! the final is [`FinalLaw::GlideSlope`]; the Monte Carlo comparison that decided between them
-//! is in `crates/stx-gnc/GNC_NOTES.md`.
+//! [`FinalLaw::GlideInversion`] by default: every update, the brake whose steady glide over the
+//! ground, into the planned headwind, ends on the aim point (the flare's start) from where the
+//! vehicle is — the glide performance inverted. The seed's glide-slope law (eqs. 5.12–5.17,
+//! [`control::vertical`](crate::control::vertical)) down a straight path whose slope is fixed
+//! at the turn onto the final is [`FinalLaw::GlideSlope`]; the Monte Carlo comparison that
+//! decided between them is in `crates/stx-gnc/GNC_NOTES.md`.
 //!
 //! **Too strong a wind.** At every update until the flare, in every phase, guidance checks the
 //! glide's reach: the circle of radius `V·T` (T the time left to the ground at the current
 //! sink) around the drift point, where the wind alone would carry the stack. When the target
-//! lies outside it by more than the drift an error of 0.3 m/s in the wind makes over `T`
-//! (plus 20 m), guidance says so — an event with the wind, the reach and the best reachable
-//! point — and flies to that point, the one of the circle nearest the target, into the wind
-//! for the last 40 m. It announces the point again whenever it moves by 50 m (the recovery
-//! team drives to it), and goes back to the target only when it is well inside the circle.
+//! lies outside it by more than the drift an error of 0.3 m/s in the wind makes over `T` (plus
+//! 20 m), guidance says so — an event with the wind, the reach and the best reachable point —
+//! and flies to that point, the one of the circle nearest the target, into the wind for the
+//! last 40 m. A point moved clear of a keep-out zone lies inside the circle, so the way to it
+//! is braked to the glide that ends on it. It announces the point again whenever it moves by 50
+//! m (the recovery team drives to it), and goes back to the target only when it is well inside
+//! the circle.
 //!
 //! # How the parts fit
 //!

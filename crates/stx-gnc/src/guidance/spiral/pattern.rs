@@ -54,6 +54,8 @@ pub(super) struct Axis {
     downwind_rad: Option<f64>,
     /// Half-length of the pattern along the wind, m.
     half_length_m: Option<f64>,
+    /// Whether the axis was last placed on a wind the estimator had not yet settled on.
+    placed_unsettled: bool,
 }
 
 impl Axis {
@@ -82,6 +84,7 @@ impl Axis {
             keep_clear_rad,
         } = courses;
         let wind_speed = wind.speed_mps;
+        let wind_known = wind.known;
         let wind = wind.ne_mps;
         // The pattern's axis: downwind, unless the operator fixed the approach course; in calm
         // air it stays where it was (first: the final approach is flown towards the target
@@ -93,9 +96,16 @@ impl Axis {
         let frozen = !(reorient || free);
         // A turn of the axis at a loop's start or onto the final is limited: the vehicle is
         // placed for the axis it had, and a light wind's direction is barely known.
+        // An axis placed on an unsettled wind (a release right at an entry corner, the
+        // estimator's wind still near zero) was never a decision about the real wind: Monte
+        // Carlo seed 12 run 252 laid its pattern on 0.8 m/s from 57° against 3.9 m/s from
+        // 188°, turned 45° a loop, flew its "across" legs into the wind, came to the final 60 m
+        // short and landed in the pond. The first loop on a settled wind may turn it fully.
+        let resettle = reorient && self.placed_unsettled && wind_known;
         let largest_turn = match phase {
             _ if free => std::f64::consts::PI,
             GuidancePhase::FinalApproach => FINAL_REORIENT_MAX_RAD,
+            _ if resettle => std::f64::consts::PI,
             _ => LOOP_REORIENT_MAX_RAD,
         };
         // Where the axis would go: a keep-out course (see `keep_clear`) in place of the
@@ -116,6 +126,9 @@ impl Axis {
             (None, None, None) => rel[1].atan2(rel[0]),
         };
         self.downwind_rad = Some(downwind);
+        if !frozen {
+            self.placed_unsettled = !wind_known;
+        }
         (downwind, frozen)
     }
 
@@ -296,6 +309,66 @@ mod tests {
         spiral.update(&fixed, &plan, &est, 1.2);
         let c = spiral.status().corners_ne_m;
         assert!((0.5 * (c[1][0] - c[0][0]).hypot(c[1][1] - c[0][1]) - a).abs() < 1e-9);
+    }
+
+    /// An axis placed on the estimator's unsettled wind turns fully at the first loop on a
+    /// settled one (Monte Carlo seed 12 run 252); one placed on a settled wind still turns at
+    /// most 45° a loop.
+    #[test]
+    fn an_axis_placed_on_an_unsettled_wind_turns_fully_at_the_first_loop_on_a_settled_one() {
+        let sc = SpiralConfig::default();
+        let no_courses = Courses {
+            operator_rad: None,
+            keep_clear_rad: None,
+        };
+        let wind = |from_deg: f64, known: bool| {
+            let to = (from_deg + 180.0).to_radians();
+            let ne_mps = [3.9 * to.cos(), 3.9 * to.sin()];
+            WindNow {
+                measured_ne_mps: ne_mps,
+                ne_mps,
+                speed_mps: 3.9,
+                known,
+            }
+        };
+        let deg = |rad: f64| rad.to_degrees().rem_euclid(360.0);
+        // Downwind of a wind from 188° is 8°; the first axis was laid for one from 57°.
+        for (placed_known, expected_deg) in [(false, 8.0), (true, 237.0 + 45.0)] {
+            let mut axis = Axis::default();
+            let (first, _) = axis.orient(
+                GuidancePhase::Approximation,
+                false,
+                no_courses,
+                &wind(57.0, placed_known),
+                &sc,
+                [0.0, -60.0],
+            );
+            assert!((deg(first) - 237.0).abs() < 1e-6);
+            // Within the loop the axis holds, whatever the wind.
+            let (held, frozen) = axis.orient(
+                GuidancePhase::Branch3,
+                false,
+                no_courses,
+                &wind(188.0, true),
+                &sc,
+                [0.0, -60.0],
+            );
+            assert!(frozen && (deg(held) - 237.0).abs() < 1e-6);
+            let (turned, _) = axis.orient(
+                GuidancePhase::Branch1,
+                true,
+                no_courses,
+                &wind(188.0, true),
+                &sc,
+                [0.0, -60.0],
+            );
+            assert!(
+                (deg(turned) - expected_deg).abs() < 1e-6,
+                "placed on a {} wind: turned to {}°",
+                if placed_known { "settled" } else { "unsettled" },
+                deg(turned)
+            );
+        }
     }
 
     fn spiral_turn_distance(config: &GuidanceConfig) -> f64 {

@@ -22,7 +22,7 @@ const BEST_POINT_MOVED_M: f64 = 50.0;
 pub(super) const MIN_BEST_REACHABLE_S: f64 = 10.0;
 /// Below this height of the lowest body the way to the best reachable point ends into the
 /// wind, m.
-const INTO_WIND_BELOW_M: f64 = 40.0;
+pub(super) const INTO_WIND_BELOW_M: f64 = 40.0;
 
 /// The glide's reach at one update, relative to the target.
 #[derive(Debug, Clone, Copy)]
