@@ -20,7 +20,8 @@
 //!   analysis and of a tuning with it, and [`gains_file`] the gains file a tuning writes.
 //!
 //! - [`flight_log`] is a recorded flight (from a recording's telemetry or a CSV);
-//!   [`compare`] flies the model through one and sets the two side by side (issue 16).
+//!   [`compare`] flies the model through one and sets the two side by side (issue 16);
+//!   [`identify`] fits the vehicle's coefficients to flights.
 //!
 //! Pure: no files, no clocks, no randomness. The `stx` binary reads and writes files.
 
@@ -30,6 +31,7 @@ pub mod figures;
 pub mod flight_log;
 pub mod forced_response;
 pub mod gains_file;
+pub mod identify;
 pub mod jacobian;
 pub mod linearize;
 pub mod lti;

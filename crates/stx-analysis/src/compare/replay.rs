@@ -10,8 +10,9 @@
 //! the transient from that glide to the recorded one; a flight logged in a steady glide has
 //! almost none.
 //!
-//! The commands are interpolated linearly between samples and held over each integration
-//! step (fixed-step RK4; the servos' own first-order lag smooths the steps). The wind is the
+//! Each recorded command is held until the next one (see [`FlightLog::commands_at`]); the
+//! integration (fixed-step RK4) steps land on the log's instants, so no step straddles a
+//! command change. The wind is the
 //! estimate interpolated in time, uniform in space: what the drone knew.
 
 use std::sync::Arc;
@@ -39,6 +40,9 @@ pub enum ReplayError {
     /// The integration failed (the model diverged).
     #[error("the model could not fly the recorded commands")]
     Integrate(#[from] IntegrateError),
+    /// The vehicle is not one the model can fly (a fitted value broke a rule).
+    #[error("invalid vehicle: {0}")]
+    InvalidVehicle(String),
     /// The integration step is not a positive number of seconds.
     #[error("integration step {0} s must be positive and finite")]
     BadStep(f64),

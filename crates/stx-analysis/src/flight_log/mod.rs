@@ -138,13 +138,19 @@ impl FlightLog {
         self.samples[self.samples.len() - 1].time_s - self.samples[0].time_s
     }
 
-    /// The commands at `time_s`, linearly interpolated between samples (held beyond them):
-    /// main line (−1 … 1), right and left brake.
+    /// The commands in force at `time_s`: main line (−1 … 1), right and left brake, each
+    /// held from its sample until the next (the first before the log). A recorded command is
+    /// what the servos were told from then on, so holding it, not interpolating between
+    /// samples, is what they did: a step interpolated over a sample interval is a step moved
+    /// by half an interval, and that bias showed in identification.
     pub fn commands_at(&self, time_s: f64) -> [f64; 3] {
-        self.interpolate(time_s, |s| [s.main_line, s.brake_right, s.brake_left])
+        let s = &self.samples;
+        let i = s.partition_point(|x| x.time_s <= time_s).saturating_sub(1);
+        [s[i].main_line, s[i].brake_right, s[i].brake_left]
     }
 
-    /// The wind estimate at `time_s`, NED, m/s, interpolated likewise.
+    /// The wind estimate at `time_s`, NED, m/s, interpolated linearly between samples (held
+    /// beyond them).
     pub fn wind_at(&self, time_s: f64) -> [f64; 3] {
         self.interpolate(time_s, |s| s.wind_ned_mps)
     }
@@ -190,9 +196,10 @@ pub(crate) mod tests {
     }
 
     #[test]
-    fn commands_are_interpolated_and_held_beyond_the_ends() {
+    fn commands_are_held_and_winds_interpolated() {
         let log = FlightLog::new(straight(5)).unwrap();
-        assert!((log.commands_at(1.5)[1] - 0.15).abs() < 1e-12);
+        assert!((log.commands_at(1.5)[1] - 0.1).abs() < 1e-12);
+        assert!((log.commands_at(2.0)[1] - 0.2).abs() < 1e-12);
         assert_eq!(log.commands_at(-3.0)[1], 0.0);
         assert!((log.commands_at(10.0)[1] - 0.4).abs() < 1e-12);
         assert_eq!(log.wind_at(2.2), [0.0, 1.0, 0.0]);

@@ -37,8 +37,9 @@ pub enum SyntheticError {
     Noise(&'static str),
 }
 
-/// One-sigma white noise of the simulated sensors.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+/// One-sigma white noise of the simulated sensors (and the weights of identification's
+/// residuals).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 pub struct SensorNoise {
     /// GPS horizontal position, m.
     pub horizontal_m: f64,

@@ -1,0 +1,156 @@
+use std::sync::atomic::AtomicBool;
+
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use rand_distr::{Distribution, StandardNormal};
+use stx_dynamics::vehicle::{STRAPLEX_TOML, VehicleConfig};
+use stx_sim::dispersions::Dispersions;
+
+use super::*;
+use crate::flight_log::synthetic::{SyntheticFlight, simulate};
+
+fn nominal() -> VehicleConfig {
+    VehicleConfig::from_toml_str(STRAPLEX_TOML).unwrap()
+}
+
+/// A vehicle whose `params` are drawn from the realistic dispersions' spread (canopy or brake
+/// 1-σ fractions, clipped at ±3 σ as stx-sim clips them), the rest nominal.
+fn dispersed(params: &[Param], seed: u64) -> VehicleConfig {
+    let d = Dispersions::realistic();
+    let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0x1de7);
+    let mut v = nominal();
+    for p in params {
+        let g: f64 = StandardNormal.sample(&mut rng);
+        let g = g.clamp(-3.0, 3.0);
+        match p {
+            Param::RiggingDeg => p.set(&mut v, d.rigging.angle_sigma_deg * g),
+            Param::ClDs | Param::CdDs | Param::ClDa | Param::CnDa => {
+                let value = p.get(&v) * (1.0 + d.aero.brake_sigma * g);
+                p.set(&mut v, value)
+            }
+            _ => {
+                let value = p.get(&v) * (1.0 + d.aero.canopy_sigma * g);
+                p.set(&mut v, value)
+            }
+        }
+    }
+    v
+}
+
+/// Trials for the coverage test: `STX_IDENTIFY_TRIALS`, or 10 (about 40 s in release).
+fn trials() -> u64 {
+    std::env::var("STX_IDENTIFY_TRIALS")
+        .ok()
+        .and_then(|t| t.parse().ok())
+        .unwrap_or(10)
+}
+
+#[test]
+fn recovers_dispersed_coefficients_closely() {
+    let params = [Param::ClAlpha, Param::Cd0, Param::CnDa];
+    let n = trials();
+    let (mut covered, mut inside_all) = ([0u64; 3], 0u64);
+    let mut worst_relative: f64 = 0.0;
+    // Worst relative error of cl_alpha and cd0, worst absolute error of cn_da.
+    let mut worst = [0.0_f64; 3];
+    for seed in 0..n {
+        let truth = dispersed(&params, seed);
+        let log = simulate(
+            &truth.clone().validate().unwrap(),
+            &SyntheticFlight::manoeuvres(seed),
+        )
+        .unwrap();
+        let report = identify(
+            &[log],
+            &params,
+            &nominal(),
+            &IdentifyOptions::default(),
+            &AtomicBool::new(false),
+            &mut |_| {},
+        )
+        .unwrap();
+        let mut all = true;
+        for (k, (p, e)) in params.iter().zip(&report.params).enumerate() {
+            let t = p.get(&truth);
+            let [lo, hi] = e.interval95.unwrap();
+            let inside = (lo..=hi).contains(&t);
+            covered[k] += u64::from(inside);
+            all &= inside;
+            worst_relative = worst_relative.max(((e.estimate - t) / t).abs());
+            let err = if k == 2 {
+                (e.estimate - t).abs()
+            } else {
+                ((e.estimate - t) / t).abs()
+            };
+            worst[k] = worst[k].max(err);
+            eprintln!(
+                "trial {seed} {}: truth {t:.5} estimate {:.5} ± {:.5} {}",
+                e.name,
+                e.estimate,
+                Z95 * e.std_error.unwrap(),
+                if inside { "in" } else { "OUT" }
+            );
+        }
+        inside_all += u64::from(all);
+        eprintln!(
+            "trial {seed}: rms {:.2} → {:.2} after {} iterations ({:?})",
+            report.residual_rms_before, report.residual_rms_after, report.iterations, report.stop
+        );
+        assert!(report.residual_rms_after <= report.residual_rms_before);
+    }
+    eprintln!(
+        "coverage over {n} trials: {:?} of {n} per parameter, {inside_all} with all three; worst relative error {worst_relative:.4}",
+        covered
+    );
+    // Not asserted: the 95 % intervals' coverage, which falls short (see the module doc of
+    // `identify`: residual model mismatch of the replay's trimmed start makes the intervals
+    // too narrow). Asserted: the estimates land close to the truth, against a realistic
+    // spread of 20 % (canopy) and 30 % (brakes) 1-σ.
+    for (k, e) in worst.iter().enumerate() {
+        assert!(*e < [0.03, 0.03, 0.0015][k], "worst errors {worst:?}");
+    }
+}
+
+#[test]
+fn the_fitted_file_is_a_vehicle_and_bad_requests_are_refused() {
+    let truth = dispersed(&[Param::ClAlpha], 3);
+    let mut flight = SyntheticFlight::manoeuvres(3);
+    flight.duration_s = 40.0;
+    let log = simulate(&truth.clone().validate().unwrap(), &flight).unwrap();
+    let mut heard = 0;
+    let report = identify(
+        std::slice::from_ref(&log),
+        &[Param::ClAlpha],
+        &nominal(),
+        &IdentifyOptions::default(),
+        &AtomicBool::new(false),
+        &mut |_| heard += 1,
+    )
+    .unwrap();
+    assert!(heard >= 1);
+    let fitted = VehicleConfig::from_toml_str(&report.vehicle_toml).unwrap();
+    assert_eq!(fitted.canopy.aero.cl_alpha, report.params[0].estimate);
+    assert_eq!(report.correlation.as_ref().unwrap()[0][0], 1.0);
+    let run = |params: &[Param], logs: &[FlightLog]| {
+        identify(
+            logs,
+            params,
+            &nominal(),
+            &IdentifyOptions::default(),
+            &AtomicBool::new(false),
+            &mut |_| {},
+        )
+    };
+    assert!(matches!(
+        run(&[], std::slice::from_ref(&log)),
+        Err(IdentifyError::NoParams)
+    ));
+    assert!(matches!(
+        run(&[Param::Cd0], &[]),
+        Err(IdentifyError::NoFlights)
+    ));
+    assert!(matches!(
+        run(&[Param::Cd0, Param::Cd0], std::slice::from_ref(&log)),
+        Err(IdentifyError::Duplicate("cd0"))
+    ));
+}
