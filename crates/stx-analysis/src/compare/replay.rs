@@ -96,8 +96,14 @@ fn controls(log: &FlightLog, vehicle: &Vehicle, time_s: f64) -> Controls {
     .saturated(vehicle.main_line_travel_m)
 }
 
-/// The stack's state at the log's first sample (see the module doc).
-pub fn initial_state(log: &FlightLog, vehicle: &Vehicle) -> Result<StateVector, ReplayError> {
+/// The stack's state at the log's first sample (see the module doc), turned by `turn_rad`
+/// from the recorded heading (identification fits that turn: one noisy heading sample sets
+/// the course of the whole replay).
+pub fn initial_state(
+    log: &FlightLog,
+    vehicle: &Vehicle,
+    turn_rad: f64,
+) -> Result<StateVector, ReplayError> {
     let first = log.samples()[0];
     let c = controls(log, vehicle, first.time_s);
     let brake = 0.5 * (c.brake_right + c.brake_left);
@@ -110,7 +116,7 @@ pub fn initial_state(log: &FlightLog, vehicle: &Vehicle) -> Result<StateVector, 
     let drone = Body::Drone as usize;
     let kin = Kinematics::new(vehicle, &x, 0.0);
     let drone_yaw = euler_from_t(&kin.t_i_body[drone]).z;
-    x[idx::CANOPY_EULER + 2] += first.euler_rad[2] - drone_yaw;
+    x[idx::CANOPY_EULER + 2] += first.euler_rad[2] + turn_rad - drone_yaw;
     x[idx::MAIN_LINE] = c.main_line_m;
     x[idx::BRAKE_RIGHT] = c.brake_right;
     x[idx::BRAKE_LEFT] = c.brake_left;
@@ -127,6 +133,16 @@ pub fn initial_state(log: &FlightLog, vehicle: &Vehicle) -> Result<StateVector, 
 /// Flies `vehicle` through `log` with RK4 steps of at most `step_s`, and returns what its
 /// drone did at each of the log's instants.
 pub fn fly(log: &FlightLog, vehicle: &Vehicle, step_s: f64) -> Result<Vec<Flown>, ReplayError> {
+    fly_turned(log, vehicle, step_s, 0.0)
+}
+
+/// [`fly`] from a start turned by `turn_rad` from the recorded heading.
+pub fn fly_turned(
+    log: &FlightLog,
+    vehicle: &Vehicle,
+    step_s: f64,
+    turn_rad: f64,
+) -> Result<Vec<Flown>, ReplayError> {
     if !(step_s.is_finite() && step_s > 0.0) {
         return Err(ReplayError::BadStep(step_s));
     }
@@ -143,7 +159,7 @@ pub fn fly(log: &FlightLog, vehicle: &Vehicle, step_s: f64) -> Result<Vec<Flown>
             ground_altitude_msl_m: 0.0,
         },
     );
-    let mut x = initial_state(log, vehicle)?;
+    let mut x = initial_state(log, vehicle, turn_rad)?;
     let mut out = Vec::with_capacity(samples.len());
     let mut t = samples[0].time_s;
     for (k, s) in samples.iter().enumerate() {

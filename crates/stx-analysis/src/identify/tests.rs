@@ -37,20 +37,23 @@ fn dispersed(params: &[Param], seed: u64) -> VehicleConfig {
     v
 }
 
-/// Trials for the coverage test: `STX_IDENTIFY_TRIALS`, or 10 (about 40 s in release).
+/// Trials for the coverage test: `STX_IDENTIFY_TRIALS`, or 20 (about 40 s in release).
 fn trials() -> u64 {
     std::env::var("STX_IDENTIFY_TRIALS")
         .ok()
         .and_then(|t| t.parse().ok())
-        .unwrap_or(10)
+        .unwrap_or(20)
 }
 
+/// Seeded flights of vehicles whose lift slope, zero-lift drag and turn term are drawn from
+/// the realistic dispersions, logged with white sensor noise; each fitted from the nominal
+/// vehicle. Measured (module doc): 19, 19, 20 of 20 inside the 95 % interval (28, 28, 29 of
+/// 30); worst errors 0.5 %, 0.6 % and 0.0002.
 #[test]
-fn recovers_dispersed_coefficients_closely() {
+fn the_95_percent_intervals_hold_the_truth_in_at_least_9_of_10_trials() {
     let params = [Param::ClAlpha, Param::Cd0, Param::CnDa];
     let n = trials();
-    let (mut covered, mut inside_all) = ([0u64; 3], 0u64);
-    let mut worst_relative: f64 = 0.0;
+    let mut covered = [0u64; 3];
     // Worst relative error of cl_alpha and cd0, worst absolute error of cn_da.
     let mut worst = [0.0_f64; 3];
     for seed in 0..n {
@@ -69,14 +72,11 @@ fn recovers_dispersed_coefficients_closely() {
             &mut |_| {},
         )
         .unwrap();
-        let mut all = true;
         for (k, (p, e)) in params.iter().zip(&report.params).enumerate() {
             let t = p.get(&truth);
             let [lo, hi] = e.interval95.unwrap();
             let inside = (lo..=hi).contains(&t);
             covered[k] += u64::from(inside);
-            all &= inside;
-            worst_relative = worst_relative.max(((e.estimate - t) / t).abs());
             let err = if k == 2 {
                 (e.estimate - t).abs()
             } else {
@@ -84,30 +84,27 @@ fn recovers_dispersed_coefficients_closely() {
             };
             worst[k] = worst[k].max(err);
             eprintln!(
-                "trial {seed} {}: truth {t:.5} estimate {:.5} ± {:.5} {}",
+                "trial {seed} {}: truth {t:.5} estimate {:.5} ± {:.5} {} ({:+.2} σ)",
                 e.name,
                 e.estimate,
-                Z95 * e.std_error.unwrap(),
-                if inside { "in" } else { "OUT" }
+                e.interval95.map_or(f64::NAN, |[lo, hi]| 0.5 * (hi - lo)),
+                if inside { "in" } else { "OUT" },
+                (e.estimate - t) / e.std_error.unwrap()
             );
         }
-        inside_all += u64::from(all);
         eprintln!(
             "trial {seed}: rms {:.2} → {:.2} after {} iterations ({:?})",
             report.residual_rms_before, report.residual_rms_after, report.iterations, report.stop
         );
         assert!(report.residual_rms_after <= report.residual_rms_before);
     }
-    eprintln!(
-        "coverage over {n} trials: {:?} of {n} per parameter, {inside_all} with all three; worst relative error {worst_relative:.4}",
-        covered
-    );
-    // Not asserted: the 95 % intervals' coverage, which falls short (see the module doc of
-    // `identify`: residual model mismatch of the replay's trimmed start makes the intervals
-    // too narrow). Asserted: the estimates land close to the truth, against a realistic
-    // spread of 20 % (canopy) and 30 % (brakes) 1-σ.
+    eprintln!("inside the 95 % interval in {covered:?} of {n} trials; worst errors {worst:?}");
+    for c in covered {
+        assert!(10 * c >= 9 * n, "inside in {covered:?} of {n}");
+    }
+    // Against a realistic spread of 20 % (canopy) and 30 % (brakes) 1-σ.
     for (k, e) in worst.iter().enumerate() {
-        assert!(*e < [0.03, 0.03, 0.0015][k], "worst errors {worst:?}");
+        assert!(*e < [0.01, 0.01, 0.0005][k], "worst errors {worst:?}");
     }
 }
 
