@@ -14,6 +14,7 @@ mod bench_station;
 mod compare;
 mod drone;
 mod export;
+mod identify;
 mod import;
 mod inputs;
 mod lab;
@@ -75,6 +76,9 @@ enum Command {
     Plan(plan::PlanArgs),
     /// A flight (recording or flight-log CSV) against the model: per-channel errors.
     Compare(compare::CompareArgs),
+    /// Fit chosen vehicle coefficients to flights (recordings or flight-log CSVs): estimates,
+    /// 95 % intervals, correlations and the fitted vehicle file.
+    Identify(identify::IdentifyArgs),
     /// Station tokens: `stx token new` prints a strong random one as a `[[tokens]]` entry.
     Token(token::TokenArgs),
 }
@@ -119,6 +123,7 @@ fn main() -> ExitCode {
         Command::Token(args) => token::run(args),
         Command::Plan(args) => plan::run(args),
         Command::Compare(args) => compare::run(args),
+        Command::Identify(args) => identify::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -150,6 +155,7 @@ impl Command {
                 | Command::Token(_)
                 | Command::Plan(_)
                 | Command::Compare(_)
+                | Command::Identify(_)
         )
     }
 }
