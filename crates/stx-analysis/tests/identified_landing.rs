@@ -6,11 +6,10 @@
 //!
 //! Measured (seed 16, 300 m, wind ≤ 4 m/s, 100 runs, realistic dispersions drawn around the
 //! stack, perfect navigation): with guidance's in-flight learning of the glide frozen, mean
-//! payload miss 26.52 m planning with the nominal vehicle, 22.86 m with the identified one
-//! (paired improvement 3.66 ± 1.47 m, one standard error); with learning, as guidance flies,
+//! payload miss 26.52 m planning with the nominal vehicle, 22.96 m with the identified one
+//! (paired improvement 3.56 ± 1.47 m, one standard error); with learning, as guidance flies,
 //! 11.56 m and 10.73 m (0.83 ± 0.77 m: within the scatter). The learning recovers most of
-//! what a wrong table costs. Without dispersions (the stack flown exactly): 8.76 m and 4.04 m
-//! frozen, 5.23 m and 5.05 m learning.
+//! what a wrong table costs.
 
 use std::sync::atomic::AtomicBool;
 
@@ -130,7 +129,7 @@ fn guidance_with_the_identified_polar_lands_closer_than_with_the_nominal_one() {
         figures.push(f);
     }
     // With learning frozen the table is all guidance knows of the glide: the identified one
-    // lands closer by more than two standard errors of the paired difference (measured 2.5).
+    // lands closer by more than two standard errors of the paired difference (measured 2.4).
     let [_, _, gain, se] = figures[0];
     assert!(gain > 2.0 * se, "{figures:?}");
     // Learning in flight recovers most of it; what is left is within the runs' scatter

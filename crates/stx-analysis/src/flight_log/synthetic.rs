@@ -178,7 +178,10 @@ pub fn simulate(vehicle: &Vehicle, flight: &SyntheticFlight) -> Result<FlightLog
     for sample in run
         .samples
         .iter()
-        .filter(|s| s.time_s >= flight.settle_s - 1e-9)
+        // The simulator flies on past the scenario's end with its last commands held until it
+        // finds a steady stretch for its own summary; commands scheduled after the end would
+        // then be logged but never flown.
+        .filter(|s| s.time_s >= flight.settle_s - 1e-9 && s.time_s <= flight.duration_s + 1e-9)
     {
         let d = sample.body(Body::Drone);
         let air: f64 = (0..3)
@@ -203,4 +206,25 @@ pub fn simulate(vehicle: &Vehicle, flight: &SyntheticFlight) -> Result<FlightLog
         });
     }
     Ok(FlightLog::new(samples)?)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Regression: a flight cut short of its last commands was logged on past its end with
+    /// those commands, which the simulator (flying on with the old ones held for its steady
+    /// summary) never flew; a replay of the true vehicle then turned where the log did not.
+    #[test]
+    fn the_log_ends_with_the_flight_and_its_commands_were_flown() {
+        let mut flight = SyntheticFlight::manoeuvres(5);
+        flight.duration_s = 50.0;
+        let log = simulate(&Vehicle::straplex(), &flight).unwrap();
+        let last = log.samples().last().unwrap();
+        assert!(last.time_s <= 50.0 + 1e-9, "{}", last.time_s);
+        assert_eq!(
+            [last.main_line, last.brake_right, last.brake_left],
+            [0.0; 3]
+        );
+    }
 }

@@ -20,16 +20,16 @@
 //!
 //! Without them the fitted coefficients soaked up these errors: over 10 seeds the truth was
 //! inside the 95 % interval in 2, 0 and 0 of 10 trials for cl_alpha, cd0 and cn_da, with the
-//! residuals slow and correlated. With them: 19, 19 and 20 of 20 (28, 28, 29 of 30), worst
-//! errors 0.5 %, 0.6 % and 0.0002 (cn_da, about 2 % of it) against a dispersion of 20–30 %.
+//! residuals slow and correlated. With them: 20, 19 and 20 of 20 (29, 28, 29 of 30), worst
+//! errors 0.5 %, 0.5 % and 0.0002 (cn_da, about 2 % of it) against a dispersion of 20–30 %.
 //!
 //! The intervals come from [`covariance`]: a sandwich `B·S·B` over the per-instant scores,
 //! with a Newey–West lag for residuals correlated over `correlation_s`. The default lag is 0
 //! (White's estimator), chosen by measurement: on those flights, once the nuisances are
-//! fitted, a lag of 2 s or 5 s (10 or 25 samples) lowered the coverage of cd0 to 17 and 14 of
-//! 20 (cl_alpha and cn_da unchanged), because what is left of the error is a small bias, not
-//! slow noise: the estimates sit about 1.3 σ high on
-//! cd0 and 0.5 σ low on cl_alpha and cn_da in every trial, with a spread of about 0.6 σ
+//! fitted, a lag of 2 s (10 samples) changed nothing and one of 5 s (25 samples) lowered the
+//! coverage of cd0 to 17 of 20 (cl_alpha and cn_da unchanged), because what is left of the
+//! error is a small bias, not slow noise: over 30 trials the estimates sit 1.3 σ high on cd0
+//! and 0.6 σ and 0.5 σ low on cl_alpha and cn_da, with a spread of about 0.65 σ
 //! (the same with half the integration step or 20 s more settling, so it is neither). The
 //! lag is for real flights whose GPS wanders or whose wind estimate lags, which white-noise
 //! simulation does not test.

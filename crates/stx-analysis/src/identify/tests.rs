@@ -47,8 +47,8 @@ fn trials() -> u64 {
 
 /// Seeded flights of vehicles whose lift slope, zero-lift drag and turn term are drawn from
 /// the realistic dispersions, logged with white sensor noise; each fitted from the nominal
-/// vehicle. Measured (module doc): 19, 19, 20 of 20 inside the 95 % interval (28, 28, 29 of
-/// 30); worst errors 0.5 %, 0.6 % and 0.0002.
+/// vehicle. Measured (module doc): 20, 19, 20 of 20 inside the 95 % interval (29, 28, 29 of
+/// 30); worst errors 0.45 %, 0.48 % and 0.00015.
 #[test]
 fn the_95_percent_intervals_hold_the_truth_in_at_least_9_of_10_trials() {
     let params = [Param::ClAlpha, Param::Cd0, Param::CnDa];
