@@ -51,3 +51,4 @@ pub mod performance;
 pub mod plan_upload;
 pub mod pointmass;
 pub mod predict;
+pub mod stats;

@@ -34,6 +34,7 @@
 //! flights), not the normal 1.96.
 
 use nalgebra::{DMatrix, DVector};
+use stx_gnc::stats::student_t_975;
 
 /// Where each recorded instant's residuals sit in the residual vector: per flight, the first
 /// index of each sample's (the last sample's run to the flight's `end`).
@@ -61,16 +62,6 @@ pub struct Covariance {
     pub t95: f64,
     /// The Newey–West lag used, samples.
     pub lag: usize,
-}
-
-/// Student's t 97.5 % quantile for `dof` degrees of freedom (≥ 3) by the Cornish–Fisher
-/// expansion about the normal (0.7 % low at 3 degrees, less above).
-pub fn student_t_975(dof: f64) -> f64 {
-    let z = super::Z95;
-    let (z3, z5, z7) = (z.powi(3), z.powi(5), z.powi(7));
-    z + (z3 + z) / (4.0 * dof)
-        + (5.0 * z5 + 16.0 * z3 + 3.0 * z) / (96.0 * dof.powi(2))
-        + (3.0 * z7 + 19.0 * z5 + 17.0 * z3 - 15.0 * z) / (384.0 * dof.powi(3))
 }
 
 /// The sandwich covariance (see the module doc) with residuals correlated over

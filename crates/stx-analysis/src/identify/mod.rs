@@ -57,7 +57,7 @@ pub use lm::{LmOptions, Step, Stop};
 pub use params::{Param, UnknownParam};
 
 /// z of the two-sided 95 % normal interval.
-pub const Z95: f64 = 1.959_963_984_540_054;
+pub const Z95: f64 = stx_gnc::stats::Z_975;
 
 /// Why nothing was identified.
 #[derive(Debug, Error)]

@@ -26,6 +26,8 @@
 //!
 //! The lag is capped at half the band's samples so that `ν ≥ 3`.
 
+use crate::stats::{Z_975, student_t_975};
+
 /// The fitted value and its variance.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(super) struct Coefficient {
@@ -54,19 +56,6 @@ pub(super) struct Design {
     /// Factor on the Newey–West sum: the inverse of its white-noise bias times the squared
     /// Student-t inflation.
     correction: f64,
-}
-
-/// The standard normal's 97.5 % quantile.
-const Z_975: f64 = 1.959_963_984_540_054;
-
-/// Student's t 97.5 % quantile for `dof` (≥ 3) degrees of freedom by the Cornish–Fisher
-/// expansion about the normal (0.7 % low at 3 degrees, 0.13 % at 5, less above).
-fn student_t_975(dof: f64) -> f64 {
-    let z = Z_975;
-    let (z3, z5, z7) = (z.powi(3), z.powi(5), z.powi(7));
-    z + (z3 + z) / (4.0 * dof)
-        + (5.0 * z5 + 16.0 * z3 + 3.0 * z) / (96.0 * dof.powi(2))
-        + (3.0 * z7 + 19.0 * z5 + 17.0 * z3 - 15.0 * z) / (384.0 * dof.powi(3))
 }
 
 /// Bartlett weight of lag `l` for a window of `lag`.
