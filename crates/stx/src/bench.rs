@@ -63,8 +63,9 @@ enum BenchWhat {
         /// wrong-token requests and 200 WebSocket connects and disconnects a second.
         #[arg(long)]
         abuse: bool,
-        /// While telemetry is timed, run a Lab Monte Carlo batch of N runs (started over the
-        /// API as the Lab page does; cancelled after the window).
+        /// While telemetry is timed, keep Lab Monte Carlo batches of N runs going (each started
+        /// over the API as the Lab page does, the next as soon as one ends; the last cancelled
+        /// after the window).
         #[arg(long, value_name = "N")]
         lab_montecarlo: Option<u32>,
     },
@@ -173,14 +174,13 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
                 }
                 if let Some(l) = &report.lab {
                     println!(
-                        "Lab Monte Carlo during it: {} of {} runs flown in the window{}",
-                        l.runs_done_in_window,
-                        l.runs_asked,
-                        if l.running_at_window_end {
-                            " (still running at its end, then cancelled)"
-                        } else {
-                            " (finished before the window ended)"
-                        }
+                        "Lab Monte Carlo during it: {} batches of {} runs started back to back ({} ended on their own), {} runs flown; the Lab busy {:.1} % of the window (longest gap {:.0} ms)",
+                        l.batches,
+                        l.runs_per_batch,
+                        l.batches_finished,
+                        l.runs_flown,
+                        l.busy_fraction * 100.0,
+                        l.longest_idle_ms
                     );
                 }
                 let r = &report.recording;

@@ -53,7 +53,8 @@ pub struct StationBenchOptions {
     pub record_dir: Option<std::path::PathBuf>,
     /// Flood the station from other addresses while telemetry is timed (`bench_abuse`).
     pub abuse: bool,
-    /// Run a Lab Monte Carlo batch of this many runs while telemetry is timed (`bench_lab`).
+    /// Keep Lab Monte Carlo batches of this many runs going while telemetry is timed
+    /// (`bench_lab`).
     pub lab_montecarlo: Option<u32>,
 }
 
@@ -115,7 +116,7 @@ pub struct StationReport {
     pub recording: stx_station::messages::RecordingView,
     /// The flood during the telemetry window, with `--abuse`.
     pub abuse: Option<crate::bench_abuse::AbuseReport>,
-    /// The Lab batch during the telemetry window, with `--lab-montecarlo`.
+    /// The Lab batches during the telemetry window, with `--lab-montecarlo`.
     pub lab: Option<crate::bench_lab::LabLoadReport>,
 }
 
@@ -362,7 +363,7 @@ pub fn run(options: &StationBenchOptions) -> anyhow::Result<StationReport> {
             None => None,
         };
         let lab = match lab {
-            Some(l) => Some(l.stop(&running).await?),
+            Some(l) => Some(l.stop(timed_from, timed_to).await?),
             None => None,
         };
         if landed.load(Ordering::Relaxed) {
