@@ -1,7 +1,8 @@
 //! The Lab's endpoints (`/api/lab/…`): its status and last result for every page; starting and
 //! cancelling a job, saving a vehicle or gains file and sending gains to the drone for
 //! operators. A job's work runs on a thread of its own (`stx-lab`), never on the runtime that
-//! carries the telemetry, and reports to the pure runner ([`crate::lab::LabJobs`]).
+//! carries the telemetry, at the lowest priority ([`LAB_NICE`]), and reports to the pure
+//! runner ([`crate::lab::LabJobs`]).
 
 use std::collections::BTreeMap;
 use std::path::PathBuf;
@@ -56,6 +57,36 @@ pub(crate) async fn status(State(state): State<AppState>, _caller: Caller) -> Re
     }
 }
 
+/// The nice value of the Lab's thread and of the threads it starts: the lowest priority. A
+/// Monte Carlo batch keeps a core busy for minutes; at the station's own priority the
+/// scheduler shares that core evenly between it and the runtime carrying telemetry, so on a
+/// two-core machine a page's `state` could wait out the Lab's time slice. At nice 19 the
+/// scheduler runs a station thread the moment it wakes.
+pub const LAB_NICE: i32 = 19;
+
+/// Lowers the calling thread (not the process: Linux schedules each thread on its own) to
+/// [`LAB_NICE`]; threads it starts inherit it. Elsewhere, or when refused, the job runs at
+/// the station's priority and the log says so.
+fn lower_this_thread() {
+    #[cfg(target_os = "linux")]
+    {
+        // SAFETY: gettid and setpriority only read and set the calling thread's scheduling
+        // attributes; no memory is passed.
+        let refused = unsafe {
+            let tid = libc::gettid();
+            libc::setpriority(libc::PRIO_PROCESS, tid as libc::id_t, LAB_NICE)
+        };
+        if refused != 0 {
+            tracing::warn!(
+                error = %std::io::Error::last_os_error(),
+                "the Lab's thread runs at the station's priority"
+            );
+        }
+    }
+    #[cfg(not(target_os = "linux"))]
+    tracing::warn!("the Lab's thread runs at the station's priority (Linux only lowers it)");
+}
+
 struct Control {
     shared: Arc<Shared>,
     lab: Arc<LabService>,
@@ -101,6 +132,7 @@ pub(crate) async fn start(
     let spawned = std::thread::Builder::new()
         .name("stx-lab".into())
         .spawn(move || {
+            lower_this_thread();
             let worker = control.lab.worker();
             let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
                 worker.run(&job, &vehicle, &control)
@@ -333,4 +365,42 @@ pub(crate) async fn gains_send(
         }),
     )
         .into_response())
+}
+
+#[cfg(all(test, target_os = "linux"))]
+mod tests {
+    use super::{LAB_NICE, lower_this_thread};
+
+    /// The nice value of the calling thread, from `/proc/thread-self/stat` (field 19).
+    fn nice_of_this_thread() -> i32 {
+        let stat = std::fs::read_to_string("/proc/thread-self/stat").expect("stat");
+        // The command name (field 2) may hold spaces; the fields after it do not.
+        let after_name = &stat[stat.rfind(')').expect("name") + 2..];
+        after_name
+            .split(' ')
+            .nth(16)
+            .expect("nice")
+            .parse()
+            .expect("a number")
+    }
+
+    #[test]
+    fn the_lab_s_thread_and_those_it_starts_run_at_the_lowest_priority_alone() {
+        let before = nice_of_this_thread();
+        let (own, started) = std::thread::spawn(|| {
+            lower_this_thread();
+            let started = std::thread::spawn(nice_of_this_thread)
+                .join()
+                .expect("joins");
+            (nice_of_this_thread(), started)
+        })
+        .join()
+        .expect("joins");
+        assert_eq!((own, started), (LAB_NICE, LAB_NICE));
+        assert_eq!(
+            nice_of_this_thread(),
+            before,
+            "the station's threads keep theirs"
+        );
+    }
 }
