@@ -174,8 +174,9 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
                 }
                 if let Some(l) = &report.lab {
                     println!(
-                        "Lab Monte Carlo during it: {} batches of {} runs started back to back ({} ended on their own), {} runs flown; the Lab busy {:.1} % of the window (longest gap {:.0} ms)",
+                        "Lab Monte Carlo during it: {} batch{} of {} runs started back to back ({} ended on their own), {} runs flown; the Lab busy {:.1} % of the window (longest gap {:.0} ms)",
                         l.batches,
+                        if l.batches == 1 { "" } else { "es" },
                         l.runs_per_batch,
                         l.batches_finished,
                         l.runs_flown,
