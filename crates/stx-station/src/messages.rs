@@ -485,7 +485,8 @@ pub struct TrackPoint {
 pub struct ErrorBody {
     /// Machine-readable kind; every kind the station answers is listed (a new one must be).
     #[schemars(extend("enum" = ["unauthorized", "forbidden", "bad_request", "not_found", "not_armed", "too_many_requests", "replay", "replay_failed", "unreadable", "unavailable", "busy", "internal", "io",
-        "tile_pack", "not_saved", "lab_unavailable", "invalid_job", "invalid_vehicle", "invalid_gains", "no_job", "no_thread", "bad_name", "exists", "write_failed", "confirmation_required"]))]
+        "tile_pack", "not_saved", "lab_unavailable", "invalid_job", "invalid_vehicle", "invalid_gains", "no_job", "no_thread", "bad_name", "exists", "write_failed", "confirmation_required",
+        "unknown_recording", "no_flight"]))]
     pub error: &'static str,
     /// For people: what is wrong.
     pub reason: String,

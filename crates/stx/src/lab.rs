@@ -1,6 +1,7 @@
 //! The Lab's work for `stx serve`: the station's Lab (`stx_station::lab`) decides what runs
-//! and when; this flies the scenario, the Monte Carlo batch, the stability analysis or the
-//! tuning run with the simulator and the analysis, which only the binary links.
+//! and when; this flies the scenario, the Monte Carlo batch, the stability analysis, the
+//! tuning run or a recording's comparison with the model (`crate::lab_compare`) with the
+//! simulator and the analysis, which only the binary links.
 
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -18,8 +19,8 @@ use stx_sim::open_loop;
 use stx_sim::run::Run;
 use stx_sim::scenario::Scenario;
 use stx_station::lab::{
-    JobControl, LabJobBody, LabResult, LabService, LabWorker, MonteCarloSummary, ScenarioSeries,
-    StabilitySummary, TuneSummary,
+    JobControl, JobInputs, LabJobBody, LabResult, LabService, LabWorker, MonteCarloSummary,
+    ScenarioSeries, StabilitySummary, TuneSummary,
 };
 
 /// A Lab job's longest run, s.
@@ -37,9 +38,10 @@ impl LabWorker for Worker {
     fn run(
         &self,
         job: &LabJobBody,
-        vehicle: &Vehicle,
+        inputs: &JobInputs,
         control: &dyn JobControl,
     ) -> Result<LabResult, String> {
+        let vehicle = &inputs.vehicle;
         match job {
             LabJobBody::Scenario { scenario, .. } => scenario_run(scenario, vehicle),
             LabJobBody::MonteCarlo {
@@ -64,6 +66,16 @@ impl LabWorker for Worker {
                 controller,
                 altitude_m,
             } => tuning(controller, vehicle, *altitude_m, control),
+            LabJobBody::Compare {
+                recording,
+                vehicle: edits,
+            } => {
+                let path = inputs
+                    .recording
+                    .as_deref()
+                    .ok_or("the station gave the comparison no recording (a bug)")?;
+                crate::lab_compare::run(recording, path, vehicle, edits, control)
+            }
         }
     }
 }

@@ -18,6 +18,7 @@ mod identify;
 mod import;
 mod inputs;
 mod lab;
+mod lab_compare;
 mod logging;
 mod montecarlo;
 mod plan;

@@ -291,6 +291,35 @@ export type LabResult =
        */
       gains_toml: string;
       kind: "tune";
+    }
+  | {
+      /**
+       * Each channel.
+       */
+      channels: CompareChannel[];
+      /**
+       * Duration of the recorded flight, s.
+       */
+      duration_s: number;
+      kind: "compare";
+      /**
+       * The recording's file name.
+       */
+      recording: string;
+      /**
+       * Samples in the recorded flight (one per GPS position).
+       */
+      samples: number;
+      /**
+       * Times of the plotted instants, s from the flight's first sample (at most
+       * [`MAX_COMPARE_POINTS`], spread evenly).
+       */
+      time_s: number[];
+      /**
+       * The vehicle parameters changed from the seed's for the model (`name = value`; empty:
+       * the seed's STRAPLEX vehicle).
+       */
+      vehicle_changes: string[];
     };
 /**
  * A message from the page on the WebSocket.
@@ -422,6 +451,20 @@ export type LabJobBody =
        */
       controller: string;
       kind: "tune";
+    }
+  | {
+      kind: "compare";
+      /**
+       * A recording's file name in the station's recordings directory, as
+       * `GET /api/recordings` lists it.
+       */
+      recording: string;
+      /**
+       * Parameters changed from the seed's vehicle.
+       */
+      vehicle?: {
+        [k: string]: number | undefined;
+      };
     };
 
 /**
@@ -1846,7 +1889,9 @@ export interface ErrorBody {
     | "bad_name"
     | "exists"
     | "write_failed"
-    | "confirmation_required";
+    | "confirmation_required"
+    | "unknown_recording"
+    | "no_flight";
   /**
    * For people: what is wrong.
    */
@@ -2216,7 +2261,7 @@ export interface LabJobView {
    */
   id: number;
   /**
-   * `scenario`, `monte_carlo`, `stability` or `tune`.
+   * `scenario`, `monte_carlo`, `stability`, `tune` or `compare`.
    */
   kind: string;
   /**
@@ -2260,6 +2305,45 @@ export interface LabOutcomeView {
    * Who started it.
    */
   started_by: string;
+}
+/**
+ * One channel of a comparison: recorded and modelled at the plotted instants, and the error
+ * figures over every sample.
+ */
+export interface CompareChannel {
+  /**
+   * Mean of model − recorded.
+   */
+  bias: number;
+  /**
+   * Samples the figures are over.
+   */
+  count: number;
+  /**
+   * Largest |model − recorded|.
+   */
+  max_abs: number;
+  /**
+   * What the model flew (`null` where its value is not a finite number).
+   */
+  model: (number | null)[];
+  /**
+   * `north_m`, `east_m`, `height_m`, `roll_deg`, `pitch_deg`, `yaw_deg`, `airspeed_mps`,
+   * `sink_mps` or `turn_rate_deg_s`.
+   */
+  name: string;
+  /**
+   * What the drone recorded (`null` where it measured nothing, as airspeed without pitot).
+   */
+  recorded: (number | null)[];
+  /**
+   * Root-mean-square of model − recorded (yaw wrapped to ±180°).
+   */
+  rms: number;
+  /**
+   * Unit of the values and of the error figures (`m`, `deg`, `m/s`, `deg/s`).
+   */
+  unit: string;
 }
 /**
  * `POST /api/lab/jobs`' answer: the job started.

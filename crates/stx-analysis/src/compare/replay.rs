@@ -46,6 +46,12 @@ pub enum ReplayError {
     /// The integration step is not a positive number of seconds.
     #[error("integration step {0} s must be positive and finite")]
     BadStep(f64),
+    /// The caller asked the replay to stop (a cancelled or timed-out Lab job).
+    #[error("stopped at {time_s:.1} s of the flight")]
+    Stopped {
+        /// The log's time reached, s.
+        time_s: f64,
+    },
 }
 
 /// What the model's drone did at one recorded instant (what its sensors would have seen).
@@ -143,6 +149,28 @@ pub fn fly_turned(
     step_s: f64,
     turn_rad: f64,
 ) -> Result<Vec<Flown>, ReplayError> {
+    fly_from(log, vehicle, step_s, turn_rad, |_, _| true)
+}
+
+/// [`fly`], telling `go(done, total)` the samples flown after each one; it stops with
+/// [`ReplayError::Stopped`] when `go` answers false (a long recording flies for seconds, and a
+/// Lab job must stop when cancelled).
+pub fn fly_watched(
+    log: &FlightLog,
+    vehicle: &Vehicle,
+    step_s: f64,
+    go: impl FnMut(usize, usize) -> bool,
+) -> Result<Vec<Flown>, ReplayError> {
+    fly_from(log, vehicle, step_s, 0.0, go)
+}
+
+fn fly_from(
+    log: &FlightLog,
+    vehicle: &Vehicle,
+    step_s: f64,
+    turn_rad: f64,
+    mut go: impl FnMut(usize, usize) -> bool,
+) -> Result<Vec<Flown>, ReplayError> {
     if !(step_s.is_finite() && step_s > 0.0) {
         return Err(ReplayError::BadStep(step_s));
     }
@@ -184,6 +212,9 @@ pub fn fly_turned(
             euler_rad: truth.euler_rad.into(),
             airspeed_mps: truth.air_velocity_body_mps.norm(),
         });
+        if !go(k + 1, samples.len()) {
+            return Err(ReplayError::Stopped { time_s: t });
+        }
     }
     Ok(out)
 }

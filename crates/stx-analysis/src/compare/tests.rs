@@ -69,3 +69,27 @@ fn error_figures_and_wrapping() {
     assert_eq!(wrap_deg(350.0), -10.0);
     assert_eq!(wrap_deg(-190.0), 170.0);
 }
+
+#[test]
+fn a_watched_replay_reports_each_sample_and_stops_when_told() {
+    let vehicle = nominal().validate().unwrap();
+    let log = simulate(&vehicle, &SyntheticFlight::manoeuvres(2)).unwrap();
+    let total = log.samples().len();
+    let mut seen = Vec::new();
+    let flown = fly_watched(&log, &vehicle, DEFAULT_STEP_S, |done, all| {
+        seen.push((done, all));
+        true
+    })
+    .unwrap();
+    assert_eq!(flown.len(), total);
+    assert_eq!(seen.first(), Some(&(1, total)));
+    assert_eq!(seen.last(), Some(&(total, total)));
+    let stop_at = 5;
+    let stopped = fly_watched(&log, &vehicle, DEFAULT_STEP_S, |done, _| done < stop_at);
+    assert_eq!(
+        stopped,
+        Err(ReplayError::Stopped {
+            time_s: log.samples()[stop_at - 1].time_s
+        })
+    );
+}

@@ -2,7 +2,9 @@
 //! cancelling a job, saving a vehicle or gains file and sending gains to the drone for
 //! operators. A job's work runs on a thread of its own (`stx-lab`), never on the runtime that
 //! carries the telemetry, at the lowest priority (the idle scheduling class and
-//! [`LAB_NICE`]), and reports to the pure runner ([`crate::lab::LabJobs`]).
+//! [`LAB_NICE`]), and reports to the pure runner ([`crate::lab::LabJobs`]). A comparison's
+//! recording is checked before its job starts: a plain name of the recordings directory (as
+//! `GET /api/recordings` lists them), a readable file, holding a flight.
 
 use std::collections::BTreeMap;
 use std::path::PathBuf;
@@ -21,8 +23,9 @@ use crate::core::CommandRequest;
 use crate::lab::bodies::{
     LabGain, LabGainsBody, LabGainsListBody, LabSavedBody, LabStartedBody, LabVehicleBody,
 };
+use crate::lab::compare::missing_flight;
 use crate::lab::vehicle_fields::{FieldError, edited_config, edited_vehicle, fields};
-use crate::lab::{JobControl, LabJobBody, LabJobs, LabService, VehicleEdits};
+use crate::lab::{JobControl, JobInputs, LabJobBody, LabJobs, LabService, VehicleEdits};
 
 /// A refused field as every refusal is answered (`ErrorBody`): the reason starts with the
 /// field's dotted name, so a page can mark it.
@@ -125,6 +128,11 @@ pub(crate) async fn start(
         Ok(v) => v,
         Err(e) => return Ok(field_error(StatusCode::BAD_REQUEST, "invalid_vehicle", e)),
     };
+    let recording = match &job {
+        LabJobBody::Compare { recording, .. } => Some(flight_recording(&state, recording).await?),
+        _ => None,
+    };
+    let inputs = JobInputs { vehicle, recording };
     let kind = job.kind();
     let id = lab
         .jobs()
@@ -141,7 +149,7 @@ pub(crate) async fn start(
             lower_this_thread();
             let worker = control.lab.worker();
             let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-                worker.run(&job, &vehicle, &control)
+                worker.run(&job, &inputs, &control)
             }))
             .unwrap_or_else(|_| Err("the job panicked (a bug: see the station's log)".into()));
             let now = control.shared.now_s();
@@ -161,6 +169,49 @@ pub(crate) async fn start(
     }
     tracing::info!(id, kind, by = %caller.name, "Lab job started");
     Ok((StatusCode::ACCEPTED, Json(LabStartedBody { id, kind })).into_response())
+}
+
+/// The path of the recording `name` for a comparison: a plain name of the recordings
+/// directory, a file that opens as a recording and holds a flight.
+async fn flight_recording(state: &AppState, name: &str) -> Result<PathBuf, HttpError> {
+    let unknown = |why: &str| {
+        error(
+            StatusCode::NOT_FOUND,
+            "unknown_recording",
+            format!("no recording named {name:?} {why}"),
+        )
+    };
+    if !super::recordings::valid_name(name) {
+        return Err(unknown(
+            "(a plain file name of the recordings directory, ending in .mcap)",
+        ));
+    }
+    let Some(dir) = state.config.recording.dir.as_ref() else {
+        return Err(unknown("(this station has no recordings directory)"));
+    };
+    let path = dir.join(name);
+    if !std::fs::metadata(&path).is_ok_and(|m| m.is_file()) {
+        return Err(unknown("in the recordings directory"));
+    }
+    // Reading the index is file I/O (a scan, for a file cut short): off the async workers.
+    let opened = path.clone();
+    let checked = tokio::task::spawn_blocking(move || {
+        let recording = stx_record::Recording::open(&opened).map_err(|e| {
+            (
+                StatusCode::UNPROCESSABLE_ENTITY,
+                "unreadable",
+                format!("{}: {e}", opened.display()),
+            )
+        })?;
+        match missing_flight(&recording) {
+            Some(why) => Err((StatusCode::UNPROCESSABLE_ENTITY, "no_flight", why)),
+            None => Ok(()),
+        }
+    })
+    .await
+    .map_err(|e| error(StatusCode::INTERNAL_SERVER_ERROR, "internal", e.to_string()))?;
+    checked.map_err(|(status, kind, reason)| error(status, kind, reason))?;
+    Ok(path)
 }
 
 pub(crate) async fn cancel(

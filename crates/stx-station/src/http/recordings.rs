@@ -23,7 +23,7 @@ use crate::recording::summary::summarize;
 use crate::replies::{RecordingsBody, UnreadableRecording};
 
 /// A plain recording file name (see the module documentation).
-fn valid_name(name: &str) -> bool {
+pub(crate) fn valid_name(name: &str) -> bool {
     name.len() <= 200
         && name.ends_with(".mcap")
         && !name.starts_with('.')

@@ -1,14 +1,16 @@
 //! The Lab: the engineering tools (a scenario, a Monte Carlo batch, the stability analysis, a
-//! tuning run) run from the dashboard on the station's machine, one at a time, in the
+//! tuning run, a recorded flight compared with the model) run from the dashboard on the station's machine, one at a time, in the
 //! background, never on the telemetry path.
 //!
 //! The station cannot fly a scenario itself (stx-sim and stx-analysis sit above it in the
 //! crates' order), so the work is a [`LabWorker`] the binary hands over when it starts the
 //! daemon; the station owns what the pages see and send: the requests ([`LabJobBody`]), the
 //! results ([`LabResult`]), the job's life ([`jobs::LabJobs`]: one at a time, a time cap,
-//! progress, cancel, the last outcome kept) and the vehicle editor ([`vehicle_fields`]).
+//! progress, cancel, the last outcome kept), the vehicle editor ([`vehicle_fields`]) and
+//! what a comparison needs of a recording ([`compare`]).
 
 pub mod bodies;
+pub mod compare;
 pub mod jobs;
 pub mod vehicle_fields;
 
@@ -20,6 +22,7 @@ use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 use stx_dynamics::vehicle::Vehicle;
 
+pub use compare::{CompareChannel, CompareSeries};
 pub use jobs::{LabBusy, LabJobs, StopReason};
 
 /// Largest Monte Carlo batch the Lab flies (a bigger campaign is `stx montecarlo`'s).
@@ -68,6 +71,16 @@ pub enum LabJobBody {
         /// Altitude of the trim, m above sea level (−5000 … 86000).
         altitude_m: f64,
     },
+    /// Fly the model through a recorded flight and compare the two (`stx compare`): from the
+    /// recorded initial state, with the recorded servo commands and wind estimate.
+    Compare {
+        /// A recording's file name in the station's recordings directory, as
+        /// `GET /api/recordings` lists it.
+        recording: String,
+        /// Parameters changed from the seed's vehicle.
+        #[serde(default)]
+        vehicle: VehicleEdits,
+    },
 }
 
 impl LabJobBody {
@@ -78,13 +91,16 @@ impl LabJobBody {
             Self::MonteCarlo { .. } => "monte_carlo",
             Self::Stability { .. } => "stability",
             Self::Tune { .. } => "tune",
+            Self::Compare { .. } => "compare",
         }
     }
 
     /// The vehicle edits the job flies with (none for the others).
     pub fn vehicle_edits(&self) -> Option<&VehicleEdits> {
         match self {
-            Self::Scenario { vehicle, .. } | Self::Stability { vehicle, .. } => Some(vehicle),
+            Self::Scenario { vehicle, .. }
+            | Self::Stability { vehicle, .. }
+            | Self::Compare { vehicle, .. } => Some(vehicle),
             _ => None,
         }
     }
@@ -106,6 +122,10 @@ impl LabJobBody {
                 Err(("scenario".into(), "a scenario name is required".into()))
             }
             Self::Scenario { .. } => Ok(()),
+            Self::Compare { recording, .. } if recording.trim().is_empty() => {
+                Err(("recording".into(), "a recording's name is required".into()))
+            }
+            Self::Compare { .. } => Ok(()),
             Self::MonteCarlo {
                 runs,
                 wind_max_mps,
@@ -135,6 +155,8 @@ pub enum LabResult {
     Stability(StabilitySummary),
     /// A tuning run.
     Tune(TuneSummary),
+    /// A recorded flight beside the model's.
+    Compare(CompareSeries),
 }
 
 /// A scenario's flight as series for the plots (one entry per recorded sample).
@@ -244,14 +266,24 @@ pub trait JobControl: Sync {
     fn should_stop(&self) -> bool;
 }
 
+/// What the station made ready for a job from its request, checked.
+#[derive(Debug, Clone)]
+pub struct JobInputs {
+    /// The vehicle as edited (the seed's for the jobs that take no edits).
+    pub vehicle: Vehicle,
+    /// A comparison's recording: a file of the station's recordings directory holding a
+    /// flight ([`compare::missing_flight`]).
+    pub recording: Option<PathBuf>,
+}
+
 /// The work behind the Lab, supplied by the binary (it alone links the simulator and the
 /// analysis). Called on a blocking thread of its own.
 pub trait LabWorker: Send + Sync {
-    /// Runs `job` (already checked) on `vehicle`; `Err` is the reason it failed.
+    /// Runs `job` (already checked) with `inputs`; `Err` is the reason it failed.
     fn run(
         &self,
         job: &LabJobBody,
-        vehicle: &Vehicle,
+        inputs: &JobInputs,
         control: &dyn JobControl,
     ) -> Result<LabResult, String>;
 }

@@ -1,0 +1,172 @@
+//! The Lab's comparison of a recorded flight with the model (issue 16 item 3; `stx compare` in
+//! the dashboard): what the page asks ([`super::LabJobBody::Compare`] names a recording of the
+//! station's recordings directory), the checks made before a job starts (a recording holds a
+//! flight: [`missing_flight`]), and what the page draws ([`CompareSeries`]). The flying is the
+//! binary's (stx-analysis sits above the station); it hands the series over thinned to at
+//! most [`MAX_COMPARE_POINTS`] instants ([`plotted`]), while the error figures are over every
+//! recorded sample.
+
+use std::io::{Read, Seek};
+
+use schemars::JsonSchema;
+use serde::Serialize;
+use stx_record::Recording;
+
+use crate::recording::telemetry_topic;
+
+/// Most instants a comparison's plots carry: a plot a few hundred pixels wide shows no more,
+/// and an hour's flight at 4 Hz (14,400 samples × 9 channels × 2) would be megabytes of JSON
+/// on every page's poll.
+pub const MAX_COMPARE_POINTS: usize = 1500;
+
+/// The telemetry a flight log is made of, and how many messages of each it needs: the GPS
+/// position is the time base (at least three instants to fly between), the attitude and the
+/// servo commands are held from their latest (stx-analysis' `flight_log::recording`).
+pub const FLIGHT_TELEMETRY: [(&str, u64); 3] = [
+    ("GLOBAL_POSITION_INT", 3),
+    ("ATTITUDE", 1),
+    ("SERVO_OUTPUT_RAW", 1),
+];
+
+/// Why `recording` holds no flight to compare (the telemetry it lacks), from its index
+/// alone: `None` when it has what [`FLIGHT_TELEMETRY`] asks.
+pub fn missing_flight<R: Read + Seek>(recording: &Recording<R>) -> Option<String> {
+    let missing: Vec<String> = FLIGHT_TELEMETRY
+        .iter()
+        .filter_map(|(name, least)| {
+            let have = recording
+                .channel(&telemetry_topic(name))
+                .map_or(0, |c| c.message_count);
+            (have < *least).then(|| format!("{name} ({have} of at least {least} messages)"))
+        })
+        .collect();
+    (!missing.is_empty()).then(|| {
+        format!(
+            "the recording holds no flight to compare: it lacks {} telemetry",
+            missing.join(", ")
+        )
+    })
+}
+
+/// The indices of the instants plotted of `n` samples: all of them up to `max`, else `max`
+/// spread evenly, the first and the last included.
+pub fn plotted(n: usize, max: usize) -> Vec<usize> {
+    if n <= max {
+        return (0..n).collect();
+    }
+    if max < 2 {
+        return (0..max).collect();
+    }
+    let last = (n - 1) as f64;
+    let steps = (max - 1) as f64;
+    let mut out: Vec<usize> = (0..max)
+        .map(|k| (k as f64 * last / steps).round() as usize)
+        .collect();
+    out.dedup();
+    out
+}
+
+/// One channel of a comparison: recorded and modelled at the plotted instants, and the error
+/// figures over every sample.
+#[derive(Debug, Clone, Default, Serialize, JsonSchema)]
+pub struct CompareChannel {
+    /// `north_m`, `east_m`, `height_m`, `roll_deg`, `pitch_deg`, `yaw_deg`, `airspeed_mps`,
+    /// `sink_mps` or `turn_rate_deg_s`.
+    pub name: String,
+    /// Unit of the values and of the error figures (`m`, `deg`, `m/s`, `deg/s`).
+    pub unit: String,
+    /// What the drone recorded (`null` where it measured nothing, as airspeed without pitot).
+    pub recorded: Vec<Option<f64>>,
+    /// What the model flew (`null` where its value is not a finite number).
+    pub model: Vec<Option<f64>>,
+    /// Root-mean-square of model − recorded (yaw wrapped to ±180°).
+    pub rms: f64,
+    /// Largest |model − recorded|.
+    pub max_abs: f64,
+    /// Mean of model − recorded.
+    pub bias: f64,
+    /// Samples the figures are over.
+    pub count: u32,
+}
+
+/// A recording compared with the model (`stx compare` in the Lab).
+#[derive(Debug, Clone, Default, Serialize, JsonSchema)]
+pub struct CompareSeries {
+    /// The recording's file name.
+    pub recording: String,
+    /// The vehicle parameters changed from the seed's for the model (`name = value`; empty:
+    /// the seed's STRAPLEX vehicle).
+    pub vehicle_changes: Vec<String>,
+    /// Duration of the recorded flight, s.
+    pub duration_s: f64,
+    /// Samples in the recorded flight (one per GPS position).
+    pub samples: u32,
+    /// Times of the plotted instants, s from the flight's first sample (at most
+    /// [`MAX_COMPARE_POINTS`], spread evenly).
+    pub time_s: Vec<f64>,
+    /// Each channel.
+    pub channels: Vec<CompareChannel>,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::time::Duration;
+    use stx_record::{CoreOptions, RecorderCore, RecordingInfo, foxglove};
+
+    #[test]
+    fn plotted_keeps_short_flights_whole_and_thins_long_ones_evenly() {
+        assert_eq!(plotted(4, 10), vec![0, 1, 2, 3]);
+        assert_eq!(plotted(0, 10), Vec::<usize>::new());
+        let long = plotted(14_400, MAX_COMPARE_POINTS);
+        assert_eq!(long.len(), MAX_COMPARE_POINTS);
+        assert_eq!((long[0], long[long.len() - 1]), (0, 14_399));
+        let gaps: Vec<usize> = long.windows(2).map(|w| w[1] - w[0]).collect();
+        assert!(gaps.iter().all(|g| (9..=10).contains(g)), "{gaps:?}");
+        assert_eq!(plotted(11, 2), vec![0, 10]);
+    }
+
+    /// A closed recording with `counts` messages on each telemetry topic.
+    fn recording(counts: &[(&str, u64)]) -> Recording<std::io::Cursor<Vec<u8>>> {
+        let info = RecordingInfo::new("test", "straplex-2", "lab compare");
+        let mut core = RecorderCore::new(CoreOptions::default(), info, Duration::ZERO).unwrap();
+        let t0 = 1_767_225_600_000_000_000u64;
+        for (name, n) in counts {
+            let spec = foxglove::log_channel(telemetry_topic(name)).unwrap();
+            let ch = core.add_channel(Duration::ZERO, spec).unwrap();
+            for i in 0..*n {
+                let t = t0 + i * 250_000_000;
+                core.write(Duration::from_millis(250 * i), ch, t, t, b"{}")
+                    .unwrap();
+            }
+        }
+        core.finish().unwrap();
+        let mut bytes = Vec::new();
+        while let Some(out) = core.poll_output() {
+            if let stx_record::Output::Bytes { data, .. } = out {
+                bytes.extend(data);
+            }
+        }
+        Recording::from_reader(std::io::Cursor::new(bytes)).unwrap()
+    }
+
+    #[test]
+    fn a_recording_without_position_attitude_or_commands_holds_no_flight() {
+        let whole = [
+            ("GLOBAL_POSITION_INT", 3),
+            ("ATTITUDE", 2),
+            ("SERVO_OUTPUT_RAW", 1),
+            ("VFR_HUD", 1),
+        ];
+        assert_eq!(missing_flight(&recording(&whole)), None);
+        let why = missing_flight(&recording(&[("ATTITUDE", 5), ("GLOBAL_POSITION_INT", 2)]))
+            .expect("no flight");
+        assert!(
+            why.contains("GLOBAL_POSITION_INT (2 of at least 3")
+                && why.contains("SERVO_OUTPUT_RAW (0 of")
+                && !why.contains("ATTITUDE"),
+            "{why}"
+        );
+        assert!(missing_flight(&recording(&[])).is_some());
+    }
+}
