@@ -1,5 +1,5 @@
 import { describe, expect, it } from "vitest";
-import { complexPlane, metres, outcomeLine, progressOf, vehicleEdits } from "./lab";
+import { compareRows, complexPlane, metres, outcomeLine, progressOf, recordingOption, vehicleEdits } from "./lab";
 
 const fields = [
   { name: "canopy.mass_kg", unit: "kg", seed: 0.7 },
@@ -24,6 +24,9 @@ describe("progressOf", () => {
   const job = { id: 1, kind: "monte_carlo", started_by: "op", elapsed_s: 12.4, done: 3, total: 12, cancelling: false };
   it("gives the runs done as a fraction and a label", () => {
     expect(progressOf(job)).toEqual({ fraction: 0.25, label: "3/12 runs, 12 s" });
+  });
+  it("counts a comparison's recorded samples", () => {
+    expect(progressOf({ ...job, kind: "compare", done: 40, total: 160 })).toEqual({ fraction: 0.25, label: "40/160 samples, 12 s" });
   });
   it("has no fraction when the job cannot tell, and shows a cancel", () => {
     expect(progressOf({ ...job, kind: "scenario", total: 0, done: 0, cancelling: true })).toEqual({ fraction: null, label: "scenario running, 12 s, cancelling…" });
@@ -59,5 +62,29 @@ describe("metres", () => {
   it("shows a missing or infinite figure as a dash", () => {
     expect(metres(null)).toBe("–");
     expect(metres(12.345)).toBe("12.3 m");
+  });
+});
+
+describe("recordingOption", () => {
+  const r = { name: "stx-20261128T120733Z-001.mcap", size_bytes: 217715, start_ms: Date.UTC(2026, 10, 28, 12, 7, 33), duration_ms: 24_900, messages: 1847, mission: "rehearsal", vehicle: "straplex-2", complete: true, recording_now: false, last_stage: "descent", landing: null };
+  it("names the file, when it starts, how long it lasts and its mission", () => {
+    expect(recordingOption(r)).toEqual({ value: r.name, label: "stx-20261128T120733Z-001.mcap — 2026-11-28 12:07 UTC, 25 s, rehearsal" });
+  });
+  it("says which one is being written, and leaves out what it does not know", () => {
+    expect(recordingOption({ ...r, start_ms: null, mission: null, duration_ms: 3_725_000, recording_now: true }).label).toBe("stx-20261128T120733Z-001.mcap — 1 h 02 min (recording now)");
+  });
+});
+
+describe("compareRows", () => {
+  const channel = (name: string, unit: string, rms: number, max_abs: number, bias: number, count: number) => ({ name, unit, rms, max_abs, bias, count, recorded: [], model: [] });
+  it("reads each channel's errors with its unit and a sensible precision", () => {
+    expect(compareRows({ channels: [channel("north_m", "m", 4.2549, 5.616, 3.976, 98), channel("airspeed_mps", "m/s", 0.2163, 1.021, -0.0874, 97), channel("turn_rate_deg_s", "deg/s", 8.737, 38.735, -0.763, 98)] })).toEqual([
+      ["north", "m", "4.3 m", "5.6 m", "4.0 m", "98"],
+      ["airspeed", "m/s", "0.22 m/s", "1.02 m/s", "-0.09 m/s", "97"],
+      ["turn rate", "deg/s", "8.7 deg/s", "38.7 deg/s", "-0.8 deg/s", "98"],
+    ]);
+  });
+  it("keeps a channel it does not know by its name, and shows a figure that is no number as a dash", () => {
+    expect(compareRows({ channels: [channel("glide", "", Number.NaN, Infinity, 0.5, 0)] })).toEqual([["glide", "", "–", "–", "0.50", "0"]]);
   });
 });

@@ -1,12 +1,16 @@
 // The Lab page's logic without the DOM: the vehicle editor's edits (only fields changed from
 // the seed's value are sent; text that is no number is refused here, the rest by the station's
 // own validation), a job's progress as a fraction and a label, the eigenvalue plot's geometry
-// (the complex plane scaled to the points), and how an outcome reads.
+// (the complex plane scaled to the points), how an outcome reads, and a comparison's recording
+// picker and error table.
 
 import type * as Wire from "../generated/api";
+import { fmtDuration } from "./format";
 
 export type VehicleField = Wire.VehicleField;
 export type LabStatus = Wire.LabStatusBody;
+/** A comparison's result (the contract inlines each kind of result in `LabResult`). */
+export type CompareResult = Extract<Wire.LabResult, { kind: "compare" }>;
 
 /** The edits of a vehicle form: `values` by field name as typed; fields equal to their seed value are left out. */
 export function vehicleEdits(fields: readonly VehicleField[], values: ReadonlyMap<string, string>): { edits: Record<string, number>; errors: Record<string, string> } {
@@ -31,7 +35,7 @@ export function progressOf(job: Wire.LabJobView): { fraction: number | null; lab
   const cancelling = job.cancelling ? ", cancelling…" : "";
   if (job.total <= 0) return { fraction: null, label: `${job.kind} running, ${secs}${cancelling}` };
   const fraction = Math.min(1, Math.max(0, job.done / job.total));
-  const unit = job.kind === "monte_carlo" ? "runs" : "steps";
+  const unit = job.kind === "monte_carlo" ? "runs" : job.kind === "compare" ? "samples" : "steps";
   return { fraction, label: `${job.done}/${job.total} ${unit}, ${secs}${cancelling}` };
 }
 
@@ -69,4 +73,39 @@ export function complexPlane(points: readonly (readonly [number, number])[], box
 /** A Monte Carlo figure in metres, or "–" (a failed run makes the maximum infinite, sent as null). */
 export function metres(v: number | null | undefined): string {
   return v === null || v === undefined || !Number.isFinite(v) ? "–" : `${v.toFixed(1)} m`;
+}
+
+/** A recording in the compare picker: its file name, when and how long, what of. */
+export function recordingOption(r: Wire.RecordingSummary): { value: string; label: string } {
+  const when = r.start_ms === null ? null : `${new Date(r.start_ms).toISOString().slice(0, 16).replace("T", " ")} UTC`;
+  const about = [when, fmtDuration(r.duration_ms / 1000), r.mission].filter((p) => p !== null && p !== "").join(", ");
+  return { value: r.name, label: `${r.name} — ${about}${r.recording_now ? " (recording now)" : ""}` };
+}
+
+/** What each channel of a comparison is, for its plot's title and the error table. */
+export const COMPARE_CHANNELS: Readonly<Record<string, string>> = {
+  north_m: "north",
+  east_m: "east",
+  height_m: "height (MSL)",
+  roll_deg: "roll",
+  pitch_deg: "pitch",
+  yaw_deg: "yaw",
+  airspeed_mps: "airspeed",
+  sink_mps: "sink rate",
+  turn_rate_deg_s: "turn rate",
+};
+
+/** Decimals an error figure is shown with, by unit: centimetres and tenths of a degree say nothing more. */
+const DIGITS: Readonly<Record<string, number>> = { m: 1, deg: 1, "m/s": 2, "deg/s": 1 };
+
+/** A figure with its unit, or "–" when it is no finite number. */
+export function figure(v: number | null | undefined, unit: string): string {
+  if (v === null || v === undefined || !Number.isFinite(v)) return "–";
+  const n = v.toFixed(DIGITS[unit] ?? 2);
+  return unit === "" ? n : `${n} ${unit}`;
+}
+
+/** The error table of a comparison: channel, unit, RMS, largest and mean error (model − recorded, with units), samples. */
+export function compareRows(r: { channels: readonly Wire.CompareChannel[] }): [string, string, string, string, string, string][] {
+  return r.channels.map((c) => [COMPARE_CHANNELS[c.name] ?? c.name, c.unit, figure(c.rms, c.unit), figure(c.max_abs, c.unit), figure(c.bias, c.unit), String(c.count)]);
 }

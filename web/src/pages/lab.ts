@@ -1,7 +1,8 @@
 // The Lab page: edit the vehicle (units and the seed's values beside each field, checked by the
 // station with the model's own rules), run a scenario, a Monte Carlo batch, the stability
-// analysis or a tuning run in the station's background, follow its progress (cancel a batch),
-// and see the plots; save a vehicle or gains file, send tuned gains to the drone after a
+// analysis or a tuning run in the station's background, or compare a recording of the station
+// with the model (recorded and modelled side by side per channel, with the error table), follow
+// its progress (cancel a batch or a comparison), and see the plots; save a vehicle or gains file, send tuned gains to the drone after a
 // confirmation. Operators run and save; viewers see the results only (the station refuses them
 // anyway). The status is polled: twice a second while a job runs, every 3 s otherwise.
 
@@ -10,11 +11,12 @@ import "../styles/lab.css";
 import uPlot from "uplot";
 import "uplot/dist/uPlot.min.css";
 import { Api, ApiError } from "../lib/api";
-import { complexPlane, metres, outcomeLine, progressOf, vehicleEdits } from "../lib/lab";
+import { complexPlane, metres, outcomeLine, progressOf, recordingOption, vehicleEdits } from "../lib/lab";
 import { isObj } from "../lib/parse";
 import { resolveToken, searchWithoutToken, withToken } from "../lib/token";
 import type * as Wire from "../generated/api";
 import { h, s, setText } from "../ui/dom";
+import { compareView } from "../ui/labCompare";
 import { applyRole } from "../ui/role";
 
 const SCENARIOS = ["uncontrolled", "spiral-exit", "spiral-landing", "vertical", "localizer", "stratospheric"];
@@ -48,6 +50,9 @@ const el = {
   controller: h("select", { "data-testid": "tune-controller" }, ...CONTROLLERS.map((n) => h("option", { value: n }, n))),
   start: h("button", { type: "button", "data-testid": "job-start", "data-role": "operator" }, "Run"),
   cancel: h("button", { type: "button", "data-testid": "job-cancel", "data-role": "operator" }, "Cancel"),
+  recording: h("select", { "data-testid": "compare-recording" }),
+  recordingsRefresh: h("button", { type: "button", "data-testid": "compare-refresh" }, "Refresh"),
+  compare: h("button", { type: "button", "data-testid": "compare-start", "data-role": "operator" }, "Compare"),
   progress: h("progress", { "data-testid": "job-progress", max: "1" }),
   progressLabel: h("div", { "data-testid": "job-progress-label", role: "status" }),
   jobMsg: h("div", { "data-testid": "job-msg", class: "error", role: "alert" }),
@@ -140,6 +145,31 @@ async function post(a: Api, path: string, body: unknown, where: HTMLElement): Pr
 async function start(): Promise<void> {
   setText(el.jobMsg, "");
   const r = await post(api, "/api/lab/jobs", jobBody(), el.jobMsg);
+  if (r !== null) void poll();
+}
+
+/** Fills the recording picker from the station's recordings directory, keeping the choice. */
+async function loadRecordings(): Promise<void> {
+  const chosen = el.recording.value;
+  try {
+    const list = await api.get<Wire.RecordingsBody>("/api/recordings");
+    const options = list.recordings.map(recordingOption).map((o) => h("option", { value: o.value }, o.label));
+    if (options.length === 0) options.push(h("option", { value: "", disabled: true }, list.directory === null ? "this station keeps no recordings" : "no recordings yet"));
+    el.recording.replaceChildren(...options);
+    if (list.recordings.some((r) => r.name === chosen)) el.recording.value = chosen;
+  } catch (e) {
+    showError(e, el.jobMsg);
+  }
+}
+
+async function compare(): Promise<void> {
+  setText(el.jobMsg, "");
+  if (el.recording.value === "") {
+    setText(el.jobMsg, "choose a recording to compare");
+    return;
+  }
+  const body: Wire.LabJobBody = { kind: "compare", recording: el.recording.value, vehicle: vehicleEdits(fields, typed).edits };
+  const r = await post(api, "/api/lab/jobs", body, el.jobMsg);
   if (r !== null) void poll();
 }
 
@@ -245,6 +275,9 @@ function showResult(r: Wire.LabResult): void {
     for (const w of r.warnings) parts.push(h("div", { class: "note" }, `warning: ${w}`));
   } else if (r.kind === "tune") {
     parts.push(gainsPanel(r));
+  } else if (r.kind === "compare") {
+    const columns = (el.results.clientWidth || 700) >= 900 ? 3 : 2;
+    parts.push(...compareView(r, Math.max(260, Math.floor((el.results.clientWidth || 700) / columns) - 16)));
   }
   el.results.replaceChildren(...parts);
 }
@@ -268,6 +301,7 @@ function render(st: Wire.LabStatusBody): void {
   const job = st.job;
   el.start.disabled = !operator || job !== null || !st.available;
   el.cancel.disabled = !operator || job === null;
+  el.compare.disabled = el.start.disabled;
   if (job) {
     const p = progressOf(job);
     if (p.fraction === null) el.progress.removeAttribute("value");
@@ -304,6 +338,8 @@ async function main(): Promise<void> {
   save.addEventListener("click", () => void saveVehicle());
   el.start.addEventListener("click", () => void start());
   el.cancel.addEventListener("click", () => void cancel());
+  el.compare.addEventListener("click", () => void compare());
+  el.recordingsRefresh.addEventListener("click", () => void loadRecordings());
   const dashboard = h("a", { href: withToken("index.html", token), "data-testid": "dashboard-link" }, "Dashboard");
   const page = h("div", {},
     h("header", {}, h("strong", {}, "stx — Lab"), el.role, dashboard),
@@ -318,10 +354,15 @@ async function main(): Promise<void> {
           h("div", { class: "row" }, h("label", {}, "runs ", el.runs), h("label", {}, "seed ", el.seed), h("label", {}, "wind max m/s ", el.wind), h("label", {}, "release height m ", el.releaseAlt)),
           h("div", { class: "row" }, h("label", {}, "trim altitude m ", el.trimAlt), h("label", {}, "controller ", el.controller)),
           h("div", { class: "row" }, el.start, el.cancel),
+          h("h2", {}, "Compare a recorded flight with the model"),
+          h("div", { class: "row" }, h("label", {}, "recording ", el.recording), el.recordingsRefresh),
+          h("div", { class: "row note" }, "flown from its first recorded state with its servo commands and wind estimate, by the vehicle as edited above"),
+          h("div", { class: "row" }, el.compare),
           el.progress, el.progressLabel, el.jobMsg, el.outcome)),
       h("section", {}, h("h2", {}, "Results"), el.results)));
   app.replaceChildren(page);
   applyRole(page, operator);
+  await loadRecordings();
   await poll();
 }
 
