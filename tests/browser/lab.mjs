@@ -4,15 +4,18 @@
 // with the model's rule; a scenario runs and its plots draw; a Monte Carlo batch shows its
 // progress and is cancelled part-way, keeping the runs it flew; the stability analysis draws its
 // eigenvalues beside the seed's; a second job while one runs is 409 and a viewer's start 403;
-// the viewer's page shows the results without the controls. Compare/identify on a recording is
-// not in the Lab yet (see the report of issue 16 item 3).
+// the viewer's page shows the results without the controls. Compare on a recording: a first
+// station flies the rehearsal in real time for a few seconds and stops, leaving its recording;
+// the Lab picks it, compares it with the model (as edited) and draws the nine channels' plots
+// and the error table with finite figures; a viewer cannot start a comparison, nor can anyone
+// name a file outside the recordings directory. (Identify is not in the Lab yet.)
 //
 // Usage: node tests/browser/lab.mjs [path/to/stx]   (default target/release/stx)
 
 import { mkdtemp, readdir } from "node:fs/promises";
 import { tmpdir } from "node:os";
 import { join } from "node:path";
-import { OPERATOR, VIEWER, out, speed, check, newContext, startStation, until, text, apiOf, registerRest, watchErrors, runFlights } from "./harness.mjs";
+import { OPERATOR, VIEWER, out, speed, sleep, check, newContext, startStation, until, text, apiOf, registerRest, watchErrors, runFlights } from "./harness.mjs";
 
 registerRest("GET", /^\/api\/lab$/, null, "LabStatusBody");
 registerRest("POST", /^\/api\/lab\/jobs$/, "LabJobBody", "LabStartedBody");
@@ -26,7 +29,23 @@ registerRest("POST", /^\/api\/lab\/gains\/(save|send)$/, "LabGainsBody", "LabSav
 const labDir = await mkdtemp(join(tmpdir(), "stx-browser-lab-"));
 const outcome = (page) => text(page, "job-outcome").catch(() => "");
 
+/** A recording of a short flight: a station whose drone flies the rehearsal in real time (a
+ *  recording's times are the station's clock, so a faster drone would compress the flight)
+ *  for `seconds` of GPS positions, then stops and closes its file. Its name. */
+async function recordFlight(seconds) {
+  const { io, base } = await startStation(["--sim", "--sim-scenario", "rehearsal", "--sim-speed", "1", "--link", "udpin:127.0.0.1:0"]);
+  const api = apiOf(base);
+  const current = async () => (await api("/api/recordings")).body?.recordings?.find((r) => r.recording_now) ?? null;
+  const flying = await until(current, (r) => r !== null && r.duration_ms >= seconds * 1000, 60000, 500);
+  const exited = new Promise((r) => io.proc.once("exit", r));
+  io.proc.kill("SIGTERM");
+  await Promise.race([exited, sleep(15000)]);
+  check("a first station records a short flight and closes the file when stopped", flying !== null && io.proc.exitCode === 0, `${flying?.name} ${flying?.duration_ms} ms, exit ${io.proc.exitCode}`);
+  return flying?.name ?? "";
+}
+
 async function lab() {
+  const recorded = await recordFlight(12);
   const { base } = await startStation(["--sim", "--sim-scenario", "rehearsal", "--sim-speed", String(speed), "--link", "udpin:127.0.0.1:0", "--lab-dir", labDir]);
   const api = apiOf(base);
   const ctx = await newContext("lab", { viewport: { width: 1440, height: 1000 } });
@@ -98,8 +117,33 @@ async function lab() {
   await vpage.locator('[data-testid="eigen-plot"]').waitFor({ timeout: 10000 }).catch(() => {});
   check("viewer: the Lab page shows the last result read-only (Run disabled)",
     (await vpage.locator('[data-testid="eigen-plot"] circle.point').count()) === ours && (await vpage.locator('[data-testid="job-start"]').isDisabled()), `${await text(vpage, "lab-role")}`);
+
+  // Compare the first station's recording with the model (the vehicle as edited above).
+  await page.click('[data-testid="compare-refresh"]');
+  await until(() => page.locator(`[data-testid="compare-recording"] option[value="${recorded}"]`).count(), (n) => n === 1, 5000);
+  await page.selectOption('[data-testid="compare-recording"]', recorded);
+  await page.click('[data-testid="compare-start"]');
+  const cmp = await until(() => outcome(page), (t) => /compare.*: (done|failed)/.test(t), 120000, 500);
+  await page.locator('[data-testid="compare-errors"]').waitFor({ timeout: 5000 }).catch(() => {});
+  const comparePlots = await page.locator('[data-testid^="compare-plot-"] .uplot').count();
+  const rows = await page.locator('[data-testid="compare-errors"] tr').evaluateAll((trs) => trs.slice(1).map((tr) => [...tr.querySelectorAll("td")].map((td) => td.textContent ?? "")));
+  const finite = rows.length === 9 && rows.every((r) => r.length === 6 && [2, 3, 4].every((i) => Number.isFinite(parseFloat(r[i])) && r[i].endsWith(r[1])) && Number(r[5]) >= 30);
+  const summary = await text(page, "compare-summary").catch(() => "");
+  check("compare: the recording is flown by the model as edited, its nine channels plotted recorded vs model, and the error table has finite figures with units",
+    cmp.includes("done") && comparePlots === 9 && finite && summary.startsWith(recorded) && summary.includes("canopy.mass_kg = 0.8"),
+    `"${cmp}", ${comparePlots} plots, "${summary}", ${rows.map((r) => `${r[0]} ${r[2]}`).join("; ")}`);
+  await page.screenshot({ path: join(out, "lab-compare.png"), fullPage: true });
+  const job = { kind: "compare", recording: recorded };
+  const viewerCompare = await api("/api/lab/jobs", VIEWER, { method: "POST", body: JSON.stringify(job) });
+  const outside = await api("/api/lab/jobs", OPERATOR, { method: "POST", body: JSON.stringify({ ...job, recording: "../station.toml" }) });
+  await vpage.reload();
+  await vpage.locator('[data-testid="compare-errors"]').waitFor({ timeout: 10000 }).catch(() => {});
+  const viewerPlots = await vpage.locator('[data-testid^="compare-plot-"] .uplot').count();
+  check("compare: a viewer sees the comparison but cannot start one (button disabled, 403); a name outside the recordings directory is 404 unknown_recording",
+    viewerPlots === 9 && (await vpage.locator('[data-testid="compare-start"]').isDisabled()) && viewerCompare.status === 403 && outside.status === 404 && outside.body?.error === "unknown_recording",
+    `${viewerPlots} plots for the viewer; viewer ${viewerCompare.status}; outside ${outside.status} ${outside.body?.error}`);
   await vctx.close();
   await ctx.close();
 }
 
-await runFlights(lab, ["Session", "LabStatusBody", "LabStartedBody", "VehicleFieldsBody", "LabSavedBody"]);
+await runFlights(lab, ["Session", "LabStatusBody", "LabStartedBody", "VehicleFieldsBody", "LabSavedBody", "RecordingsBody"]);
