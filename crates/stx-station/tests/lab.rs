@@ -17,7 +17,8 @@ use common::*;
 use serde_json::{Value, json};
 use stx_record::{CoreOptions, RecorderCore, RecordingInfo, foxglove};
 use stx_station::lab::{
-    CompareSeries, JobControl, JobInputs, LabJobBody, LabResult, LabService, LabWorker,
+    CompareSeries, IdentifiedParam, IdentifySummary, JobControl, JobInputs, LabJobBody, LabResult,
+    LabService, LabWorker,
 };
 
 /// Answers a comparison with the recording it was handed: its name and its positions.
@@ -30,8 +31,31 @@ impl LabWorker for ReadsTheRecording {
         inputs: &JobInputs,
         _control: &dyn JobControl,
     ) -> Result<LabResult, String> {
-        let LabJobBody::Compare { recording, .. } = job else {
-            return Err("only comparisons here".into());
+        let recording = match job {
+            LabJobBody::Compare { recording, .. } => recording,
+            LabJobBody::Identify {
+                recording, params, ..
+            } => {
+                return Ok(LabResult::Identify(IdentifySummary {
+                    recording: format!(
+                        "{recording} at {}",
+                        inputs
+                            .recording
+                            .as_deref()
+                            .unwrap_or(Path::new("?"))
+                            .display()
+                    ),
+                    params: params
+                        .iter()
+                        .map(|p| IdentifiedParam {
+                            name: p.clone(),
+                            ..IdentifiedParam::default()
+                        })
+                        .collect(),
+                    ..IdentifySummary::default()
+                }));
+            }
+            _ => return Err("only comparisons and identifications here".into()),
         };
         let path = inputs
             .recording
@@ -100,6 +124,20 @@ async fn start(station: &Station, token: &'static str, body: Value) -> (u16, Val
         Some(&body),
     )
     .await
+}
+
+/// The Lab's last outcome once the job has finished (`null` after 5 s).
+async fn last_outcome(station: &Station) -> Value {
+    let mut last = Value::Null;
+    for _ in 0..100 {
+        let (_, lab) = http(station.http(), "GET", "/api/lab", Some(VIEWER), None).await;
+        last = lab["last"].clone();
+        if !last.is_null() {
+            break;
+        }
+        tokio::time::sleep(Duration::from_millis(50)).await;
+    }
+    last
 }
 
 #[tokio::test]
@@ -178,15 +216,7 @@ async fn a_recording_of_the_directory_is_compared_and_every_page_sees_the_result
     .await;
     assert_eq!(status, 202, "{body}");
     assert_eq!(body["kind"], "compare");
-    let mut last = Value::Null;
-    for _ in 0..100 {
-        let (_, lab) = http(station.http(), "GET", "/api/lab", Some(VIEWER), None).await;
-        last = lab["last"].clone();
-        if !last.is_null() {
-            break;
-        }
-        tokio::time::sleep(Duration::from_millis(50)).await;
-    }
+    let last = last_outcome(&station).await;
     assert_eq!(last["outcome"], "done", "{last}");
     assert_eq!(last["kind"], "compare");
     let result = &last["result"];
@@ -194,4 +224,78 @@ async fn a_recording_of_the_directory_is_compared_and_every_page_sees_the_result
     let expected = format!("flight-1.mcap at {}", dir.join("flight-1.mcap").display());
     assert_eq!(result["recording"], json!(expected));
     assert_eq!(result["samples"], 40);
+}
+
+#[tokio::test]
+async fn an_identification_is_checked_as_a_comparison_and_its_parameters_before_it_starts() {
+    let dir = temp_dir("identify");
+    write_recording(&dir.join("flight.mcap"), &FLIGHT);
+    let station = station_with_lab(Some(dir.clone())).await;
+    let identify = |name: &str, params: Value| json!({"kind": "identify", "recording": name, "params": params});
+    let (status, body) = start(
+        &station,
+        VIEWER,
+        identify("flight.mcap", json!(["cl_alpha"])),
+    )
+    .await;
+    assert_eq!((status, body["error"].as_str()), (403, Some("forbidden")));
+    for params in [
+        json!([]),
+        json!(["cl_alpha", "wingspan"]),
+        json!(["cd0", "CD0"]),
+    ] {
+        let (status, body) =
+            start(&station, OPERATOR, identify("flight.mcap", params.clone())).await;
+        assert_eq!(
+            (status, body["error"].as_str()),
+            (400, Some("invalid_job")),
+            "{params}: {body}"
+        );
+        let reason = body["reason"].as_str().unwrap_or_default();
+        assert!(reason.starts_with("params: "), "{reason}");
+    }
+    let (_, body) = start(
+        &station,
+        OPERATOR,
+        identify("flight.mcap", json!(["wingspan"])),
+    )
+    .await;
+    let reason = body["reason"].as_str().unwrap_or_default();
+    assert!(
+        reason.contains("\"wingspan\"") && reason.contains("cl_alpha"),
+        "{reason}"
+    );
+    for name in ["missing.mcap", "../outside.mcap", "flight"] {
+        let (status, body) = start(&station, OPERATOR, identify(name, json!(["cl_alpha"]))).await;
+        assert_eq!(
+            (status, body["error"].as_str()),
+            (404, Some("unknown_recording")),
+            "{name}: {body}"
+        );
+    }
+    let (_, lab) = http(station.http(), "GET", "/api/lab", Some(VIEWER), None).await;
+    assert_eq!((&lab["job"], &lab["last"]), (&Value::Null, &Value::Null));
+
+    let (status, body) = start(
+        &station,
+        OPERATOR,
+        identify("flight.mcap", json!(["cl_alpha", "cd0"])),
+    )
+    .await;
+    assert_eq!(
+        (status, body["kind"].as_str()),
+        (202, Some("identify")),
+        "{body}"
+    );
+    let last = last_outcome(&station).await;
+    assert_eq!(
+        (&last["outcome"], &last["kind"]),
+        (&json!("done"), &json!("identify")),
+        "{last}"
+    );
+    let result = &last["result"];
+    assert_eq!(result["kind"], "identify");
+    let expected = format!("flight.mcap at {}", dir.join("flight.mcap").display());
+    assert_eq!(result["recording"], json!(expected));
+    assert_eq!(result["params"][1]["name"], "cd0");
 }

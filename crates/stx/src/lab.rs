@@ -1,6 +1,7 @@
 //! The Lab's work for `stx serve`: the station's Lab (`stx_station::lab`) decides what runs
 //! and when; this flies the scenario, the Monte Carlo batch, the stability analysis, the
-//! tuning run or a recording's comparison with the model (`crate::lab_compare`) with the
+//! tuning run, a recording's comparison with the model (`crate::lab_compare`) or its
+//! parameters' identification (`crate::lab_identify`) with the
 //! simulator and the analysis, which only the binary links.
 
 use std::path::PathBuf;
@@ -75,6 +76,17 @@ impl LabWorker for Worker {
                     .as_deref()
                     .ok_or("the station gave the comparison no recording (a bug)")?;
                 crate::lab_compare::run(recording, path, vehicle, edits, control)
+            }
+            LabJobBody::Identify {
+                recording,
+                params,
+                vehicle: edits,
+            } => {
+                let path = inputs
+                    .recording
+                    .as_deref()
+                    .ok_or("the station gave the identification no recording (a bug)")?;
+                crate::lab_identify::run(recording, path, params, vehicle, edits, control)
             }
         }
     }

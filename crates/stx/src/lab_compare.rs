@@ -77,7 +77,7 @@ pub fn series(
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use std::sync::Mutex;
     use std::time::Duration;
@@ -93,7 +93,7 @@ mod tests {
 
     /// `log` as the station records a drone's telemetry (the same channels, the same JSON), at
     /// one position, attitude, airspeed, command and wind message per sample.
-    fn recording_of(log: &FlightLog, path: &Path) {
+    pub(crate) fn recording_of(log: &FlightLog, path: &Path) {
         let info = RecordingInfo::new("test", "straplex-2", "lab compare");
         let mut core = RecorderCore::new(CoreOptions::default(), info, Duration::ZERO).unwrap();
         let channels = TelemetryChannels::register(&mut core, Duration::ZERO).unwrap();

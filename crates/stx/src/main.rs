@@ -19,6 +19,7 @@ mod import;
 mod inputs;
 mod lab;
 mod lab_compare;
+mod lab_identify;
 mod logging;
 mod montecarlo;
 mod plan;

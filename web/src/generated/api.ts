@@ -320,6 +320,47 @@ export type LabResult =
        * the seed's STRAPLEX vehicle).
        */
       vehicle_changes: string[];
+    }
+  | {
+      /**
+       * Correlation matrix of the estimates, rows and columns in the order of `params`
+       * (`null` when the flight does not tell the parameters apart).
+       */
+      correlation: number[][] | null;
+      /**
+       * Levenberg–Marquardt iterations.
+       */
+      iterations: number;
+      kind: "identify";
+      /**
+       * Each parameter, in the order asked.
+       */
+      params: IdentifiedParam[];
+      /**
+       * The recording's file name.
+       */
+      recording: string;
+      /**
+       * The same after.
+       */
+      residual_rms_after: number;
+      /**
+       * RMS of the residuals before the fit, in multiples of the sensor noise.
+       */
+      residual_rms_before: number;
+      /**
+       * Why the fit stopped (`converged`, …; `cancelled` when stopped early, the best point
+       * so far reported).
+       */
+      stop: string;
+      /**
+       * The vehicle parameters changed from the seed's before the fit (`name = value`).
+       */
+      vehicle_changes: string[];
+      /**
+       * The fitted vehicle file (TOML).
+       */
+      vehicle_toml: string;
     };
 /**
  * A message from the page on the WebSocket.
@@ -454,6 +495,25 @@ export type LabJobBody =
     }
   | {
       kind: "compare";
+      /**
+       * A recording's file name in the station's recordings directory, as
+       * `GET /api/recordings` lists it.
+       */
+      recording: string;
+      /**
+       * Parameters changed from the seed's vehicle.
+       */
+      vehicle?: {
+        [k: string]: number | undefined;
+      };
+    }
+  | {
+      kind: "identify";
+      /**
+       * The parameters to fit, by their vehicle-file names (`cl_alpha`, `cd0`, …; see
+       * [`identify::IDENTIFY_PARAMS`]).
+       */
+      params: string[];
       /**
        * A recording's file name in the station's recordings directory, as
        * `GET /api/recordings` lists it.
@@ -2261,7 +2321,7 @@ export interface LabJobView {
    */
   id: number;
   /**
-   * `scenario`, `monte_carlo`, `stability`, `tune` or `compare`.
+   * `scenario`, `monte_carlo`, `stability`, `tune`, `compare` or `identify`.
    */
   kind: string;
   /**
@@ -2344,6 +2404,35 @@ export interface CompareChannel {
    * Unit of the values and of the error figures (`m`, `deg`, `m/s`, `deg/s`).
    */
   unit: string;
+}
+/**
+ * One fitted parameter.
+ */
+export interface IdentifiedParam {
+  /**
+   * Fitted value.
+   */
+  fitted: number;
+  /**
+   * High end of the 95 % interval.
+   */
+  interval95_high: number | null;
+  /**
+   * Low end of the 95 % interval (`null` with the standard error).
+   */
+  interval95_low: number | null;
+  /**
+   * Name, as in the vehicle file (`rigging_deg`: change of rigging angle, degrees).
+   */
+  name: string;
+  /**
+   * Value before the fit (the vehicle as edited).
+   */
+  nominal: number;
+  /**
+   * Standard error (`null` when the flight does not determine it).
+   */
+  std_error: number | null;
 }
 /**
  * `POST /api/lab/jobs`' answer: the job started.

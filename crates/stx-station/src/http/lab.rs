@@ -129,7 +129,9 @@ pub(crate) async fn start(
         Err(e) => return Ok(field_error(StatusCode::BAD_REQUEST, "invalid_vehicle", e)),
     };
     let recording = match &job {
-        LabJobBody::Compare { recording, .. } => Some(flight_recording(&state, recording).await?),
+        LabJobBody::Compare { recording, .. } | LabJobBody::Identify { recording, .. } => {
+            Some(flight_recording(&state, recording).await?)
+        }
         _ => None,
     };
     let inputs = JobInputs { vehicle, recording };
@@ -171,7 +173,7 @@ pub(crate) async fn start(
     Ok((StatusCode::ACCEPTED, Json(LabStartedBody { id, kind })).into_response())
 }
 
-/// The path of the recording `name` for a comparison: a plain name of the recordings
+/// The path of the recording `name` for a comparison or an identification: a plain name of the recordings
 /// directory, a file that opens as a recording and holds a flight.
 async fn flight_recording(state: &AppState, name: &str) -> Result<PathBuf, HttpError> {
     let unknown = |why: &str| {

@@ -43,7 +43,7 @@ struct Job {
 pub struct LabJobView {
     /// Job number (1, 2, … since the station started).
     pub id: u64,
-    /// `scenario`, `monte_carlo`, `stability`, `tune` or `compare`.
+    /// `scenario`, `monte_carlo`, `stability`, `tune`, `compare` or `identify`.
     pub kind: String,
     /// Who started it (token name).
     pub started_by: String,

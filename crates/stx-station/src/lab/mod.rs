@@ -1,5 +1,5 @@
 //! The Lab: the engineering tools (a scenario, a Monte Carlo batch, the stability analysis, a
-//! tuning run, a recorded flight compared with the model) run from the dashboard on the station's machine, one at a time, in the
+//! tuning run, a recorded flight compared with the model or its parameters identified) run from the dashboard on the station's machine, one at a time, in the
 //! background, never on the telemetry path.
 //!
 //! The station cannot fly a scenario itself (stx-sim and stx-analysis sit above it in the
@@ -7,10 +7,12 @@
 //! daemon; the station owns what the pages see and send: the requests ([`LabJobBody`]), the
 //! results ([`LabResult`]), the job's life ([`jobs::LabJobs`]: one at a time, a time cap,
 //! progress, cancel, the last outcome kept), the vehicle editor ([`vehicle_fields`]) and
-//! what a comparison needs of a recording ([`compare`]).
+//! what a comparison needs of a recording ([`compare`]), the parameters an identification
+//! fits ([`identify`]).
 
 pub mod bodies;
 pub mod compare;
+pub mod identify;
 pub mod jobs;
 pub mod vehicle_fields;
 
@@ -23,6 +25,7 @@ use serde::{Deserialize, Serialize};
 use stx_dynamics::vehicle::Vehicle;
 
 pub use compare::{CompareChannel, CompareSeries};
+pub use identify::{IdentifiedParam, IdentifySummary};
 pub use jobs::{LabBusy, LabJobs, StopReason};
 
 /// Largest Monte Carlo batch the Lab flies (a bigger campaign is `stx montecarlo`'s).
@@ -81,6 +84,20 @@ pub enum LabJobBody {
         #[serde(default)]
         vehicle: VehicleEdits,
     },
+    /// Fit chosen vehicle parameters to a recorded flight (`stx identify`), starting from the
+    /// seed's vehicle or as edited; progress per iteration, a cancel stopping after the
+    /// current one.
+    Identify {
+        /// A recording's file name in the station's recordings directory, as
+        /// `GET /api/recordings` lists it.
+        recording: String,
+        /// The parameters to fit, by their vehicle-file names (`cl_alpha`, `cd0`, …; see
+        /// [`identify::IDENTIFY_PARAMS`]).
+        params: Vec<String>,
+        /// Parameters changed from the seed's vehicle.
+        #[serde(default)]
+        vehicle: VehicleEdits,
+    },
 }
 
 impl LabJobBody {
@@ -92,6 +109,7 @@ impl LabJobBody {
             Self::Stability { .. } => "stability",
             Self::Tune { .. } => "tune",
             Self::Compare { .. } => "compare",
+            Self::Identify { .. } => "identify",
         }
     }
 
@@ -100,7 +118,8 @@ impl LabJobBody {
         match self {
             Self::Scenario { vehicle, .. }
             | Self::Stability { vehicle, .. }
-            | Self::Compare { vehicle, .. } => Some(vehicle),
+            | Self::Compare { vehicle, .. }
+            | Self::Identify { vehicle, .. } => Some(vehicle),
             _ => None,
         }
     }
@@ -126,6 +145,12 @@ impl LabJobBody {
                 Err(("recording".into(), "a recording's name is required".into()))
             }
             Self::Compare { .. } => Ok(()),
+            Self::Identify { recording, .. } if recording.trim().is_empty() => {
+                Err(("recording".into(), "a recording's name is required".into()))
+            }
+            Self::Identify { params, .. } => {
+                identify::check_params(params).map_err(|e| ("params".into(), e))
+            }
             Self::MonteCarlo {
                 runs,
                 wind_max_mps,
@@ -157,6 +182,8 @@ pub enum LabResult {
     Tune(TuneSummary),
     /// A recorded flight beside the model's.
     Compare(CompareSeries),
+    /// Parameters fitted to a recorded flight.
+    Identify(IdentifySummary),
 }
 
 /// A scenario's flight as series for the plots (one entry per recorded sample).
@@ -271,7 +298,7 @@ pub trait JobControl: Sync {
 pub struct JobInputs {
     /// The vehicle as edited (the seed's for the jobs that take no edits).
     pub vehicle: Vehicle,
-    /// A comparison's recording: a file of the station's recordings directory holding a
+    /// A comparison's or an identification's recording: a file of the station's recordings directory holding a
     /// flight ([`compare::missing_flight`]).
     pub recording: Option<PathBuf>,
 }
