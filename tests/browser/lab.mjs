@@ -131,7 +131,7 @@ async function lab() {
   const summary = await text(page, "compare-summary").catch(() => "");
   check("compare: the recording is flown by the model as edited, its nine channels plotted recorded vs model, and the error table has finite figures with units",
     cmp.includes("done") && comparePlots === 9 && finite && summary.startsWith(recorded) && summary.includes("canopy.mass_kg = 0.8"),
-    `"${cmp}", ${comparePlots} plots, "${summary}", ${rows.map((r) => `${r[0]} ${r[2]}`).join("; ")}`);
+    `"${cmp}", ${comparePlots} plots, picked ${recorded}: "${summary}", ${rows.map((r) => r.join(" | ")).join("; ")}`);
   await page.screenshot({ path: join(out, "lab-compare.png"), fullPage: true });
   const job = { kind: "compare", recording: recorded };
   const viewerCompare = await api("/api/lab/jobs", VIEWER, { method: "POST", body: JSON.stringify(job) });

@@ -150,9 +150,11 @@ async function start(): Promise<void> {
 
 /** Fills the recording picker from the station's recordings directory, keeping the choice. */
 async function loadRecordings(): Promise<void> {
-  const chosen = el.recording.value;
   try {
     const list = await api.get<Wire.RecordingsBody>("/api/recordings");
+    // The choice as it is when the list arrives: one made while the list was on its way is kept
+    // (read before the request, it was lost, and Compare flew another recording).
+    const chosen = el.recording.value;
     const options = list.recordings.map(recordingOption).map((o) => h("option", { value: o.value }, o.label));
     if (options.length === 0) options.push(h("option", { value: "", disabled: true }, list.directory === null ? "this station keeps no recordings" : "no recordings yet"));
     el.recording.replaceChildren(...options);
