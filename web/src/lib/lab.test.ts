@@ -1,5 +1,5 @@
 import { describe, expect, it } from "vitest";
-import { compareRows, complexPlane, metres, outcomeLine, progressOf, recordingOption, vehicleEdits } from "./lab";
+import { compareRows, complexPlane, correlationCells, fittedEdits, identifyParams, identifyRows, metres, outcomeLine, progressOf, recordingOption, vehicleEdits } from "./lab";
 
 const fields = [
   { name: "canopy.mass_kg", unit: "kg", seed: 0.7 },
@@ -27,6 +27,9 @@ describe("progressOf", () => {
   });
   it("counts a comparison's recorded samples", () => {
     expect(progressOf({ ...job, kind: "compare", done: 40, total: 160 })).toEqual({ fraction: 0.25, label: "40/160 samples, 12 s" });
+  });
+  it("counts an identification's iterations", () => {
+    expect(progressOf({ ...job, kind: "identify", done: 2, total: 30 }).label).toBe("2/30 iterations, 12 s");
   });
   it("has no fraction when the job cannot tell, and shows a cancel", () => {
     expect(progressOf({ ...job, kind: "scenario", total: 0, done: 0, cancelling: true })).toEqual({ fraction: null, label: "scenario running, 12 s, cancelling…" });
@@ -86,5 +89,43 @@ describe("compareRows", () => {
   });
   it("keeps a channel it does not know by its name, and shows a figure that is no number as a dash", () => {
     expect(compareRows({ channels: [channel("glide", "", Number.NaN, Infinity, 0.5, 0)] })).toEqual([["glide", "", "–", "–", "0.50", "0"]]);
+  });
+});
+
+describe("identifyParams", () => {
+  it("splits the names at commas and spaces", () => {
+    expect(identifyParams(" cl_alpha, cd0  cn_da,")).toEqual({ params: ["cl_alpha", "cd0", "cn_da"] });
+  });
+  it("refuses an empty list and a name given twice (in any case)", () => {
+    expect(identifyParams(" , ")).toEqual({ error: "name at least one parameter to fit, e.g. cl_alpha, cd0" });
+    expect(identifyParams("cd0, CL_alpha, cl_alpha")).toEqual({ error: "cl_alpha is listed twice" });
+  });
+});
+
+describe("identification", () => {
+  const param = (name: string, nominal: number, fitted: number, se: number | null) => ({
+    name,
+    nominal,
+    fitted,
+    std_error: se,
+    interval95_low: se === null ? null : fitted - 1.96 * se,
+    interval95_high: se === null ? null : fitted + 1.96 * se,
+  });
+  const r = { params: [param("cl_alpha", 2.7, 2.16043, 0.0123), param("cd0", 0.12, 0.1293, null), param("rigging_deg", 0, 1.25, 0.5), param("cn_da", 0.0115, 0.01, 0.001)], correlation: [[1, -0.4567, 0.1, 0], [-0.4567, 1, 0, 0], [0.1, 0, 1, 0], [0, 0, 0, 1]] };
+  it("reads before, fitted, standard error, interval and change with four significant figures", () => {
+    expect(identifyRows(r)).toEqual([
+      ["cl_alpha", "2.7", "2.16", "± 0.012", "2.136 … 2.185", "-20.0 %"],
+      ["cd0", "0.12", "0.1293", "–", "not determined", "7.8 %"],
+      ["rigging_deg", "0", "1.25", "± 0.5", "0.27 … 2.23", "–"],
+      ["cn_da", "0.0115", "0.01", "± 0.001", "0.00804 … 0.01196", "-13.0 %"],
+    ]);
+  });
+  it("shows the correlation matrix with two decimals, or nothing when the flight cannot tell", () => {
+    expect(correlationCells(r)?.[0]).toEqual(["1.00", "-0.46", "0.10", "0.00"]);
+    expect(correlationCells({ correlation: null })).toBeNull();
+  });
+  it("puts the fitted coefficients into the vehicle form's fields, the rigging apart", () => {
+    const form = [{ name: "canopy.aero.cl_alpha", unit: "1", seed: 2.7 }, { name: "canopy.aero.cd0", unit: "1", seed: 0.12 }, { name: "canopy.brakes.cn_da", unit: "1", seed: 0.0115 }, { name: "canopy.mass_kg", unit: "kg", seed: 0.7 }];
+    expect(fittedEdits(r, form)).toEqual({ edits: { "canopy.aero.cl_alpha": 2.16043, "canopy.aero.cd0": 0.1293, "canopy.brakes.cn_da": 0.01 }, apart: ["rigging_deg"] });
   });
 });

@@ -1,8 +1,9 @@
 // The Lab page's logic without the DOM: the vehicle editor's edits (only fields changed from
 // the seed's value are sent; text that is no number is refused here, the rest by the station's
 // own validation), a job's progress as a fraction and a label, the eigenvalue plot's geometry
-// (the complex plane scaled to the points), how an outcome reads, and a comparison's recording
-// picker and error table.
+// (the complex plane scaled to the points), how an outcome reads, a comparison's recording
+// picker and error table, and an identification's parameter list, result table, correlation
+// matrix and the fitted values as edits of the vehicle form.
 
 import type * as Wire from "../generated/api";
 import { fmtDuration } from "./format";
@@ -11,6 +12,8 @@ export type VehicleField = Wire.VehicleField;
 export type LabStatus = Wire.LabStatusBody;
 /** A comparison's result (the contract inlines each kind of result in `LabResult`). */
 export type CompareResult = Extract<Wire.LabResult, { kind: "compare" }>;
+/** An identification's result. */
+export type IdentifyResult = Extract<Wire.LabResult, { kind: "identify" }>;
 
 /** The edits of a vehicle form: `values` by field name as typed; fields equal to their seed value are left out. */
 export function vehicleEdits(fields: readonly VehicleField[], values: ReadonlyMap<string, string>): { edits: Record<string, number>; errors: Record<string, string> } {
@@ -29,13 +32,16 @@ export function vehicleEdits(fields: readonly VehicleField[], values: ReadonlyMa
   return { edits, errors };
 }
 
+/** What a job counts its progress in. */
+const UNITS: Readonly<Record<string, string>> = { monte_carlo: "runs", compare: "samples", identify: "iterations" };
+
 /** A running job's progress: fraction 0…1 (null when the job cannot tell) and a label. */
 export function progressOf(job: Wire.LabJobView): { fraction: number | null; label: string } {
   const secs = `${job.elapsed_s.toFixed(0)} s`;
   const cancelling = job.cancelling ? ", cancelling…" : "";
   if (job.total <= 0) return { fraction: null, label: `${job.kind} running, ${secs}${cancelling}` };
   const fraction = Math.min(1, Math.max(0, job.done / job.total));
-  const unit = job.kind === "monte_carlo" ? "runs" : job.kind === "compare" ? "samples" : "steps";
+  const unit = UNITS[job.kind] ?? "steps";
   return { fraction, label: `${job.done}/${job.total} ${unit}, ${secs}${cancelling}` };
 }
 
@@ -108,4 +114,49 @@ export function figure(v: number | null | undefined, unit: string): string {
 /** The error table of a comparison: channel, unit, RMS, largest and mean error (model − recorded, with units), samples. */
 export function compareRows(r: { channels: readonly Wire.CompareChannel[] }): [string, string, string, string, string, string][] {
   return r.channels.map((c) => [COMPARE_CHANNELS[c.name] ?? c.name, c.unit, figure(c.rms, c.unit), figure(c.max_abs, c.unit), figure(c.bias, c.unit), String(c.count)]);
+}
+
+/** The parameters to identify as typed ("cl_alpha, cd0"): names split at commas or spaces. None
+ *  or one listed twice is refused here; whether a name is known is the station's to say (its
+ *  refusal lists the names it knows). */
+export function identifyParams(text: string): { params: string[] } | { error: string } {
+  const params = text.split(/[\s,]+/).filter((p) => p !== "");
+  if (params.length === 0) return { error: "name at least one parameter to fit, e.g. cl_alpha, cd0" };
+  const twice = params.find((p, i) => params.slice(0, i).some((q) => q.toLowerCase() === p.toLowerCase()));
+  return twice === undefined ? { params } : { error: `${twice} is listed twice` };
+}
+
+/** A coefficient with four significant figures (they span 1e-4 to 10), or "–". */
+function sig(v: number | null | undefined, digits = 4): string {
+  return v === null || v === undefined || !Number.isFinite(v) ? "–" : String(Number(v.toPrecision(digits)));
+}
+
+/** The table of an identification: parameter, before, fitted, ± standard error, 95 % interval,
+ *  change from before in per cent. A parameter the flight does not determine has "–" where its
+ *  standard error and interval would be. */
+export function identifyRows(r: Pick<IdentifyResult, "params">): [string, string, string, string, string, string][] {
+  return r.params.map((p) => {
+    const interval = p.interval95_low === null || p.interval95_high === null ? "not determined" : `${sig(p.interval95_low)} … ${sig(p.interval95_high)}`;
+    const change = p.nominal === 0 ? "–" : `${(100 * (p.fitted / p.nominal - 1)).toFixed(1)} %`;
+    return [p.name, sig(p.nominal), sig(p.fitted), p.std_error === null ? "–" : `± ${sig(p.std_error, 2)}`, interval, change];
+  });
+}
+
+/** The correlation matrix as text with two decimals, or null when the flight does not tell the parameters apart. */
+export function correlationCells(r: Pick<IdentifyResult, "correlation">): string[][] | null {
+  return r.correlation === null ? null : r.correlation.map((row) => row.map((c) => (Number.isFinite(c) ? c.toFixed(2) : "–")));
+}
+
+/** The fitted values as edits of the vehicle form: each coefficient goes to the form's field of
+ *  that name in the canopy's aerodynamics or brake terms. A parameter with no such field (the rigging angle
+ *  turns several geometry vectors) is listed apart: it reaches a vehicle only through the fitted file. */
+export function fittedEdits(r: Pick<IdentifyResult, "params">, fields: readonly VehicleField[]): { edits: Record<string, number>; apart: string[] } {
+  const edits: Record<string, number> = {};
+  const apart: string[] = [];
+  for (const p of r.params) {
+    const field = fields.find((f) => f.name === `canopy.aero.${p.name}` || f.name === `canopy.brakes.${p.name}`);
+    if (field === undefined || !Number.isFinite(p.fitted)) apart.push(p.name);
+    else edits[field.name] = p.fitted;
+  }
+  return { edits, apart };
 }

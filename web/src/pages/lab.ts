@@ -1,9 +1,10 @@
 // The Lab page: edit the vehicle (units and the seed's values beside each field, checked by the
 // station with the model's own rules), run a scenario, a Monte Carlo batch, the stability
-// analysis or a tuning run in the station's background, or compare a recording of the station
-// with the model (recorded and modelled side by side per channel, with the error table), follow
-// its progress (cancel a batch or a comparison), and see the plots; save a vehicle or gains file, send tuned gains to the drone after a
-// confirmation. Operators run and save; viewers see the results only (the station refuses them
+// analysis or a tuning run in the station's background, compare a recording of the station
+// with the model (recorded and modelled side by side per channel, with the error table) or fit
+// chosen coefficients to it (table with intervals, correlation matrix, the fitted values into
+// the form or as a file), follow its progress (cancel a batch, a comparison or a fit), and see
+// the plots; save a vehicle or gains file, send tuned gains to the drone after a confirmation. Operators run and save; viewers see the results only (the station refuses them
 // anyway). The status is polled: twice a second while a job runs, every 3 s otherwise.
 
 import "../styles/common.css";
@@ -11,12 +12,13 @@ import "../styles/lab.css";
 import uPlot from "uplot";
 import "uplot/dist/uPlot.min.css";
 import { Api, ApiError } from "../lib/api";
-import { complexPlane, metres, outcomeLine, progressOf, recordingOption, vehicleEdits } from "../lib/lab";
+import { complexPlane, identifyParams, metres, outcomeLine, progressOf, recordingOption, vehicleEdits } from "../lib/lab";
 import { isObj } from "../lib/parse";
 import { resolveToken, searchWithoutToken, withToken } from "../lib/token";
 import type * as Wire from "../generated/api";
 import { h, s, setText } from "../ui/dom";
 import { compareView } from "../ui/labCompare";
+import { identifyView } from "../ui/labIdentify";
 import { applyRole } from "../ui/role";
 
 const SCENARIOS = ["uncontrolled", "spiral-exit", "spiral-landing", "vertical", "localizer", "stratospheric"];
@@ -53,6 +55,8 @@ const el = {
   recording: h("select", { "data-testid": "compare-recording", class: "recording-picker" }),
   recordingsRefresh: h("button", { type: "button", "data-testid": "compare-refresh" }, "Refresh"),
   compare: h("button", { type: "button", "data-testid": "compare-start", "data-role": "operator" }, "Compare"),
+  identifyParams: h("input", { type: "text", "data-testid": "identify-params", value: "cl_alpha, cd0", class: "params-input", "aria-label": "parameters to fit" }),
+  identify: h("button", { type: "button", "data-testid": "identify-start", "data-role": "operator" }, "Identify"),
   progress: h("progress", { "data-testid": "job-progress", max: "1" }),
   progressLabel: h("div", { "data-testid": "job-progress-label", role: "status" }),
   jobMsg: h("div", { "data-testid": "job-msg", class: "error", role: "alert" }),
@@ -175,6 +179,31 @@ async function compare(): Promise<void> {
   if (r !== null) void poll();
 }
 
+async function identify(): Promise<void> {
+  setText(el.jobMsg, "");
+  if (el.recording.value === "") {
+    setText(el.jobMsg, "choose a recording to identify from");
+    return;
+  }
+  const asked = identifyParams(el.identifyParams.value);
+  if ("error" in asked) {
+    setText(el.jobMsg, `parameters: ${asked.error}`);
+    return;
+  }
+  const body: Wire.LabJobBody = { kind: "identify", recording: el.recording.value, params: asked.params, vehicle: vehicleEdits(fields, typed).edits };
+  const r = await post(api, "/api/lab/jobs", body, el.jobMsg);
+  if (r !== null) void poll();
+}
+
+/** Puts values into the vehicle form as if typed there. */
+function fillVehicle(edits: Record<string, number>): void {
+  for (const [name, value] of Object.entries(edits)) {
+    typed.set(name, String(value));
+    const input = el.vehicleRows.querySelector<HTMLInputElement>(`input[data-testid="vehicle-${CSS.escape(name)}"]`);
+    if (input) input.value = String(value);
+  }
+}
+
 async function cancel(): Promise<void> {
   try {
     await api.post("/api/lab/cancel", {});
@@ -280,6 +309,8 @@ function showResult(r: Wire.LabResult): void {
   } else if (r.kind === "compare") {
     const columns = (el.results.clientWidth || 700) >= 900 ? 3 : 2;
     parts.push(...compareView(r, Math.max(260, Math.floor((el.results.clientWidth || 700) / columns) - 16)));
+  } else if (r.kind === "identify") {
+    parts.push(...identifyView(r, fields, fillVehicle));
   }
   el.results.replaceChildren(...parts);
 }
@@ -304,6 +335,7 @@ function render(st: Wire.LabStatusBody): void {
   el.start.disabled = !operator || job !== null || !st.available;
   el.cancel.disabled = !operator || job === null;
   el.compare.disabled = el.start.disabled;
+  el.identify.disabled = el.start.disabled;
   if (job) {
     const p = progressOf(job);
     if (p.fraction === null) el.progress.removeAttribute("value");
@@ -341,6 +373,7 @@ async function main(): Promise<void> {
   el.start.addEventListener("click", () => void start());
   el.cancel.addEventListener("click", () => void cancel());
   el.compare.addEventListener("click", () => void compare());
+  el.identify.addEventListener("click", () => void identify());
   el.recordingsRefresh.addEventListener("click", () => void loadRecordings());
   const dashboard = h("a", { href: withToken("index.html", token), "data-testid": "dashboard-link" }, "Dashboard");
   const page = h("div", {},
@@ -356,10 +389,12 @@ async function main(): Promise<void> {
           h("div", { class: "row" }, h("label", {}, "runs ", el.runs), h("label", {}, "seed ", el.seed), h("label", {}, "wind max m/s ", el.wind), h("label", {}, "release height m ", el.releaseAlt)),
           h("div", { class: "row" }, h("label", {}, "trim altitude m ", el.trimAlt), h("label", {}, "controller ", el.controller)),
           h("div", { class: "row" }, el.start, el.cancel),
-          h("h2", {}, "Compare a recorded flight with the model"),
+          h("h2", {}, "A recorded flight: compare with the model, identify coefficients"),
           h("div", { class: "row" }, h("label", { class: "recording-label" }, "recording ", el.recording), el.recordingsRefresh),
           h("div", { class: "row note" }, "flown from its first recorded state with its servo commands and wind estimate, by the vehicle as edited above"),
           h("div", { class: "row" }, el.compare),
+          h("div", { class: "row" }, h("label", {}, "parameters ", el.identifyParams), el.identify),
+          h("div", { class: "row note" }, "fits the named coefficients of the vehicle as edited to the recording by least squares (names as in the vehicle file: cl_alpha, cd0, cn_da, …; rigging_deg for the rigging angle)"),
           el.progress, el.progressLabel, el.jobMsg, el.outcome)),
       h("section", {}, h("h2", {}, "Results"), el.results)));
   app.replaceChildren(page);
