@@ -55,7 +55,14 @@ pub fn read_log(path: &Path) -> anyhow::Result<FlightLog> {
 
 /// The per-channel error table.
 pub fn table(report: &CompareReport) -> String {
-    let mut out = format!(
+    let mut out = match report.part {
+        Some(p) => format!(
+            "the recording's parafoil stage, {:.1} … {:.1} s of its {:.1} s (the rest is not the model's to fly)\n",
+            p.from_s, p.to_s, p.recorded_s
+        ),
+        None => String::new(),
+    };
+    out += &format!(
         "flight of {:.1} s, {} samples; simulated − recorded:\n{:<16} {:>5} {:>10} {:>10} {:>10} {:>7}\n",
         report.duration_s,
         report.time_s.len(),

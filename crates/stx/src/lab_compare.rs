@@ -51,6 +51,8 @@ pub fn series(
         recording: name.to_string(),
         vehicle_changes: edits.iter().map(|(k, v)| format!("{k} = {v}")).collect(),
         duration_s: report.duration_s,
+        parafoil_stage_s: report.part.map(|p| [p.from_s, p.to_s]),
+        recorded_s: report.part.map_or(report.duration_s, |p| p.recorded_s),
         samples: u32::try_from(report.time_s.len()).unwrap_or(u32::MAX),
         time_s: keep.iter().map(|&i| report.time_s[i]).collect(),
         channels: report

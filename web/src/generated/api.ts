@@ -303,6 +303,18 @@ export type LabResult =
       duration_s: number;
       kind: "compare";
       /**
+       * The part of the recording compared, `[from, to]` in s of its drone clock from its first
+       * position: a mission recording's parafoil stage (`null`: the whole recording).
+       *
+       * @minItems 2
+       * @maxItems 2
+       */
+      parafoil_stage_s: [number, number] | null;
+      /**
+       * How long the recording's positions last, s.
+       */
+      recorded_s: number;
+      /**
        * The recording's file name.
        */
       recording: string;

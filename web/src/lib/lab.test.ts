@@ -1,5 +1,5 @@
 import { describe, expect, it } from "vitest";
-import { compareRows, complexPlane, correlationCells, fittedEdits, identifyParams, identifyRows, metres, outcomeLine, progressOf, recordingOption, vehicleEdits } from "./lab";
+import { comparedPart, compareRows, complexPlane, correlationCells, fittedEdits, identifyParams, identifyRows, metres, outcomeLine, progressOf, recordingOption, vehicleEdits } from "./lab";
 
 const fields = [
   { name: "canopy.mass_kg", unit: "kg", seed: 0.7 },
@@ -127,5 +127,12 @@ describe("identification", () => {
   it("puts the fitted coefficients into the vehicle form's fields, the rigging apart", () => {
     const form = [{ name: "canopy.aero.cl_alpha", unit: "1", seed: 2.7 }, { name: "canopy.aero.cd0", unit: "1", seed: 0.12 }, { name: "canopy.brakes.cn_da", unit: "1", seed: 0.0115 }, { name: "canopy.mass_kg", unit: "kg", seed: 0.7 }];
     expect(fittedEdits(r, form)).toEqual({ edits: { "canopy.aero.cl_alpha": 2.16043, "canopy.aero.cd0": 0.1293, "canopy.brakes.cn_da": 0.01 }, apart: ["rigging_deg"] });
+  });
+});
+
+describe("comparedPart", () => {
+  it("says when a mission recording was compared over its parafoil stage only", () => {
+    expect(comparedPart({ parafoil_stage_s: [796.84, 1179.52], recorded_s: 1270.3 })).toBe("its parafoil stage, 796.8 … 1179.5 s of 1270.3 s recorded");
+    expect(comparedPart({ parafoil_stage_s: null, recorded_s: 12 })).toBe("the whole recording");
   });
 });

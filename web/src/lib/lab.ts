@@ -160,3 +160,9 @@ export function fittedEdits(r: Pick<IdentifyResult, "params">, fields: readonly 
   }
   return { edits, apart };
 }
+
+/** Which part of its recording a comparison flew: a mission's parafoil stage, or all of it. */
+export function comparedPart(r: Pick<CompareResult, "parafoil_stage_s" | "recorded_s">): string {
+  const p = r.parafoil_stage_s;
+  return p === null ? "the whole recording" : `its parafoil stage, ${p[0].toFixed(1)} … ${p[1].toFixed(1)} s of ${r.recorded_s.toFixed(1)} s recorded`;
+}

@@ -3,7 +3,7 @@
 // recorded and the modelled series over each other, the plots side by side in a grid.
 
 import uPlot from "uplot";
-import { COMPARE_CHANNELS, compareRows, type CompareResult } from "../lib/lab";
+import { COMPARE_CHANNELS, comparedPart, compareRows, type CompareResult } from "../lib/lab";
 import { h } from "./dom";
 
 const RECORDED = "#0b2f8a";
@@ -26,7 +26,7 @@ function channelPlot(r: CompareResult, c: CompareResult["channels"][number], wid
 /** The parts of the Lab's results for a comparison, plots `width` pixels wide. */
 export function compareView(r: CompareResult, width: number): HTMLElement[] {
   const vehicle = r.vehicle_changes.length === 0 ? "the seed's vehicle" : `the vehicle with ${r.vehicle_changes.join(", ")}`;
-  const head = h("h2", { "data-testid": "compare-summary" }, `${r.recording}: ${r.samples} samples over ${r.duration_s.toFixed(1)} s, flown by ${vehicle}`);
+  const head = h("h2", { "data-testid": "compare-summary" }, `${r.recording} (${comparedPart(r)}): ${r.samples} samples over ${r.duration_s.toFixed(1)} s, flown by ${vehicle}`);
   const header = h("tr", {}, ...["channel", "unit", "RMS", "largest |error|", "bias", "samples"].map((t) => h("th", {}, t)));
   const rows = compareRows(r).map((cells) => h("tr", {}, ...cells.map((t) => h("td", {}, t))));
   const table = h("table", { "data-testid": "compare-errors" }, h("caption", {}, "model − recorded, over every recorded sample"), header, ...rows);

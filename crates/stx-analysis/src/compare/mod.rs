@@ -75,6 +75,9 @@ pub struct CompareReport {
     pub time_s: Vec<f64>,
     /// Flight duration, s.
     pub duration_s: f64,
+    /// The part of a longer recording compared (a mission's parafoil stage; `None`: all of it).
+    #[serde(default)]
+    pub part: Option<crate::flight_log::RecordedPart>,
     /// Each channel.
     pub channels: Vec<ChannelComparison>,
 }
@@ -198,6 +201,7 @@ pub fn report(log: &FlightLog, flown: &[Flown]) -> CompareReport {
     CompareReport {
         time_s: times.iter().map(|t| t - t0).collect(),
         duration_s: log.duration_s(),
+        part: log.part(),
         channels,
     }
 }

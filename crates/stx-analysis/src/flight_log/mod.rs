@@ -77,6 +77,25 @@ pub struct LogSample {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct FlightLog {
     samples: Vec<LogSample>,
+    /// Where in a longer recording the log was taken from (`None`: the whole of it).
+    #[serde(default)]
+    part: Option<RecordedPart>,
+}
+
+/// The part of a recording a log holds, when it is not the whole: a mission recording's
+/// parafoil flight (the model is a parafoil's; the balloon's ascent, the round chute, the
+/// canopy's inflation and the ground are not its to fly).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
+pub struct RecordedPart {
+    /// The flight stage the log holds (`parafoil`).
+    #[schemars(with = "String")]
+    pub stage: stx_gnc::mission::FlightStage,
+    /// Its start and end, s of the recording's drone clock from the recording's first position.
+    pub from_s: f64,
+    /// End, s.
+    pub to_s: f64,
+    /// How long the recording's positions last, s.
+    pub recorded_s: f64,
 }
 
 impl FlightLog {
@@ -114,7 +133,21 @@ impl FlightLog {
                 });
             }
         }
-        Ok(Self { samples })
+        Ok(Self {
+            samples,
+            part: None,
+        })
+    }
+
+    /// The same log, marked as `part` of a longer recording.
+    pub fn taken_from(mut self, part: RecordedPart) -> Self {
+        self.part = Some(part);
+        self
+    }
+
+    /// Where in a longer recording the log was taken from (`None`: the whole of it).
+    pub fn part(&self) -> Option<RecordedPart> {
+        self.part
     }
 
     /// The samples, in time order.
@@ -130,7 +163,10 @@ impl FlightLog {
             .filter(|s| from_s.is_none_or(|f| s.time_s >= f) && to_s.is_none_or(|t| s.time_s <= t))
             .copied()
             .collect();
-        Self::new(kept)
+        Ok(Self {
+            part: self.part,
+            ..Self::new(kept)?
+        })
     }
 
     /// Duration, s.

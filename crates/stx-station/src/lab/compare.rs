@@ -99,6 +99,11 @@ pub struct CompareSeries {
     pub vehicle_changes: Vec<String>,
     /// Duration of the recorded flight, s.
     pub duration_s: f64,
+    /// The part of the recording compared, `[from, to]` in s of its drone clock from its first
+    /// position: a mission recording's parafoil stage (`null`: the whole recording).
+    pub parafoil_stage_s: Option<[f64; 2]>,
+    /// How long the recording's positions last, s.
+    pub recorded_s: f64,
     /// Samples in the recorded flight (one per GPS position).
     pub samples: u32,
     /// Times of the plotted instants, s from the flight's first sample (at most
