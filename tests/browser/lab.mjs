@@ -3,7 +3,9 @@
 // live telemetry flows while the Lab works): the vehicle editor refuses a bad value on its row
 // with the model's rule; a scenario runs and its plots draw; a Monte Carlo batch shows its
 // progress and is cancelled part-way, keeping the runs it flew; the stability analysis draws its
-// eigenvalues beside the seed's; a second job while one runs is 409 and a viewer's start 403;
+// eigenvalues beside the seed's; a course-controller tuning run shows its gains, which are saved
+// as a file and, after a confirmation, sent to the drone, which holds them as parameters (an
+// unconfirmed or a viewer's send refused); a second job while one runs is 409 and a viewer's start 403;
 // the viewer's page shows the results without the controls. Compare on a recording: a first
 // station flies the rehearsal in real time for a few seconds and stops, leaving its recording;
 // the Lab picks it, compares it with the model (as edited) and draws the nine channels' plots
@@ -121,6 +123,45 @@ async function lab() {
   await vpage.locator('[data-testid="eigen-plot"]').waitFor({ timeout: 10000 }).catch(() => {});
   check("viewer: the Lab page shows the last result read-only (Run disabled)",
     (await vpage.locator('[data-testid="eigen-plot"] circle.point').count()) === ours && (await vpage.locator('[data-testid="job-start"]').isDisabled()), `${await text(vpage, "lab-role")}`);
+
+  // A tuning run of the course controller, its gains saved as a file and, confirmed, sent to
+  // the drone as parameters, which it then holds.
+  await page.selectOption('[data-testid="job-kind"]', "tune");
+  await page.selectOption('[data-testid="tune-controller"]', "course");
+  await page.click('[data-testid="job-start"]');
+  const tuned = await until(() => outcome(page), (t) => /tune.*: (done|failed|timed out)/.test(t), 300000, 500);
+  await page.locator('[data-testid="tune-gains"]').waitFor({ timeout: 5000 }).catch(() => {});
+  const tuneHead = await text(page, "tune-result").catch(() => "");
+  const gainRows = await page.locator('[data-testid="tune-gains"] tr').evaluateAll((trs) => trs.slice(1).map((tr) => [...tr.querySelectorAll("td")].map((td) => td.textContent ?? "")));
+  check("tuning: a course-controller tuning run shows its costs and the gains it found", tuned.includes("done") && /Tuned course: cost/.test(tuneHead) && gainRows.length > 0 && gainRows.every(([k, v]) => k.startsWith("GN_") && Number.isFinite(Number(v))),
+    `"${tuned}": ${tuneHead.slice(0, 90)}; ${gainRows.map((r) => r.join(" = ")).join(", ")}`);
+  await page.fill('[data-testid="gains-name"]', "tuned-course");
+  await page.click('[data-testid="gains-save"]');
+  const gainsSaved = await until(() => text(page, "gains-msg"), (t) => t.startsWith("saved") || t.includes(":"), 5000);
+  const gainsFiles = await readdir(labDir);
+  const { gains } = (await api("/api/lab", OPERATOR)).body?.last?.result ?? {};
+  const unconfirmed = await api("/api/lab/gains/send", OPERATOR, { method: "POST", body: JSON.stringify({ gains, confirm: false }) });
+  const viewerSend = await api("/api/lab/gains/send", VIEWER, { method: "POST", body: JSON.stringify({ gains, confirm: true }) });
+  check("tuning: the gains are saved as a file in the Lab's directory; sending them unconfirmed is refused, a viewer's send 403",
+    gainsSaved.includes("tuned-course.toml") && gainsFiles.includes("tuned-course.toml") && unconfirmed.status === 400 && unconfirmed.body?.error === "confirmation_required" && viewerSend.status === 403,
+    `"${gainsSaved}"; unconfirmed ${unconfirmed.status} ${unconfirmed.body?.error}; viewer ${viewerSend.status}`);
+  await page.click('[data-testid="gains-send"]');
+  const warned = await text(page, "gains-msg");
+  const confirmShown = await page.locator('[data-testid="gains-confirm"]').isVisible();
+  await page.click('[data-testid="gains-confirm"]');
+  const sent = await until(() => text(page, "gains-msg"), (t) => t.startsWith("sent") || t.includes(":"), 10000);
+  const held = async () => {
+    const table = (await api("/api/params", OPERATOR)).body?.params ?? [];
+    return Object.entries(gains ?? {}).map(([name, v]) => [name, v, table.find((p) => p.name === name)?.value]);
+  };
+  const defaults = Object.fromEntries(((await api("/api/lab/gains", OPERATOR)).body?.gains ?? []).map((g) => [g.name, g.value]));
+  const changed = Object.entries(gains ?? {}).filter(([name, v]) => typeof defaults[name] === "number" && Math.abs(defaults[name] - v) > 1e-6 * Math.abs(v)).map(([name]) => name);
+  const onDrone = await until(held, (rows) => rows.length > 0 && rows.every(([, v, d]) => typeof d === "number" && Math.abs(d - v) <= 1e-6 * Math.max(1, Math.abs(v))), 30000, 500);
+  check("tuning: Send asks for a confirmation first; confirmed, the gains (some changed by the tuning) go to the drone as parameters and the drone holds them (float32)",
+    changed.length > 0 && confirmShown && /will change the drone's guidance/.test(warned) && sent.startsWith(`sent: ${Object.keys(gains ?? {}).length} parameter requests`) &&
+      onDrone.every(([, v, d]) => typeof d === "number" && Math.abs(d - v) <= 1e-6 * Math.max(1, Math.abs(v))),
+    `"${warned}" → "${sent}"; changed by the tuning: ${changed.join(", ")}; ${onDrone.map(([n, v, d]) => `${n} ${v} on the drone ${d}`).join(", ")}`);
+  await page.screenshot({ path: join(out, "lab-tune.png") });
 
   // Compare the first station's recording with the model (the vehicle as edited above).
   await page.click('[data-testid="compare-refresh"]');

@@ -206,12 +206,24 @@ fn tuning(
     .map_err(|e| e.to_string())?;
     let mut settings = OnboardSettings::default();
     settings.guidance.gains = report.gains_out;
-    let cost = |c: &stx_analysis::tune::Candidate| c.nonlinear_cost.unwrap_or(f64::NAN);
+    // Gains the 14-DOF model has not flown are not offered for the drone: the job fails with
+    // the model's reason (low down, "the stack reached the ground during the step").
+    let Some(cost_tuned) = report.tuned.nonlinear_cost else {
+        let t = &report.tuned;
+        let why = [&t.small, &t.large]
+            .into_iter()
+            .find_map(|trial| trial.nonlinear_error.clone())
+            .unwrap_or_else(|| "no step flown".into());
+        return Err(format!(
+            "the tuned gains failed the 14-DOF step at {altitude_m} m: {why} (tune at {} m, where the Monte Carlo releases, or higher)",
+            crate::tune::DEFAULT_ALTITUDE_M
+        ));
+    };
     Ok(LabResult::Tune(TuneSummary {
         controller: controller.name().to_string(),
-        cost_before: cost(&report.current),
-        cost_tuned: cost(&report.tuned),
-        cost_seed: cost(&report.seed),
+        cost_before: report.current.nonlinear_cost,
+        cost_tuned,
+        cost_seed: report.seed.nonlinear_cost,
         gains: CATALOG
             .iter()
             .filter(|p| p.name.starts_with("GN_"))
@@ -219,4 +231,36 @@ fn tuning(
             .collect(),
         gains_toml: gains_file(&report, "the built-in gains"),
     }))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    struct Quiet;
+
+    impl JobControl for Quiet {
+        fn progress(&self, _done: usize, _total: usize) {}
+        fn should_stop(&self) -> bool {
+            false
+        }
+    }
+
+    /// Regression: the page's trim altitude (100 m) reached the Lab's tuning, whose 14-DOF
+    /// steps hit the ground there; the costs went out as `null` where the contract promises
+    /// numbers and the page failed drawing them. Such a tuning now fails with the model's reason.
+    #[test]
+    fn lab_tuning_too_low_fails_with_the_model_s_reason_and_at_600_m_gives_flown_gains() {
+        let vehicle = Vehicle::straplex();
+        let low = tuning("course", &vehicle, 100.0, &Quiet).expect_err("fails at 100 m");
+        assert!(
+            low.contains("reached the ground") && low.contains("600 m"),
+            "{low}"
+        );
+        let Ok(LabResult::Tune(t)) = tuning("course", &vehicle, 600.0, &Quiet) else {
+            panic!("tunes at 600 m");
+        };
+        assert!(t.cost_tuned.is_finite() && t.cost_before.is_some_and(f64::is_finite));
+        assert!(t.gains.values().all(|g| g.is_finite()) && !t.gains.is_empty());
+    }
 }

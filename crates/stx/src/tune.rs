@@ -21,6 +21,10 @@ use stx_sim::sensors::SensorConfig;
 use crate::BadInput;
 use crate::inputs::{load_gains, load_vehicle};
 
+/// The altitude tuning trims at unless told, m: where the Monte Carlo releases, high enough
+/// for the 14-DOF steps to finish before the ground (at 100 m they do not).
+pub const DEFAULT_ALTITUDE_M: f64 = 600.0;
+
 #[derive(Args)]
 pub struct TuneArgs {
     /// The controller: heading, course, localizer or vertical.
@@ -30,7 +34,7 @@ pub struct TuneArgs {
     #[arg(long)]
     vehicle: Option<PathBuf>,
     /// Altitude of the trim the loop is tuned at, m (the Monte Carlo releases at 600 m).
-    #[arg(long, default_value_t = 600.0)]
+    #[arg(long, default_value_t = DEFAULT_ALTITUDE_M)]
     altitude: f64,
     /// Gains to start from and keep for the other controllers (default: the --out file if it
     /// exists, else the built-in defaults, which `config/gains.toml` holds).

@@ -269,15 +269,15 @@ export type LabResult =
        */
       controller: string;
       /**
-       * Nonlinear step cost with the gains before.
+       * Nonlinear step cost with the gains before (`null`: the 14-DOF step with them failed).
        */
-      cost_before: number;
+      cost_before: number | null;
       /**
-       * … with the seed's (A.13) gains.
+       * … with the seed's (A.13) gains (`null`: failed).
        */
-      cost_seed: number;
+      cost_seed: number | null;
       /**
-       * … with the tuned gains.
+       * … with the tuned gains (a tuning whose gains fail the 14-DOF step is a failed job).
        */
       cost_tuned: number;
       /**

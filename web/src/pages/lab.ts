@@ -49,6 +49,8 @@ const el = {
   wind: num("mc-wind", "4", "0", "15"),
   releaseAlt: num("mc-altitude", "600", "50", "3000"),
   trimAlt: num("trim-altitude", "100", "-5000", "86000"),
+  // Tuning flies 14-DOF steps from its trim: at 100 m they reach the ground, so it has its own height.
+  tuneAlt: num("tune-altitude", "600", "-5000", "86000"),
   controller: h("select", { "data-testid": "tune-controller" }, ...CONTROLLERS.map((n) => h("option", { value: n }, n))),
   start: h("button", { type: "button", "data-testid": "job-start", "data-role": "operator" }, "Run"),
   cancel: h("button", { type: "button", "data-testid": "job-cancel", "data-role": "operator" }, "Cancel"),
@@ -73,7 +75,7 @@ function jobBody(): Wire.LabJobBody {
     case "stability":
       return { kind: "stability", altitude_m: n(el.trimAlt), vehicle: edits };
     case "tune":
-      return { kind: "tune", controller: el.controller.value, altitude_m: n(el.trimAlt) };
+      return { kind: "tune", controller: el.controller.value, altitude_m: n(el.tuneAlt) };
     default:
       return { kind: "scenario", scenario: el.scenario.value, vehicle: edits };
   }
@@ -246,6 +248,9 @@ function table(testid: string, rows: [string, string, string?][]): HTMLElement {
 /** A tuning run's result (the contract inlines each kind of result in `LabResult`). */
 type TuneResult = Extract<Wire.LabResult, { kind: "tune" }>;
 
+/** A step cost, or "–" where the 14-DOF step failed. */
+const cost = (c: number | null): string => (c === null ? "–" : c.toFixed(3));
+
 function gainsPanel(t: TuneResult): HTMLElement {
   const gains: Record<string, number> = {};
   for (const [k, v] of Object.entries(t.gains)) if (v !== undefined) gains[k] = v;
@@ -269,7 +274,7 @@ function gainsPanel(t: TuneResult): HTMLElement {
     if (isObj(r) && Array.isArray(r.request_ids)) setText(msg, `sent: ${r.request_ids.length} parameter requests (see the dashboard's command list)`);
   });
   const rows = Object.entries(gains).map(([k, v]) => [k, v.toPrecision(4)] as [string, string]);
-  const panel = h("div", { "data-testid": "tune-result" }, h("h2", {}, `Tuned ${t.controller}: cost ${t.cost_before.toFixed(3)} → ${t.cost_tuned.toFixed(3)} (seed's gains ${t.cost_seed.toFixed(3)})`), table("tune-gains", rows), h("div", { class: "row" }, name, save, send, confirm), msg);
+  const panel = h("div", { "data-testid": "tune-result" }, h("h2", {}, `Tuned ${t.controller}: cost ${cost(t.cost_before)} → ${cost(t.cost_tuned)} (seed's gains ${cost(t.cost_seed)})`), table("tune-gains", rows), h("div", { class: "row" }, name, save, send, confirm), msg);
   applyRole(panel, operator);
   return panel;
 }
@@ -387,7 +392,8 @@ async function main(): Promise<void> {
           h("div", { class: "row" }, h("label", {}, "job ", el.kind)),
           h("div", { class: "row" }, h("label", {}, "scenario ", el.scenario)),
           h("div", { class: "row" }, h("label", {}, "runs ", el.runs), h("label", {}, "seed ", el.seed), h("label", {}, "wind max m/s ", el.wind), h("label", {}, "release height m ", el.releaseAlt)),
-          h("div", { class: "row" }, h("label", {}, "trim altitude m ", el.trimAlt), h("label", {}, "controller ", el.controller)),
+          h("div", { class: "row" }, h("label", {}, "trim altitude m ", el.trimAlt)),
+          h("div", { class: "row" }, h("label", {}, "controller ", el.controller), h("label", {}, "tune at m ", el.tuneAlt)),
           h("div", { class: "row" }, el.start, el.cancel),
           h("h2", {}, "A recorded flight: compare with the model, identify coefficients"),
           h("div", { class: "row" }, h("label", { class: "recording-label" }, "recording ", el.recording), el.recordingsRefresh),

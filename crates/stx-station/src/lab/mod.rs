@@ -273,12 +273,12 @@ pub struct StabilitySummary {
 pub struct TuneSummary {
     /// The controller tuned.
     pub controller: String,
-    /// Nonlinear step cost with the gains before.
-    pub cost_before: f64,
-    /// … with the tuned gains.
+    /// Nonlinear step cost with the gains before (`null`: the 14-DOF step with them failed).
+    pub cost_before: Option<f64>,
+    /// … with the tuned gains (a tuning whose gains fail the 14-DOF step is a failed job).
     pub cost_tuned: f64,
-    /// … with the seed's (A.13) gains.
-    pub cost_seed: f64,
+    /// … with the seed's (A.13) gains (`null`: failed).
+    pub cost_seed: Option<f64>,
     /// The tuned gains by parameter name.
     pub gains: BTreeMap<String, f64>,
     /// The gains file (TOML) with every controller's gains.
