@@ -2,12 +2,14 @@
 //! (`[canopy.aero]`, `[canopy.brakes]`), plus the rigging angle.
 //!
 //! The rigging angle is not a field of the file: it turns the canopy's pressure centre and
-//! its lines' attachment points about its pitch axis (as stx-sim's dispersions do), which
-//! turns the canopy's trim against its lines. It is fitted as a change from the file's
-//! geometry, in degrees, starting at 0, and written into the new file's geometry.
+//! its lines' attachment points about its pitch axis ([`rotate_rigging`], the same change
+//! stx-sim's dispersions draw), which turns the canopy's trim against its lines. It is
+//! fitted as a change from the file's geometry, in degrees, starting at 0, and written into
+//! the new file's geometry.
 
 use serde::{Deserialize, Serialize};
 use stx_dynamics::vehicle::VehicleConfig;
+use stx_sim::dispersions::rotate_rigging;
 use thiserror::Error;
 
 /// A parameter name that is not one of [`Param::ALL`].
@@ -147,20 +149,6 @@ impl Param {
             Param::RiggingDeg => 1.0,
             _ => value.abs().max(1e-3),
         }
-    }
-}
-
-/// Turns the canopy's pressure centre and line attachments by `deg` about its pitch axis.
-pub fn rotate_rigging(v: &mut VehicleConfig, deg: f64) {
-    let (sin, cos) = deg.to_radians().sin_cos();
-    let g = &mut v.geometry;
-    for p in [
-        &mut g.canopy_pressure_centre_m,
-        &mut g.right_line_on_canopy_m,
-        &mut g.left_line_on_canopy_m,
-    ] {
-        let [x, y, z] = *p;
-        *p = [cos * x + sin * z, y, -sin * x + cos * z];
     }
 }
 

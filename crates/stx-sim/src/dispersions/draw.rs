@@ -181,6 +181,26 @@ impl DispersedFlight {
     }
 }
 
+/// Changes `v`'s rigging angle by `deg`: turns the canopy's pressure centre and its lines'
+/// canopy ends about the canopy's pitch axis (a right-handed turn about its y axis, x forward
+/// and z down), which turns the canopy's trim against its lines by that angle.
+///
+/// The rigging angle is not a field of the vehicle file, so what "a rigging change" means is
+/// defined only here: a dispersed flight draws one, and identification (stx-analysis) fits
+/// one. Both call this, so a fitted angle is the same change the Monte Carlo disperses.
+pub fn rotate_rigging(v: &mut VehicleConfig, deg: f64) {
+    let (sin, cos) = deg.to_radians().sin_cos();
+    let g = &mut v.geometry;
+    for p in [
+        &mut g.canopy_pressure_centre_m,
+        &mut g.right_line_on_canopy_m,
+        &mut g.left_line_on_canopy_m,
+    ] {
+        let [x, y, z] = *p;
+        *p = [cos * x + sin * z, y, -sin * x + cos * z];
+    }
+}
+
 fn disperse_vehicle(
     d: &Dispersions,
     nominal: &VehicleConfig,
@@ -226,19 +246,9 @@ fn disperse_vehicle(
     ] {
         scaled(rng, m, s);
     }
-    // The rigging angle: the pressure centre and the lines' canopy ends turned about the
-    // canopy's pitch axis, which turns the canopy's trim against its lines by that angle.
     let rigging_deg = d.rigging.angle_sigma_deg * clipped_gauss(rng);
-    let (sin, cos) = rigging_deg.to_radians().sin_cos();
+    rotate_rigging(&mut v, rigging_deg);
     let g = &mut v.geometry;
-    for p in [
-        &mut g.canopy_pressure_centre_m,
-        &mut g.right_line_on_canopy_m,
-        &mut g.left_line_on_canopy_m,
-    ] {
-        let [x, y, z] = *p;
-        *p = [cos * x + sin * z, y, -sin * x + cos * z];
-    }
     let line = 1.0 + d.rigging.line_length_sigma * clipped_gauss(rng);
     for l in [&mut g.right_line_m, &mut g.left_line_m] {
         *l = l.map(|c| c * line);

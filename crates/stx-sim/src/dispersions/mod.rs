@@ -15,4 +15,4 @@ pub use config::{
     AeroDispersions, Dispersions, DispersionsError, MassDispersions, NOMINAL_TOML, REALISTIC_TOML,
     RiggingDispersions, SensorDispersions, ServoDispersions, WindDispersions,
 };
-pub use draw::{DispersedFlight, DrawSummary, ServoErrors, WindShape};
+pub use draw::{DispersedFlight, DrawSummary, ServoErrors, WindShape, rotate_rigging};
