@@ -1,8 +1,8 @@
 //! The Lab's work for `stx serve`: the station's Lab (`stx_station::lab`) decides what runs
 //! and when; this flies the scenario, the Monte Carlo batch, the stability analysis, the
 //! tuning run, a recording's comparison with the model (`crate::lab_compare`) or its
-//! parameters' identification (`crate::lab_identify`) with the
-//! simulator and the analysis, which only the binary links.
+//! parameters' identification (`crate::lab_identify`; what the two share is
+//! `crate::lab_recording`) with the simulator and the analysis, which only the binary links.
 
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -70,24 +70,12 @@ impl LabWorker for Worker {
             LabJobBody::Compare {
                 recording,
                 vehicle: edits,
-            } => {
-                let path = inputs
-                    .recording
-                    .as_deref()
-                    .ok_or("the station gave the comparison no recording (a bug)")?;
-                crate::lab_compare::run(recording, path, vehicle, edits, control)
-            }
+            } => crate::lab_compare::run(recording, inputs, edits, control),
             LabJobBody::Identify {
                 recording,
                 params,
                 vehicle: edits,
-            } => {
-                let path = inputs
-                    .recording
-                    .as_deref()
-                    .ok_or("the station gave the identification no recording (a bug)")?;
-                crate::lab_identify::run(recording, path, params, vehicle, edits, control)
-            }
+            } => crate::lab_identify::run(recording, params, inputs, edits, control),
         }
     }
 }

@@ -4,30 +4,26 @@
 //! `stx_analysis::compare`, stopping when the job is cancelled or over its cap, and hands the
 //! page both series thinned for plotting beside each channel's error figures over every sample.
 
-use std::path::Path;
-
 use stx_analysis::compare::{CompareReport, DEFAULT_STEP_S, fly_watched, report};
-use stx_dynamics::vehicle::Vehicle;
 use stx_station::lab::compare::{MAX_COMPARE_POINTS, plotted};
-use stx_station::lab::{CompareChannel, CompareSeries, JobControl, LabResult, VehicleEdits};
+use stx_station::lab::{
+    CompareChannel, CompareSeries, JobControl, JobInputs, LabResult, VehicleEdits,
+};
 
-use crate::compare::read_log;
+use crate::lab_recording::{flight_log, vehicle_changes, watcher};
 
-/// Compares the recording `name` at `path` with `vehicle` (edited from the seed's by `edits`).
+/// Compares the recording `name` with the vehicle of `inputs` (edited from the seed's by
+/// `edits`).
 pub fn run(
     name: &str,
-    path: &Path,
-    vehicle: &Vehicle,
+    inputs: &JobInputs,
     edits: &VehicleEdits,
     control: &dyn JobControl,
 ) -> Result<LabResult, String> {
-    let log = read_log(path).map_err(|e| format!("{e:#}"))?;
+    let log = flight_log(name, inputs)?;
     control.progress(0, log.samples().len());
-    let flown = fly_watched(&log, vehicle, DEFAULT_STEP_S, |done, total| {
-        control.progress(done, total);
-        !control.should_stop()
-    })
-    .map_err(|e| format!("flying the model through {name}: {e}"))?;
+    let flown = fly_watched(&log, &inputs.vehicle, DEFAULT_STEP_S, watcher(control))
+        .map_err(|e| format!("flying the model through {name}: {e}"))?;
     let compared = report(&log, &flown);
     Ok(LabResult::Compare(series(
         name,
@@ -49,7 +45,7 @@ pub fn series(
     let finite = |v: f64| v.is_finite().then_some(v);
     CompareSeries {
         recording: name.to_string(),
-        vehicle_changes: edits.iter().map(|(k, v)| format!("{k} = {v}")).collect(),
+        vehicle_changes: vehicle_changes(edits),
         duration_s: report.duration_s,
         parafoil_stage_s: report.part.map(|p| [p.from_s, p.to_s]),
         recorded_s: report.part.map_or(report.duration_s, |p| p.recorded_s),
@@ -79,128 +75,13 @@ pub fn series(
 }
 
 #[cfg(test)]
-pub(crate) mod tests {
+mod tests {
     use super::*;
-    use std::sync::Mutex;
-    use std::time::Duration;
-
-    use nalgebra::Vector3;
     use stx_analysis::compare::{CompareOptions, compare};
-    use stx_analysis::flight_log::FlightLog;
     use stx_analysis::flight_log::synthetic::{SyntheticFlight, simulate};
-    use stx_gnc::geo::LocalFrame;
-    use stx_link::telemetry::{Actuators, Attitude, GlobalPosition, Hud, Telemetry, Wind};
-    use stx_record::{CoreOptions, Output, RecorderCore, RecordingInfo};
-    use stx_station::recording::telemetry::TelemetryChannels;
+    use stx_dynamics::vehicle::Vehicle;
 
-    /// `log` as the station records a drone's telemetry (the same channels, the same JSON), at
-    /// one position, attitude, airspeed, command and wind message per sample.
-    pub(crate) fn recording_of(log: &FlightLog, path: &Path) {
-        let info = RecordingInfo::new("test", "straplex-2", "lab compare");
-        let mut core = RecorderCore::new(CoreOptions::default(), info, Duration::ZERO).unwrap();
-        let channels = TelemetryChannels::register(&mut core, Duration::ZERO).unwrap();
-        let frame = LocalFrame {
-            lat_deg: 41.0,
-            lon_deg: -8.0,
-            alt_msl_m: 0.0,
-        };
-        let t0_ns = 1_767_225_600_000_000_000u64;
-        for s in log.samples() {
-            let t_ns = t0_ns + (s.time_s * 1e9).round() as u64;
-            let (lat_deg, lon_deg, alt_msl_m) = frame.to_geodetic(&Vector3::from(s.position_ned_m));
-            let [v_north_mps, v_east_mps, v_down_mps] = s.velocity_ned_mps;
-            let [roll_rad, pitch_rad, yaw_rad] = s.euler_rad;
-            let [wn, we, wd] = s.wind_ned_mps;
-            let messages = [
-                Telemetry::Attitude(Attitude {
-                    time_boot_ms: 0,
-                    roll_rad,
-                    pitch_rad,
-                    yaw_rad,
-                    roll_rate_radps: 0.0,
-                    pitch_rate_radps: 0.0,
-                    yaw_rate_radps: 0.0,
-                }),
-                Telemetry::Actuators(Actuators {
-                    time_usec: 0,
-                    main_line: s.main_line,
-                    brake_right: s.brake_right,
-                    brake_left: s.brake_left,
-                }),
-                Telemetry::Hud(Hud {
-                    airspeed_mps: s.airspeed_mps.unwrap_or(0.0),
-                    groundspeed_mps: v_north_mps.hypot(v_east_mps),
-                    heading_deg: yaw_rad.to_degrees().rem_euclid(360.0),
-                    climb_mps: -v_down_mps,
-                    alt_msl_m,
-                }),
-                Telemetry::Wind(Wind {
-                    time_usec: 0,
-                    wind_north_mps: Some(wn),
-                    wind_east_mps: Some(we),
-                    wind_down_mps: Some(wd),
-                    var_horiz_mps: None,
-                    var_vert_mps: None,
-                    alt_msl_m: None,
-                    horiz_accuracy_mps: 0.0,
-                    vert_accuracy_mps: 0.0,
-                }),
-                Telemetry::Position(GlobalPosition {
-                    time_boot_ms: 0,
-                    lat_deg,
-                    lon_deg,
-                    alt_msl_m,
-                    alt_rel_m: alt_msl_m,
-                    v_north_mps,
-                    v_east_mps,
-                    v_down_mps,
-                    heading_deg: None,
-                }),
-            ];
-            let now = Duration::from_nanos(t_ns - t0_ns);
-            for m in &messages {
-                for (ch, data) in channels.records(t_ns, m) {
-                    core.write(now, ch, t_ns, t_ns, &data).unwrap();
-                }
-            }
-        }
-        core.finish().unwrap();
-        let mut bytes = Vec::new();
-        while let Some(out) = core.poll_output() {
-            if let Output::Bytes { data, .. } = out {
-                bytes.extend(data);
-            }
-        }
-        std::fs::write(path, bytes).unwrap();
-    }
-
-    /// A job's control: its progress kept, told to stop after `stop_after` samples.
-    struct Control {
-        seen: Mutex<Vec<(usize, usize)>>,
-        stop_after: usize,
-    }
-
-    impl JobControl for Control {
-        fn progress(&self, done: usize, total: usize) {
-            self.seen.lock().unwrap().push((done, total));
-        }
-        fn should_stop(&self) -> bool {
-            self.seen.lock().unwrap().last().map_or(0, |p| p.0) >= self.stop_after
-        }
-    }
-
-    fn control(stop_after: usize) -> Control {
-        Control {
-            seen: Mutex::new(Vec::new()),
-            stop_after,
-        }
-    }
-
-    fn temp(name: &str) -> std::path::PathBuf {
-        let dir = std::env::temp_dir().join(format!("stx-lab-compare-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        dir.join(name)
-    }
+    use crate::lab_recording::tests::{control, inputs, recording_of, temp};
 
     #[test]
     fn a_recorded_flight_is_compared_as_stx_compare_compares_it() {
@@ -210,7 +91,9 @@ pub(crate) mod tests {
         recording_of(&log, &path);
         let c = control(usize::MAX);
         let edits = VehicleEdits::from([("canopy.mass_kg".to_string(), 0.8)]);
-        let LabResult::Compare(s) = run("flight.mcap", &path, &vehicle, &edits, &c).unwrap() else {
+        let LabResult::Compare(s) =
+            run("flight.mcap", &inputs(&vehicle, &path), &edits, &c).unwrap()
+        else {
             panic!("not a comparison");
         };
         let n = log.samples().len();
@@ -269,7 +152,13 @@ pub(crate) mod tests {
         let path = temp("cancelled.mcap");
         recording_of(&log, &path);
         let c = control(10);
-        let e = run("cancelled.mcap", &path, &vehicle, &VehicleEdits::new(), &c).unwrap_err();
+        let e = run(
+            "cancelled.mcap",
+            &inputs(&vehicle, &path),
+            &VehicleEdits::new(),
+            &c,
+        )
+        .unwrap_err();
         assert!(
             e.contains("cancelled.mcap") && e.contains("stopped at"),
             "{e}"
@@ -283,8 +172,7 @@ pub(crate) mod tests {
         std::fs::write(&path, b"not a recording").unwrap();
         let e = run(
             "junk.mcap",
-            &path,
-            &Vehicle::straplex(),
+            &inputs(&Vehicle::straplex(), &path),
             &VehicleEdits::new(),
             &control(usize::MAX),
         )

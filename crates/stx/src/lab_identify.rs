@@ -5,22 +5,21 @@
 //! progress and cancelling the fit after the current iteration when the job is cancelled or
 //! over its cap (the library's cancel flag), and hands the page the estimates.
 
-use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use stx_analysis::identify::{IdentifyOptions, IdentifyReport, Param, identify};
-use stx_dynamics::vehicle::Vehicle;
-use stx_station::lab::{IdentifiedParam, IdentifySummary, JobControl, LabResult, VehicleEdits};
+use stx_station::lab::{
+    IdentifiedParam, IdentifySummary, JobControl, JobInputs, LabResult, VehicleEdits,
+};
 
-use crate::compare::read_log;
+use crate::lab_recording::{flight_log, vehicle_changes, watcher};
 
-/// Fits `params` to the recording `name` at `path`, from `vehicle` (edited from the seed's
-/// by `edits`).
+/// Fits `params` to the recording `name`, from the vehicle of `inputs` (edited from the
+/// seed's by `edits`).
 pub fn run(
     name: &str,
-    path: &Path,
     params: &[String],
-    vehicle: &Vehicle,
+    inputs: &JobInputs,
     edits: &VehicleEdits,
     control: &dyn JobControl,
 ) -> Result<LabResult, String> {
@@ -29,20 +28,20 @@ pub fn run(
         .map(|p| Param::parse(p))
         .collect::<Result<Vec<_>, _>>()
         .map_err(|e| e.to_string())?;
-    let log = read_log(path).map_err(|e| format!("{e:#}"))?;
+    let log = flight_log(name, inputs)?;
     let options = IdentifyOptions::default();
     let total = options.max_iterations;
     control.progress(0, total);
     let cancel = AtomicBool::new(false);
+    let mut go_on = watcher(control);
     let report = identify(
         &[log],
         &params,
-        &vehicle.config,
+        &inputs.vehicle.config,
         &options,
         &cancel,
         &mut |p| {
-            control.progress(p.iteration.min(total), total);
-            if control.should_stop() {
+            if !go_on(p.iteration.min(total), total) {
                 cancel.store(true, Ordering::Relaxed);
             }
         },
@@ -55,7 +54,7 @@ pub fn run(
 pub fn summary(name: &str, edits: &VehicleEdits, report: &IdentifyReport) -> IdentifySummary {
     IdentifySummary {
         recording: name.to_string(),
-        vehicle_changes: edits.iter().map(|(k, v)| format!("{k} = {v}")).collect(),
+        vehicle_changes: vehicle_changes(edits),
         params: report
             .params
             .iter()
@@ -83,32 +82,11 @@ pub fn summary(name: &str, edits: &VehicleEdits, report: &IdentifyReport) -> Ide
 #[cfg(test)]
 mod tests {
     use super::*;
-    use std::sync::Mutex;
-
     use stx_analysis::flight_log::synthetic::{SyntheticFlight, simulate};
+    use stx_dynamics::vehicle::Vehicle;
     use stx_station::lab::identify::IDENTIFY_PARAMS;
 
-    use crate::lab_compare::tests::recording_of;
-
-    struct Control {
-        seen: Mutex<Vec<(usize, usize)>>,
-        stop: bool,
-    }
-
-    impl JobControl for Control {
-        fn progress(&self, done: usize, total: usize) {
-            self.seen.lock().unwrap().push((done, total));
-        }
-        fn should_stop(&self) -> bool {
-            self.stop
-        }
-    }
-
-    fn temp(name: &str) -> std::path::PathBuf {
-        let dir = std::env::temp_dir().join(format!("stx-lab-identify-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        dir.join(name)
-    }
+    use crate::lab_recording::tests::{control, inputs, recording_of, temp};
 
     #[test]
     fn the_station_knows_the_library_s_parameters() {
@@ -128,16 +106,12 @@ mod tests {
         let log = simulate(&truth, &SyntheticFlight::manoeuvres(3)).unwrap();
         let path = temp("flight.mcap");
         recording_of(&log, &path);
-        let c = Control {
-            seen: Mutex::new(Vec::new()),
-            stop: false,
-        };
+        let c = control(usize::MAX);
         let params = vec!["cl_alpha".to_string()];
         let result = run(
             "flight.mcap",
-            &path,
             &params,
-            &seed,
+            &inputs(&seed, &path),
             &VehicleEdits::new(),
             &c,
         )
@@ -167,16 +141,12 @@ mod tests {
         let log = simulate(&seed, &SyntheticFlight::manoeuvres(4)).unwrap();
         let path = temp("cancelled.mcap");
         recording_of(&log, &path);
-        let c = Control {
-            seen: Mutex::new(Vec::new()),
-            stop: true,
-        };
+        let c = control(0);
         let params = vec!["cl_alpha".to_string(), "cd0".to_string()];
         let LabResult::Identify(s) = run(
             "cancelled.mcap",
-            &path,
             &params,
-            &seed,
+            &inputs(&seed, &path),
             &VehicleEdits::new(),
             &c,
         )
@@ -190,16 +160,12 @@ mod tests {
     fn an_unknown_parameter_or_a_junk_file_fails_with_its_name() {
         let path = temp("junk.mcap");
         std::fs::write(&path, b"not a recording").unwrap();
-        let c = Control {
-            seen: Mutex::new(Vec::new()),
-            stop: false,
-        };
+        let c = control(usize::MAX);
         let seed = Vehicle::straplex();
         let e = run(
             "junk.mcap",
-            &path,
             &["cl_alpha".into()],
-            &seed,
+            &inputs(&seed, &path),
             &VehicleEdits::new(),
             &c,
         )
@@ -207,9 +173,8 @@ mod tests {
         assert!(e.contains("junk.mcap"), "{e}");
         let e = run(
             "junk.mcap",
-            &path,
             &["span".into()],
-            &seed,
+            &inputs(&seed, &path),
             &VehicleEdits::new(),
             &c,
         )

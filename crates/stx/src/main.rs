@@ -20,6 +20,7 @@ mod inputs;
 mod lab;
 mod lab_compare;
 mod lab_identify;
+mod lab_recording;
 mod logging;
 mod montecarlo;
 mod plan;

@@ -1,0 +1,171 @@
+//! What the Lab's jobs on a recording (`crate::lab_compare`, `crate::lab_identify`) share:
+//! the recording the station checked before the job started, read as a flight log as the
+//! command line reads it; a job's progress and cancel in the form the analysis' loops take;
+//! and the vehicle edits as the results list them.
+
+use stx_analysis::flight_log::FlightLog;
+use stx_station::lab::{JobControl, JobInputs, VehicleEdits};
+
+use crate::compare::read_log;
+
+/// The flight log of the recording `name`, which the station checked (a file of its
+/// recordings directory holding a flight) and put in `inputs`.
+pub fn flight_log(name: &str, inputs: &JobInputs) -> Result<FlightLog, String> {
+    let path = inputs
+        .recording
+        .as_deref()
+        .ok_or_else(|| format!("the station gave the job on {name} no recording (a bug)"))?;
+    read_log(path).map_err(|e| format!("{e:#}"))
+}
+
+/// A loop's watcher for `control`: told `done` of `total`, reports it and answers whether to
+/// go on (not once the job is cancelled or over its time cap).
+pub fn watcher(control: &dyn JobControl) -> impl FnMut(usize, usize) -> bool + '_ {
+    |done, total| {
+        control.progress(done, total);
+        !control.should_stop()
+    }
+}
+
+/// `edits` as a result lists them: `name = value`.
+pub fn vehicle_changes(edits: &VehicleEdits) -> Vec<String> {
+    edits.iter().map(|(k, v)| format!("{k} = {v}")).collect()
+}
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use std::path::{Path, PathBuf};
+    use std::sync::Mutex;
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    use std::time::Duration;
+
+    use nalgebra::Vector3;
+    use stx_analysis::flight_log::FlightLog;
+    use stx_dynamics::vehicle::Vehicle;
+    use stx_gnc::geo::LocalFrame;
+    use stx_link::telemetry::{Actuators, Attitude, GlobalPosition, Hud, Telemetry, Wind};
+    use stx_record::{CoreOptions, Output, RecorderCore, RecordingInfo};
+    use stx_station::lab::{JobControl, JobInputs};
+    use stx_station::recording::telemetry::TelemetryChannels;
+
+    /// `log` as the station records a drone's telemetry (the same channels, the same JSON), at
+    /// one position, attitude, airspeed, command and wind message per sample.
+    pub(crate) fn recording_of(log: &FlightLog, path: &Path) {
+        let info = RecordingInfo::new("test", "straplex-2", "lab compare");
+        let mut core = RecorderCore::new(CoreOptions::default(), info, Duration::ZERO).unwrap();
+        let channels = TelemetryChannels::register(&mut core, Duration::ZERO).unwrap();
+        let frame = LocalFrame {
+            lat_deg: 41.0,
+            lon_deg: -8.0,
+            alt_msl_m: 0.0,
+        };
+        let t0_ns = 1_767_225_600_000_000_000u64;
+        for s in log.samples() {
+            let t_ns = t0_ns + (s.time_s * 1e9).round() as u64;
+            let (lat_deg, lon_deg, alt_msl_m) = frame.to_geodetic(&Vector3::from(s.position_ned_m));
+            let [v_north_mps, v_east_mps, v_down_mps] = s.velocity_ned_mps;
+            let [roll_rad, pitch_rad, yaw_rad] = s.euler_rad;
+            let [wn, we, wd] = s.wind_ned_mps;
+            let messages = [
+                Telemetry::Attitude(Attitude {
+                    time_boot_ms: 0,
+                    roll_rad,
+                    pitch_rad,
+                    yaw_rad,
+                    roll_rate_radps: 0.0,
+                    pitch_rate_radps: 0.0,
+                    yaw_rate_radps: 0.0,
+                }),
+                Telemetry::Actuators(Actuators {
+                    time_usec: 0,
+                    main_line: s.main_line,
+                    brake_right: s.brake_right,
+                    brake_left: s.brake_left,
+                }),
+                Telemetry::Hud(Hud {
+                    airspeed_mps: s.airspeed_mps.unwrap_or(0.0),
+                    groundspeed_mps: v_north_mps.hypot(v_east_mps),
+                    heading_deg: yaw_rad.to_degrees().rem_euclid(360.0),
+                    climb_mps: -v_down_mps,
+                    alt_msl_m,
+                }),
+                Telemetry::Wind(Wind {
+                    time_usec: 0,
+                    wind_north_mps: Some(wn),
+                    wind_east_mps: Some(we),
+                    wind_down_mps: Some(wd),
+                    var_horiz_mps: None,
+                    var_vert_mps: None,
+                    alt_msl_m: None,
+                    horiz_accuracy_mps: 0.0,
+                    vert_accuracy_mps: 0.0,
+                }),
+                Telemetry::Position(GlobalPosition {
+                    time_boot_ms: 0,
+                    lat_deg,
+                    lon_deg,
+                    alt_msl_m,
+                    alt_rel_m: alt_msl_m,
+                    v_north_mps,
+                    v_east_mps,
+                    v_down_mps,
+                    heading_deg: None,
+                }),
+            ];
+            let now = Duration::from_nanos(t_ns - t0_ns);
+            for m in &messages {
+                for (ch, data) in channels.records(t_ns, m) {
+                    core.write(now, ch, t_ns, t_ns, &data).unwrap();
+                }
+            }
+        }
+        core.finish().unwrap();
+        let mut bytes = Vec::new();
+        while let Some(out) = core.poll_output() {
+            if let Output::Bytes { data, .. } = out {
+                bytes.extend(data);
+            }
+        }
+        std::fs::write(path, bytes).unwrap();
+    }
+
+    /// A job's control: its progress kept, told to stop once `stop_after` steps are done
+    /// (0: from the start; `usize::MAX`: never).
+    pub(crate) struct Control {
+        pub(crate) seen: Mutex<Vec<(usize, usize)>>,
+        stop_after: usize,
+    }
+
+    impl JobControl for Control {
+        fn progress(&self, done: usize, total: usize) {
+            self.seen.lock().unwrap().push((done, total));
+        }
+        fn should_stop(&self) -> bool {
+            self.seen.lock().unwrap().last().map_or(0, |p| p.0) >= self.stop_after
+        }
+    }
+
+    pub(crate) fn control(stop_after: usize) -> Control {
+        Control {
+            seen: Mutex::new(Vec::new()),
+            stop_after,
+        }
+    }
+
+    /// `name` in a directory of its own (tests run in parallel and reuse names).
+    pub(crate) fn temp(name: &str) -> PathBuf {
+        static NEXT: AtomicUsize = AtomicUsize::new(0);
+        let n = NEXT.fetch_add(1, Ordering::Relaxed);
+        let dir = std::env::temp_dir().join(format!("stx-lab-{}-{n}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        dir.join(name)
+    }
+
+    /// What the station hands a job on the recording at `path`, with `vehicle`.
+    pub(crate) fn inputs(vehicle: &Vehicle, path: &Path) -> JobInputs {
+        JobInputs {
+            vehicle: vehicle.clone(),
+            recording: Some(path.to_path_buf()),
+        }
+    }
+}
