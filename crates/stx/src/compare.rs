@@ -1,7 +1,9 @@
-//! `stx compare FILE [--vehicle FILE] [--json]`: a flight against the model (issue 16 item 1).
-//! Reads a station recording (MCAP) or a flight-log CSV (format: `stx_analysis::flight_log::csv`,
-//! README "Flight versus model"), flies the vehicle through it with the recorded commands and
-//! wind (`stx_analysis::compare`) and prints the error of each channel. Files and printing only.
+//! `stx compare FILE [--vehicle FILE] [--from S] [--to S] [--json]`: a flight against the
+//! model (issue 16 item 1). Reads a station recording (MCAP) or a flight-log CSV (format:
+//! `stx_analysis::flight_log::csv`, README "Flight versus model"), keeps the part between
+//! `--from` and `--to` (`stx_analysis::flight_log::window`; `stx identify` takes the same
+//! flags), flies the vehicle through it with the recorded commands and wind
+//! (`stx_analysis::compare`) and prints the error of each channel. Files and printing only.
 
 use std::path::{Path, PathBuf};
 
@@ -9,6 +11,7 @@ use anyhow::Context;
 use clap::Args;
 use stx_analysis::compare::{CompareOptions, CompareReport, compare};
 use stx_analysis::flight_log::recording::LogBuilder;
+use stx_analysis::flight_log::window::{Window, WindowEnd, WindowError};
 use stx_analysis::flight_log::{FlightLog, csv::from_csv};
 use stx_record::Recording;
 
@@ -23,9 +26,59 @@ pub struct CompareArgs {
     /// Vehicle file to fly (default: the shipped STRAPLEX vehicle).
     #[arg(long, value_name = "FILE")]
     vehicle: Option<PathBuf>,
+    #[command(flatten)]
+    window: WindowArgs,
     /// Print the whole report (series and error figures) as JSON instead of the table.
     #[arg(long)]
     json: bool,
+}
+
+/// `--from S --to S`: the part of a flight to use (the ascent and a round-chute descent
+/// are in a mission's recording too; the model flies the parafoil).
+#[derive(Args, Debug, Clone, Copy)]
+pub struct WindowArgs {
+    /// Use the flight from this time on: seconds from the flight log's first sample, on the
+    /// log's own clock (a recording's is the drone's). The model starts from the recorded
+    /// state there.
+    #[arg(long = "from", value_name = "S")]
+    from_s: Option<f64>,
+    /// Use the flight up to this time: seconds from the flight log's first sample.
+    #[arg(long = "to", value_name = "S")]
+    to_s: Option<f64>,
+}
+
+impl WindowArgs {
+    /// The window, checked before any file is read; bad ends are bad input naming the flag.
+    pub fn checked(&self) -> anyhow::Result<Window> {
+        let window = Window {
+            from_s: self.from_s,
+            to_s: self.to_s,
+        };
+        window.check().map_err(|e| flag_error(e, None))?;
+        Ok(window)
+    }
+}
+
+fn flag_error(e: WindowError, path: Option<&Path>) -> anyhow::Error {
+    let flag = match e.end() {
+        WindowEnd::From => "--from",
+        WindowEnd::To => "--to",
+        WindowEnd::Both => "--from/--to",
+    };
+    let e = anyhow::Error::new(e);
+    let e = match path {
+        Some(path) => e.context(format!("{flag}: {}", path.display())),
+        None => e.context(flag),
+    };
+    BadInput(e).into()
+}
+
+/// The flight log of `path` (as [`read_log`]) cut to `window`; a window holding no flight
+/// of it is bad input naming the flags and the file.
+pub fn read_window(path: &Path, window: &Window) -> anyhow::Result<FlightLog> {
+    read_log(path)?
+        .cut(window)
+        .map_err(|e| flag_error(e, Some(path)))
 }
 
 /// The flight log of a recording or a CSV file; what cannot be read is bad input.
@@ -83,7 +136,8 @@ pub fn table(report: &CompareReport) -> String {
 }
 
 pub fn run(args: CompareArgs) -> anyhow::Result<()> {
-    let log = read_log(&args.file)?;
+    let window = args.window.checked()?;
+    let log = read_window(&args.file, &window)?;
     let vehicle = load_vehicle(args.vehicle.as_deref())?;
     let report = compare(&log, &vehicle, &CompareOptions::default())
         .with_context(|| format!("flying the model through {}", args.file.display()))

@@ -1,6 +1,6 @@
-//! `stx identify FILE… --params NAME,… --out FILE [--vehicle FILE] [--json]`: fit chosen
-//! vehicle parameters to flights (issue 16 item 2). Reads recordings and flight-log CSVs as
-//! `stx compare` does, fits with `stx_analysis::identify`, prints each parameter's nominal and
+//! `stx identify FILE… --params NAME,… --out FILE [--vehicle FILE] [--from S] [--to S]
+//! [--json]`: fit chosen vehicle parameters to flights (issue 16 item 2). Reads recordings
+//! and flight-log CSVs as `stx compare` does (the window cutting each file alike), fits with `stx_analysis::identify`, prints each parameter's nominal and
 //! fitted values, standard error, 95 % interval and their correlations, and writes the
 //! fitted vehicle file. Files and printing only.
 
@@ -12,7 +12,7 @@ use clap::Args;
 use stx_analysis::identify::{IdentifyOptions, IdentifyReport, Param, identify};
 
 use crate::BadInput;
-use crate::compare::read_log;
+use crate::compare::{WindowArgs, read_window};
 use crate::inputs::load_vehicle;
 
 #[derive(Args, Debug)]
@@ -31,6 +31,9 @@ pub struct IdentifyArgs {
     /// Vehicle file to start from (default: the shipped STRAPLEX vehicle).
     #[arg(long, value_name = "FILE")]
     vehicle: Option<PathBuf>,
+    // The same window cuts every file.
+    #[command(flatten)]
+    window: WindowArgs,
     /// Print the report as JSON instead of the table.
     #[arg(long)]
     json: bool,
@@ -111,11 +114,12 @@ pub fn run(args: IdentifyArgs) -> anyhow::Result<()> {
     let params = Param::parse_list(&args.params)
         .context("--params")
         .map_err(BadInput)?;
+    let window = args.window.checked()?;
     let vehicle = load_vehicle(args.vehicle.as_deref())?;
     let logs = args
         .files
         .iter()
-        .map(|f| read_log(f))
+        .map(|f| read_window(f, &window))
         .collect::<anyhow::Result<Vec<_>>>()?;
     let quiet = args.json;
     let report = identify(

@@ -5,11 +5,12 @@
 //! Kept apart from where it came from so that both analyses stay pure: [`csv`] reads and
 //! writes the documented one-file CSV form, [`recording`] builds a log from the decoded
 //! telemetry of a station recording (the caller reads the MCAP file), and tests build logs
-//! from simulated flights.
+//! from simulated flights. [`window`] cuts the part of a log to use.
 
 pub mod csv;
 pub mod recording;
 pub mod synthetic;
+pub mod window;
 
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
@@ -20,7 +21,7 @@ pub const MIN_SAMPLES: usize = 3;
 /// Why a flight log was refused.
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum FlightLogError {
-    /// Too few samples (after windowing) to fly anything.
+    /// Too few samples to fly anything.
     #[error("flight log has {samples} samples; at least {MIN_SAMPLES} are needed")]
     TooShort { samples: usize },
     /// Times do not increase.
@@ -155,20 +156,6 @@ impl FlightLog {
         &self.samples
     }
 
-    /// The part of the log from `from_s` to `to_s` (either open), in the log's own times.
-    pub fn window(&self, from_s: Option<f64>, to_s: Option<f64>) -> Result<Self, FlightLogError> {
-        let kept = self
-            .samples
-            .iter()
-            .filter(|s| from_s.is_none_or(|f| s.time_s >= f) && to_s.is_none_or(|t| s.time_s <= t))
-            .copied()
-            .collect();
-        Ok(Self {
-            part: self.part,
-            ..Self::new(kept)?
-        })
-    }
-
     /// Duration, s.
     pub fn duration_s(&self) -> f64 {
         self.samples[self.samples.len() - 1].time_s - self.samples[0].time_s
@@ -265,8 +252,5 @@ pub(crate) mod tests {
                 field: "euler_rad"
             })
         );
-        let log = FlightLog::new(straight(10)).unwrap();
-        assert_eq!(log.window(Some(2.0), Some(6.0)).unwrap().samples().len(), 5);
-        assert!(log.window(Some(8.5), None).is_err());
     }
 }
