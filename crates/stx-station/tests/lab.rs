@@ -1,8 +1,9 @@
 //! The Lab's comparison through a real daemon (`POST /api/lab/jobs`, kind `compare`): the
 //! recording is checked before the job starts — a viewer is refused, a name outside the
 //! recordings directory or not in it is `unknown_recording`, a file that is no recording is
-//! `unreadable`, a recording without flight telemetry is `no_flight` — and a good one reaches
-//! the Lab's work as the file of the directory, whose result every page then reads.
+//! `unreadable`, a recording without flight telemetry is `no_flight`, a window that is none
+//! (`from_s` ≥ `to_s`, a negative time) is `invalid_job` — and a good one reaches the Lab's
+//! work as the file of the directory, whose result every page then reads.
 //!
 //! The work here is a stand-in that reads the file it is handed (the flying is the binary's,
 //! tested in `crates/stx/src/lab_compare.rs` and by `tests/browser/lab.mjs`).
@@ -298,4 +299,41 @@ async fn an_identification_is_checked_as_a_comparison_and_its_parameters_before_
     let expected = format!("flight.mcap at {}", dir.join("flight.mcap").display());
     assert_eq!(result["recording"], json!(expected));
     assert_eq!(result["params"][1]["name"], "cd0");
+}
+
+#[tokio::test]
+async fn a_window_that_ends_before_it_starts_is_refused_before_a_job_starts() {
+    let dir = temp_dir("window");
+    write_recording(&dir.join("flight.mcap"), &FLIGHT);
+    let station = station_with_lab(Some(dir)).await;
+    let compare = json!({"kind": "compare", "recording": "flight.mcap"});
+    let identify = json!({"kind": "identify", "recording": "flight.mcap", "params": ["cd0"]});
+    for job in [&compare, &identify] {
+        for (from_s, to_s, field) in [
+            (json!(40.0), json!(40.0), "to_s: "),
+            (json!(40.0), json!(10.0), "to_s: "),
+            (json!(-1.0), Value::Null, "from_s: "),
+        ] {
+            let mut body = job.clone();
+            body["from_s"] = from_s.clone();
+            body["to_s"] = to_s.clone();
+            let (status, answer) = start(&station, OPERATOR, body).await;
+            assert_eq!(
+                (status, answer["error"].as_str()),
+                (400, Some("invalid_job")),
+                "{job} {from_s} {to_s}: {answer}"
+            );
+            let reason = answer["reason"].as_str().unwrap_or_default();
+            assert!(reason.starts_with(field), "{reason}");
+        }
+    }
+    let (_, lab) = http(station.http(), "GET", "/api/lab", Some(VIEWER), None).await;
+    assert_eq!((&lab["job"], &lab["last"]), (&Value::Null, &Value::Null));
+    // A window with its end after its start, or one end only, starts the job.
+    let mut body = compare.clone();
+    body["from_s"] = json!(2.5);
+    body["to_s"] = json!(8.0);
+    let (status, answer) = start(&station, OPERATOR, body).await;
+    assert_eq!(status, 202, "{answer}");
+    assert_eq!(last_outcome(&station).await["outcome"], "done");
 }

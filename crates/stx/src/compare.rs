@@ -50,10 +50,7 @@ pub struct WindowArgs {
 impl WindowArgs {
     /// The window, checked before any file is read; bad ends are bad input naming the flag.
     pub fn checked(&self) -> anyhow::Result<Window> {
-        let window = Window {
-            from_s: self.from_s,
-            to_s: self.to_s,
-        };
+        let window = Window::new(self.from_s, self.to_s);
         window.check().map_err(|e| flag_error(e, None))?;
         Ok(window)
     }

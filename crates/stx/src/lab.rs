@@ -8,6 +8,7 @@ use std::path::PathBuf;
 use std::sync::Arc;
 
 use stx_analysis::analysis::analyze;
+use stx_analysis::flight_log::window::Window;
 use stx_analysis::gains_file::gains_file;
 use stx_analysis::tune::{Controller, tune};
 use stx_dynamics::vehicle::Vehicle;
@@ -70,12 +71,22 @@ impl LabWorker for Worker {
             LabJobBody::Compare {
                 recording,
                 vehicle: edits,
-            } => crate::lab_compare::run(recording, inputs, edits, control),
+                from_s,
+                to_s,
+            } => {
+                let window = Window::new(*from_s, *to_s);
+                crate::lab_compare::run(recording, inputs, &window, edits, control)
+            }
             LabJobBody::Identify {
                 recording,
                 params,
                 vehicle: edits,
-            } => crate::lab_identify::run(recording, params, inputs, edits, control),
+                from_s,
+                to_s,
+            } => {
+                let window = Window::new(*from_s, *to_s);
+                crate::lab_identify::run(recording, params, inputs, &window, edits, control)
+            }
         }
     }
 }

@@ -5,6 +5,7 @@
 //! page both series thinned for plotting beside each channel's error figures over every sample.
 
 use stx_analysis::compare::{CompareReport, DEFAULT_STEP_S, fly_watched, report};
+use stx_analysis::flight_log::window::Window;
 use stx_station::lab::compare::{MAX_COMPARE_POINTS, plotted};
 use stx_station::lab::{
     CompareChannel, CompareSeries, JobControl, JobInputs, LabResult, VehicleEdits,
@@ -17,10 +18,11 @@ use crate::lab_recording::{flight_log, vehicle_changes, watcher};
 pub fn run(
     name: &str,
     inputs: &JobInputs,
+    window: &Window,
     edits: &VehicleEdits,
     control: &dyn JobControl,
 ) -> Result<LabResult, String> {
-    let log = flight_log(name, inputs)?;
+    let log = flight_log(name, inputs, window)?;
     control.progress(0, log.samples().len());
     let flown = fly_watched(&log, &inputs.vehicle, DEFAULT_STEP_S, watcher(control))
         .map_err(|e| format!("flying the model through {name}: {e}"))?;
@@ -81,19 +83,22 @@ mod tests {
     use stx_analysis::flight_log::synthetic::{SyntheticFlight, simulate};
     use stx_dynamics::vehicle::Vehicle;
 
-    use crate::lab_recording::tests::{control, inputs, recording_of, temp};
+    use crate::lab_recording::tests::{control, inputs, recorded_flight, temp};
 
     #[test]
     fn a_recorded_flight_is_compared_as_stx_compare_compares_it() {
         let vehicle = Vehicle::straplex();
-        let log = simulate(&vehicle, &SyntheticFlight::manoeuvres(3)).unwrap();
-        let path = temp("flight.mcap");
-        recording_of(&log, &path);
+        let (log, path) = recorded_flight(&vehicle, 3, "flight.mcap");
         let c = control(usize::MAX);
         let edits = VehicleEdits::from([("canopy.mass_kg".to_string(), 0.8)]);
-        let LabResult::Compare(s) =
-            run("flight.mcap", &inputs(&vehicle, &path), &edits, &c).unwrap()
-        else {
+        let LabResult::Compare(s) = run(
+            "flight.mcap",
+            &inputs(&vehicle, &path),
+            &Window::WHOLE,
+            &edits,
+            &c,
+        )
+        .unwrap() else {
             panic!("not a comparison");
         };
         let n = log.samples().len();
@@ -148,13 +153,12 @@ mod tests {
     #[test]
     fn a_cancel_stops_the_model_part_way() {
         let vehicle = Vehicle::straplex();
-        let log = simulate(&vehicle, &SyntheticFlight::manoeuvres(5)).unwrap();
-        let path = temp("cancelled.mcap");
-        recording_of(&log, &path);
+        let (_, path) = recorded_flight(&vehicle, 5, "cancelled.mcap");
         let c = control(10);
         let e = run(
             "cancelled.mcap",
             &inputs(&vehicle, &path),
+            &Window::WHOLE,
             &VehicleEdits::new(),
             &c,
         )
@@ -173,6 +177,7 @@ mod tests {
         let e = run(
             "junk.mcap",
             &inputs(&Vehicle::straplex(), &path),
+            &Window::WHOLE,
             &VehicleEdits::new(),
             &control(usize::MAX),
         )

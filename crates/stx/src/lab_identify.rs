@@ -7,6 +7,7 @@
 
 use std::sync::atomic::{AtomicBool, Ordering};
 
+use stx_analysis::flight_log::window::Window;
 use stx_analysis::identify::{IdentifyOptions, IdentifyReport, Param, identify};
 use stx_station::lab::{
     IdentifiedParam, IdentifySummary, JobControl, JobInputs, LabResult, VehicleEdits,
@@ -20,6 +21,7 @@ pub fn run(
     name: &str,
     params: &[String],
     inputs: &JobInputs,
+    window: &Window,
     edits: &VehicleEdits,
     control: &dyn JobControl,
 ) -> Result<LabResult, String> {
@@ -28,7 +30,7 @@ pub fn run(
         .map(|p| Param::parse(p))
         .collect::<Result<Vec<_>, _>>()
         .map_err(|e| e.to_string())?;
-    let log = flight_log(name, inputs)?;
+    let log = flight_log(name, inputs, window)?;
     let options = IdentifyOptions::default();
     let total = options.max_iterations;
     control.progress(0, total);
@@ -82,11 +84,10 @@ pub fn summary(name: &str, edits: &VehicleEdits, report: &IdentifyReport) -> Ide
 #[cfg(test)]
 mod tests {
     use super::*;
-    use stx_analysis::flight_log::synthetic::{SyntheticFlight, simulate};
     use stx_dynamics::vehicle::Vehicle;
     use stx_station::lab::identify::IDENTIFY_PARAMS;
 
-    use crate::lab_recording::tests::{control, inputs, recording_of, temp};
+    use crate::lab_recording::tests::{control, inputs, recorded_flight, temp};
 
     #[test]
     fn the_station_knows_the_library_s_parameters() {
@@ -103,15 +104,14 @@ mod tests {
         let nominal = Param::ClAlpha.get(&truth);
         Param::ClAlpha.set(&mut truth, nominal * 1.1);
         let truth = truth.validate().unwrap();
-        let log = simulate(&truth, &SyntheticFlight::manoeuvres(3)).unwrap();
-        let path = temp("flight.mcap");
-        recording_of(&log, &path);
+        let (_, path) = recorded_flight(&truth, 3, "flight.mcap");
         let c = control(usize::MAX);
         let params = vec!["cl_alpha".to_string()];
         let result = run(
             "flight.mcap",
             &params,
             &inputs(&seed, &path),
+            &Window::WHOLE,
             &VehicleEdits::new(),
             &c,
         )
@@ -138,15 +138,14 @@ mod tests {
     #[test]
     fn a_cancel_stops_after_the_first_iteration() {
         let seed = Vehicle::straplex();
-        let log = simulate(&seed, &SyntheticFlight::manoeuvres(4)).unwrap();
-        let path = temp("cancelled.mcap");
-        recording_of(&log, &path);
+        let (_, path) = recorded_flight(&seed, 4, "cancelled.mcap");
         let c = control(0);
         let params = vec!["cl_alpha".to_string(), "cd0".to_string()];
         let LabResult::Identify(s) = run(
             "cancelled.mcap",
             &params,
             &inputs(&seed, &path),
+            &Window::WHOLE,
             &VehicleEdits::new(),
             &c,
         )
@@ -166,6 +165,7 @@ mod tests {
             "junk.mcap",
             &["cl_alpha".into()],
             &inputs(&seed, &path),
+            &Window::WHOLE,
             &VehicleEdits::new(),
             &c,
         )
@@ -175,6 +175,7 @@ mod tests {
             "junk.mcap",
             &["span".into()],
             &inputs(&seed, &path),
+            &Window::WHOLE,
             &VehicleEdits::new(),
             &c,
         )

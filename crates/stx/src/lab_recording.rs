@@ -4,18 +4,29 @@
 //! and the vehicle edits as the results list them.
 
 use stx_analysis::flight_log::FlightLog;
+use stx_analysis::flight_log::window::{Window, WindowEnd};
 use stx_station::lab::{JobControl, JobInputs, VehicleEdits};
 
 use crate::compare::read_log;
 
 /// The flight log of the recording `name`, which the station checked (a file of its
-/// recordings directory holding a flight) and put in `inputs`.
-pub fn flight_log(name: &str, inputs: &JobInputs) -> Result<FlightLog, String> {
+/// recordings directory holding a flight) and put in `inputs`, cut to `window` (whose ends
+/// the station checked too: what is left to refuse is a window the flight does not reach).
+/// A refusal starts with the request's field names, as the station's do.
+pub fn flight_log(name: &str, inputs: &JobInputs, window: &Window) -> Result<FlightLog, String> {
     let path = inputs
         .recording
         .as_deref()
         .ok_or_else(|| format!("the station gave the job on {name} no recording (a bug)"))?;
-    read_log(path).map_err(|e| format!("{e:#}"))
+    let log = read_log(path).map_err(|e| format!("{e:#}"))?;
+    log.cut(window).map_err(|e| {
+        let field = match e.end() {
+            WindowEnd::From => "from_s",
+            WindowEnd::To => "to_s",
+            WindowEnd::Both => "from_s, to_s",
+        };
+        format!("{field}: {e} (in {name})")
+    })
 }
 
 /// A loop's watcher for `control`: told `done` of `total`, reports it and answers whether to
@@ -41,12 +52,17 @@ pub(crate) mod tests {
 
     use nalgebra::Vector3;
     use stx_analysis::flight_log::FlightLog;
+    use stx_analysis::flight_log::synthetic::{SyntheticFlight, simulate};
+    use stx_analysis::flight_log::window::{Window, WindowEnd};
     use stx_dynamics::vehicle::Vehicle;
     use stx_gnc::geo::LocalFrame;
     use stx_link::telemetry::{Actuators, Attitude, GlobalPosition, Hud, Telemetry, Wind};
     use stx_record::{CoreOptions, Output, RecorderCore, RecordingInfo};
-    use stx_station::lab::{JobControl, JobInputs};
+    use stx_station::lab::compare::check_window;
+    use stx_station::lab::{JobControl, JobInputs, LabResult, VehicleEdits};
     use stx_station::recording::telemetry::TelemetryChannels;
+
+    use super::flight_log;
 
     /// `log` as the station records a drone's telemetry (the same channels, the same JSON), at
     /// one position, attitude, airspeed, command and wind message per sample.
@@ -129,6 +145,19 @@ pub(crate) mod tests {
         std::fs::write(path, bytes).unwrap();
     }
 
+    /// A synthetic flight of `vehicle` (`SyntheticFlight::manoeuvres(seed)`) recorded as the
+    /// station records it, in a file called `name` of a directory of its own.
+    pub(crate) fn recorded_flight(
+        vehicle: &Vehicle,
+        seed: u64,
+        name: &str,
+    ) -> (FlightLog, PathBuf) {
+        let log = simulate(vehicle, &SyntheticFlight::manoeuvres(seed)).unwrap();
+        let path = temp(name);
+        recording_of(&log, &path);
+        (log, path)
+    }
+
     /// A job's control: its progress kept, told to stop once `stop_after` steps are done
     /// (0: from the start; `usize::MAX`: never).
     pub(crate) struct Control {
@@ -159,6 +188,83 @@ pub(crate) mod tests {
         let dir = std::env::temp_dir().join(format!("stx-lab-{}-{n}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         dir.join(name)
+    }
+
+    /// A window of a recording: the samples within it from the window's first, the model
+    /// started there; one the flight does not reach is refused naming the request's fields.
+    #[test]
+    fn a_window_of_the_recording_is_cut_and_one_past_its_flight_refused() {
+        let vehicle = Vehicle::straplex();
+        let (_, path) = recorded_flight(&vehicle, 3, "flight.mcap");
+        let inputs = inputs(&vehicle, &path);
+        let whole = flight_log("flight.mcap", &inputs, &Window::WHOLE).unwrap();
+        let t0 = whole.samples()[0].time_s;
+        let cut = flight_log("flight.mcap", &inputs, &Window::new(Some(30.0), Some(40.0))).unwrap();
+        let inside: Vec<f64> = whole
+            .samples()
+            .iter()
+            .map(|s| s.time_s)
+            .filter(|t| (30.0..=40.0).contains(&(t - t0)))
+            .collect();
+        let times: Vec<f64> = cut.samples().iter().map(|s| s.time_s).collect();
+        assert_eq!(times, inside);
+        assert!(
+            (cut.duration_s() - 10.0).abs() <= 0.2 + 1e-9,
+            "{}",
+            cut.duration_s()
+        );
+        let LabResult::Compare(s) = crate::lab_compare::run(
+            "flight.mcap",
+            &inputs,
+            &Window::new(Some(30.0), Some(40.0)),
+            &VehicleEdits::new(),
+            &control(usize::MAX),
+        )
+        .unwrap() else {
+            panic!("not a comparison");
+        };
+        assert_eq!(
+            (s.samples as usize, s.duration_s),
+            (inside.len(), cut.duration_s())
+        );
+        assert_eq!(s.time_s[0], 0.0);
+        let e = flight_log("flight.mcap", &inputs, &Window::new(Some(500.0), None)).unwrap_err();
+        assert!(
+            e.starts_with("from_s, to_s: ")
+                && e.contains("holds 0 samples")
+                && e.contains("flight.mcap"),
+            "{e}"
+        );
+    }
+
+    /// The station refuses before a job starts the windows the library would refuse, and no
+    /// others (it sits below stx-analysis and keeps its own copy of the rule).
+    #[test]
+    fn the_station_checks_a_window_as_the_library_does() {
+        let ends = [
+            None,
+            Some(0.0),
+            Some(2.5),
+            Some(7.0),
+            Some(-1.0),
+            Some(f64::NAN),
+            Some(f64::INFINITY),
+        ];
+        for from_s in ends {
+            for to_s in ends {
+                let library = Window::new(from_s, to_s).check();
+                let station = check_window(from_s, to_s);
+                assert_eq!(station.is_ok(), library.is_ok(), "{from_s:?} … {to_s:?}");
+                if let (Err((field, _)), Err(e)) = (station, library) {
+                    let end = if field == "from_s" {
+                        WindowEnd::From
+                    } else {
+                        WindowEnd::To
+                    };
+                    assert_eq!(end, e.end(), "{from_s:?} … {to_s:?}");
+                }
+            }
+        }
     }
 
     /// What the station hands a job on the recording at `path`, with `vehicle`.

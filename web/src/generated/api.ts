@@ -298,7 +298,7 @@ export type LabResult =
        */
       channels: CompareChannel[];
       /**
-       * Duration of the recorded flight, s.
+       * Duration of the recorded flight compared (the window's, when the job asked for one), s.
        */
       duration_s: number;
       kind: "compare";
@@ -319,11 +319,11 @@ export type LabResult =
        */
       recording: string;
       /**
-       * Samples in the recorded flight (one per GPS position).
+       * Samples in the recorded flight compared (one per GPS position).
        */
       samples: number;
       /**
-       * Times of the plotted instants, s from the flight's first sample (at most
+       * Times of the plotted instants, s from the first sample compared (at most
        * [`MAX_COMPARE_POINTS`], spread evenly).
        */
       time_s: number[];
@@ -506,12 +506,23 @@ export type LabJobBody =
       kind: "tune";
     }
   | {
+      /**
+       * Compare from this time on, s from the flight log's first sample, on the log's
+       * own clock (the drone's); the model starts from the recorded state there. Absent:
+       * from the start. Finite and ≥ 0, as `to_s`, and below `to_s` (else 400
+       * `invalid_job`); a window the flight does not reach fails the job.
+       */
+      from_s?: number | null;
       kind: "compare";
       /**
        * A recording's file name in the station's recordings directory, as
        * `GET /api/recordings` lists it.
        */
       recording: string;
+      /**
+       * Compare up to this time, s from the flight log's first sample. Absent: to the end.
+       */
+      to_s?: number | null;
       /**
        * Parameters changed from the seed's vehicle.
        */
@@ -520,6 +531,10 @@ export type LabJobBody =
       };
     }
   | {
+      /**
+       * Fit from this time on, s from the flight log's first sample (as a comparison's).
+       */
+      from_s?: number | null;
       kind: "identify";
       /**
        * The parameters to fit, by their vehicle-file names (`cl_alpha`, `cd0`, …; see
@@ -531,6 +546,10 @@ export type LabJobBody =
        * `GET /api/recordings` lists it.
        */
       recording: string;
+      /**
+       * Fit up to this time, s from the flight log's first sample.
+       */
+      to_s?: number | null;
       /**
        * Parameters changed from the seed's vehicle.
        */

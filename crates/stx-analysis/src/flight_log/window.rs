@@ -70,6 +70,11 @@ impl Window {
         to_s: None,
     };
 
+    /// The window from `from_s` to `to_s` (not checked yet).
+    pub fn new(from_s: Option<f64>, to_s: Option<f64>) -> Self {
+        Self { from_s, to_s }
+    }
+
     /// Refuses ends that are not times from the start, or that hold nothing between them
     /// (whether the log holds a flight there is [`FlightLog::cut`]'s question).
     pub fn check(&self) -> Result<(), WindowError> {
@@ -133,10 +138,6 @@ mod tests {
     use super::*;
     use crate::flight_log::tests::straight;
 
-    fn window(from_s: Option<f64>, to_s: Option<f64>) -> Window {
-        Window { from_s, to_s }
-    }
-
     #[test]
     fn a_window_counts_from_the_log_s_first_sample() {
         let mut samples = straight(10);
@@ -144,16 +145,22 @@ mod tests {
             s.time_s += 100.0;
         }
         let log = FlightLog::new(samples).unwrap();
-        let cut = log.cut(&window(Some(2.0), Some(6.0))).unwrap();
+        let cut = log.cut(&Window::new(Some(2.0), Some(6.0))).unwrap();
         let times: Vec<f64> = cut.samples().iter().map(|s| s.time_s).collect();
         assert_eq!(times, vec![102.0, 103.0, 104.0, 105.0, 106.0]);
         assert_eq!(cut.duration_s(), 4.0);
         assert_eq!(
-            log.cut(&window(Some(7.0), None)).unwrap().samples().len(),
+            log.cut(&Window::new(Some(7.0), None))
+                .unwrap()
+                .samples()
+                .len(),
             3
         );
         assert_eq!(
-            log.cut(&window(None, Some(2.0))).unwrap().samples().len(),
+            log.cut(&Window::new(None, Some(2.0)))
+                .unwrap()
+                .samples()
+                .len(),
             3
         );
         assert_eq!(log.cut(&Window::WHOLE).unwrap(), log);
@@ -162,7 +169,7 @@ mod tests {
     #[test]
     fn bad_windows_are_refused_naming_their_end() {
         let log = FlightLog::new(straight(10)).unwrap();
-        let refused = |from_s, to_s| log.cut(&window(from_s, to_s)).unwrap_err();
+        let refused = |from_s, to_s| log.cut(&Window::new(from_s, to_s)).unwrap_err();
         let e = refused(Some(-1.0), None);
         assert_eq!(e.end(), WindowEnd::From);
         assert!(e.to_string().contains("≥ 0, not -1"), "{e}");

@@ -1,9 +1,10 @@
 //! The Lab's comparison of a recorded flight with the model (issue 16 item 3; `stx compare` in
 //! the dashboard): what the page asks ([`super::LabJobBody::Compare`] names a recording of the
-//! station's recordings directory), the checks made before a job starts (a recording holds a
-//! flight: [`missing_flight`]), and what the page draws ([`CompareSeries`]). The flying is the
-//! binary's (stx-analysis sits above the station); it hands the series over thinned to at
-//! most [`MAX_COMPARE_POINTS`] instants ([`plotted`]), while the error figures are over every
+//! station's recordings directory, and may name a window of it), the checks made before a job
+//! starts (a recording holds a flight: [`missing_flight`]; a window is one:
+//! [`check_window`]), and what the page draws ([`CompareSeries`]). The flying is the binary's
+//! (stx-analysis sits above the station); it hands the series over thinned to at most
+//! [`MAX_COMPARE_POINTS`] instants ([`plotted`]), while the error figures are over every
 //! recorded sample.
 
 use std::io::{Read, Seek};
@@ -46,6 +47,30 @@ pub fn missing_flight<R: Read + Seek>(recording: &Recording<R>) -> Option<String
             missing.join(", ")
         )
     })
+}
+
+/// Refuses a window of a recording (`from_s`, `to_s`: s from its flight log's first sample)
+/// that is no window of any flight: `(field, reason)`. Either end may be absent; each must be
+/// finite and ≥ 0, and the end after the start. Whether the recording's flight reaches into
+/// the window is known only once its log is read, so the job answers that. The rule is
+/// stx-analysis' `flight_log::window::Window::check` (above the station; a test of the
+/// binary holds the two equal).
+pub fn check_window(from_s: Option<f64>, to_s: Option<f64>) -> Result<(), (String, String)> {
+    for (field, value) in [("from_s", from_s), ("to_s", to_s)] {
+        if let Some(v) = value.filter(|v| !(v.is_finite() && *v >= 0.0)) {
+            return Err((
+                field.into(),
+                format!("must be a finite number of seconds from the log's start, ≥ 0, not {v}"),
+            ));
+        }
+    }
+    match (from_s, to_s) {
+        (Some(from), Some(to)) if to <= from => Err((
+            "to_s".into(),
+            format!("the window must end after it starts (from {from} s, to {to} s)"),
+        )),
+        _ => Ok(()),
+    }
 }
 
 /// The indices of the instants plotted of `n` samples: all of them up to `max`, else `max`
@@ -97,16 +122,16 @@ pub struct CompareSeries {
     /// The vehicle parameters changed from the seed's for the model (`name = value`; empty:
     /// the seed's STRAPLEX vehicle).
     pub vehicle_changes: Vec<String>,
-    /// Duration of the recorded flight, s.
+    /// Duration of the recorded flight compared (the window's, when the job asked for one), s.
     pub duration_s: f64,
     /// The part of the recording compared, `[from, to]` in s of its drone clock from its first
     /// position: a mission recording's parafoil stage (`null`: the whole recording).
     pub parafoil_stage_s: Option<[f64; 2]>,
     /// How long the recording's positions last, s.
     pub recorded_s: f64,
-    /// Samples in the recorded flight (one per GPS position).
+    /// Samples in the recorded flight compared (one per GPS position).
     pub samples: u32,
-    /// Times of the plotted instants, s from the flight's first sample (at most
+    /// Times of the plotted instants, s from the first sample compared (at most
     /// [`MAX_COMPARE_POINTS`], spread evenly).
     pub time_s: Vec<f64>,
     /// Each channel.
@@ -118,6 +143,20 @@ mod tests {
     use super::*;
     use std::time::Duration;
     use stx_record::{CoreOptions, RecorderCore, RecordingInfo, foxglove};
+
+    #[test]
+    fn a_window_needs_times_from_the_start_and_an_end_after_its_start() {
+        assert_eq!(check_window(None, None), Ok(()));
+        assert_eq!(check_window(Some(0.0), Some(0.5)), Ok(()));
+        assert_eq!(check_window(None, Some(3.0)), Ok(()));
+        let field = |from, to| check_window(from, to).unwrap_err().0;
+        assert_eq!(field(Some(-0.1), None), "from_s");
+        assert_eq!(field(Some(f64::NAN), Some(3.0)), "from_s");
+        assert_eq!(field(None, Some(f64::INFINITY)), "to_s");
+        assert_eq!(field(Some(5.0), Some(5.0)), "to_s");
+        let (_, why) = check_window(Some(9.0), Some(2.0)).unwrap_err();
+        assert!(why.contains("end after it starts"), "{why}");
+    }
 
     #[test]
     fn plotted_keeps_short_flights_whole_and_thins_long_ones_evenly() {

@@ -83,6 +83,15 @@ pub enum LabJobBody {
         /// Parameters changed from the seed's vehicle.
         #[serde(default)]
         vehicle: VehicleEdits,
+        /// Compare from this time on, s from the flight log's first sample, on the log's
+        /// own clock (the drone's); the model starts from the recorded state there. Absent:
+        /// from the start. Finite and ≥ 0, as `to_s`, and below `to_s` (else 400
+        /// `invalid_job`); a window the flight does not reach fails the job.
+        #[serde(default)]
+        from_s: Option<f64>,
+        /// Compare up to this time, s from the flight log's first sample. Absent: to the end.
+        #[serde(default)]
+        to_s: Option<f64>,
     },
     /// Fit chosen vehicle parameters to a recorded flight (`stx identify`), starting from the
     /// seed's vehicle or as edited; progress per iteration, a cancel stopping after the
@@ -97,6 +106,12 @@ pub enum LabJobBody {
         /// Parameters changed from the seed's vehicle.
         #[serde(default)]
         vehicle: VehicleEdits,
+        /// Fit from this time on, s from the flight log's first sample (as a comparison's).
+        #[serde(default)]
+        from_s: Option<f64>,
+        /// Fit up to this time, s from the flight log's first sample.
+        #[serde(default)]
+        to_s: Option<f64>,
     },
 }
 
@@ -141,15 +156,20 @@ impl LabJobBody {
                 Err(("scenario".into(), "a scenario name is required".into()))
             }
             Self::Scenario { .. } => Ok(()),
-            Self::Compare { recording, .. } if recording.trim().is_empty() => {
+            Self::Compare { recording, .. } | Self::Identify { recording, .. }
+                if recording.trim().is_empty() =>
+            {
                 Err(("recording".into(), "a recording's name is required".into()))
             }
-            Self::Compare { .. } => Ok(()),
-            Self::Identify { recording, .. } if recording.trim().is_empty() => {
-                Err(("recording".into(), "a recording's name is required".into()))
-            }
-            Self::Identify { params, .. } => {
-                identify::check_params(params).map_err(|e| ("params".into(), e))
+            Self::Compare { from_s, to_s, .. } => compare::check_window(*from_s, *to_s),
+            Self::Identify {
+                params,
+                from_s,
+                to_s,
+                ..
+            } => {
+                identify::check_params(params).map_err(|e| ("params".into(), e))?;
+                compare::check_window(*from_s, *to_s)
             }
             Self::MonteCarlo {
                 runs,
