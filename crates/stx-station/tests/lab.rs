@@ -2,7 +2,8 @@
 //! recording is checked before the job starts — a viewer is refused, a name outside the
 //! recordings directory or not in it is `unknown_recording`, a file that is no recording is
 //! `unreadable`, a recording without flight telemetry is `no_flight`, a window that is none
-//! (`from_s` ≥ `to_s`, a negative time) is `invalid_job` — and a good one reaches the Lab's
+//! (`from_s` ≥ `to_s`, a negative time) or that the work finds past the flight is
+//! `invalid_job` — and a good one reaches the Lab's
 //! work as the file of the directory, whose result every page then reads.
 //!
 //! The work here is a stand-in that reads the file it is handed (the flying is the binary's,
@@ -71,6 +72,31 @@ impl LabWorker for ReadsTheRecording {
             samples: positions as u32,
             ..CompareSeries::default()
         }))
+    }
+
+    /// Refuses a window starting after the recording's last position (4 a second from 0 s):
+    /// the station's side of the question is what is tested here.
+    fn check_window(&self, job: &LabJobBody, inputs: &JobInputs) -> Result<(), (String, String)> {
+        let (LabJobBody::Compare { from_s, .. } | LabJobBody::Identify { from_s, .. }) = job else {
+            return Ok(());
+        };
+        let refused = |e: String| ("recording".to_string(), e);
+        let path = inputs
+            .recording
+            .as_deref()
+            .ok_or_else(|| refused("none".into()))?;
+        let opened = stx_record::Recording::open(path).map_err(|e| refused(e.to_string()))?;
+        let positions = opened
+            .channel("/telemetry/GLOBAL_POSITION_INT")
+            .map_or(0, |c| c.message_count);
+        let last_s = positions.saturating_sub(1) as f64 / 4.0;
+        match from_s {
+            Some(from) if *from > last_s => Err((
+                "from_s, to_s".into(),
+                format!("the flight ends at {last_s} s"),
+            )),
+            _ => Ok(()),
+        }
     }
 }
 
@@ -302,7 +328,7 @@ async fn an_identification_is_checked_as_a_comparison_and_its_parameters_before_
 }
 
 #[tokio::test]
-async fn a_window_that_ends_before_it_starts_is_refused_before_a_job_starts() {
+async fn a_window_that_is_none_or_past_the_flight_is_refused_before_a_job_starts() {
     let dir = temp_dir("window");
     write_recording(&dir.join("flight.mcap"), &FLIGHT);
     let station = station_with_lab(Some(dir)).await;
@@ -327,6 +353,20 @@ async fn a_window_that_ends_before_it_starts_is_refused_before_a_job_starts() {
             assert!(reason.starts_with(field), "{reason}");
         }
     }
+    let (_, lab) = http(station.http(), "GET", "/api/lab", Some(VIEWER), None).await;
+    assert_eq!((&lab["job"], &lab["last"]), (&Value::Null, &Value::Null));
+    // One the flight does not reach is refused too, the work having read the recording.
+    let mut body = identify.clone();
+    body["from_s"] = json!(12.0);
+    let (status, answer) = start(&station, OPERATOR, body).await;
+    assert_eq!(
+        (status, answer["error"].as_str(), answer["reason"].as_str()),
+        (
+            400,
+            Some("invalid_job"),
+            Some("from_s, to_s: the flight ends at 9.75 s")
+        )
+    );
     let (_, lab) = http(station.http(), "GET", "/api/lab", Some(VIEWER), None).await;
     assert_eq!((&lab["job"], &lab["last"]), (&Value::Null, &Value::Null));
     // A window with its end after its start, or one end only, starts the job.

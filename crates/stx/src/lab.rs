@@ -89,6 +89,10 @@ impl LabWorker for Worker {
             }
         }
     }
+
+    fn check_window(&self, job: &LabJobBody, inputs: &JobInputs) -> Result<(), (String, String)> {
+        crate::lab_recording::check_window(job, inputs)
+    }
 }
 
 fn scenario_run(name: &str, vehicle: &Vehicle) -> Result<LabResult, String> {

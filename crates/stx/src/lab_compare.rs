@@ -22,7 +22,7 @@ pub fn run(
     edits: &VehicleEdits,
     control: &dyn JobControl,
 ) -> Result<LabResult, String> {
-    let log = flight_log(name, inputs, window)?;
+    let log = flight_log(name, inputs, window).map_err(|e| e.to_string())?;
     control.progress(0, log.samples().len());
     let flown = fly_watched(&log, &inputs.vehicle, DEFAULT_STEP_S, watcher(control))
         .map_err(|e| format!("flying the model through {name}: {e}"))?;

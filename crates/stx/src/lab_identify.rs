@@ -30,7 +30,7 @@ pub fn run(
         .map(|p| Param::parse(p))
         .collect::<Result<Vec<_>, _>>()
         .map_err(|e| e.to_string())?;
-    let log = flight_log(name, inputs, window)?;
+    let log = flight_log(name, inputs, window).map_err(|e| e.to_string())?;
     let options = IdentifyOptions::default();
     let total = options.max_iterations;
     control.progress(0, total);

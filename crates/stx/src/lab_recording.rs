@@ -5,28 +5,71 @@
 
 use stx_analysis::flight_log::FlightLog;
 use stx_analysis::flight_log::window::{Window, WindowEnd};
-use stx_station::lab::{JobControl, JobInputs, VehicleEdits};
+use stx_station::lab::{JobControl, JobInputs, LabJobBody, VehicleEdits};
 
 use crate::compare::read_log;
+
+/// Why a job on a recording cannot run.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Refused {
+    /// The recording does not read as a flight log (or the station handed none: a bug).
+    Recording(String),
+    /// The flight does not reach the window asked for: the request's field names, and why.
+    Window { field: &'static str, reason: String },
+}
+
+impl std::fmt::Display for Refused {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Refused::Recording(reason) => f.write_str(reason),
+            Refused::Window { field, reason } => write!(f, "{field}: {reason}"),
+        }
+    }
+}
 
 /// The flight log of the recording `name`, which the station checked (a file of its
 /// recordings directory holding a flight) and put in `inputs`, cut to `window` (whose ends
 /// the station checked too: what is left to refuse is a window the flight does not reach).
-/// A refusal starts with the request's field names, as the station's do.
-pub fn flight_log(name: &str, inputs: &JobInputs, window: &Window) -> Result<FlightLog, String> {
-    let path = inputs
-        .recording
-        .as_deref()
-        .ok_or_else(|| format!("the station gave the job on {name} no recording (a bug)"))?;
-    let log = read_log(path).map_err(|e| format!("{e:#}"))?;
-    log.cut(window).map_err(|e| {
-        let field = match e.end() {
+pub fn flight_log(name: &str, inputs: &JobInputs, window: &Window) -> Result<FlightLog, Refused> {
+    let path = inputs.recording.as_deref().ok_or_else(|| {
+        Refused::Recording(format!(
+            "the station gave the job on {name} no recording (a bug)"
+        ))
+    })?;
+    let log = read_log(path).map_err(|e| Refused::Recording(format!("{e:#}")))?;
+    log.cut(window).map_err(|e| Refused::Window {
+        field: match e.end() {
             WindowEnd::From => "from_s",
             WindowEnd::To => "to_s",
             WindowEnd::Both => "from_s, to_s",
-        };
-        format!("{field}: {e} (in {name})")
+        },
+        reason: format!("{e} (in {name})"),
     })
+}
+
+/// The station's question before a job on a recording starts
+/// ([`stx_station::lab::LabWorker::check_window`]): does its flight reach the window asked?
+/// A recording that reads as no flight log passes: the job then fails saying why.
+pub fn check_window(job: &LabJobBody, inputs: &JobInputs) -> Result<(), (String, String)> {
+    let (name, window) = match job {
+        LabJobBody::Compare {
+            recording,
+            from_s,
+            to_s,
+            ..
+        }
+        | LabJobBody::Identify {
+            recording,
+            from_s,
+            to_s,
+            ..
+        } => (recording, Window::new(*from_s, *to_s)),
+        _ => return Ok(()),
+    };
+    match flight_log(name, inputs, &window) {
+        Err(Refused::Window { field, reason }) => Err((field.to_string(), reason)),
+        Ok(_) | Err(Refused::Recording(_)) => Ok(()),
+    }
 }
 
 /// A loop's watcher for `control`: told `done` of `total`, reports it and answers whether to
@@ -58,11 +101,11 @@ pub(crate) mod tests {
     use stx_gnc::geo::LocalFrame;
     use stx_link::telemetry::{Actuators, Attitude, GlobalPosition, Hud, Telemetry, Wind};
     use stx_record::{CoreOptions, Output, RecorderCore, RecordingInfo};
-    use stx_station::lab::compare::check_window;
-    use stx_station::lab::{JobControl, JobInputs, LabResult, VehicleEdits};
+    use stx_station::lab::compare;
+    use stx_station::lab::{JobControl, JobInputs, LabJobBody, LabResult, VehicleEdits};
     use stx_station::recording::telemetry::TelemetryChannels;
 
-    use super::flight_log;
+    use super::{check_window, flight_log};
 
     /// `log` as the station records a drone's telemetry (the same channels, the same JSON), at
     /// one position, attitude, airspeed, command and wind message per sample.
@@ -228,19 +271,43 @@ pub(crate) mod tests {
             (inside.len(), cut.duration_s())
         );
         assert_eq!(s.time_s[0], 0.0);
-        let e = flight_log("flight.mcap", &inputs, &Window::new(Some(500.0), None)).unwrap_err();
+        let e = flight_log("flight.mcap", &inputs, &Window::new(Some(500.0), None))
+            .unwrap_err()
+            .to_string();
         assert!(
             e.starts_with("from_s, to_s: ")
                 && e.contains("holds 0 samples")
                 && e.contains("flight.mcap"),
             "{e}"
         );
+        // The station asks the same before the job starts.
+        let job = |from_s, to_s| LabJobBody::Compare {
+            recording: "flight.mcap".into(),
+            vehicle: VehicleEdits::new(),
+            from_s,
+            to_s,
+        };
+        assert_eq!(check_window(&job(Some(30.0), Some(40.0)), &inputs), Ok(()));
+        let (field, reason) = check_window(&job(Some(500.0), None), &inputs).unwrap_err();
+        assert_eq!(field, "from_s, to_s");
+        assert!(reason.contains("holds 0 samples"), "{reason}");
+        let identify = LabJobBody::Identify {
+            recording: "flight.mcap".into(),
+            params: vec!["cd0".into()],
+            vehicle: VehicleEdits::new(),
+            from_s: None,
+            to_s: Some(0.3),
+        };
+        assert_eq!(
+            check_window(&identify, &inputs).unwrap_err().0,
+            "from_s, to_s"
+        );
     }
 
     /// The station refuses before a job starts the windows the library would refuse, and no
     /// others (it sits below stx-analysis and keeps its own copy of the rule).
     #[test]
-    fn the_station_checks_a_window_as_the_library_does() {
+    fn the_station_checks_a_window_s_ends_as_the_library_does() {
         let ends = [
             None,
             Some(0.0),
@@ -253,7 +320,7 @@ pub(crate) mod tests {
         for from_s in ends {
             for to_s in ends {
                 let library = Window::new(from_s, to_s).check();
-                let station = check_window(from_s, to_s);
+                let station = compare::check_window(from_s, to_s);
                 assert_eq!(station.is_ok(), library.is_ok(), "{from_s:?} … {to_s:?}");
                 if let (Err((field, _)), Err(e)) = (station, library) {
                     let end = if field == "from_s" {

@@ -509,8 +509,8 @@ export type LabJobBody =
       /**
        * Compare from this time on, s from the flight log's first sample, on the log's
        * own clock (the drone's); the model starts from the recorded state there. Absent:
-       * from the start. Finite and ≥ 0, as `to_s`, and below `to_s` (else 400
-       * `invalid_job`); a window the flight does not reach fails the job.
+       * from the start. Finite and ≥ 0, as `to_s`, and below `to_s`, in a window the
+       * flight reaches (else 400 `invalid_job`).
        */
       from_s?: number | null;
       kind: "compare";

@@ -4,7 +4,8 @@
 //! carries the telemetry, at the lowest priority (the idle scheduling class and
 //! [`LAB_NICE`]), and reports to the pure runner ([`crate::lab::LabJobs`]). A comparison's
 //! recording is checked before its job starts: a plain name of the recordings directory (as
-//! `GET /api/recordings` lists them), a readable file, holding a flight.
+//! `GET /api/recordings` lists them), a readable file, holding a flight, and one in the
+//! window asked for, if any (the work reads it: [`crate::lab::LabWorker::check_window`]).
 
 use std::collections::BTreeMap;
 use std::path::PathBuf;
@@ -135,6 +136,17 @@ pub(crate) async fn start(
         _ => None,
     };
     let inputs = JobInputs { vehicle, recording };
+    if job.has_window() {
+        // Reading the recording as a flight log is file I/O and work: off the async workers.
+        let (worker, job, inputs) = (lab.worker(), job.clone(), inputs.clone());
+        let checked = tokio::task::spawn_blocking(move || worker.check_window(&job, &inputs))
+            .await
+            .map_err(|e| error(StatusCode::INTERNAL_SERVER_ERROR, "internal", e.to_string()))?;
+        if let Err((field, reason)) = checked {
+            let e = FieldError { field, reason };
+            return Ok(field_error(StatusCode::BAD_REQUEST, "invalid_job", e));
+        }
+    }
     let kind = job.kind();
     let id = lab
         .jobs()

@@ -52,7 +52,8 @@ pub fn missing_flight<R: Read + Seek>(recording: &Recording<R>) -> Option<String
 /// Refuses a window of a recording (`from_s`, `to_s`: s from its flight log's first sample)
 /// that is no window of any flight: `(field, reason)`. Either end may be absent; each must be
 /// finite and ≥ 0, and the end after the start. Whether the recording's flight reaches into
-/// the window is known only once its log is read, so the job answers that. The rule is
+/// the window is known only once its log is read, so the work answers that
+/// ([`super::LabWorker::check_window`]). The rule is
 /// stx-analysis' `flight_log::window::Window::check` (above the station; a test of the
 /// binary holds the two equal).
 pub fn check_window(from_s: Option<f64>, to_s: Option<f64>) -> Result<(), (String, String)> {

@@ -85,8 +85,8 @@ pub enum LabJobBody {
         vehicle: VehicleEdits,
         /// Compare from this time on, s from the flight log's first sample, on the log's
         /// own clock (the drone's); the model starts from the recorded state there. Absent:
-        /// from the start. Finite and ≥ 0, as `to_s`, and below `to_s` (else 400
-        /// `invalid_job`); a window the flight does not reach fails the job.
+        /// from the start. Finite and ≥ 0, as `to_s`, and below `to_s`, in a window the
+        /// flight reaches (else 400 `invalid_job`).
         #[serde(default)]
         from_s: Option<f64>,
         /// Compare up to this time, s from the flight log's first sample. Absent: to the end.
@@ -125,6 +125,16 @@ impl LabJobBody {
             Self::Tune { .. } => "tune",
             Self::Compare { .. } => "compare",
             Self::Identify { .. } => "identify",
+        }
+    }
+
+    /// Whether the job names a window of its recording (`from_s` or `to_s`).
+    pub fn has_window(&self) -> bool {
+        match self {
+            Self::Compare { from_s, to_s, .. } | Self::Identify { from_s, to_s, .. } => {
+                from_s.is_some() || to_s.is_some()
+            }
+            _ => false,
         }
     }
 
@@ -333,6 +343,16 @@ pub trait LabWorker: Send + Sync {
         inputs: &JobInputs,
         control: &dyn JobControl,
     ) -> Result<LabResult, String>;
+
+    /// Refuses, before it starts, a job whose window (`from_s`, `to_s`) its recording's
+    /// flight does not reach: `(field, reason)`. Only the work reads a recording as a flight
+    /// log (on the drone's clock, which the recording's index does not give), so the station
+    /// asks it; called on a blocking thread, for jobs that name a window. The default
+    /// refuses nothing, the job then failing with the reason.
+    fn check_window(&self, job: &LabJobBody, inputs: &JobInputs) -> Result<(), (String, String)> {
+        let _ = (job, inputs);
+        Ok(())
+    }
 }
 
 /// The Lab as a live station runs it: the runner, the work, where files are saved.
