@@ -224,6 +224,23 @@ async function lab() {
   const viewerRows = await vpage.locator('[data-testid="identify-params"] tr[data-param]').count();
   check("identify: a viewer sees the fit but cannot start one (button disabled, 403)",
     viewerRows === 1 && (await vpage.locator('[data-testid="identify-start"]').isDisabled()) && viewerIdentify.status === 403, `${viewerRows} rows for the viewer; viewer ${viewerIdentify.status}`);
+
+  // A window of the recording: a bad one is refused on the page, a good one compared alone.
+  await page.fill('[data-testid="window-from"]', "8");
+  await page.fill('[data-testid="window-to"]', "2");
+  await page.click('[data-testid="compare-start"]');
+  const badWindow = await until(() => text(page, "job-msg"), (t) => t !== "", 5000);
+  await page.fill('[data-testid="window-from"]', "2");
+  await page.fill('[data-testid="window-to"]', "8");
+  await page.click('[data-testid="compare-start"]');
+  const windowed = await until(() => outcome(page), (t) => /compare.*: (done|failed)/.test(t) && t !== cmp, 60000, 500);
+  await page.locator('[data-testid="compare-summary"]').waitFor({ timeout: 5000 }).catch(() => {});
+  const windowSummary = await text(page, "compare-summary").catch(() => "");
+  const [, stageFrom, stageTo] = /its parafoil stage, ([\d.]+) … ([\d.]+) s/.exec(windowSummary) ?? [];
+  const over = Number(/samples over ([\d.]+) s/.exec(windowSummary)?.[1]);
+  check("compare: a window typed backwards is refused on the page; 2–8 s of the flight is compared alone (about 6 s of samples, inside the parafoil stage)",
+    badWindow.startsWith("window: to (2 s) must be after from (8 s)") && windowed.includes("done") && over > 5 && over <= 6.01 && Math.abs(Number(stageTo) - Number(stageFrom) - over) < 0.15,
+    `"${badWindow}"; "${windowed}": "${windowSummary}"`);
   await vctx.close();
   await ctx.close();
 }

@@ -1,5 +1,5 @@
 import { describe, expect, it } from "vitest";
-import { comparedPart, compareRows, complexPlane, correlationCells, fittedEdits, identifyParams, identifyRows, metres, outcomeLine, progressOf, recordingOption, vehicleEdits } from "./lab";
+import { comparedPart, compareRows, complexPlane, correlationCells, fittedEdits, identifyParams, identifyRows, metres, outcomeLine, progressOf, recordingOption, recordingWindow, vehicleEdits } from "./lab";
 
 const fields = [
   { name: "canopy.mass_kg", unit: "kg", seed: 0.7 },
@@ -134,5 +134,18 @@ describe("comparedPart", () => {
   it("says when a mission recording was compared over its parafoil stage only", () => {
     expect(comparedPart({ parafoil_stage_s: [796.84, 1179.52], recorded_s: 1270.3 })).toBe("its parafoil stage, 796.8 … 1179.5 s of 1270.3 s recorded");
     expect(comparedPart({ parafoil_stage_s: null, recorded_s: 12 })).toBe("the whole recording");
+  });
+});
+
+describe("recordingWindow", () => {
+  it("leaves a blank end open and reads seconds", () => {
+    expect(recordingWindow("", "")).toEqual({});
+    expect(recordingWindow(" 30 ", "")).toEqual({ from_s: 30 });
+    expect(recordingWindow("30", "58.5")).toEqual({ from_s: 30, to_s: 58.5 });
+  });
+  it("refuses what is no time and an end before the start", () => {
+    expect(recordingWindow("-1", "")).toEqual({ error: 'from: "-1" is not a number of seconds ≥ 0' });
+    expect(recordingWindow("", "soon")).toEqual({ error: 'to: "soon" is not a number of seconds ≥ 0' });
+    expect(recordingWindow("40", "40")).toEqual({ error: "to (40 s) must be after from (40 s)" });
   });
 });

@@ -166,3 +166,18 @@ export function comparedPart(r: Pick<CompareResult, "parafoil_stage_s" | "record
   const p = r.parafoil_stage_s;
   return p === null ? "the whole recording" : `its parafoil stage, ${p[0].toFixed(1)} … ${p[1].toFixed(1)} s of ${r.recorded_s.toFixed(1)} s recorded`;
 }
+
+/** The window of a recording to compare or identify over, as typed in its two boxes (seconds
+ *  from the flight's first sample; a blank box leaves that end open). Whether the flight
+ *  reaches it is the station's to say. */
+export function recordingWindow(fromText: string, toText: string): { from_s?: number; to_s?: number } | { error: string } {
+  const out: { from_s?: number; to_s?: number } = {};
+  for (const [key, text] of [["from_s", fromText], ["to_s", toText]] as const) {
+    if (text.trim() === "") continue;
+    const v = Number(text.trim());
+    if (!Number.isFinite(v) || v < 0) return { error: `${key === "from_s" ? "from" : "to"}: ${JSON.stringify(text)} is not a number of seconds ≥ 0` };
+    out[key] = v;
+  }
+  if (out.from_s !== undefined && out.to_s !== undefined && out.to_s <= out.from_s) return { error: `to (${out.to_s} s) must be after from (${out.from_s} s)` };
+  return out;
+}

@@ -12,7 +12,7 @@ import "../styles/lab.css";
 import uPlot from "uplot";
 import "uplot/dist/uPlot.min.css";
 import { Api, ApiError } from "../lib/api";
-import { complexPlane, identifyParams, metres, outcomeLine, progressOf, recordingOption, vehicleEdits } from "../lib/lab";
+import { complexPlane, identifyParams, metres, outcomeLine, progressOf, recordingOption, recordingWindow, vehicleEdits } from "../lib/lab";
 import { isObj } from "../lib/parse";
 import { resolveToken, searchWithoutToken, withToken } from "../lib/token";
 import type * as Wire from "../generated/api";
@@ -57,6 +57,8 @@ const el = {
   recording: h("select", { "data-testid": "compare-recording", class: "recording-picker" }),
   recordingsRefresh: h("button", { type: "button", "data-testid": "compare-refresh" }, "Refresh"),
   compare: h("button", { type: "button", "data-testid": "compare-start", "data-role": "operator" }, "Compare"),
+  windowFrom: h("input", { type: "number", "data-testid": "window-from", min: "0", step: "any", placeholder: "start" }),
+  windowTo: h("input", { type: "number", "data-testid": "window-to", min: "0", step: "any", placeholder: "end" }),
   identifyParams: h("input", { type: "text", "data-testid": "identify-params", value: "cl_alpha, cd0", class: "params-input", "aria-label": "parameters to fit" }),
   identify: h("button", { type: "button", "data-testid": "identify-start", "data-role": "operator" }, "Identify"),
   progress: h("progress", { "data-testid": "job-progress", max: "1" }),
@@ -170,13 +172,25 @@ async function loadRecordings(): Promise<void> {
   }
 }
 
+/** The window typed for compare and identify, or null after saying what is wrong with it. */
+function windowAsked(): { from_s?: number; to_s?: number } | null {
+  const w = recordingWindow(el.windowFrom.value, el.windowTo.value);
+  if ("error" in w) {
+    setText(el.jobMsg, `window: ${w.error}`);
+    return null;
+  }
+  return w;
+}
+
 async function compare(): Promise<void> {
   setText(el.jobMsg, "");
   if (el.recording.value === "") {
     setText(el.jobMsg, "choose a recording to compare");
     return;
   }
-  const body: Wire.LabJobBody = { kind: "compare", recording: el.recording.value, vehicle: vehicleEdits(fields, typed).edits };
+  const span = windowAsked();
+  if (span === null) return;
+  const body: Wire.LabJobBody = { kind: "compare", recording: el.recording.value, vehicle: vehicleEdits(fields, typed).edits, ...span };
   const r = await post(api, "/api/lab/jobs", body, el.jobMsg);
   if (r !== null) void poll();
 }
@@ -192,7 +206,9 @@ async function identify(): Promise<void> {
     setText(el.jobMsg, `parameters: ${asked.error}`);
     return;
   }
-  const body: Wire.LabJobBody = { kind: "identify", recording: el.recording.value, params: asked.params, vehicle: vehicleEdits(fields, typed).edits };
+  const span = windowAsked();
+  if (span === null) return;
+  const body: Wire.LabJobBody = { kind: "identify", recording: el.recording.value, params: asked.params, vehicle: vehicleEdits(fields, typed).edits, ...span };
   const r = await post(api, "/api/lab/jobs", body, el.jobMsg);
   if (r !== null) void poll();
 }
@@ -397,7 +413,8 @@ async function main(): Promise<void> {
           h("div", { class: "row" }, el.start, el.cancel),
           h("h2", {}, "A recorded flight: compare with the model, identify coefficients"),
           h("div", { class: "row" }, h("label", { class: "recording-label" }, "recording ", el.recording), el.recordingsRefresh),
-          h("div", { class: "row note" }, "flown from its first recorded state with its servo commands and wind estimate, by the vehicle as edited above"),
+          h("div", { class: "row" }, h("label", {}, "from s ", el.windowFrom), h("label", {}, "to s ", el.windowTo)),
+          h("div", { class: "row note" }, "its parafoil stage (a mission's ascent, round chute and canopy inflation left out), or the window typed, in s from its start; flown from its first recorded state with its servo commands and wind estimate, by the vehicle as edited above"),
           h("div", { class: "row" }, el.compare),
           h("div", { class: "row" }, h("label", {}, "parameters ", el.identifyParams), el.identify),
           h("div", { class: "row note" }, "fits the named coefficients of the vehicle as edited to the recording by least squares (names as in the vehicle file: cl_alpha, cd0, cn_da, …; rigging_deg for the rigging angle)"),
