@@ -31,6 +31,10 @@ pub struct CompareArgs {
     /// Print the whole report (series and error figures) as JSON instead of the table.
     #[arg(long)]
     json: bool,
+    /// Also write the flight as compared (after the stage and the window) as a flight-log CSV
+    /// (`stx_analysis::flight_log::csv`), for other tools or to edit and compare again.
+    #[arg(long, value_name = "FILE.csv")]
+    write_log: Option<PathBuf>,
 }
 
 /// `--from S --to S`: the part of a flight to use (the ascent and a round-chute descent
@@ -135,6 +139,10 @@ pub fn table(report: &CompareReport) -> String {
 pub fn run(args: CompareArgs) -> anyhow::Result<()> {
     let window = args.window.checked()?;
     let log = read_window(&args.file, &window)?;
+    if let Some(out) = &args.write_log {
+        std::fs::write(out, stx_analysis::flight_log::csv::to_csv(&log))
+            .with_context(|| format!("writing {}", out.display()))?;
+    }
     let vehicle = load_vehicle(args.vehicle.as_deref())?;
     let report = compare(&log, &vehicle, &CompareOptions::default())
         .with_context(|| format!("flying the model through {}", args.file.display()))

@@ -243,9 +243,26 @@ fn a_recording_of_an_accelerated_drone_compares_on_the_drone_s_clock() {
         .filter_map(|e| e.ok().map(|e| e.path()))
         .find(|p| p.extension().is_some_and(|x| x == "mcap"))
         .expect("a recording");
-    let rms = rms(&stx(&["compare", file.to_str().unwrap(), "--json"]));
+    let written = dir.join("flight.csv");
+    let rms = rms(&stx(&[
+        "compare",
+        file.to_str().unwrap(),
+        "--json",
+        "--write-log",
+        written.to_str().unwrap(),
+    ]));
     for channel in ["north_m", "east_m", "height_m"] {
         assert!(rms[channel] < 25.0, "{channel} RMS {} m", rms[channel]);
+    }
+    // The flight as compared, written as a flight-log CSV, compares the same (its figures
+    // rounded as the CSV writes them).
+    let again = self::rms(&stx(&["compare", written.to_str().unwrap(), "--json"]));
+    for (channel, figure) in &rms {
+        assert!(
+            (again[channel] - figure).abs() <= 0.01 * figure.abs().max(1.0),
+            "{channel}: {figure} from the recording, {} from its CSV",
+            again[channel]
+        );
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
