@@ -156,10 +156,12 @@ async function lab() {
   };
   const defaults = Object.fromEntries(((await api("/api/lab/gains", OPERATOR)).body?.gains ?? []).map((g) => [g.name, g.value]));
   const changed = Object.entries(gains ?? {}).filter(([name, v]) => typeof defaults[name] === "number" && Math.abs(defaults[name] - v) > 1e-6 * Math.abs(v)).map(([name]) => name);
-  const onDrone = await until(held, (rows) => rows.length > 0 && rows.every(([, v, d]) => typeof d === "number" && Math.abs(d - v) <= 1e-6 * Math.max(1, Math.abs(v))), 30000, 500);
+  // The drone keeps parameters as float32: equal to about 7 digits.
+  const holds = ([, v, d]) => typeof d === "number" && Math.abs(d - v) <= 1e-6 * Math.max(1, Math.abs(v));
+  const onDrone = await until(held, (rows) => rows.length > 0 && rows.every(holds), 30000, 500);
   check("tuning: Send asks for a confirmation first; confirmed, the gains (some changed by the tuning) go to the drone as parameters and the drone holds them (float32)",
     changed.length > 0 && confirmShown && /will change the drone's guidance/.test(warned) && sent.startsWith(`sent: ${Object.keys(gains ?? {}).length} parameter requests`) &&
-      onDrone.every(([, v, d]) => typeof d === "number" && Math.abs(d - v) <= 1e-6 * Math.max(1, Math.abs(v))),
+      onDrone.every(holds),
     `"${warned}" → "${sent}"; changed by the tuning: ${changed.join(", ")}; ${onDrone.map(([n, v, d]) => `${n} ${v} on the drone ${d}`).join(", ")}`);
   await page.screenshot({ path: join(out, "lab-tune.png") });
 

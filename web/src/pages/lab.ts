@@ -4,8 +4,9 @@
 // with the model (recorded and modelled side by side per channel, with the error table) or fit
 // chosen coefficients to it (table with intervals, correlation matrix, the fitted values into
 // the form or as a file), follow its progress (cancel a batch, a comparison or a fit), and see
-// the plots; save a vehicle or gains file, send tuned gains to the drone after a confirmation. Operators run and save; viewers see the results only (the station refuses them
-// anyway). The status is polled: twice a second while a job runs, every 3 s otherwise.
+// the plots; save a vehicle or gains file, send tuned gains to the drone after a confirmation.
+// Operators run and save; viewers see the results only (the station refuses them anyway).
+// The status is polled: twice a second while a job runs, every 3 s otherwise.
 
 import "../styles/common.css";
 import "../styles/lab.css";
