@@ -14,9 +14,11 @@ use crate::config::{ForecastRow, Role};
 pub use crate::ascent_wind_msg::{AscentBandView, AscentWindMsg};
 mod flight_path;
 mod footprint;
+mod mission;
 mod vehicle;
 pub use flight_path::{FlightPathView, PathPointView};
 pub use footprint::{FootprintContourView, FootprintView, FootprintZoneHit};
+pub use mission::{DisagreementView, LandingView};
 pub use vehicle::{
     AirView, AttitudeView, GpsView, OnboardLandingView, PowerView, ServosView, VehicleView,
 };
@@ -216,6 +218,9 @@ pub struct GuidanceView {
     pub age_s: Option<f64>,
     /// Old: show it as stale.
     pub stale: bool,
+    /// The replica disagrees with the drone (or did, a few seconds ago): an alarm for every
+    /// page; `null` while they agree.
+    pub disagreement: Option<DisagreementView>,
 }
 
 /// Servo commands of the replica.
@@ -263,8 +268,10 @@ pub struct MissionView {
     /// Stage.
     #[schemars(with = "Option<FlightStage>")]
     pub stage: Option<String>,
-    /// When an armed cutdown expires, s.
+    /// When an armed cutdown expires, s of the station's clock.
     pub cutdown_armed_until_s: Option<f64>,
+    /// Where the drone landed and how far from its target, once it has.
+    pub landing: Option<LandingView>,
 }
 
 /// The `state` message.
@@ -274,8 +281,12 @@ pub struct StateMsg {
     #[serde(rename = "type")]
     #[schemars(extend("const" = "state"))]
     pub kind: &'static str,
-    /// Mission clock, s.
+    /// The station's clock: s since it started (its timers and ages run on it).
     pub time_s: f64,
+    /// The mission clock: the drone's (s since its boot) at its newest time-stamped telemetry;
+    /// plots, the T+ clock, countdowns and the log show it, at any rehearsal speed. `null`
+    /// before the drone is heard.
+    pub mission_time_s: Option<f64>,
     /// Unix time, ms.
     pub wall_ms: u64,
     /// Link.
@@ -377,8 +388,10 @@ pub struct EventMsg {
     #[serde(rename = "type")]
     #[schemars(extend("const" = "event"))]
     pub kind: &'static str,
-    /// Mission clock, s.
+    /// The station's clock, s since it started.
     pub time_s: f64,
+    /// The mission clock (the drone's, s) when it happened; `null` before the drone is heard.
+    pub mission_time_s: Option<f64>,
     /// Unix time, ms.
     pub wall_ms: u64,
     /// Level.
@@ -463,15 +476,17 @@ pub struct ParamsMsg {
     pub params: Vec<ParamView>,
     /// Every parameter arrived.
     pub complete: bool,
-    /// Mission clock, s.
+    /// The station's clock, s.
     pub time_s: f64,
 }
 
 /// A point of the track.
 #[derive(Debug, Clone, Copy, Serialize, JsonSchema)]
 pub struct TrackPoint {
-    /// Mission clock, s.
+    /// The station's clock, s.
     pub time_s: f64,
+    /// The mission clock (the drone's), s.
+    pub mission_time_s: f64,
     /// Latitude, degrees.
     pub lat_deg: f64,
     /// Longitude, degrees.

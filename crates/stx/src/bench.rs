@@ -2,7 +2,9 @@
 //!
 //! `stx bench dynamics` is `stx_sim::speed` (derivative evaluations per second, and the
 //! stratospheric descent's real-time factor per integrator); `stx bench memory` and
-//! `stx bench station` measure the station daemon (see their modules).
+//! `stx bench station` measure the station daemon (see their modules); `stx bench agreement`
+//! flies whole missions and holds what the station shows against the truth
+//! (`stx_agreement`).
 
 use clap::{Args, Subcommand};
 
@@ -14,6 +16,35 @@ pub struct BenchArgs {
 
 #[derive(Subcommand)]
 enum BenchWhat {
+    /// Whole missions, pad to landing, with the station beside the simulated drone: what the
+    /// station shows held against the truth every control period (exits 1 if a goal is not
+    /// met).
+    Agreement {
+        /// Print one JSON object instead of tables.
+        #[arg(long)]
+        json: bool,
+        /// The short campaign of the test command instead of the full one.
+        #[arg(long)]
+        short: bool,
+        /// Built-in missions (comma-separated); default: the campaign's.
+        #[arg(long, value_delimiter = ',')]
+        missions: Option<Vec<String>>,
+        /// Seeds (comma-separated); default: the campaign's.
+        #[arg(long, value_delimiter = ',')]
+        seeds: Option<Vec<u64>>,
+        /// Speeds, factors of real time or `max` (comma-separated); default: 20,max.
+        #[arg(long, value_delimiter = ',', value_parser = crate::bench_agreement::parse_speed)]
+        speeds: Option<Vec<f64>>,
+        /// Dispersion set: `nominal`, `realistic` or a file; default: realistic.
+        #[arg(long)]
+        dispersions: Option<String>,
+        /// The station's keep-out zones.
+        #[arg(long, default_value = "config/keep-out/sample.geojson")]
+        keep_out: std::path::PathBuf,
+        /// Threads flying missions at once.
+        #[arg(long, default_value_t = 2)]
+        threads: usize,
+    },
     /// Flight-model evaluations per second and the stratospheric descent's real-time factor.
     Dynamics {
         /// Print one JSON object instead of a table.
@@ -73,6 +104,40 @@ enum BenchWhat {
 
 pub fn run(args: BenchArgs) -> anyhow::Result<()> {
     match args.what {
+        BenchWhat::Agreement {
+            json,
+            short,
+            missions,
+            seeds,
+            speeds,
+            dispersions,
+            keep_out,
+            threads,
+        } => {
+            let mut campaign = if short {
+                stx_agreement::campaign::CampaignOptions::short()
+            } else {
+                stx_agreement::campaign::CampaignOptions::full()
+            };
+            if let Some(m) = missions {
+                campaign.missions = m;
+            }
+            if let Some(s) = seeds {
+                campaign.seeds = s;
+            }
+            if let Some(s) = speeds {
+                campaign.speeds = s;
+            }
+            if let Some(d) = dispersions {
+                campaign.dispersions = Some(d);
+            }
+            crate::bench_agreement::run_bench(crate::bench_agreement::AgreementBenchOptions {
+                campaign,
+                keep_out: Some(keep_out),
+                threads,
+                json,
+            })
+        }
         BenchWhat::Memory {
             json,
             mission_hours,

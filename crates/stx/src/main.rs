@@ -7,6 +7,7 @@
 mod analyze;
 mod bench;
 mod bench_abuse;
+mod bench_agreement;
 mod bench_http;
 mod bench_lab;
 mod bench_memory;

@@ -189,6 +189,21 @@ impl Guidance {
         }
     }
 
+    /// Takes the phase `phase` from another copy of this guidance flying the same plan (the
+    /// ground station's replica from the drone): in spiral landing only, without an event (the
+    /// caller says why). The spiral goes on from there with what it has planned.
+    pub fn adopt_phase(&mut self, phase: GuidancePhase, time_s: f64) {
+        if self.mode == FlightMode::SpiralLanding {
+            self.spiral.adopt_phase(phase, time_s);
+        }
+    }
+
+    /// Whether the spiral has planned since the mode or plan last changed (its status is a
+    /// plan only then).
+    pub fn spiral_has_run(&self) -> bool {
+        self.spiral.has_run()
+    }
+
     /// The spiral's planning state for display (pattern, final-approach height, reach).
     pub fn spiral_status(&self) -> &SpiralStatus {
         self.spiral.status()

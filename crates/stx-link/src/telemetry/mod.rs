@@ -11,6 +11,7 @@
 //! |---|---|---|
 //! | [`VehicleStatus`] | HEARTBEAT | `custom_mode = mode \| stage << 8 \| phase << 16` (codes from `stx_gnc::mission`), `base_mode = CUSTOM_MODE_ENABLED`, `type = MAV_TYPE_PARAFOIL` (exists in the dialect, 28), autopilot `GENERIC` |
 //! | [`GpsRaw`] | GPS_RAW_INT | extensions carry h_acc / v_acc; `UINT16_MAX` / `255` / `0` = unknown |
+//! | [`GpsSolution`] | GPS_INPUT | the receiver's whole solution beside GPS_RAW_INT: NED velocity (vertical too) and accuracies as floats, for the station's estimator (see `gps_solution.rs`) |
 //! | [`GlobalPosition`] | GLOBAL_POSITION_INT | onboard estimate; NED velocity in cm/s |
 //! | [`Attitude`] | ATTITUDE | rad, rad/s |
 //! | [`AirData`] | SCALED_PRESSURE | pitot: wire hPa ↔ Pa, cdegC ↔ °C |
@@ -44,6 +45,7 @@
 //! Each message family keeps its types and their mapping both ways together; this file holds
 //! [`Telemetry`], which dispatches to them.
 //! - `system.rs`: [`VehicleStatus`] (HEARTBEAT), [`SystemStatus`], [`BatteryStatus`].
+//! - `gps_solution.rs`: [`GpsSolution`] (GPS_INPUT).
 //! - `navigation.rs`: [`GpsRaw`], [`GlobalPosition`], [`Attitude`], [`AirData`], [`Hud`].
 //! - `actuators.rs`: [`Actuators`] and the servo pulse mapping.
 //! - `status_text.rs`: [`StatusText`], [`Severity`], splitting and re-assembly.
@@ -51,6 +53,7 @@
 //! - `units.rs`: the scaled integers of the wire.
 
 mod actuators;
+mod gps_solution;
 mod guidance;
 mod navigation;
 mod status_text;
@@ -60,6 +63,7 @@ mod units;
 pub use actuators::{
     Actuators, pwm_us_to_signed, pwm_us_to_unit, signed_to_pwm_us, unit_to_pwm_us,
 };
+pub use gps_solution::GpsSolution;
 pub use guidance::{GuidanceStatus, PredictedLanding, Wind};
 pub use navigation::{AirData, Attitude, GlobalPosition, GpsFix, GpsRaw, Hud};
 pub use status_text::{
@@ -77,6 +81,7 @@ use serde::{Deserialize, Serialize};
 pub enum Telemetry {
     Status(VehicleStatus),
     GpsRaw(GpsRaw),
+    GpsSolution(GpsSolution),
     Position(GlobalPosition),
     Attitude(Attitude),
     AirData(AirData),
@@ -96,6 +101,7 @@ impl Telemetry {
         match self {
             Self::Status(_) => "HEARTBEAT",
             Self::GpsRaw(_) => "GPS_RAW_INT",
+            Self::GpsSolution(_) => "GPS_INPUT",
             Self::Position(_) => "GLOBAL_POSITION_INT",
             Self::Attitude(_) => "ATTITUDE",
             Self::AirData(_) => "SCALED_PRESSURE",
@@ -115,6 +121,7 @@ impl Telemetry {
         match self {
             Self::Status(s) => s.to_mavlink(),
             Self::GpsRaw(g) => g.to_mavlink(),
+            Self::GpsSolution(g) => g.to_mavlink(),
             Self::Position(p) => p.to_mavlink(),
             Self::Attitude(a) => a.to_mavlink(),
             Self::AirData(d) => d.to_mavlink(),
@@ -135,6 +142,7 @@ impl Telemetry {
         Some(match msg {
             MavMessage::HEARTBEAT(h) => Self::Status(VehicleStatus::from_mavlink(h)?),
             MavMessage::GPS_RAW_INT(g) => Self::GpsRaw(GpsRaw::from_mavlink(g)),
+            MavMessage::GPS_INPUT(g) => Self::GpsSolution(GpsSolution::from_mavlink(g)),
             MavMessage::GLOBAL_POSITION_INT(p) => Self::Position(GlobalPosition::from_mavlink(p)),
             MavMessage::ATTITUDE(a) => Self::Attitude(Attitude::from_mavlink(a)),
             MavMessage::SCALED_PRESSURE(d) => Self::AirData(AirData::from_mavlink(d)),

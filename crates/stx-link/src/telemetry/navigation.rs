@@ -28,7 +28,7 @@ pub enum GpsFix {
 }
 
 impl GpsFix {
-    fn to_mav(self) -> mc::GpsFixType {
+    pub(super) fn to_mav(self) -> mc::GpsFixType {
         use mc::GpsFixType as G;
         match self {
             Self::NoGps => G::GPS_FIX_TYPE_NO_GPS,
@@ -42,7 +42,7 @@ impl GpsFix {
             Self::Ppp => G::GPS_FIX_TYPE_PPP,
         }
     }
-    fn from_mav(g: mc::GpsFixType) -> Self {
+    pub(super) fn from_mav(g: mc::GpsFixType) -> Self {
         use mc::GpsFixType as G;
         match g {
             G::GPS_FIX_TYPE_NO_GPS => Self::NoGps,

@@ -52,6 +52,7 @@
 mod commands;
 pub mod config;
 pub mod config_error;
+pub mod dispersed;
 pub mod failures;
 pub mod link;
 pub mod mission;
@@ -84,6 +85,7 @@ use crate::guided::CONTROL_PERIOD_S;
 use crate::sensors::{DeliveryQueue, SensorSuite};
 pub use config::MissionConfig;
 pub use config_error::MissionError;
+pub use dispersed::{DispersedDroneError, dispersed_inputs};
 use failures::{LinkFaults, Servo, ServoFault};
 use mission::{MissionPhysics, PhysicsError};
 use onboard::{HardwareRequest, Onboard, mode_name};

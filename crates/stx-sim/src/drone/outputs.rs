@@ -37,6 +37,10 @@ impl Drone {
                 if self.streams.due(msg::GPS_RAW_INT, arrival_s) {
                     self.send(Telemetry::GpsRaw(telemetry::gps_raw(&self.frame, fix)));
                 }
+                if self.streams.due(msg::GPS_INPUT, arrival_s) {
+                    let solution = telemetry::gps_solution(&self.frame, fix);
+                    self.send(Telemetry::GpsSolution(solution));
+                }
             }
             Measurement::Attitude(a) => {
                 if self.streams.due(msg::ATTITUDE, arrival_s) {

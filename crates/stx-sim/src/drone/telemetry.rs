@@ -5,7 +5,7 @@
 //! | message | rate | content |
 //! |---|---|---|
 //! | HEARTBEAT | 1 Hz (the link's own timer) | mode, stage, phase, state ([`crate::drone::Drone::status`]) |
-//! | GPS_RAW_INT, ATTITUDE, SCALED_PRESSURE | each measurement as it reaches the drone's computer (4 Hz) | the receiver's fix (converted to latitude/longitude from the launch site), the AHRS's angles (rates by difference of successive samples), the pitot's pressures and temperature; without a fix for a second, GPS_RAW_INT says `NoFix` at 1 Hz (latitude/longitude 0) |
+//! | GPS_RAW_INT, GPS_INPUT, ATTITUDE, SCALED_PRESSURE | each measurement as it reaches the drone's computer (4 Hz) | the receiver's fix (converted to latitude/longitude from the launch site), the AHRS's angles (rates by difference of successive samples), the pitot's pressures and temperature; GPS_INPUT is the receiver's whole solution beside GPS_RAW_INT (its vertical velocity and accuracies, which GPS_RAW_INT lacks, so the station's estimator sees what the onboard one sees); without a fix for a second, GPS_RAW_INT says `NoFix` at 1 Hz (latitude/longitude 0) |
 //! | GLOBAL_POSITION_INT, VFR_HUD, SERVO_OUTPUT_RAW | 4 Hz | the onboard estimate (once it has a solution), the servos' positions |
 //! | WIND_COV, NAV_CONTROLLER_OUTPUT, SYS_STATUS, BATTERY_STATUS | 1 Hz | wind estimate, guidance state, health and battery |
 //! | POSITION_TARGET_GLOBAL_INT (predicted landing) | every `telemetry.prediction_period_s` (2 s) | see `Drone` |
@@ -28,7 +28,8 @@ use stx_gnc::geo::LocalFrame;
 use stx_gnc::measurement::{AirDataSample, AttitudeSample, GpsFix as Fix};
 use stx_link::command::CommandResult;
 use stx_link::telemetry::{
-    Actuators, AirData, Attitude, BatteryStatus, GlobalPosition, GpsFix, GpsRaw, Hud, Wind,
+    Actuators, AirData, Attitude, BatteryStatus, GlobalPosition, GpsFix, GpsRaw, GpsSolution, Hud,
+    Wind,
 };
 
 use crate::drone::config::BatteryConfig;
@@ -41,6 +42,8 @@ pub mod msg {
     pub const SYS_STATUS: u32 = 1;
     /// GPS_RAW_INT.
     pub const GPS_RAW_INT: u32 = 24;
+    /// GPS_INPUT (the receiver's whole solution).
+    pub const GPS_INPUT: u32 = 232;
     /// SCALED_PRESSURE.
     pub const SCALED_PRESSURE: u32 = 29;
     /// ATTITUDE.
@@ -102,6 +105,7 @@ impl Streams {
         Self {
             streams: vec![
                 sensor(msg::GPS_RAW_INT),
+                sensor(msg::GPS_INPUT),
                 sensor(msg::ATTITUDE),
                 sensor(msg::SCALED_PRESSURE),
                 scheduled(msg::GLOBAL_POSITION_INT, 0.25),
@@ -285,6 +289,24 @@ pub fn gps_raw(frame: &LocalFrame, fix: &Fix) -> GpsRaw {
         satellites: Some(12),
         h_acc_m: Some(fix.horizontal_accuracy_m),
         v_acc_m: Some(fix.vertical_accuracy_m),
+    }
+}
+
+/// GPS_INPUT of a fix: the receiver's solution as it measured it.
+pub fn gps_solution(frame: &LocalFrame, fix: &Fix) -> GpsSolution {
+    let (lat_deg, lon_deg, alt_msl_m) = frame.to_geodetic(&fix.position_ned_m);
+    let v = fix.velocity_ned_mps;
+    GpsSolution {
+        time_usec: (fix.time_s.max(0.0) * 1e6).round() as u64,
+        fix: GpsFix::Fix3d,
+        lat_deg,
+        lon_deg,
+        alt_msl_m,
+        velocity_ned_mps: Some([v.x, v.y, v.z]),
+        speed_accuracy_mps: Some(fix.speed_accuracy_mps),
+        horizontal_accuracy_m: Some(fix.horizontal_accuracy_m),
+        vertical_accuracy_m: Some(fix.vertical_accuracy_m),
+        satellites: Some(12),
     }
 }
 

@@ -6,9 +6,7 @@ use std::io;
 use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
 
 use serde::Serialize;
-use stx_dynamics::vehicle::Vehicle;
 
-use crate::dispersions::DispersedFlight;
 use stx_link::sansio::IoStats;
 use stx_link::signing::persist::{persist_signing_mark, start_signing};
 use stx_link_tokio::{Action, DriveOptions, DriverEvent, Transport, TransportError, drive};
@@ -19,7 +17,7 @@ use super::observe::{FlightObserver, StepReport, log_event};
 use super::options::{FlyOptions, Speed};
 use super::pacing::Pacer;
 use crate::drone::link::{DroneEvent, LinkCounters, LinkedDrone};
-use crate::drone::{Drone, DroneError, MissionSummary, stage_name};
+use crate::drone::{DispersedDroneError, Drone, DroneError, MissionSummary, stage_name};
 use crate::guided::CONTROL_PERIOD_S;
 
 /// Steps handed to the driver ahead of its progress at maximum speed.
@@ -150,28 +148,18 @@ impl Flight {
         let mission = options.mission.name.clone();
         // A dispersed drone flies a vehicle and sensors drawn from the mission's seed; its
         // onboard software keeps the nominal vehicle, as on a real flight.
-        let (mission_config, vehicle) = match &options.dispersions {
-            Some(d) => {
-                let drawn = DispersedFlight::draw(
-                    d,
-                    &Vehicle::straplex().config,
-                    &options.mission.sensors,
-                    options.mission.seed,
-                )
-                .map_err(|source| FlyError::Dispersed {
+        let drone = Drone::dispersed(&options.mission, options.dispersions.as_ref()).map_err(
+            |e| match e {
+                DispersedDroneError::Vehicle(source) => FlyError::Dispersed {
                     mission: mission.clone(),
                     source,
-                })?;
-                let mut m = options.mission.clone();
-                m.sensors = drawn.sensors;
-                (m, drawn.vehicle)
-            }
-            None => (options.mission.clone(), Vehicle::straplex()),
-        };
-        let drone = Drone::new(&mission_config, vehicle).map_err(|source| FlyError::Drone {
-            mission: mission.clone(),
-            source,
-        })?;
+                },
+                DispersedDroneError::Drone(source) => FlyError::Drone {
+                    mission: mission.clone(),
+                    source,
+                },
+            },
+        )?;
         let transport = Transport::open_str(&options.connect)
             .await
             .map_err(|source| FlyError::Open {

@@ -28,13 +28,16 @@ mod fence;
 mod flight_path;
 mod footprint;
 mod keep_out;
+mod landing;
 mod manual;
 mod navigation;
 mod operator;
 mod params;
+mod phase_sync;
+mod replica;
 mod requests;
 mod sync;
-mod views;
+pub(crate) mod views;
 
 use std::collections::VecDeque;
 
@@ -59,7 +62,7 @@ pub use flight_path::FLIGHT_PATH_EVERY_S;
 pub use footprint::{FootprintDone, FootprintJob};
 pub use keep_out::{CLEAR_AFTER_S, CheckedZones};
 pub use manual::MANUAL_SILENCE_S;
-pub use navigation::{Predicted, PredictionJob};
+pub use navigation::{PREDICTION_EVERY_S, Predicted, PredictionJob};
 pub use requests::{ApiError, CommandRequest};
 pub use sync::TargetSource;
 
@@ -81,6 +84,8 @@ pub(crate) struct Latest {
     pub guidance: Option<(stx_link::telemetry::GuidanceStatus, f64)>,
     /// The drone's own prediction of its touchdown.
     pub predicted_landing: Option<(stx_link::telemetry::PredictedLanding, f64)>,
+    /// The drone's clock of the newest GPS_INPUT the estimator took, s.
+    pub gps_solution_s: Option<f64>,
     /// The newest GPS, attitude or air data: what navigation last learnt from.
     pub sensors_s: Option<f64>,
     pub any_s: Option<f64>,
@@ -110,12 +115,12 @@ pub struct StationCore {
     /// Unix time at mission time 0, ms.
     wall_origin_ms: u64,
     pub(crate) latest: Latest,
-    estimator: Estimator,
+    pub(crate) estimator: Estimator,
     /// The wind measured from the ascent's drift.
     ascent: ascent::AscentWinds,
     /// The drone's clock (s since its boot) from the newest time-stamped telemetry:
     /// navigation runs on it, so radio delays and accelerated rehearsals do not distort it.
-    drone_time_s: Option<f64>,
+    pub(crate) drone_time_s: Option<f64>,
     pub(crate) estimate: Option<Estimate>,
     pub(crate) guidance: Guidance,
     pub(crate) prediction: Option<LandingPrediction>,
@@ -131,7 +136,13 @@ pub struct StationCore {
     /// The plan download and where the replica's plan comes from.
     pub(crate) sync: sync::PlanSync,
     /// The drone's clock of the estimate guidance last ran on, s.
-    guided_at_s: Option<f64>,
+    pub(crate) guided_at_s: Option<f64>,
+    /// The replica's guidance phase against the drone's.
+    pub(crate) phase_sync: phase_sync::PhaseSync,
+    /// The landing, measured once.
+    pub(crate) landing: landing::LandingWatch,
+    /// The drone's clock of the estimate the last landing prediction started from, s.
+    predicted_from_s: Option<f64>,
     pub(crate) track: Vec<TrackPoint>,
     next_track_s: f64,
     pub(crate) events: VecDeque<EventMsg>,
@@ -166,7 +177,7 @@ impl StationCore {
     pub fn new(config: StationConfig, wall_origin_ms: u64) -> Self {
         let frame = config.origin;
         let guidance = Guidance::new(config.guidance);
-        let estimator = navigation::new_estimator();
+        let estimator = navigation::new_estimator(config.origin.alt_msl_m);
         Self {
             frame,
             wall_origin_ms,
@@ -181,6 +192,9 @@ impl StationCore {
             footprint: None,
             sync: sync::PlanSync::default(),
             guided_at_s: None,
+            phase_sync: Default::default(),
+            landing: Default::default(),
+            predicted_from_s: None,
             track: Vec::new(),
             next_track_s: 0.0,
             events: VecDeque::new(),
@@ -222,6 +236,7 @@ impl StationCore {
         let event = EventMsg {
             kind: "event",
             time_s: now_s,
+            mission_time_s: self.drone_time_s,
             wall_ms: self.wall_ms(now_s),
             level,
             source,
@@ -353,6 +368,7 @@ impl StationCore {
                     self.after_command_result(now_s, &msg);
                 }
                 if self.params.on_event(&e) {
+                    self.replica_on_params(now_s);
                     let params = self.params_msg(now_s);
                     self.outbound.push(Outbound::Params(params));
                 }

@@ -11,7 +11,7 @@ use stx_gnc::estimate::Estimate;
 use stx_gnc::estimator::{Estimator, EstimatorConfig};
 use stx_gnc::guidance::{Guidance, Plan};
 use stx_gnc::measurement::{AirDataSample, AttitudeSample, GpsFix, Measurement};
-use stx_gnc::mission::FlightMode;
+use stx_gnc::mission::{FlightMode, FlightStage};
 use stx_gnc::predict::{LandingPrediction, PredictorConfig, predict_in_wind};
 use stx_link::telemetry::Telemetry;
 
@@ -48,14 +48,68 @@ pub(crate) fn has_3d_fix(g: &stx_link::telemetry::GpsRaw) -> bool {
     )
 }
 
+/// Seconds of the drone's clock between two landing predictions.
+pub const PREDICTION_EVERY_S: f64 = 1.0;
+
+/// A GPS_INPUT this close to the drone's clock, s, means the drone sends its receiver's
+/// solution, and GPS_RAW_INT is not fed to the estimator as well.
+const SOLUTION_FRESH_S: f64 = 2.0;
+
+/// A GPS measurement from the receiver's solution (GPS_INPUT), as the onboard estimator takes
+/// it: at the time the receiver measured it when its stamp is on the drone's clock (`drone_s`,
+/// within 10 s before it), else at `drone_s`; `None` without a 3-D fix or a velocity.
+fn solution_measurement(
+    frame: &stx_gnc::geo::LocalFrame,
+    drone_s: f64,
+    g: &stx_link::telemetry::GpsSolution,
+) -> Option<Measurement> {
+    use stx_link::telemetry::GpsFix as Fix;
+    if !matches!(
+        g.fix,
+        Fix::Fix3d | Fix::Dgps | Fix::RtkFloat | Fix::RtkFixed | Fix::Static | Fix::Ppp
+    ) {
+        return None;
+    }
+    let [vn, ve, vd] = g.velocity_ned_mps?;
+    Some(Measurement::Gps(GpsFix {
+        time_s: receiver_time_s(g.time_usec, drone_s),
+        position_ned_m: frame.to_ned(g.lat_deg, g.lon_deg, g.alt_msl_m),
+        velocity_ned_mps: Vector3::new(vn, ve, vd),
+        horizontal_accuracy_m: g.horizontal_accuracy_m.unwrap_or(2.5),
+        vertical_accuracy_m: g.vertical_accuracy_m.unwrap_or(5.0),
+        speed_accuracy_mps: g.speed_accuracy_mps.unwrap_or(0.3),
+    }))
+}
+
+/// When a GPS receiver measured a fix stamped `time_usec`, on the drone's clock whose newest
+/// time is `drone_s`: the stamp itself when it is on that clock (µs since boot, up to 10 s
+/// old), else `drone_s` (a stamp in Unix time, which MAVLink allows).
+fn receiver_time_s(time_usec: u64, drone_s: f64) -> f64 {
+    let stamp_s = time_usec as f64 / 1e6;
+    if (drone_s - 10.0..=drone_s + 0.5).contains(&stamp_s) {
+        stamp_s
+    } else {
+        drone_s
+    }
+}
+
 /// Seconds the drone's clock may step back before the station takes it for a reboot.
 const REBOOT_STEP_BACK_S: f64 = 5.0;
 
-pub(crate) fn new_estimator() -> Estimator {
-    match Estimator::new(EstimatorConfig::default()) {
+/// The station's estimator for a local frame whose origin is `ground_altitude_msl_m` above sea
+/// level: the barometer's altitude is referred to it, as the drone's is to its site. (With the
+/// default 0 m, at Évora's 245 m, the station's air was thinner than the drone's and its
+/// airspeed and wind parted from the drone's by 0.3 m/s after every restart.)
+pub(crate) fn new_estimator(ground_altitude_msl_m: f64) -> Estimator {
+    let config = EstimatorConfig {
+        ground_altitude_msl_m,
+        ..EstimatorConfig::default()
+    };
+    match Estimator::new(config) {
         Ok(e) => e,
-        // The default configuration is validated by the estimator's own tests.
-        Err(e) => panic!("default estimator configuration is invalid: {e}"),
+        // The default configuration is validated by the estimator's own tests, and the
+        // station's origin by its configuration's.
+        Err(e) => panic!("the station's estimator configuration is invalid: {e}"),
     }
 }
 
@@ -111,7 +165,7 @@ impl StationCore {
         let t = f64::from(time_boot_ms) / 1000.0;
         match self.drone_time_s {
             Some(last) if last - t > REBOOT_STEP_BACK_S => {
-                self.estimator = new_estimator();
+                self.estimator = new_estimator(self.frame.alt_msl_m);
                 self.estimate = None;
                 self.log(
                     now_s,
@@ -136,6 +190,9 @@ impl StationCore {
             Telemetry::Status(s) => {
                 let previous = self.latest.status.map(|(p, _)| p);
                 self.latest.status = Some((s, now_s));
+                self.replica_on_stage(now_s, previous.map(|p| p.stage), s);
+                let drone_s = self.drone_time_s.unwrap_or(0.0);
+                self.landing_on_stage(previous.map(|p| p.stage), s.stage, drone_s);
                 if previous.map(|p| p.mode) != Some(s.mode) {
                     let at = self.drone_time_s.unwrap_or(0.0);
                     self.guidance.set_mode(s.mode, at);
@@ -157,12 +214,27 @@ impl StationCore {
                 // GPS_RAW_INT's time may be the receiver's (Unix) clock: it is stamped with
                 // the drone's clock of the burst it came in.
                 if let Some(t) = self.drone_time_s {
-                    if let Some(m) = self.gps_measurement(t, now_s, &g) {
+                    if has_3d_fix(&g) {
+                        let measured_s = receiver_time_s(g.time_usec, t);
+                        self.landing_fix(now_s, measured_s, g.lat_deg, g.lon_deg, g.alt_msl_m);
+                    }
+                    if !self.has_gps_solution(t)
+                        && let Some(m) = self.gps_measurement(t, &g)
+                    {
                         self.estimator.handle(t, &m);
                     }
                     if let Some(fix) = self.ascent_fix(now_s, &g) {
                         self.ascent.push(now_s, t, fix);
                     }
+                }
+            }
+            Telemetry::GpsSolution(g) => {
+                self.latest.sensors_s = Some(now_s);
+                if let Some(t) = self.drone_time_s
+                    && let Some(m) = solution_measurement(&self.frame, t, &g)
+                {
+                    self.latest.gps_solution_s = Some(t);
+                    self.estimator.handle(t, &m);
                 }
             }
             Telemetry::Position(p) => {
@@ -211,14 +283,19 @@ impl StationCore {
         }
     }
 
-    /// A GPS measurement for the estimator. GPS_RAW_INT carries no vertical velocity: the
-    /// drone's own estimate (GLOBAL_POSITION_INT) stands in for it when it is recent.
-    fn gps_measurement(
-        &self,
-        drone_s: f64,
-        now_s: f64,
-        g: &stx_link::telemetry::GpsRaw,
-    ) -> Option<Measurement> {
+    /// Whether the drone sends its receiver's whole solution (GPS_INPUT), which its estimator
+    /// then takes instead of GPS_RAW_INT: one within [`SOLUTION_FRESH_S`] of the drone's clock
+    /// `drone_s`.
+    fn has_gps_solution(&self, drone_s: f64) -> bool {
+        self.latest
+            .gps_solution_s
+            .is_some_and(|t| (drone_s - t).abs() <= SOLUTION_FRESH_S)
+    }
+
+    /// A GPS measurement from GPS_RAW_INT, for a drone that sends no GPS_INPUT. GPS_RAW_INT
+    /// carries no vertical velocity: the drone's own estimate (GLOBAL_POSITION_INT) stands in
+    /// for it when it is of the same second of the drone's clock.
+    fn gps_measurement(&self, drone_s: f64, g: &stx_link::telemetry::GpsRaw) -> Option<Measurement> {
         if !has_3d_fix(g) {
             return None;
         }
@@ -228,7 +305,7 @@ impl StationCore {
         let down = self
             .latest
             .position
-            .filter(|(_, t)| now_s - t < 1.0)
+            .filter(|(p, _)| (drone_s - f64::from(p.time_boot_ms) / 1000.0).abs() < 1.0)
             .map_or(0.0, |(p, _)| p.v_down_mps);
         Some(Measurement::Gps(GpsFix {
             time_s: drone_s,
@@ -249,7 +326,10 @@ impl StationCore {
         let usable = est.filter(|e| e.position_sigma_m.iter().all(|s| s.is_finite()));
         if let Some(est) = usable {
             let mode = self.guidance.mode();
-            if !self.plan_known_for(mode) {
+            if !self.replica_flies() {
+                // The drone holds its servos neutral before its parafoil flies.
+                self.replica_command = stx_dynamics::state::Controls::default();
+            } else if !self.plan_known_for(mode) {
                 // Flying towards a target the drone may not have would draw and log a
                 // pattern that does not exist.
                 self.replica_command = stx_dynamics::state::Controls::default();
@@ -261,6 +341,10 @@ impl StationCore {
                     .air_at(self.frame.alt_msl_m - est.position_ned_m.z)
                     .density_kg_per_m3;
                 self.replica_command = self.guidance.update(&est, density).controls;
+                let fresh = self.latest.status.is_some_and(|(_, at)| {
+                    now_s - at <= self.config.link.stale_after_s && self.link.connected
+                });
+                self.sync_phase(now_s, est.time_s, fresh);
             }
             for e in self.guidance.drain_events() {
                 self.log(
@@ -276,6 +360,7 @@ impl StationCore {
                 let (lat, lon, alt) = self.frame.to_geodetic(&est.position_ned_m);
                 self.track.push(TrackPoint {
                     time_s: now_s,
+                    mission_time_s: est.time_s,
                     lat_deg: lat,
                     lon_deg: lon,
                     alt_msl_m: alt,
@@ -304,9 +389,25 @@ impl StationCore {
     }
 
     /// A landing prediction from the current estimate and plan, to be run away from the
-    /// telemetry path; `None` until navigation has a solution.
-    pub fn prediction_job(&self) -> Option<PredictionJob> {
+    /// telemetry path, when one is due: under the parafoil (or while the drone has not said
+    /// its stage), once the drone's clock has moved [`PREDICTION_EVERY_S`] past the estimate the
+    /// last one started from. Predictions keep to the drone's clock, so a rehearsal flown at
+    /// any speed is predicted as often per second of flight.
+    pub fn prediction_job(&mut self) -> Option<PredictionJob> {
         let estimate = self.estimate?;
+        if !matches!(
+            self.drone_stage(),
+            None | Some(FlightStage::ParafoilDeploy | FlightStage::Parafoil)
+        ) {
+            return None;
+        }
+        if self
+            .predicted_from_s
+            .is_some_and(|t| estimate.time_s - t < PREDICTION_EVERY_S && estimate.time_s >= t)
+        {
+            return None;
+        }
+        self.predicted_from_s = Some(estimate.time_s);
         Some(PredictionJob {
             data_s: self.latest.sensors_s,
             estimate,
@@ -323,6 +424,13 @@ impl StationCore {
 
     /// Takes the result of a [`PredictionJob`].
     pub fn set_prediction(&mut self, predicted: Predicted) {
+        if !matches!(
+            self.drone_stage(),
+            None | Some(FlightStage::ParafoilDeploy | FlightStage::Parafoil)
+        ) {
+            // Started under the parafoil, finished on the ground.
+            return;
+        }
         self.prediction = Some(predicted.prediction);
         self.prediction_data_s = predicted.data_s;
     }
@@ -351,6 +459,7 @@ mod track_tests {
         for t in 0..43_200 {
             track.push(TrackPoint {
                 time_s: f64::from(t),
+                mission_time_s: f64::from(t),
                 lat_deg: 50.0,
                 lon_deg: 14.0,
                 alt_msl_m: 300.0,

@@ -12,7 +12,7 @@ use crate::messages::{
     PredictionView, RadioView, ServosView, StateMsg, TouchdownView, VehicleView,
 };
 
-fn snake<T: serde::Serialize + std::fmt::Debug>(v: T) -> String {
+pub(crate) fn snake<T: serde::Serialize + std::fmt::Debug>(v: T) -> String {
     serde_json::to_value(&v)
         .ok()
         .and_then(|j| j.as_str().map(String::from))
@@ -182,7 +182,13 @@ impl StationCore {
         });
         let mode = self.guidance.mode();
         let plan_known = self.plan_known_for(mode);
-        let phase = self.guidance.phase();
+        let flying = self.replica_flies();
+        // The replica flies only under the parafoil; before and after, the phase is the
+        // drone's (idle, landed), as the onboard guidance reports it.
+        let phase = match self.latest.status {
+            Some((s, _)) if !flying => s.phase,
+            _ => self.guidance.phase(),
+        };
         let spiral = self.guidance.spiral_status();
         let guidance = Some(GuidanceView {
             mode: snake(mode),
@@ -196,7 +202,14 @@ impl StationCore {
             }),
             age_s: estimate_age_s,
             stale: stale(estimate_age_s),
-            pattern: (plan_known && phase != GuidancePhase::Idle).then(|| PatternView {
+            disagreement: self.disagreement_view(self.drone_time_s),
+            // Before its first update under the parafoil the spiral has planned nothing: its
+            // status would put the pattern at the origin.
+            pattern: (flying
+                && plan_known
+                && phase != GuidancePhase::Idle
+                && self.guidance.spiral_has_run())
+            .then(|| PatternView {
                 corners: spiral.corners_ne_m.iter().map(|c| to_pair(*c)).collect(),
                 final_entry: to_pair(spiral.final_entry_ne_m),
                 final_course_deg: wrap_pi(spiral.final_course_rad)
@@ -241,6 +254,7 @@ impl StationCore {
         StateMsg {
             kind: "state",
             time_s: now_s,
+            mission_time_s: self.drone_time_s,
             wall_ms: self.wall_ms(now_s),
             link,
             vehicle,
@@ -253,6 +267,7 @@ impl StationCore {
             mission: MissionView {
                 stage: self.latest.status.map(|(s, _)| snake(s.stage)),
                 cutdown_armed_until_s: self.cutdown.armed_until(),
+                landing: self.landing.landing.clone(),
             },
             keep_out_alarms: self.keep_out_alarms(),
             recording: None,

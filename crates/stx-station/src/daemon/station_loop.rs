@@ -9,7 +9,9 @@
 //!   dropped;
 //! - `state` follows each burst of telemetry within [`COALESCE`], and the 4 Hz timer fills
 //!   the gaps so pages see the link go stale when nothing arrives;
-//! - landing predictions run on a blocking thread once a second.
+//! - landing predictions run on a blocking thread, one at a time, whenever the core says one is
+//!   due (once a second of the drone's clock: a rehearsal at 20× is predicted 20 times a
+//!   second of wall time, as often per second of its flight as a real one).
 
 use std::collections::VecDeque;
 use std::sync::Arc;
@@ -33,8 +35,6 @@ const TIMER_PERIOD: Duration = Duration::from_millis(100);
 /// `state` message: the drone sends its sensors in bursts, and one message per burst keeps
 /// pages current without flooding them.
 const COALESCE: Duration = Duration::from_millis(1);
-/// Landing predictions run this often, off the station loop.
-const PREDICTION_PERIOD: Duration = Duration::from_secs(1);
 /// The reachable footprint is refreshed this often under the parafoil (the issue asks for at
 /// least every 5 s; one refresh takes tens of milliseconds).
 const FOOTPRINT_PERIOD: Duration = Duration::from_secs(2);
@@ -60,7 +60,6 @@ pub(super) async fn station_loop(mut io: StationLoop) {
     let mut state_timer = tokio::time::interval(STATE_PERIOD);
     let mut stats_timer = tokio::time::interval(STATS_PERIOD);
     let mut core_timer = tokio::time::interval(TIMER_PERIOD);
-    let mut prediction_timer = tokio::time::interval(PREDICTION_PERIOD);
     let (prediction_tx, mut prediction_rx) = mpsc::channel(1);
     let mut predicting = false;
     let mut footprint_timer = tokio::time::interval(FOOTPRINT_PERIOD);
@@ -110,16 +109,6 @@ pub(super) async fn station_loop(mut io: StationLoop) {
                 predicting = false;
                 shared.core().set_prediction(prediction);
             }
-            _ = prediction_timer.tick() => {
-                let job = if predicting { None } else { shared.core().prediction_job() };
-                if let Some(job) = job {
-                    predicting = true;
-                    let tx = prediction_tx.clone();
-                    tokio::task::spawn_blocking(move || {
-                        let _ = tx.blocking_send(job.run());
-                    });
-                }
-            }
             Some(done) = footprint_rx.recv() => {
                 footprinting = false;
                 shared.core().set_footprint(done);
@@ -148,10 +137,18 @@ pub(super) async fn station_loop(mut io: StationLoop) {
             _ = io.stop.changed() => break,
         }
         let now = shared.now_s();
-        let (actions, outbound) = {
+        let (actions, outbound, prediction) = {
             let mut core = shared.core();
-            (core.take_link_actions(now), core.drain_outbound())
+            let prediction = if predicting { None } else { core.prediction_job() };
+            (core.take_link_actions(now), core.drain_outbound(), prediction)
         };
+        if let Some(job) = prediction {
+            predicting = true;
+            let tx = prediction_tx.clone();
+            tokio::task::spawn_blocking(move || {
+                let _ = tx.blocking_send(job.run());
+            });
+        }
         outgoing.extend(actions.into_iter().map(|a| apply(shared.started, a)));
         if driver_gone {
             outgoing.clear();

@@ -154,10 +154,15 @@ async fn serve_socket(state: AppState, caller: Caller, mut socket: WebSocket) {
 /// The `event` a page gets back when its message is refused (to that page only, not logged).
 fn refusal(state: &Shared, text: &str) -> Message {
     let now = state.now_s();
+    let (wall_ms, mission_time_s) = {
+        let core = state.core();
+        (core.wall_ms(now), core.mission_time_s())
+    };
     let reply = EventMsg {
         kind: "event",
         time_s: now,
-        wall_ms: state.core().wall_ms(now),
+        mission_time_s,
+        wall_ms,
         level: Level::Error,
         source: "station",
         text: text.to_string(),

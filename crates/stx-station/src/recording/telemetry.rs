@@ -11,8 +11,9 @@ use nalgebra::UnitQuaternion;
 use schemars::{JsonSchema, schema_for};
 use serde_json::Value;
 use stx_link::telemetry::{
-    Actuators, AirData, Attitude, BatteryStatus, GlobalPosition, GpsRaw, GuidanceStatus, Hud,
-    PredictedLanding, StatusText, SystemStatus, Telemetry, VehicleStatus, Wind,
+    Actuators, AirData, Attitude, BatteryStatus, GlobalPosition, GpsRaw, GpsSolution,
+    GuidanceStatus, Hud, PredictedLanding, StatusText, SystemStatus, Telemetry, VehicleStatus,
+    Wind,
 };
 use stx_record::foxglove::{
     self, FrameTransform, LocationFix, PositionCovarianceType, Quaternion, Timestamp, Vector3,
@@ -32,6 +33,7 @@ fn kinds() -> Vec<(&'static str, Value)> {
     vec![
         ("HEARTBEAT", s::<VehicleStatus>()),
         ("GPS_RAW_INT", s::<GpsRaw>()),
+        ("GPS_INPUT", s::<GpsSolution>()),
         ("GLOBAL_POSITION_INT", s::<GlobalPosition>()),
         ("ATTITUDE", s::<Attitude>()),
         ("SCALED_PRESSURE", s::<AirData>()),
@@ -98,6 +100,7 @@ fn value_json(t: &Telemetry) -> Vec<u8> {
     match t {
         Telemetry::Status(v) => compact_json(v),
         Telemetry::GpsRaw(v) => compact_json(v),
+        Telemetry::GpsSolution(v) => compact_json(v),
         Telemetry::Position(v) => compact_json(v),
         Telemetry::Attitude(v) => compact_json(v),
         Telemetry::AirData(v) => compact_json(v),

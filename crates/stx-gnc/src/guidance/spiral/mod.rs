@@ -69,6 +69,7 @@
 //! `config.rs`. Only this module holds the parts' memories together; the parts do not know
 //! the [`Spiral`].
 
+mod adopt;
 pub(super) mod config;
 mod energy;
 mod final_approach;
@@ -211,6 +212,16 @@ impl Spiral {
     /// Sets the phase without a decision (mode or plan changes).
     pub fn force_phase(&mut self, phase: GuidancePhase) {
         self.machine.phase = phase;
+    }
+
+    /// Takes `phase` from another copy of this guidance at `now_s` (see `adopt.rs`).
+    pub fn adopt_phase(&mut self, phase: GuidancePhase, now_s: f64) {
+        self.machine.adopt(phase, now_s);
+    }
+
+    /// Whether it has run since it was made: before, its status is not a plan.
+    pub fn has_run(&self) -> bool {
+        self.status != SpiralStatus::default()
     }
 
     /// The plan as it stands.

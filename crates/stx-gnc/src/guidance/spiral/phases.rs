@@ -69,21 +69,21 @@ pub(super) struct PhaseMachine {
     /// vehicle was when it ran short of height and went for the downwind leg directly.
     pub(super) downwind_y_m: Option<f64>,
     /// The downwind leg is extended past its corner until the height allows turning base.
-    extending: bool,
+    pub(super) extending: bool,
     /// The flare began while flying to the best reachable point, off the final line: it
     /// holds the heading into the wind rather than a line it may be drifting backwards on.
     pub(super) flare_off_line: bool,
     /// Time the current phase was entered, s.
-    phase_since_s: f64,
+    pub(super) phase_since_s: f64,
     /// The pattern's axis may follow the wind at the next update: in the approximation, and
     /// once at the start of each loop. Within a loop, and from the decision to leave the
     /// pattern to the ground, the axis is held: in light wind the estimated direction
     /// wanders, and every turn of the axis moves the vehicle within the pattern, upsetting
     /// decisions already taken (a base leg that never met its final line, a final turned
     /// from far out).
-    reorient: bool,
+    pub(super) reorient: bool,
     /// Loops of the pattern begun (the first at the entry corner), for the operator's log.
-    loop_number: u32,
+    pub(super) loop_number: u32,
 }
 
 impl PhaseMachine {
@@ -106,7 +106,7 @@ impl PhaseMachine {
 
     /// Where the base leg is turned (m downwind of the target) and, flown diagonally, where
     /// it meets the final line; both together, so a base leg never keeps another's join.
-    fn set_base(&mut self, x_m: Option<f64>, join_x_m: Option<f64>) {
+    pub(super) fn set_base(&mut self, x_m: Option<f64>, join_x_m: Option<f64>) {
         self.base_x_m = x_m;
         self.base_join_x_m = join_x_m;
     }
