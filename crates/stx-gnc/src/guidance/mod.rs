@@ -204,6 +204,16 @@ impl Guidance {
         self.spiral.has_run()
     }
 
+    /// The glide performance as learned in flight so far (the configured polar with the
+    /// airspeed and sink scaled at each brake setting, and the turn rate), which the spiral
+    /// plans with; the configured polar outside spiral landing.
+    pub fn learned_performance(&self) -> crate::performance::GlidePerformance {
+        match self.mode {
+            FlightMode::SpiralLanding => self.spiral.learned_performance(&self.config.performance),
+            _ => self.config.performance,
+        }
+    }
+
     /// The spiral's planning state for display (pattern, final-approach height, reach).
     pub fn spiral_status(&self) -> &SpiralStatus {
         self.spiral.status()

@@ -414,7 +414,7 @@ impl StationCore {
             guidance: self.guidance.clone(),
             performance: self.config.guidance.performance,
             ground_altitude_msl_m: self.frame.alt_msl_m,
-            wind_profile: self.wind_profile(),
+            wind_profile: if std::env::var_os("STX_NO_PROFILE").is_some() { None } else { self.wind_profile() },
             config: PredictorConfig {
                 hang_height_m: self.config.guidance.spiral.hang_height_m,
                 ..PredictorConfig::default()

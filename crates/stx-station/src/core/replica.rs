@@ -97,7 +97,10 @@ impl StationCore {
         fresh.set_mode(self.guidance.mode(), at);
         fresh.drain_events();
         self.guidance = fresh;
-        self.guided_at_s = None;
+        // The drone's first update under the parafoil is at its next control period: the
+        // replica's is with the first estimate after the one the news came with (one more
+        // update would put every sum it learns a step ahead of the drone's).
+        self.guided_at_s = self.drone_time_s;
         self.phase_sync = Default::default();
     }
 
@@ -110,11 +113,16 @@ impl StationCore {
             ..OnboardSettings::default()
         };
         for (name, p) in &self.params.values {
-            if let Some(def) = find(name) {
-                // One at a time each value is only range-checked: the rules between them are
-                // checked on the whole table below.
-                let _ = def.set(&mut settings, f64::from(p.value));
+            let Some(def) = find(name) else { continue };
+            // The wire carries f32: a value that rounds to the one in force is that value (the
+            // drone flies 0.00661, the wire says 0.0066100000403…), and taking the rounded one
+            // would make the replica's sums part from the drone's.
+            if def.get(&settings) as f32 == p.value {
+                continue;
             }
+            // One at a time each value is only range-checked: the rules between them are
+            // checked on the whole table below.
+            let _ = def.set(&mut settings, f64::from(p.value));
         }
         if let Err(e) = settings.check() {
             self.log(

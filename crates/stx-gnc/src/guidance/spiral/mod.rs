@@ -219,6 +219,14 @@ impl Spiral {
         self.machine.adopt(phase, now_s);
     }
 
+    /// The polar `perf` with the glide and turn rate learned so far.
+    pub fn learned_performance(
+        &self,
+        perf: &crate::performance::GlidePerformance,
+    ) -> crate::performance::GlidePerformance {
+        self.turn.performance(&self.glide.performance(perf))
+    }
+
     /// Whether it has run since it was made: before, its status is not a plan.
     pub fn has_run(&self) -> bool {
         self.status != SpiralStatus::default()
