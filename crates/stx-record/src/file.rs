@@ -3,41 +3,45 @@
 //!
 //! Callers write through a [`RecorderHandle`] (cheap to clone, one per producer). A message
 //! that finds the queue full is dropped and counted; so is every message of a chunk the disk
-//! refused. After a write error the file is given up (it stays readable up to its last whole
-//! chunk, and `recover` makes a clean copy) and a new file is tried every
-//! [`RecorderConfig::retry_after`], so a disk that frees up is used again. What went wrong is
-//! in [`RecorderHandle::status`] and in the log, once per kind of problem per
-//! [`RecorderConfig::log_every`].
+//! refused. What went wrong is in [`RecorderHandle::status`] and in the log, once per kind of
+//! problem per [`RecorderConfig::log_every`].
 //!
-//! Files are named by the run's start (UTC) and part number —
-//! `stx-20261105T143012Z-001.mcap`; a failed attempt uses up its number — in the directory
-//! the caller chose, by default
+//! When the disk refuses the recording (full, or any other I/O error) the writer thread
+//! (`thread`) keeps what the file holds: it cuts the file back to its last whole chunk, so it
+//! reads as a file cut there and `stx record recover` makes it whole, and closes it. A file
+//! that holds no message of the flight (the disk refused its first bytes) is removed instead,
+//! and its number used again. Nothing more is created until the next try, after
+//! [`RecorderConfig::retry_after`], doubling after each try that fails up to
+//! [`RecorderConfig::retry_max`] ([`crate::backoff`]); the messages of the meantime are
+//! counted lost. A try that succeeds resumes in the next file, not the kept one: the core has
+//! already handed out (and indexed, for the summary) the chunks the disk refused, so the kept
+//! file cannot go on as one valid MCAP file unless every refused byte were held in memory for
+//! as long as the disk stays full.
+//!
+//! Files ([`Directory`]) are named by the run's start (UTC) and number —
+//! `stx-20261105T143012Z-001.mcap` — in the directory the caller chose, by default
 //! [`recordings_dir`] of the station's state directory. Each chunk is one `write` to the OS,
 //! so a killed process leaves whole chunks behind; files are synced when they end.
 
-use std::fs::{File, OpenOptions};
-use std::io::{self, Write};
+mod directory;
+mod thread;
+
+pub use directory::{Directory, RECORDINGS_DIR_NAME, recordings_dir, run_started_ms_from_name};
+
+use std::io;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::sync::atomic::Ordering;
-use std::sync::mpsc::{self, Receiver, RecvTimeoutError, SyncSender, TrySendError};
+use std::sync::mpsc::{self, SyncSender, TrySendError};
 use std::thread::JoinHandle;
-use std::time::{Duration, Instant, SystemTime};
+use std::time::Duration;
 
 use serde::Serialize;
 
+use crate::backoff::Backoff;
 use crate::channel::ChannelId;
 use crate::status::{IssueKind, RecorderStatus, Shared};
-use crate::writer::{Output, RecorderCore};
-
-/// Name of the recordings directory inside the station's state directory.
-pub const RECORDINGS_DIR_NAME: &str = "recordings";
-
-/// Where recordings go by default: `recordings/` in the station's state directory (found
-/// like the signing timestamp's: `stx_link::signing::persist::default_state_dir`).
-pub fn recordings_dir(state_dir: &Path) -> PathBuf {
-    state_dir.join(RECORDINGS_DIR_NAME)
-}
+use crate::writer::RecorderCore;
 
 /// How the writer thread behaves.
 #[derive(Debug, Clone, PartialEq)]
@@ -45,8 +49,13 @@ pub struct RecorderConfig {
     /// Messages the queue holds before new ones are dropped. At a few hundred messages a
     /// second, the default is more than 10 s of a stalled disk.
     pub queue_capacity: usize,
-    /// After a file could not be created or written, how long before a new one is tried, s.
+    /// After a file could not be created or written, how long before the first try, s. Each
+    /// try that fails doubles the wait, up to [`RecorderConfig::retry_max`].
     pub retry_after: Duration,
+    /// The longest wait between tries, s. The default, 2 min, uses space freed during a long
+    /// outage within 2 minutes; the tries before it (5, 10, 20, 40, 80 s) use space that
+    /// frees soon, sooner. Each try that fails leaves nothing behind.
+    pub retry_max: Duration,
     /// A kind of problem is logged at most once per this interval, s (it is always counted).
     pub log_every: Duration,
 }
@@ -56,6 +65,7 @@ impl Default for RecorderConfig {
         Self {
             queue_capacity: 8192,
             retry_after: Duration::from_secs(5),
+            retry_max: Duration::from_secs(120),
             log_every: Duration::from_secs(60),
         }
     }
@@ -66,107 +76,19 @@ impl Default for RecorderConfig {
 pub trait Storage: Send + 'static {
     /// Creates file `part` (from 1) of the run; returns its path and the file.
     fn create(&mut self, part: u32) -> io::Result<(PathBuf, Box<dyn StorageFile>)>;
+    /// Removes a file it created, closed (one that holds no message of the flight).
+    fn remove(&mut self, path: &Path) -> io::Result<()>;
 }
 
 /// One file being written.
 pub trait StorageFile: Send {
     /// Appends `data`.
     fn write_all(&mut self, data: &[u8]) -> io::Result<()>;
+    /// Cuts the file back to its first `len` bytes: after a write the disk refused, which
+    /// may have left part of its data.
+    fn truncate(&mut self, len: u64) -> io::Result<()>;
     /// Makes what was written durable (the file is finished).
     fn sync(&mut self) -> io::Result<()>;
-}
-
-impl StorageFile for File {
-    fn write_all(&mut self, data: &[u8]) -> io::Result<()> {
-        Write::write_all(self, data)
-    }
-
-    fn sync(&mut self) -> io::Result<()> {
-        self.sync_data()
-    }
-}
-
-/// Recording files in a directory (created when the first file is).
-#[derive(Debug, Clone)]
-pub struct Directory {
-    dir: PathBuf,
-    run_stamp: String,
-}
-
-impl Directory {
-    /// Files in `dir` for a run started at `run_started` (wall clock, names the files).
-    pub fn new(dir: impl Into<PathBuf>, run_started: SystemTime) -> Self {
-        let t = time::OffsetDateTime::from(run_started);
-        Self {
-            dir: dir.into(),
-            run_stamp: format!(
-                "{:04}{:02}{:02}T{:02}{:02}{:02}Z",
-                t.year(),
-                u8::from(t.month()),
-                t.day(),
-                t.hour(),
-                t.minute(),
-                t.second()
-            ),
-        }
-    }
-
-    /// The name of file `part` (`stx-20261105T143012Z-001.mcap`).
-    pub fn file_name(&self, part: u32) -> String {
-        format!("stx-{}-{part:03}.mcap", self.run_stamp)
-    }
-}
-
-/// When the run that wrote the file `name` started, as its name says (the names
-/// [`Directory::file_name`] gives), Unix milliseconds; `None` for any other name. A file
-/// just begun holds no message yet that could say so.
-pub fn run_started_ms_from_name(name: &str) -> Option<u64> {
-    let stamp = name.strip_prefix("stx-")?.get(..16)?;
-    let digits = |range: std::ops::Range<usize>| stamp.get(range)?.parse::<u32>().ok();
-    if stamp.as_bytes().get(8) != Some(&b'T') || stamp.as_bytes().get(15) != Some(&b'Z') {
-        return None;
-    }
-    let month = time::Month::try_from(u8::try_from(digits(4..6)?).ok()?).ok()?;
-    let date = time::Date::from_calendar_date(
-        i32::try_from(digits(0..4)?).ok()?,
-        month,
-        u8::try_from(digits(6..8)?).ok()?,
-    )
-    .ok()?;
-    let at = date
-        .with_hms(
-            u8::try_from(digits(9..11)?).ok()?,
-            u8::try_from(digits(11..13)?).ok()?,
-            u8::try_from(digits(13..15)?).ok()?,
-        )
-        .ok()?
-        .assume_utc();
-    u64::try_from(at.unix_timestamp()).ok().map(|s| s * 1000)
-}
-
-impl Storage for Directory {
-    fn create(&mut self, part: u32) -> io::Result<(PathBuf, Box<dyn StorageFile>)> {
-        std::fs::create_dir_all(&self.dir)?;
-        let base = self.file_name(part);
-        // Two runs started within the same second: never overwrite, add a counter.
-        for attempt in 0..100 {
-            let name = if attempt == 0 {
-                base.clone()
-            } else {
-                base.replace(".mcap", &format!("-{attempt}.mcap"))
-            };
-            let path = self.dir.join(name);
-            match OpenOptions::new().write(true).create_new(true).open(&path) {
-                Ok(file) => return Ok((path, Box::new(file))),
-                Err(e) if e.kind() == io::ErrorKind::AlreadyExists => continue,
-                Err(e) => return Err(e),
-            }
-        }
-        Err(io::Error::new(
-            io::ErrorKind::AlreadyExists,
-            format!("{base}: 100 files of that name exist"),
-        ))
-    }
 }
 
 /// Messages made on the writer's thread: see [`RecorderHandle::write_later`].
@@ -318,14 +240,8 @@ impl Recorder {
     ) -> io::Result<Self> {
         let (tx, rx) = mpsc::sync_channel(config.queue_capacity.max(1));
         let shared = Arc::new(Shared::new(config.log_every));
-        let writer = Writer {
-            core,
-            storage: Box::new(storage),
-            file: FileState::Closed,
-            shared: shared.clone(),
-            retry_after: config.retry_after,
-            origin: Instant::now(),
-        };
+        let backoff = Backoff::new(config.retry_after, config.retry_max);
+        let writer = thread::Writer::new(core, Box::new(storage), shared.clone(), backoff);
         let thread = std::thread::Builder::new()
             .name("stx-record".into())
             .spawn(move || writer.run(rx))?;
@@ -371,195 +287,5 @@ impl Recorder {
 impl Drop for Recorder {
     fn drop(&mut self) {
         self.stop();
-    }
-}
-
-enum FileState {
-    Closed,
-    Open(Box<dyn StorageFile>),
-    /// Given up at `since` (adapter clock); a new file is tried after `retry_after`.
-    Broken {
-        since: Duration,
-    },
-}
-
-struct Writer {
-    core: RecorderCore,
-    storage: Box<dyn Storage>,
-    file: FileState,
-    shared: Arc<Shared>,
-    retry_after: Duration,
-    origin: Instant,
-}
-
-impl Writer {
-    fn now(&self) -> Duration {
-        self.origin.elapsed()
-    }
-
-    fn run(mut self, rx: Receiver<Command>) {
-        loop {
-            self.apply_outputs();
-            self.retry_if_due();
-            let now = self.now();
-            let wait = match self.core.poll_timeout() {
-                Some(deadline) => deadline.saturating_sub(now),
-                None => self.retry_after,
-            };
-            let received = rx.recv_timeout(wait);
-            if matches!(
-                received,
-                Ok(Command::Message { .. } | Command::Encode { .. })
-            ) {
-                self.shared.queued.fetch_sub(1, Ordering::Relaxed);
-            }
-            match received {
-                Ok(Command::Message {
-                    channel,
-                    log_time,
-                    publish_time,
-                    payload,
-                }) => self.write(channel, log_time, publish_time, &payload),
-                Ok(Command::Encode {
-                    log_time,
-                    publish_time,
-                    encode,
-                }) => {
-                    for (channel, payload) in encode() {
-                        self.write(channel, log_time, publish_time, &payload);
-                    }
-                }
-                Ok(Command::Flush(ack)) => {
-                    let now = self.now();
-                    if let Err(e) = self.core.flush(now) {
-                        self.shared.report(IssueKind::Core, e.to_string());
-                    }
-                    self.apply_outputs();
-                    let _ = ack.send(());
-                }
-                Ok(Command::Finish) | Err(RecvTimeoutError::Disconnected) => {
-                    // Messages other handles queued after the finish will not be written.
-                    let late = rx
-                        .try_iter()
-                        .filter(|c| matches!(c, Command::Message { .. } | Command::Encode { .. }))
-                        .count();
-                    self.shared.lost(late as u64);
-                    break;
-                }
-                Err(RecvTimeoutError::Timeout) => {
-                    let now = self.now();
-                    if let Err(e) = self.core.handle_timeout(now) {
-                        self.shared.report(IssueKind::Core, e.to_string());
-                    }
-                }
-            }
-        }
-        if let Err(e) = self.core.finish() {
-            self.shared.report(IssueKind::Core, e.to_string());
-        }
-        self.apply_outputs();
-    }
-
-    fn write(&mut self, channel: ChannelId, log_time: u64, publish_time: u64, payload: &[u8]) {
-        let now = self.now();
-        if let Err(e) = self
-            .core
-            .write(now, channel, log_time, publish_time, payload)
-        {
-            self.shared.lost(1);
-            self.shared.report(IssueKind::Core, e.to_string());
-            if matches!(e, crate::writer::WriteError::Mcap(_)) {
-                let _ = self.core.start_new_file(now);
-            }
-        }
-    }
-
-    fn retry_if_due(&mut self) {
-        let now = self.now();
-        if let FileState::Broken { since } = self.file
-            && now.saturating_sub(since) >= self.retry_after
-        {
-            if let Err(e) = self.core.start_new_file(now) {
-                self.shared.report(IssueKind::Core, e.to_string());
-            }
-            self.apply_outputs();
-        }
-    }
-
-    fn apply_outputs(&mut self) {
-        while let Some(output) = self.core.poll_output() {
-            match output {
-                Output::StartFile { part } => self.open(part),
-                Output::Bytes { data, messages } => self.append(&data, messages),
-                Output::EndFile => self.close(),
-                Output::Lost { messages } => self.shared.lost(messages),
-            }
-        }
-    }
-
-    fn open(&mut self, part: u32) {
-        self.close();
-        match self.storage.create(part) {
-            Ok((path, file)) => {
-                self.shared.file_opened(path);
-                self.file = FileState::Open(file);
-            }
-            Err(e) => {
-                self.shared.report(
-                    IssueKind::Create,
-                    format!("cannot create recording file {part}: {e}"),
-                );
-                self.file = FileState::Broken { since: self.now() };
-            }
-        }
-    }
-
-    fn append(&mut self, data: &[u8], messages: u64) {
-        let FileState::Open(file) = &mut self.file else {
-            self.shared.lost(messages);
-            return;
-        };
-        match file.write_all(data) {
-            Ok(()) => self.shared.written(data.len() as u64, messages),
-            Err(e) => {
-                self.shared.lost(messages);
-                self.shared
-                    .report(IssueKind::Write, format!("writing the recording: {e}"));
-                self.shared.file_closed();
-                self.file = FileState::Broken { since: self.now() };
-            }
-        }
-    }
-
-    fn close(&mut self) {
-        if let FileState::Open(file) = &mut self.file {
-            if let Err(e) = file.sync() {
-                self.shared
-                    .report(IssueKind::Sync, format!("syncing the recording: {e}"));
-            }
-            self.shared.file_closed();
-            self.file = FileState::Closed;
-        }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn a_file_name_says_when_its_run_started() {
-        let started = SystemTime::UNIX_EPOCH + Duration::from_secs(1_795_000_212);
-        let name = Directory::new("/tmp", started).file_name(2);
-        assert_eq!(run_started_ms_from_name(&name), Some(1_795_000_212_000));
-        let counted = name.replace(".mcap", "-1.mcap");
-        assert_eq!(run_started_ms_from_name(&counted), Some(1_795_000_212_000));
-        for other in [
-            "flight.mcap",
-            "stx-2026.mcap",
-            "stx-20261399T000000Z-001.mcap",
-        ] {
-            assert_eq!(run_started_ms_from_name(other), None, "{other}");
-        }
     }
 }

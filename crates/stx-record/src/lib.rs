@@ -14,8 +14,10 @@
 //!   about a second), files rotate at a size or duration.
 //! - Writing, to disk. [`Recorder`] ([`file`](mod@file)) runs a core on its own thread fed by a
 //!   bounded queue that never blocks the caller; what it could not write is counted and
-//!   reported ([`status`]). Files go to [`file::recordings_dir`] of the station's state
-//!   directory unless the station says otherwise.
+//!   reported ([`status`]). A disk that refuses the recording is tried again after waits
+//!   that double ([`backoff`]), keeping what was written and leaving no empty files. Files go
+//!   to [`file::recordings_dir`] of the station's state directory unless the station says
+//!   otherwise.
 //! - Reading. [`Recording`] ([`read`]) lists channels, counts, time range and metadata from
 //!   the file's summary (or, for a file cut before its summary, from one scan of it —
 //!   `read::scan`) and iterates messages in log-time order from any time through the chunk
@@ -25,6 +27,7 @@
 //!
 //! No tokio: the core is plain data; the file adapter uses a thread and a std channel.
 
+pub mod backoff;
 pub mod channel;
 pub mod export;
 pub mod file;
@@ -43,5 +46,5 @@ pub use frame::{Direction, MavlinkFrame};
 pub use info::{Named, RecordingInfo};
 pub use read::{ChannelInfo, IndexSource, ReadError, RecordedMessage, Recording};
 pub use recover::{RecoverError, RecoverReport, recover, recover_file};
-pub use status::{IssueKind, RecorderIssue, RecorderStatus};
+pub use status::{Failing, IssueKind, RecorderIssue, RecorderStatus, Resumed};
 pub use writer::{Compression, CoreOptions, CoreStats, Output, RecorderCore, WriteError};

@@ -1,6 +1,8 @@
-//! What the file adapter tells its caller: bytes and messages written, messages lost, and
-//! the last problem — polled by the station for its dashboard, and logged once per kind of
-//! problem per interval so a full disk does not flood the log.
+//! What the file adapter tells its caller: bytes and messages written, messages lost, the
+//! last problem, and while the disk fails the recording since when and when it is tried
+//! again (then, once it works again, when it resumed) — polled by the station for its
+//! dashboard, and logged once per kind of problem per interval so a full disk does not
+//! flood the log.
 
 use std::collections::HashMap;
 use std::path::PathBuf;
@@ -41,6 +43,31 @@ pub struct RecorderIssue {
     pub occurrences: u64,
 }
 
+/// Writing has been failing (a file could not be created or written): nothing is recorded
+/// until a try succeeds. Times are from the snapshot.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub struct Failing {
+    /// How long it has been failing, s.
+    pub duration: Duration,
+    /// When the next try is, from now, s (zero: under way).
+    pub next_try_in: Duration,
+    /// Tries that failed, the first failure included.
+    pub failed_tries: u32,
+    /// Messages lost since it began.
+    pub messages_lost: u64,
+}
+
+/// The last time writing worked again after failing. Times are from the snapshot.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub struct Resumed {
+    /// How long ago, s.
+    pub ago: Duration,
+    /// How long it had been failing, s.
+    pub after: Duration,
+    /// Messages lost while it was failing.
+    pub messages_lost: u64,
+}
+
 /// A snapshot of a recorder's state.
 #[derive(Debug, Clone, Default, PartialEq, Eq, Serialize)]
 pub struct RecorderStatus {
@@ -50,12 +77,31 @@ pub struct RecorderStatus {
     pub messages_written: u64,
     /// Messages dropped: queue full, writer stopped, or their chunk could not be written.
     pub messages_lost: u64,
-    /// Files opened.
+    /// Files started and kept (a file removed for holding no message is not counted).
     pub files_started: u32,
     /// The file being written, if one is open.
     pub current_file: Option<PathBuf>,
     /// The most recent problem, if any.
     pub last_error: Option<RecorderIssue>,
+    /// While writing fails: since when, and the next try.
+    pub failing: Option<Failing>,
+    /// When writing last worked again after failing.
+    pub resumed: Option<Resumed>,
+}
+
+/// An outage as the writer thread reports it.
+struct Outage {
+    since: Instant,
+    next_try: Instant,
+    failed_tries: u32,
+    /// `messages_lost` when it began.
+    lost_before: u64,
+}
+
+struct ResumedAt {
+    at: Instant,
+    after: Duration,
+    messages_lost: u64,
 }
 
 #[derive(Default)]
@@ -65,6 +111,8 @@ struct Issues {
     occurrences: HashMap<IssueKind, u64>,
     /// When each kind was last logged, and how many were not logged since.
     logged: HashMap<IssueKind, (Instant, u64)>,
+    failing: Option<Outage>,
+    resumed: Option<ResumedAt>,
 }
 
 /// Counters shared by the caller's handles and the writer thread.
@@ -114,12 +162,49 @@ impl Shared {
 
     pub(crate) fn file_opened(&self, path: PathBuf) {
         self.files_started.fetch_add(1, Ordering::Relaxed);
-        tracing::info!(file = %path.display(), "recording to a new file");
         self.issues().current_file = Some(path);
     }
 
     pub(crate) fn file_closed(&self) {
         self.issues().current_file = None;
+    }
+
+    /// The file just closed was removed: its `bytes` (written, but of no message) and the
+    /// file itself no longer count.
+    pub(crate) fn file_removed(&self, bytes: u64) {
+        self.files_started.fetch_sub(1, Ordering::Relaxed);
+        self.bytes_written.fetch_sub(bytes, Ordering::Relaxed);
+        self.file_closed();
+    }
+
+    /// Writing failed (again): it has been failing since `since`, and is tried next at
+    /// `next_try`.
+    pub(crate) fn failing(&self, since: Instant, next_try: Instant, failed_tries: u32) {
+        let lost = self.messages_lost.load(Ordering::Relaxed);
+        let mut issues = self.issues();
+        let lost_before = issues.failing.as_ref().map_or(lost, |o| o.lost_before);
+        issues.failing = Some(Outage {
+            since,
+            next_try,
+            failed_tries,
+            lost_before,
+        });
+    }
+
+    /// Writing works again at `at`: returns the messages lost while it failed.
+    pub(crate) fn resumed(&self, at: Instant) -> u64 {
+        let lost = self.messages_lost.load(Ordering::Relaxed);
+        let mut issues = self.issues();
+        let Some(outage) = issues.failing.take() else {
+            return 0;
+        };
+        let messages_lost = lost.saturating_sub(outage.lost_before);
+        issues.resumed = Some(ResumedAt {
+            at,
+            after: at.saturating_duration_since(outage.since),
+            messages_lost,
+        });
+        messages_lost
     }
 
     /// A message dropped because the writer's queue is full: counted at once, reported (the
@@ -210,13 +295,26 @@ impl Shared {
         {
             last.occurrences += self.queue_full_pending.load(Ordering::Relaxed);
         }
+        let now = Instant::now();
+        let messages_lost = self.messages_lost.load(Ordering::Relaxed);
         RecorderStatus {
             bytes_written: self.bytes_written.load(Ordering::Relaxed),
             messages_written: self.messages_written.load(Ordering::Relaxed),
-            messages_lost: self.messages_lost.load(Ordering::Relaxed),
+            messages_lost,
             files_started: self.files_started.load(Ordering::Relaxed),
             current_file: issues.current_file.clone(),
             last_error,
+            failing: issues.failing.as_ref().map(|o| Failing {
+                duration: now.saturating_duration_since(o.since),
+                next_try_in: o.next_try.saturating_duration_since(now),
+                failed_tries: o.failed_tries,
+                messages_lost: messages_lost.saturating_sub(o.lost_before),
+            }),
+            resumed: issues.resumed.as_ref().map(|r| Resumed {
+                ago: now.saturating_duration_since(r.at),
+                after: r.after,
+                messages_lost: r.messages_lost,
+            }),
         }
     }
 

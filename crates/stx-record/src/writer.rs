@@ -171,7 +171,7 @@ pub struct CoreStats {
     pub messages: u64,
     /// Chunks closed.
     pub chunks: u64,
-    /// Files started.
+    /// Files started (a file started again under its number counts again).
     pub files: u32,
 }
 
@@ -320,6 +320,19 @@ impl RecorderCore {
         }
         // A writer that failed cannot write its summary; the file is given up either way.
         let ended = self.end_file();
+        self.start_file(now)?;
+        ended
+    }
+
+    /// Ends the current file and starts it again under the same number: what the adapter asks
+    /// for when it removed what it had of the file (it held no message, e.g. a full disk
+    /// refused its first bytes), so the run's file numbers keep no gap.
+    pub fn restart_file(&mut self, now: Duration) -> Result<(), WriteError> {
+        if self.writer.is_none() {
+            return Err(WriteError::Finished);
+        }
+        let ended = self.end_file();
+        self.part = self.part.saturating_sub(1);
         self.start_file(now)?;
         ended
     }

@@ -365,8 +365,21 @@ pub struct RecordingView {
     pub messages_written: u64,
     /// Messages that could not be written (queue full, disk full, unwritable).
     pub messages_lost: u64,
-    /// The last problem, if any.
+    /// The last problem, if any (it stays after recording resumes: see `resumed_ms`).
     pub problem: Option<String>,
+    /// While the disk refuses the recording: when it began, Unix ms.
+    pub failing_since_ms: Option<u64>,
+    /// While the disk refuses the recording: seconds until the next try (0: under way). The
+    /// wait doubles after each failed try, from 5 s up to 2 min.
+    pub next_try_in_s: Option<f64>,
+    /// While the disk refuses the recording: tries that failed, the first failure included;
+    /// 0 otherwise.
+    pub failed_tries: u32,
+    /// When recording last resumed after the disk refused it, Unix ms; `null` if it never
+    /// did.
+    pub resumed_ms: Option<u64>,
+    /// How long the disk had refused the recording before it resumed, s.
+    pub resumed_after_s: Option<f64>,
 }
 
 /// Event levels.

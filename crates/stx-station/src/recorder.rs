@@ -1,7 +1,8 @@
 //! The daemon's recording (an adapter: a thread and files): starts stx-record's writer thread on the station's channels
 //! (`crate::recording`), and feeds it what the station loop and the link driver see. Never
 //! blocks the station: a message the writer cannot take is dropped and counted, and the
-//! dashboard's `state.recording` says so.
+//! dashboard's `state.recording` says so — while the disk refuses the recording, since when
+//! and when it is tried next, and once it resumes, when.
 
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -10,7 +11,7 @@ use std::time::{Duration, Instant, SystemTime};
 use stx_record::frame::mavlink_frame_channel;
 use stx_record::{
     ChannelId, CoreOptions, Direction, Directory, MavlinkFrame, Recorder, RecorderConfig,
-    RecorderCore, RecorderHandle, RecordingInfo,
+    RecorderCore, RecorderHandle, RecorderStatus, RecordingInfo,
 };
 
 use crate::config::StationConfig;
@@ -151,37 +152,9 @@ impl Recording {
     /// What the dashboard shows.
     pub fn view(&self) -> RecordingView {
         match self {
-            Self::Off => RecordingView {
-                state: RecordingState::Off,
-                file: None,
-                bytes_written: 0,
-                messages_written: 0,
-                messages_lost: 0,
-                problem: None,
-            },
-            Self::Unavailable(why) => RecordingView {
-                state: RecordingState::Failing,
-                file: None,
-                bytes_written: 0,
-                messages_written: 0,
-                messages_lost: 0,
-                problem: Some(why.clone()),
-            },
-            Self::On(r) => {
-                let s = r.handle.status();
-                RecordingView {
-                    state: if s.current_file.is_some() {
-                        RecordingState::On
-                    } else {
-                        RecordingState::Failing
-                    },
-                    file: s.current_file.map(|p| p.display().to_string()),
-                    bytes_written: s.bytes_written,
-                    messages_written: s.messages_written,
-                    messages_lost: s.messages_lost,
-                    problem: s.last_error.map(|e| e.message),
-                }
-            }
+            Self::Off => not_recording(RecordingState::Off, None),
+            Self::Unavailable(why) => not_recording(RecordingState::Failing, Some(why.clone())),
+            Self::On(r) => view(&r.handle.status(), r.now_unix()),
         }
     }
 
@@ -254,6 +227,53 @@ impl StationRecorder {
     fn now_ns(&self) -> u64 {
         now_ns(self.started, self.wall_origin_ms)
     }
+
+    /// Unix time now on the mission clock.
+    fn now_unix(&self) -> Duration {
+        Duration::from_millis(self.wall_origin_ms) + self.started.elapsed()
+    }
+}
+
+/// A recording that writes nothing, and has no writer to say more.
+fn not_recording(state: RecordingState, problem: Option<String>) -> RecordingView {
+    RecordingView {
+        state,
+        file: None,
+        bytes_written: 0,
+        messages_written: 0,
+        messages_lost: 0,
+        problem,
+        failing_since_ms: None,
+        next_try_in_s: None,
+        failed_tries: 0,
+        resumed_ms: None,
+        resumed_after_s: None,
+    }
+}
+
+/// The writer's status as the dashboard shows it, at Unix time `now`. Failing while the
+/// disk refuses the recording, even while a try has a file open: the outage ends when a
+/// message reaches the disk.
+fn view(s: &RecorderStatus, now: Duration) -> RecordingView {
+    // In whole ns until the end, so a time an outage began reads the same in every state.
+    let ago_ms = |d: Duration| now.saturating_sub(d).as_millis() as u64;
+    RecordingView {
+        state: if s.failing.is_some() || s.current_file.is_none() {
+            RecordingState::Failing
+        } else {
+            RecordingState::On
+        },
+        file: s.current_file.as_ref().map(|p| p.display().to_string()),
+        bytes_written: s.bytes_written,
+        messages_written: s.messages_written,
+        messages_lost: s.messages_lost,
+        problem: s.last_error.as_ref().map(|e| e.message.clone()),
+        failing_since_ms: s.failing.map(|f| ago_ms(f.duration)),
+        next_try_in_s: s.failing.map(|f| f.next_try_in.as_secs_f64()),
+        failed_tries: s.failing.map_or(0, |f| f.failed_tries),
+        resumed_ms: s.resumed.map(|r| ago_ms(r.ago)),
+        resumed_after_s: s.resumed.map(|r| r.after.as_secs_f64()),
+    }
 }
 
 /// Unix time now on the mission clock, ns, in whole milliseconds: the resolution of
@@ -288,5 +308,57 @@ impl FrameTap for Tap {
         self.handle.write_later(t, t, move || {
             vec![(frames, MavlinkFrame::encode(direction, radio, t, &bytes))]
         });
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use stx_record::{Failing, Resumed};
+
+    const NOW_MS: u64 = 1_795_000_000_000;
+    const NOW: Duration = Duration::from_millis(NOW_MS);
+
+    #[test]
+    fn a_refused_disk_shows_failing_since_when_and_the_next_try_even_with_a_try_open() {
+        let status = RecorderStatus {
+            messages_lost: 700,
+            // A try has a file open, but no message has reached it yet.
+            current_file: Some("/rec/stx-20261129T064226Z-002.mcap".into()),
+            failing: Some(Failing {
+                duration: Duration::from_millis(75_500),
+                next_try_in: Duration::from_millis(12_250),
+                failed_tries: 4,
+                messages_lost: 650,
+            }),
+            ..RecorderStatus::default()
+        };
+        let v = view(&status, NOW);
+        assert_eq!(v.state, RecordingState::Failing);
+        assert_eq!(v.failing_since_ms, Some(NOW_MS - 75_500));
+        assert_eq!(v.next_try_in_s, Some(12.25));
+        assert_eq!((v.failed_tries, v.messages_lost), (4, 700));
+        assert_eq!((v.resumed_ms, v.resumed_after_s), (None, None));
+    }
+
+    #[test]
+    fn a_resumed_recording_is_on_and_says_when_it_resumed() {
+        let status = RecorderStatus {
+            current_file: Some("/rec/stx-20261129T064226Z-002.mcap".into()),
+            resumed: Some(Resumed {
+                ago: Duration::from_secs(30),
+                after: Duration::from_millis(95_000),
+                messages_lost: 650,
+            }),
+            ..RecorderStatus::default()
+        };
+        let v = view(&status, NOW);
+        assert_eq!(v.state, RecordingState::On);
+        assert_eq!(v.resumed_ms, Some(NOW_MS - 30_000));
+        assert_eq!(v.resumed_after_s, Some(95.0));
+        assert_eq!(
+            (v.failing_since_ms, v.next_try_in_s, v.failed_tries),
+            (None, None, 0)
+        );
     }
 }

@@ -1,9 +1,10 @@
 //! The station's recording through the real daemon (`stx serve --sim`): killed with SIGKILL
 //! mid-flight, its file still reads up to about a second before the kill and `stx record
 //! recover` makes it whole; stopped cleanly, the file is whole and holds every channel of a
-//! flight; given a directory it cannot write, the station keeps flying and says so; `stx
-//! replay` refuses what it cannot play. (Replay itself is driven from a browser:
-//! tests/browser/live.mjs.)
+//! flight; given a directory it cannot write, the station keeps flying and says so; on a
+//! full disk (a tmpfs filled up) it leaves no empty files, says since when and the next try,
+//! and resumes when space returns; `stx replay` refuses what it cannot play. (Replay itself
+//! is driven from a browser: tests/browser/live.mjs.)
 
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
@@ -350,6 +351,124 @@ fn an_unwritable_directory_leaves_the_station_flying_and_saying_so() {
     let later = wait_for(&d, 30.0, |s| s["time_s"].as_f64() > Some(t0 + 2.0));
     assert!(later["estimate"].is_object());
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A small tmpfs mounted for a test, unmounted when it ends (declare it before the daemon
+/// writing to it, so the daemon stops first). Mounting needs root, as CI runs; without it the
+/// test fails and says so: it is never skipped.
+struct Tmpfs {
+    dir: PathBuf,
+}
+
+impl Tmpfs {
+    fn mount(name: &str, size: &str) -> Self {
+        let dir = temp_dir(name);
+        let out = Command::new("mount")
+            .args(["-t", "tmpfs", "-o", &format!("size={size}"), "tmpfs"])
+            .arg(&dir)
+            .output()
+            .expect("mount runs");
+        assert!(
+            out.status.success(),
+            "this test mounts a tmpfs to fill it up, which needs root: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        Self { dir }
+    }
+
+    /// Fills the file system with one file, `filler`, until the disk refuses.
+    fn fill(&self) -> PathBuf {
+        use std::io::Write;
+        let path = self.dir.join("filler");
+        let mut f = std::fs::File::create(&path).expect("filler");
+        let block = vec![0u8; 64 * 1024];
+        let err = loop {
+            if let Err(e) = f.write_all(&block) {
+                break e;
+            }
+        };
+        assert_eq!(err.kind(), std::io::ErrorKind::StorageFull, "{err}");
+        path
+    }
+}
+
+impl Drop for Tmpfs {
+    fn drop(&mut self) {
+        let _ = Command::new("umount").arg("-l").arg(&self.dir).status();
+        let _ = std::fs::remove_dir_all(&self.dir);
+    }
+}
+
+fn mcap_files(dir: &Path) -> Vec<PathBuf> {
+    std::fs::read_dir(dir)
+        .map(|entries| {
+            entries
+                .filter_map(|e| e.ok().map(|e| e.path()))
+                .filter(|p| p.extension().is_some_and(|x| x == "mcap"))
+                .collect()
+        })
+        .unwrap_or_default()
+}
+
+#[test]
+fn a_full_disk_leaves_no_empty_files_says_when_it_tries_again_and_resumes_when_space_returns() {
+    let fs = Tmpfs::mount("full-disk", "1m");
+    let filler = fs.fill();
+    let dir = fs.dir.join("recordings");
+    let d = serve(&dir);
+    // Tries at 5 and 15 s after the first failure: none leaves a file behind.
+    let s = wait_for(&d, 60.0, |s| {
+        s["estimate"].is_object() && s["recording"]["failed_tries"].as_u64() >= Some(2)
+    });
+    let rec = &s["recording"];
+    assert_eq!(rec["state"], "failing", "{rec}");
+    assert!(
+        rec["problem"]
+            .as_str()
+            .is_some_and(|p| p.contains("No space left")),
+        "{rec}"
+    );
+    let since = rec["failing_since_ms"].as_u64().expect("since when");
+    let wall = s["wall_ms"].as_u64().expect("wall");
+    assert!(since <= wall && wall - since < 60_000, "{rec}");
+    let next = rec["next_try_in_s"].as_f64().expect("the next try");
+    assert!(
+        (0.0..=20.0).contains(&next),
+        "the third try 20 s after the second: {rec}"
+    );
+    assert!(rec["messages_lost"].as_u64() > Some(0), "{rec}");
+    assert_eq!(
+        mcap_files(&dir),
+        Vec::<PathBuf>::new(),
+        "no file of a failed try"
+    );
+    // Space returns: the next try resumes, and the station says when.
+    std::fs::remove_file(&filler).expect("space freed");
+    let s = wait_for(&d, 60.0, |s| s["recording"]["state"] == "on");
+    let rec = &s["recording"];
+    assert!(
+        rec["resumed_ms"].as_u64().is_some_and(|r| r > since),
+        "{rec}"
+    );
+    assert!(rec["resumed_after_s"].as_f64() >= Some(14.0), "{rec}");
+    assert!(
+        rec["failing_since_ms"].is_null() && rec["next_try_in_s"].is_null(),
+        "{rec}"
+    );
+    // The run's one file, file 1, holds the flight from the resumption on.
+    let written = rec["messages_written"].as_u64().expect("written");
+    wait_for(&d, 30.0, |s| {
+        s["recording"]["messages_written"].as_u64() > Some(written + 100)
+    });
+    let file = only_file(&dir);
+    assert!(
+        file.to_string_lossy().ends_with("-001.mcap"),
+        "{}",
+        file.display()
+    );
+    let rec = Recording::open(&file).expect("the file reads");
+    assert!(rec.message_count() > 100, "{}", rec.message_count());
+    drop(d);
 }
 
 #[test]

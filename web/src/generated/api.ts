@@ -1255,6 +1255,15 @@ export interface RecordingView {
    */
   bytes_written: number;
   /**
+   * While the disk refuses the recording: tries that failed, the first failure included;
+   * 0 otherwise.
+   */
+  failed_tries: number;
+  /**
+   * While the disk refuses the recording: when it began, Unix ms.
+   */
+  failing_since_ms: number | null;
+  /**
    * The file being written.
    */
   file: string | null;
@@ -1267,9 +1276,23 @@ export interface RecordingView {
    */
   messages_written: number;
   /**
-   * The last problem, if any.
+   * While the disk refuses the recording: seconds until the next try (0: under way). The
+   * wait doubles after each failed try, from 5 s up to 2 min.
+   */
+  next_try_in_s: number | null;
+  /**
+   * The last problem, if any (it stays after recording resumes: see `resumed_ms`).
    */
   problem: string | null;
+  /**
+   * How long the disk had refused the recording before it resumed, s.
+   */
+  resumed_after_s: number | null;
+  /**
+   * When recording last resumed after the disk refused it, Unix ms; `null` if it never
+   * did.
+   */
+  resumed_ms: number | null;
   /**
    * Recording, off, or failing.
    */

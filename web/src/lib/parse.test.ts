@@ -35,7 +35,7 @@ const STATE = {
   mission: { stage: "parafoil", cutdown_armed_until_s: null },
   flight_path: null,
   keep_out_alarms: [{ prediction: "uncontrolled", zone: "Pond", since_s: 790.5 }],
-  recording: { state: "on", file: "/var/lib/stx/recordings/stx-20261124T100000Z-001.mcap", bytes_written: 1200000, messages_written: 9000, messages_lost: 0, problem: null },
+  recording: { state: "on", file: "/var/lib/stx/recordings/stx-20261124T100000Z-001.mcap", bytes_written: 1200000, messages_written: 9000, messages_lost: 0, problem: null, failing_since_ms: null, next_try_in_s: null, failed_tries: 0, resumed_ms: null, resumed_after_s: null },
   replay: null,
 };
 const SESSION = {

@@ -469,6 +469,11 @@ function parseRecording(o: Obj): Recording | null {
     messages_written: num(o, "messages_written"),
     messages_lost: num(o, "messages_lost"),
     problem: str(o, "problem"),
+    failing_since_ms: num(o, "failing_since_ms"),
+    next_try_in_s: num(o, "next_try_in_s"),
+    failed_tries: num(o, "failed_tries"),
+    resumed_ms: num(o, "resumed_ms"),
+    resumed_after_s: num(o, "resumed_after_s"),
   };
 }
 

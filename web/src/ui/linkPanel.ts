@@ -1,9 +1,11 @@
 // Link quality: rate, loss, age of the last message, error counters (the station's and this
 // page's own count of malformed WebSocket messages), each radio's own figures when the station
-// holds more than one, and per-message ages in a details popover.
+// holds more than one, and per-message ages in a details popover. Also the station's recording:
+// a readout, and below it, while the disk refuses the recording, the problem, since when and the
+// next try (then, once it resumes, when).
 
 import { h, panel, readout, setText } from "./dom";
-import { fmt } from "../lib/format";
+import { fmt, fmtDuration, fmtWallUtc } from "../lib/format";
 import { messageAges, type StaleVerdict } from "../lib/staleness";
 import type { MessageStats } from "../lib/parse";
 import type { Link, Radio, Recording } from "../lib/types";
@@ -17,6 +19,7 @@ export class LinkPanel {
   private readonly bad: HTMLElement;
   private readonly state: HTMLElement;
   private readonly rec: HTMLElement;
+  private readonly recDetail: HTMLElement;
   private readonly agesBody: HTMLTableSectionElement;
   private readonly radiosTable: HTMLTableElement;
   private readonly radiosBody: HTMLTableSectionElement;
@@ -30,6 +33,7 @@ export class LinkPanel {
     const st = readout("Link", "link-state");
     const rec = readout("Recording", "recording-state", "the station's MCAP recording of this run");
     [this.rate, this.loss, this.age, this.errors, this.bad, this.state, this.rec] = [r.value, l.value, a.value, e.value, b.value, st.value, rec.value];
+    this.recDetail = h("div", { class: "rec-detail", "data-testid": "recording-problem", hidden: true });
     this.agesBody = h("tbody");
     const details = h("details", { class: "ages", "data-testid": "link-details" },
       h("summary", { "data-testid": "link-details-toggle" }, "Per-message ages"),
@@ -37,7 +41,7 @@ export class LinkPanel {
     this.radiosBody = h("tbody");
     this.radiosTable = h("table", { class: "radios", "data-testid": "link-radios", hidden: true },
       h("thead", {}, h("tr", {}, ...["radio", "rate", "loss", "age", "copies"].map((c) => h("th", {}, c)))), this.radiosBody);
-    this.root = panel("Link", "panel-link", h("div", { class: "ro-grid three" }, st.root, r.root, l.root, a.root, e.root, b.root, rec.root), this.radiosTable, details);
+    this.root = panel("Link", "panel-link", h("div", { class: "ro-grid three" }, st.root, r.root, l.root, a.root, e.root, b.root, rec.root), this.recDetail, this.radiosTable, details);
   }
 
   update(link: Link | null, verdict: StaleVerdict, stats: MessageStats, receivedAtMs: number | null, nowMs: number, recording: Recording | null = null): void {
@@ -60,20 +64,16 @@ export class LinkPanel {
     this.agesBody.replaceChildren(...rows);
   }
 
-  /** REC with what was written, OFF, or FAILING with why (the station keeps flying either way). */
   private showRecording(r: Recording | null): void {
-    if (r === null) {
-      setText(this.rec, "—");
-      delete this.rec.dataset.state;
-      this.rec.title = "";
-      return;
-    }
-    const mb = r.bytes_written === null ? "—" : `${(r.bytes_written / 1e6).toFixed(1)} MB`;
-    const lost = r.messages_lost ? `, ${r.messages_lost} lost` : "";
-    setText(this.rec, r.state === "on" ? `REC ${mb}${lost}` : r.state === "off" ? "OFF" : `FAILING${lost}`);
-    this.rec.dataset.state = r.state;
-    this.rec.classList.toggle("warn", r.state === "failing" || (r.messages_lost ?? 0) > 0);
-    this.rec.title = [r.file, r.problem].filter((x) => x).join("\n");
+    const text = recordingText(r);
+    setText(this.rec, text.readout);
+    if (r === null) delete this.rec.dataset.state;
+    else this.rec.dataset.state = r.state;
+    this.rec.classList.toggle("warn", text.warn);
+    this.rec.title = text.title;
+    setText(this.recDetail, text.detail);
+    this.recDetail.hidden = text.detail === "";
+    this.recDetail.classList.toggle("warn", r?.state === "failing");
   }
 
   /** One row per radio, only when there is a choice of radios: which one carries the commands
@@ -90,4 +90,45 @@ export class LinkPanel {
         h("td", {}, r.duplicates === null ? "—" : String(r.duplicates))));
     this.radiosBody.replaceChildren(...rows);
   }
+}
+
+/** What the panel says of the recording. */
+export interface RecordingText {
+  /** REC with what was written, OFF, or FAILING (the station keeps flying either way). */
+  readout: string;
+  /** Below the readouts: while failing, the problem, since when and the next try; once it
+   *  resumed, when and after how long; "" when there is nothing to say. */
+  detail: string;
+  /** Failing, or messages lost. */
+  warn: boolean;
+  /** The file and the last problem, on hover. */
+  title: string;
+}
+
+export function recordingText(r: Recording | null): RecordingText {
+  if (r === null) return { readout: "—", detail: "", warn: false, title: "" };
+  const mb = r.bytes_written === null ? "—" : `${(r.bytes_written / 1e6).toFixed(1)} MB`;
+  const lost = r.messages_lost ? `, ${r.messages_lost} lost` : "";
+  const readout = r.state === "on" ? `REC ${mb}${lost}` : r.state === "off" ? "OFF" : `FAILING${lost}`;
+  const problem = r.problem ?? "nothing is being written";
+  // The readout's cell may be too narrow for the count: the line below says it too.
+  const lostLine = r.messages_lost ? `; ${r.messages_lost} messages lost` : "";
+  let detail = "";
+  if (r.state === "failing") {
+    // No `failing_since_ms`: the station never started writing (no directory) and does not retry.
+    if (r.failing_since_ms === null) detail = `${problem}${lostLine}`;
+    else {
+      const tries = r.failed_tries ?? 0;
+      const next = r.next_try_in_s === null ? "" : r.next_try_in_s <= 0 ? "; trying again now" : `; next try in ${fmtDuration(r.next_try_in_s)}`;
+      detail = `${problem} — since ${fmtWallUtc(r.failing_since_ms)}${next} (${tries} ${tries === 1 ? "try" : "tries"} failed)${lostLine}`;
+    }
+  } else if (r.state === "on" && r.resumed_ms !== null) {
+    detail = `Resumed ${fmtWallUtc(r.resumed_ms)} after failing ${fmtDuration(r.resumed_after_s)} (${problem})${lostLine}`;
+  }
+  return {
+    readout,
+    detail,
+    warn: r.state === "failing" || (r.messages_lost ?? 0) > 0,
+    title: [r.file, r.problem].filter((x) => x).join("\n"),
+  };
 }

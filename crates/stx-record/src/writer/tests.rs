@@ -248,6 +248,43 @@ fn rotation_keeps_channels_registered_in_every_file() {
 }
 
 #[test]
+fn a_file_started_again_keeps_its_number_and_its_channels() {
+    let mut core = RecorderCore::new(CoreOptions::default(), info(), Duration::ZERO).unwrap();
+    let a = core
+        .add_channel(Duration::ZERO, foxglove::log_channel("/events").unwrap())
+        .unwrap();
+    core.write(ms(1), a, T0, T0, &payload(0)).unwrap();
+    // The adapter removed what it had of file 1 (a full disk): the core starts it again.
+    core.restart_file(ms(2)).unwrap();
+    core.write(ms(3), a, T0 + 1, T0 + 1, &payload(1)).unwrap();
+    core.finish().unwrap();
+    let outputs = drain(&mut core);
+    let parts: Vec<u32> = outputs
+        .iter()
+        .filter_map(|o| match o {
+            Output::StartFile { part } => Some(*part),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(parts, [1, 1]);
+    assert_eq!(core.part(), 1);
+    // The second file 1 is whole on its own and names its channel.
+    let second = outputs
+        .iter()
+        .skip_while(|o| **o != Output::EndFile)
+        .filter_map(|o| match o {
+            Output::Bytes { data, .. } => Some(data.clone()),
+            _ => None,
+        })
+        .flatten()
+        .collect::<Vec<u8>>();
+    assert_eq!(
+        read_all(&second),
+        [("/events".to_owned(), T0 + 1, payload(1))]
+    );
+}
+
+#[test]
 fn bad_calls_are_refused() {
     let (mut core, a, _) = core_with(CoreOptions::default());
     assert!(matches!(
