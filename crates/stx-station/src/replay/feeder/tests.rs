@@ -103,15 +103,19 @@ impl Default for Sink {
     }
 }
 
+/// The frames among `seen`, by number.
+fn frames_in(seen: &[Seen]) -> Vec<u16> {
+    seen.iter()
+        .filter_map(|s| match s {
+            Seen::Frame(i, _) => Some(*i),
+            _ => None,
+        })
+        .collect()
+}
+
 impl Sink {
     fn frames(&self) -> Vec<u16> {
-        self.seen
-            .iter()
-            .filter_map(|s| match s {
-                Seen::Frame(i, _) => Some(*i),
-                _ => None,
-            })
-            .collect()
+        frames_in(&self.seen)
     }
 
     fn count(&self, f: impl Fn(&Seen) -> bool) -> usize {
@@ -251,13 +255,7 @@ fn a_seek_while_paused_rebuilds_up_to_the_new_place_at_once_and_stays_there() {
     let Seen::Restart(epoch, 1000) = rebuilt[0] else {
         panic!("{:?}", rebuilt[0]);
     };
-    let frames: Vec<_> = rebuilt
-        .iter()
-        .filter_map(|s| match s {
-            Seen::Frame(i, _) => Some(*i),
-            _ => None,
-        })
-        .collect();
+    let frames = frames_in(rebuilt);
     let expected: Vec<u16> = (0..=100u16).filter(|i| i % 5 != 0).collect();
     assert_eq!(frames, expected, "from the start up to 1000 ms");
     assert_eq!(rebuilt.last(), Some(&Seen::CaughtUp(1000)));
