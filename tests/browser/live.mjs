@@ -490,8 +490,8 @@ async function replay(rehearsalStation) {
   const refused = await api("/api/commands/mode", OPERATOR, { method: "POST", body: JSON.stringify({ mode: "heading" }) });
   check("replay: the page says REPLAY, its command controls are off and the station refuses commands", badge && modeDisabled && refused.status === 409 && refused.body?.error === "replay", `badge ${badge}, controls still on: [${enabled.join(", ")}], command → ${refused.status} ${refused.body?.error}`);
   // It plays: the re-run station estimates the recorded flight.
-  const playing = await until(() => api("/api/state"), (r) => r.body?.estimate && r.body?.replay?.position_ms > 2000, 20000);
-  check("replay: the recorded flight plays through the station (an estimate, the position moves)", !!playing.body?.estimate && playing.body?.replay?.position_ms > 2000, JSON.stringify(playing.body?.replay));
+  const playing = await until(() => api("/api/state"), (r) => r.body?.estimate && r.body?.replay?.position_ms > 12000, 30000);
+  check("replay: the recorded flight plays through the station (an estimate, the position moves)", !!playing.body?.estimate && playing.body?.replay?.position_ms > 12000, JSON.stringify(playing.body?.replay));
   // Pause from the page: the position stops.
   await page.click('[data-testid="replay-toggle"]');
   await page.waitForFunction(() => document.querySelector('[data-testid="replay-bar"]')?.dataset.paused === "true", null, { timeout: 5000 }).catch(() => {});
@@ -499,23 +499,53 @@ async function replay(rehearsalStation) {
   await sleep(1500);
   const p2 = (await api("/api/replay")).body?.position_ms;
   check("replay: pause from the page stops the position", p1 !== undefined && p1 === p2 && (await text(page, "replay-toggle")) === "Play", `${p1} → ${p2} ms while paused`);
-  // Seek from the page's timeline to 5 s, then play at 2×.
+  // Seek back from the page's timeline to 5 s while paused: the page shows the flight as it was
+  // then — the track and the plots end there, the state is that moment's (mode, stage), fresh.
+  const epochBefore = (await api("/api/replay")).body?.epoch;
   await page.locator('[data-testid="replay-seek"]').evaluate((el) => {
     el.value = "5000";
     el.dispatchEvent(new Event("input"));
     el.dispatchEvent(new Event("change"));
   });
-  await page.waitForFunction(() => Number(document.querySelector('[data-testid="replay-bar"]')?.dataset.positionMs) === 5000, null, { timeout: 5000 }).catch(() => {});
+  await page.waitForFunction((e) => {
+    const bar = document.querySelector('[data-testid="replay-bar"]');
+    return Number(bar?.dataset.positionMs) === 5000 && Number(bar?.dataset.epoch) > e && bar?.dataset.seeking === "false";
+  }, epochBefore, { timeout: 30000 }).catch(() => {});
   const sought = (await api("/api/replay")).body;
-  check("replay: a seek on the page's timeline moves the replay there", sought?.position_ms === 5000 && sought?.paused === true, JSON.stringify(sought));
-  await page.selectOption('[data-testid="replay-speed"]', "2");
+  check("replay: a seek back on the page's timeline moves the replay there (paused)", sought?.position_ms === 5000 && sought?.paused === true && sought?.epoch > epochBefore && sought?.seeking === false, JSON.stringify(sought));
+  await sleep(3000); // paused: nothing may age into stale; the plots redraw once a second
+  const then = (await api("/api/state")).body;
+  const shownThen = await page.evaluate(() => {
+    const map = document.querySelector('[data-testid="map"]');
+    const u = document.querySelector('[data-testid="plot-altitude"]')?.uplot;
+    return {
+      trackLastS: Number(map?.dataset.trackLastS), trackPoints: Number(map?.dataset.trackPoints),
+      plotLastS: u ? Math.max(...Array.from(u.data[0])) : null, plotPoints: u ? u.data[0].length : 0,
+      freshness: document.body.dataset.freshness, banner: document.querySelector('[data-testid="banner"]')?.hidden,
+    };
+  });
+  const modeText = await text(page, "hdr-mode");
+  const stageText = await text(page, "hdr-stage");
+  const wantMode = (then?.vehicle?.mode ?? "").replace(/_/g, " ");
+  const wantStage = (then?.mission?.stage ?? "").replace(/_/g, " ");
+  check("replay: after the seek back the track and the plots end at 5 s (no line back from later), not empty",
+    shownThen.trackLastS <= 5 && shownThen.trackLastS > 3 && shownThen.trackPoints > 2 && shownThen.plotLastS !== null && shownThen.plotLastS <= 5 && shownThen.plotPoints > 2,
+    JSON.stringify(shownThen));
+  check("replay: paused after the seek, the page shows that moment's state, fresh (mode, stage as the station had them at 5 s, no STALE)",
+    then?.time_s === 5 && then?.link?.stale === false && wantMode !== "" && wantMode !== "uncontrolled" && modeText === wantMode && stageText === wantStage && shownThen.freshness === "fresh" && shownThen.banner === true,
+    `station at ${then?.time_s} s: mode ${then?.vehicle?.mode}, stage ${then?.mission?.stage}, stale ${then?.link?.stale}; page: mode "${modeText}", stage "${stageText}", ${shownThen.freshness}, banner hidden ${shownThen.banner}`);
+  // Any speed the station accepts, typed in the box: 3×.
+  await page.fill('[data-testid="replay-speed"]', "3");
+  await page.locator('[data-testid="replay-speed"]').dispatchEvent("change");
+  await until(() => api("/api/replay"), (r) => r.body?.speed === 3, 5000);
   await page.click('[data-testid="replay-toggle"]');
   const t0 = Date.now();
   const s0 = (await api("/api/replay")).body;
   await sleep(2000);
   const s1 = (await api("/api/replay")).body;
   const rate = (s1.position_ms - s0.position_ms) / (Date.now() - t0);
-  check("replay: the speed chosen on the page is the replay's (2×)", s1.speed === 2 && s1.paused === false && rate > 1.5 && rate < 2.5, `speed ${s1.speed}, ${rate.toFixed(2)} ms of flight per ms`);
+  const boxShows = await page.locator('[data-testid="replay-speed"]').inputValue();
+  check("replay: a speed typed in the box (3×) is the replay's, and the box shows it", s1.speed === 3 && s1.paused === false && rate > 2.3 && rate < 3.7 && boxShows === "3", `speed ${s1.speed}, ${rate.toFixed(2)} ms of flight per ms, box "${boxShows}"`);
   await page.screenshot({ path: join(out, "replay.png") });
   await ctx.close();
   return file;
@@ -525,7 +555,8 @@ async function replay(rehearsalStation) {
 /** The day after: a live station (no drone yet) lists the recordings of the runs above, downloads
  *  the rehearsal's and opens it in a replay station of its own beside the live one. */
 async function pastRecordings(rehearsalFile, landing) {
-  const { base } = await startStation([]);
+  // No drone: a link on any free port (the default one may be another station's on this machine).
+  const { base } = await startStation(["--link", "udpin:127.0.0.1:0"]);
   const api = apiOf(base);
   const ctx = await newContext("recordings", { viewport: { width: 1440, height: 900 } });
   const page = await ctx.newPage();

@@ -337,6 +337,14 @@ pub struct ReplayView {
     pub paused: bool,
     /// At the end of the recording.
     pub finished: bool,
+    /// The seek what is shown belongs to (0 from the start, +1 each seek): when it changes,
+    /// the flight is shown as it was at the new position and a page starts its track, plots
+    /// and event log over from the `history` of that epoch (sent to every page after the
+    /// seek), never mixing what it had from before.
+    pub epoch: u64,
+    /// The station is being rebuilt at the position just sought (the recording run through
+    /// it from the start): no `state` is sent until it is done.
+    pub seeking: bool,
 }
 
 /// Whether the station is recording.

@@ -25,7 +25,8 @@ pub struct HelloMsg {
     pub name: String,
 }
 
-/// Sent once after `hello` and the first `state`: what happened before the page connected.
+/// Sent once after `hello` and the first `state`: what happened before the page connected;
+/// in a replay also to every page after each seek: what happened before the new position.
 #[derive(Debug, Clone, Serialize, JsonSchema)]
 pub struct HistoryMsg {
     /// Always `history`.
@@ -38,6 +39,10 @@ pub struct HistoryMsg {
     pub events: Vec<EventMsg>,
     /// The last 5 minutes of states at 1 Hz, for the plots.
     pub states: Vec<StateMsg>,
+    /// In a replay, the seek it belongs to (`ReplayView.epoch`): after each seek every page
+    /// gets the history at the new position, which replaces its track, plots and event log;
+    /// `null` on a live station.
+    pub replay_epoch: Option<u64>,
 }
 
 /// The page fell more than the backlog behind: it missed events, command results or

@@ -1307,6 +1307,13 @@ export interface ReplayView {
    */
   duration_ms: number;
   /**
+   * The seek what is shown belongs to (0 from the start, +1 each seek): when it changes,
+   * the flight is shown as it was at the new position and a page starts its track, plots
+   * and event log over from the `history` of that epoch (sent to every page after the
+   * seek), never mixing what it had from before.
+   */
+  epoch: number;
+  /**
    * The recording.
    */
   file: string;
@@ -1326,6 +1333,11 @@ export interface ReplayView {
    * Where the replay is, ms after the start.
    */
   position_ms: number;
+  /**
+   * The station is being rebuilt at the position just sought (the recording run through
+   * it from the start): no `state` is sent until it is done.
+   */
+  seeking: boolean;
   /**
    * × real time.
    */
@@ -1740,13 +1752,20 @@ export interface AscentBandView {
   wind_north_mps: number;
 }
 /**
- * Sent once after `hello` and the first `state`: what happened before the page connected.
+ * Sent once after `hello` and the first `state`: what happened before the page connected;
+ * in a replay also to every page after each seek: what happened before the new position.
  */
 export interface HistoryMsg {
   /**
    * The last 500 events, oldest first.
    */
   events: EventMsg[];
+  /**
+   * In a replay, the seek it belongs to (`ReplayView.epoch`): after each seek every page
+   * gets the history at the new position, which replaces its track, plots and event log;
+   * `null` on a live station.
+   */
+  replay_epoch: number | null;
   /**
    * The last 5 minutes of states at 1 Hz, for the plots.
    */

@@ -454,6 +454,8 @@ function parseReplay(o: Obj): Replay | null {
     speed: num(o, "speed"),
     paused: bool(o, "paused"),
     finished: bool(o, "finished"),
+    epoch: num(o, "epoch"),
+    seeking: bool(o, "seeking"),
   };
 }
 
@@ -594,6 +596,7 @@ function parseHistory(v: Obj): Parsed<History & { dropped: number }> {
     track: track.items,
     events: events.items,
     states: states.items,
+    replay_epoch: num(v, "replay_epoch"),
     dropped: track.dropped + events.dropped + states.dropped,
   });
 }

@@ -10,6 +10,7 @@ import { fmt, fmtMissionTime, label } from "../lib/format";
 import { parseAscentWind, parseKeepOut, parseParams, parseSession, isObj } from "../lib/parse";
 import { LiveSocket, type SocketStatus } from "../lib/socket";
 import { landingBadge, phaseLabel } from "../lib/recovery";
+import { SeekEpoch } from "../lib/replaySeek";
 import { judgeStaleness, type StaleVerdict } from "../lib/staleness";
 import { resolveToken, searchWithoutToken, withToken } from "../lib/token";
 import type { EventMsg, Level, Session, State, TrackPoint } from "../lib/types";
@@ -77,6 +78,8 @@ function build(session: Session): void {
   let socketStatus: SocketStatus = { kind: "connecting", attempt: 0 };
   let verdict: StaleVerdict = judgeStaleness({ socketOpen: false, link: null, receivedAtMs: null, nowMs: Date.now() });
   let track: TrackPoint[] = [];
+  /** A replay's seek shown: after a seek the track, plots and log start over, one timeline. */
+  const seeks = new SeekEpoch();
   const station = session.station;
 
   // ---- panels
@@ -139,7 +142,7 @@ function build(session: Session): void {
           onState(m);
           break;
         case "history":
-          onHistory(m.track, m.events, m.states);
+          onHistory(m.track, m.events, m.states, m.replay_epoch);
           break;
         case "event":
           events.add(m);
@@ -264,6 +267,9 @@ function build(session: Session): void {
   }
 
   function onState(s: State): void {
+    const seek = seeks.state(s.replay?.epoch ?? null);
+    if (seek === "drop") return; // built before the seek now shown
+    if (seek === "restart") startOver();
     latest = s;
     replayBar.update(s.replay);
     receivedAtMs = Date.now();
@@ -283,12 +289,22 @@ function build(session: Session): void {
     render();
   }
 
-  function onHistory(t: TrackPoint[], ev: EventMsg[], states: State[]): void {
+  function onHistory(t: TrackPoint[], ev: EventMsg[], states: State[], epoch: number | null): void {
+    if (!seeks.history(epoch)) return; // of a seek already left
     track = t.slice();
     map.setTrack(track);
     view3d.setTrack(track);
     events.reset(ev);
-    plots.reset(states, latest);
+    plots.reset(states, latest !== null && seeks.shows(latest.replay?.epoch ?? null) ? latest : null);
+  }
+
+  /** A replay jumped: what the page drew belongs to another moment (the history of the new one follows). */
+  function startOver(): void {
+    track = [];
+    map.setTrack(track);
+    view3d.setTrack(track);
+    events.reset([]);
+    plots.reset([], null);
   }
 
   function render(): void {

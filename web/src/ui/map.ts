@@ -177,6 +177,9 @@ export class MapView {
     const key = `${points.length}:${last?.time_s ?? ""}`;
     if (key === this.lastTrackKey) return;
     this.lastTrackKey = key;
+    // What the track holds, for the end-to-end test (a replay's seek cuts it at that moment).
+    this.root.dataset.trackPoints = String(points.length);
+    this.root.dataset.trackLastS = last === undefined ? "" : String(last.time_s);
     this.track.setLatLngs(points.slice(-MAX_TRACK).map((p) => [p.lat_deg, p.lon_deg] as L.LatLngTuple));
   }
 

@@ -62,6 +62,7 @@ pub use flight_path::FLIGHT_PATH_EVERY_S;
 pub use footprint::{FootprintDone, FootprintJob};
 pub use keep_out::{CLEAR_AFTER_S, CheckedZones};
 pub use manual::MANUAL_SILENCE_S;
+pub(crate) use navigation::{MAX_TRACK_POINTS, thin_track};
 pub use navigation::{PREDICTION_EVERY_S, Predicted, PredictionJob};
 pub use requests::{ApiError, CommandRequest};
 pub use sync::TargetSource;

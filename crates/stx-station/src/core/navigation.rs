@@ -29,7 +29,7 @@ pub(crate) const MAX_TRACK_POINTS: usize = 4096;
 /// Drops every other point of the older half of `track`, keeping its first point: the recent
 /// half stays at full resolution, and the further back, the coarser (each thinning halves
 /// what is older again), so the shape of the whole flight stays on the map.
-fn thin_track(track: &mut Vec<TrackPoint>) {
+pub(crate) fn thin_track(track: &mut Vec<TrackPoint>) {
     let half = track.len() / 2;
     let mut i = 0;
     track.retain(|_| {

@@ -1,9 +1,12 @@
 //! The daemon's tokio wiring: the link driver (`stx_link_tokio::drive_paths` running the
 //! station's [`StationLink`] over every configured radio), the `station_loop` (messages
 //! between the driver, the core and the pages), and the HTTP server (HTTPS with `[tls]`, see
-//! `tls`), all stopped together by one shutdown signal. Nothing here decides anything: the
-//! core does.
+//! `tls`), all stopped together by one shutdown signal; `pages` sends the pages their states
+//! and messages. A replay station's core is fed by the recording's feeder thread instead of
+//! the link (`replay_feed`); the live station opens them (`replay_sessions`). Nothing here
+//! decides anything: the core does.
 
+mod pages;
 mod replay_feed;
 mod replay_sessions;
 mod station_loop;

@@ -1,8 +1,8 @@
 //! Replay stations: `stx replay FILE` runs one ([`serve_replay`]), and the live station opens
 //! them for its pages (`POST /api/recordings/{name}/replay`, [`replay_sessions`]). Each is a
-//! whole station of its own in this process — its own core, its link on a loopback port fed
-//! by the recording's feeder thread, its own HTTP port on the live station's address — so the
-//! live station's core, link and recording are untouched by it.
+//! whole station of its own in this process — its own core fed by the recording's feeder
+//! thread, its own HTTP port on the live station's address — so the live station's core, link
+//! and recording are untouched by it.
 //!
 //! The live station keeps at most [`MAX_SESSIONS`] at once; one that has had no page for
 //! [`IDLE`] ends, and all end with the live station.
@@ -84,8 +84,8 @@ impl PreparedReplay {
 }
 
 /// Runs a station replaying `prepared` until `shutdown` (`config`'s link is replaced by a
-/// loopback port the feeder sends to; nothing is recorded). `started` is called once it
-/// listens, before the feeder starts.
+/// loopback port that hears nothing: the feeder runs the recording through the core itself;
+/// nothing is recorded). `started` is called once it listens, before the feeder starts.
 pub async fn serve_replay(
     mut config: StationConfig,
     prepared: PreparedReplay,
@@ -104,16 +104,11 @@ pub async fn serve_replay(
     let feeder_control = control.clone();
     let result = run_replay(config, control, shutdown, move |running| {
         started(&running);
-        let Some(link) = running.link_local else {
-            tracing::error!("the replay station has no link to feed");
-            return;
-        };
         if let Err(e) = spawn_replay_feeder(
             recording,
             file,
             feeder_control,
             running.shared.clone(),
-            link,
             feeder_stop,
         ) {
             tracing::error!(error = %e, "the replay could not start");

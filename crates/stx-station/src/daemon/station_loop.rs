@@ -12,6 +12,11 @@
 //! - landing predictions run on a blocking thread, one at a time, whenever the core says one is
 //!   due (once a second of the drone's clock: a rehearsal at 20× is predicted 20 times a
 //!   second of wall time, as often per second of its flight as a real one).
+//!
+//! A replay station's link hears nothing: its feeder runs the recording through the core on
+//! the recording's clock (`replay_feed`), link actions and statistics included. Here it only
+//! gets the state sent four times a second, and the predictions and footprints, each of
+//! which is dropped if a seek has replaced the core it was computed from.
 
 use std::collections::VecDeque;
 use std::sync::Arc;
@@ -21,7 +26,8 @@ use stx_link::endpoint::GroundEvent;
 use stx_link_tokio::{Action, DriverEvent};
 use tokio::sync::{mpsc, watch};
 
-use crate::core::{LinkAction, Outbound};
+use super::pages::{send_outbound, show_state};
+use crate::core::LinkAction;
 use crate::http::Shared;
 use crate::link::{LinkReport, StationLink};
 
@@ -82,7 +88,10 @@ pub(super) async fn station_loop(mut io: StationLoop) {
         tokio::select! {
             event = io.events.recv() => {
                 let Some(event) = event else { break };
-                if on_driver_event(&shared, event) && burst_deadline.is_none() {
+                if shared.replay.is_none()
+                    && on_driver_event(&shared, event)
+                    && burst_deadline.is_none()
+                {
                     burst_deadline = Some(tokio::time::Instant::now() + COALESCE);
                 }
             }
@@ -105,13 +114,17 @@ pub(super) async fn station_loop(mut io: StationLoop) {
                 last_state = tokio::time::Instant::now();
                 publish_state(&shared);
             }
-            Some(prediction) = prediction_rx.recv() => {
+            Some((epoch, prediction)) = prediction_rx.recv() => {
                 predicting = false;
-                shared.core().set_prediction(prediction);
+                if epoch == replay_epoch(&shared) {
+                    shared.core().set_prediction(prediction);
+                }
             }
-            Some(done) = footprint_rx.recv() => {
+            Some((epoch, done)) = footprint_rx.recv() => {
                 footprinting = false;
-                shared.core().set_footprint(done);
+                if epoch == replay_epoch(&shared) {
+                    shared.core().set_footprint(done);
+                }
             }
             _ = footprint_timer.tick() => {
                 let now = shared.now_s();
@@ -119,12 +132,13 @@ pub(super) async fn station_loop(mut io: StationLoop) {
                 if let Some(job) = job {
                     footprinting = true;
                     let tx = footprint_tx.clone();
+                    let epoch = replay_epoch(&shared);
                     tokio::task::spawn_blocking(move || {
-                        let _ = tx.blocking_send(job.run());
+                        let _ = tx.blocking_send((epoch, job.run()));
                     });
                 }
             }
-            _ = stats_timer.tick() => {
+            _ = stats_timer.tick(), if shared.replay.is_none() => {
                 outgoing.push_back(Box::new(|link: &mut StationLink, now| link.sample_stats(now)));
             }
             _ = core_timer.tick() => {}
@@ -140,13 +154,19 @@ pub(super) async fn station_loop(mut io: StationLoop) {
         let (actions, outbound, prediction) = {
             let mut core = shared.core();
             let prediction = if predicting { None } else { core.prediction_job() };
-            (core.take_link_actions(now), core.drain_outbound(), prediction)
+            let actions = if shared.replay.is_none() {
+                core.take_link_actions(now)
+            } else {
+                Vec::new()
+            };
+            (actions, core.drain_outbound(), prediction)
         };
         if let Some(job) = prediction {
             predicting = true;
             let tx = prediction_tx.clone();
+            let epoch = replay_epoch(&shared);
             tokio::task::spawn_blocking(move || {
-                let _ = tx.blocking_send(job.run());
+                let _ = tx.blocking_send((epoch, job.run()));
             });
         }
         outgoing.extend(actions.into_iter().map(|a| apply(shared.started, a)));
@@ -188,8 +208,19 @@ fn on_driver_event(shared: &Shared, event: DriverEvent<LinkReport>) -> bool {
     }
 }
 
-/// Ticks the core and sends what it queued, then the fresh `state`.
+/// The seek a replay station's core belongs to (0 live): a job computed from another core is
+/// not for this one.
+fn replay_epoch(shared: &Shared) -> u64 {
+    shared.replay.as_ref().map_or(0, |r| r.shown_epoch())
+}
+
+/// Ticks the core and sends what it queued, then the fresh `state`; a replay's core is
+/// ticked by its feeder, and its pages get the state it holds.
 fn publish_state(shared: &Shared) {
+    if let Some(replay) = &shared.replay {
+        super::replay_feed::show_replay_state(shared, replay);
+        return;
+    }
     let now = shared.now_s();
     let (mut state, outbound) = {
         let mut core = shared.core();
@@ -197,43 +228,9 @@ fn publish_state(shared: &Shared) {
         (state, core.drain_outbound())
     };
     send_outbound(shared, outbound);
-    if let Some(replay) = &shared.replay {
-        if replay.mode() == crate::replay::ReplayMode::Recorded {
-            // The recorded states go to the pages (the feeder); this station heard nothing.
-            return;
-        }
-        state.replay = Some(replay.view());
-    } else {
-        state.recording = Some(shared.recording.view());
-        shared.recording.state(&state);
-    }
+    state.recording = Some(shared.recording.view());
+    shared.recording.state(&state);
     if let Ok(text) = serde_json::to_string(&state) {
-        // Latest wins: a page that is behind gets the newest state, never a queue of old ones.
-        shared.states.send_modify(|frame| {
-            frame.seq += 1;
-            frame.text = text.into();
-        });
-    }
-}
-
-fn send_outbound(shared: &Shared, outbound: Vec<Outbound>) {
-    shared.recording.outbound(&outbound);
-    for o in outbound {
-        let text = match o {
-            Outbound::Event(e) => serde_json::to_string(&e),
-            Outbound::CommandResult(r) => serde_json::to_string(&r),
-            Outbound::Params(p) => serde_json::to_string(&p),
-            Outbound::AscentWind(a) => serde_json::to_string(&a),
-            Outbound::KeepOut(k) => serde_json::to_string(&k),
-            // Recorded only: pages see the request's event.
-            Outbound::Command(_) => continue,
-        };
-        if let Ok(text) = text {
-            shared
-                .broadcast_total
-                .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-            // No page connected is not an error.
-            let _ = shared.broadcast.send(text.into());
-        }
+        show_state(shared, text);
     }
 }

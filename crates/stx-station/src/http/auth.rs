@@ -105,7 +105,7 @@ impl FromRequestParts<AppState> for Caller {
             .extensions
             .get::<ConnectInfo<SocketAddr>>()
             .map(|c| c.0.ip());
-        let now = state.now_s();
+        let now = state.elapsed_s();
         // An address that has sent too many wrong tokens is not heard until its bucket
         // refills, whatever it sends (so a guesser cannot tell a right guess from the wait).
         if let Some(ip) = address

@@ -89,6 +89,9 @@ pub(crate) async fn session(State(state): State<AppState>, caller: Caller) -> Js
 }
 
 pub(crate) async fn state_now(State(state): State<AppState>, _caller: Caller) -> Response {
+    if let Some(recorded) = super::replay::recorded_state(&state) {
+        return Json(recorded).into_response();
+    }
     let now = state.now_s();
     let mut msg = state.core().state_msg_now(now);
     msg.recording = state.replay.is_none().then(|| state.recording.view());

@@ -143,8 +143,19 @@ impl ClientCounters {
 }
 
 impl Shared {
-    /// Seconds on the mission clock.
+    /// Seconds on the mission clock: since the station started, or in a replay station the
+    /// replay's position in its recording (its core runs on the recording's clock: a pause
+    /// stops it, a seek moves it).
     pub fn now_s(&self) -> f64 {
+        match &self.replay {
+            Some(replay) => replay.mission_s(),
+            None => self.elapsed_s(),
+        }
+    }
+
+    /// Seconds since the station started, on the wall clock (request limits run on it, also
+    /// in a replay).
+    pub fn elapsed_s(&self) -> f64 {
         self.started.elapsed().as_secs_f64()
     }
 
@@ -157,16 +168,6 @@ impl Shared {
     pub fn core(&self) -> std::sync::MutexGuard<'_, StationCore> {
         // A panic while holding the lock would be a bug in the core; keep serving.
         self.core.lock().unwrap_or_else(|e| e.into_inner())
-    }
-
-    /// Starts the core afresh (a replay jumped: what it had heard no longer holds).
-    pub fn reset_core(&self) {
-        let mut core = self.core();
-        let wall_origin_ms = core.wall_origin_ms();
-        // The zones are the station's, not what it heard.
-        let keep_out = core.keep_out.clone();
-        *core = StationCore::new(self.config.clone(), wall_origin_ms);
-        core.keep_out = keep_out;
     }
 }
 

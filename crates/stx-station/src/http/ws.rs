@@ -67,26 +67,38 @@ async fn serve_socket(state: AppState, caller: Caller, mut socket: WebSocket) {
         .unwrap_or_else(|e| e.into_inner())
         .insert(id, counters.clone());
     let greeting = {
-        let now = state.now_s();
-        let core = state.core();
         let hello = HelloMsg {
             kind: "hello",
             session: session_of(&state, &caller),
             role: caller.role,
             name: caller.name.clone(),
         };
-        let mut events = core.events_since(f64::NEG_INFINITY);
-        let history = HistoryMsg {
-            kind: "history",
-            track: core.track(1.0),
-            events: events.split_off(events.len().saturating_sub(500)),
-            states: core.history(),
+        let [state_msg, history] = match super::replay::recorded_greeting(&state) {
+            Some(recorded) => recorded,
+            None => {
+                let now = state.now_s();
+                let core = state.core();
+                let mut events = core.events_since(f64::NEG_INFINITY);
+                let history = HistoryMsg {
+                    kind: "history",
+                    track: core.track(1.0),
+                    events: events.split_off(events.len().saturating_sub(500)),
+                    states: core.history(),
+                    replay_epoch: state.replay.as_ref().map(|r| r.shown_epoch()),
+                };
+                let mut state_msg = core.state_msg_now(now);
+                state_msg.recording = state.replay.is_none().then(|| state.recording.view());
+                state_msg.replay = state.replay.as_ref().map(|r| r.view());
+                [
+                    serde_json::to_string(&state_msg).unwrap_or_default(),
+                    serde_json::to_string(&history).unwrap_or_default(),
+                ]
+            }
         };
-        let state_msg = core.state_msg_now(now);
         [
             serde_json::to_string(&hello).unwrap_or_default(),
-            serde_json::to_string(&state_msg).unwrap_or_default(),
-            serde_json::to_string(&history).unwrap_or_default(),
+            state_msg,
+            history,
         ]
     };
     let mut open = true;

@@ -1,6 +1,11 @@
 //! Where a replay is in its recording: a position that runs at a chosen speed from an anchor
 //! on the caller's clock, and stops at pause and at the recording's end. Pure: the feeder
 //! gives `now` (any monotonic clock), so pause, seek and speed are tested on a fake one.
+//!
+//! A seek (and the start) holds the position where it was put until the feeder has rebuilt
+//! what the station shows there ([`ReplayClock::release`]): a replay that plays on resumes
+//! from the place sought, however long the rebuild took, and the pages are told which seek
+//! what they are shown belongs to ([`ReplayClock::shown_epoch`]).
 
 use std::time::Duration;
 
@@ -34,6 +39,11 @@ pub struct ReplayClock {
     paused: bool,
     /// Bumped by every seek, so the feeder knows to start reading again from the position.
     epoch: u64,
+    /// Waiting for the feeder to rebuild the station at the position (after the start or a
+    /// seek): the position does not move.
+    held: bool,
+    /// The seek whose rebuild the feeder finished last: what the pages are shown.
+    shown_epoch: u64,
 }
 
 impl ReplayClock {
@@ -48,12 +58,14 @@ impl ReplayClock {
             speed,
             paused: false,
             epoch: 0,
+            held: true,
+            shown_epoch: 0,
         })
     }
 
     /// The position at `now`, ns (never past the end).
     pub fn position(&self, now: Duration) -> u64 {
-        if self.paused {
+        if self.paused || self.held {
             return self.at_anchor_ns;
         }
         let run = now.saturating_sub(self.anchor).as_secs_f64() * self.speed * 1e9;
@@ -93,10 +105,33 @@ impl ReplayClock {
         self.epoch
     }
 
-    /// The real time at which the position reaches `log_ns` (`None` while paused, or if it
-    /// is past the end).
+    /// The seek (epoch) whose rebuild is done: what the station shows belongs to it.
+    pub fn shown_epoch(&self) -> u64 {
+        self.shown_epoch
+    }
+
+    /// Waiting for the station to be rebuilt at the position (the start or a seek).
+    pub fn held(&self) -> bool {
+        self.held
+    }
+
+    /// The feeder has rebuilt the station at the position for seek `epoch`: the position
+    /// moves on from `now` (unless paused). False, and nothing changes, if another seek came
+    /// since or it was released already.
+    pub fn release(&mut self, now: Duration, epoch: u64) -> bool {
+        if epoch != self.epoch || !self.held {
+            return false;
+        }
+        self.held = false;
+        self.shown_epoch = epoch;
+        self.anchor = now;
+        true
+    }
+
+    /// The real time at which the position reaches `log_ns` (`None` while paused or held, or
+    /// if it is past the end).
     pub fn due_at(&self, log_ns: u64) -> Option<Duration> {
-        if self.paused || log_ns > self.end_ns {
+        if self.paused || self.held || log_ns > self.end_ns {
             return None;
         }
         let ahead_ns = log_ns.saturating_sub(self.at_anchor_ns) as f64 / self.speed;
@@ -128,7 +163,8 @@ impl ReplayClock {
         Ok(())
     }
 
-    /// Jumps to `offset_ms` after the recording's start (paused or playing as before).
+    /// Jumps to `offset_ms` after the recording's start (paused or playing as before), held
+    /// there until the feeder has rebuilt the station at it ([`ReplayClock::release`]).
     pub fn seek(&mut self, now: Duration, offset_ms: i64) -> Result<(), ReplayError> {
         let span_ms = (self.end_ns - self.start_ns) / 1_000_000;
         if offset_ms < 0 || offset_ms as u64 > span_ms {
@@ -137,6 +173,7 @@ impl ReplayClock {
         self.at_anchor_ns = self.start_ns + offset_ms as u64 * 1_000_000;
         self.anchor = now;
         self.epoch += 1;
+        self.held = true;
         Ok(())
     }
 }
@@ -161,7 +198,13 @@ mod tests {
 
     #[test]
     fn plays_at_its_speed_pauses_and_stops_at_the_end() {
-        let mut c = ReplayClock::new(100 * S, 200 * S, 2.0, at(10.0)).unwrap();
+        let mut c = ReplayClock::new(100 * S, 200 * S, 2.0, at(0.0)).unwrap();
+        assert_eq!(
+            c.position(at(10.0)),
+            100 * S,
+            "held until the feeder is ready"
+        );
+        assert!(c.release(at(10.0), 0));
         assert_eq!(c.position(at(10.0)), 100 * S);
         assert_eq!(c.position(at(15.0)), 110 * S, "2× for 5 s");
         c.pause(at(15.0));
@@ -176,6 +219,7 @@ mod tests {
     #[test]
     fn speed_changes_keep_the_position_and_are_bounded() {
         let mut c = ReplayClock::new(0, 3600 * S, 1.0, at(0.0)).unwrap();
+        c.release(at(0.0), 0);
         c.set_speed(at(10.0), 64.0).unwrap();
         assert_eq!(c.position(at(10.0)), 10 * S);
         assert_eq!(c.position(at(11.0)), 74 * S);
@@ -188,6 +232,7 @@ mod tests {
     #[test]
     fn a_seek_moves_the_position_and_counts_and_a_bad_one_is_refused() {
         let mut c = ReplayClock::new(50 * S, 150 * S, 1.0, at(0.0)).unwrap();
+        c.release(at(0.0), 0);
         c.pause(at(3.0));
         c.seek(at(4.0), 60_000).unwrap();
         assert_eq!(
@@ -205,5 +250,33 @@ mod tests {
             Err(ReplayError::Position(..))
         ));
         assert_eq!(c.epoch(), 1, "a refused seek changes nothing");
+    }
+
+    #[test]
+    fn a_seek_holds_the_position_until_the_rebuild_for_it_is_done() {
+        let mut c = ReplayClock::new(0, 100 * S, 2.0, at(0.0)).unwrap();
+        c.release(at(0.0), 0);
+        c.seek(at(5.0), 40_000).unwrap();
+        c.seek(at(6.0), 30_000).unwrap();
+        assert!(c.held());
+        assert_eq!(
+            c.position(at(9.0)),
+            30 * S,
+            "held while the station is rebuilt"
+        );
+        assert_eq!(c.due_at(31 * S), None);
+        assert!(
+            !c.release(at(9.0), 1),
+            "the rebuild for an older seek does not release it"
+        );
+        assert_eq!((c.held(), c.shown_epoch()), (true, 0));
+        assert!(c.release(at(10.0), 2));
+        assert_eq!((c.held(), c.shown_epoch()), (false, 2));
+        assert!(!c.release(at(10.5), 2), "once");
+        assert_eq!(
+            c.position(at(11.0)),
+            32 * S,
+            "plays on from the place sought"
+        );
     }
 }
