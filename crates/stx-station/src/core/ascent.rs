@@ -2,7 +2,9 @@
 //! pure [`AscentWindEstimator`]; the bands it measures are refitted at most every
 //! [`REFIT_EVERY_S`], sent to the pages (`ascent_wind`) when they change, and joined to the
 //! forecast into the profile every descent prediction flies in
-//! ([`StationCore::wind_profile`]).
+//! ([`StationCore::wind_profile`]). A band the estimator refuses as implausible (faster than
+//! any wind a balloon meets at its height, or too uncertain: `stx_gnc::ascent_wind`'s
+//! `plausible.rs`) is sent with its reason and logged once, but never merged.
 //!
 //! **Clock.** Fixes are timed on the drone's clock (radio delays and accelerated rehearsals
 //! do not distort it), continued across a restart of the drone: the estimator needs times
