@@ -830,10 +830,21 @@ export interface EstimateView {
  */
 export interface FlightPathView {
   /**
-   * Where the balloon bursts (or the drone cuts it away at `MIS_CUTDOWN_M`); `null` under
-   * the round chute.
+   * Where the ascent rate comes from: `drone` (`MIS_ASCENT_MPS`) or `station_config`
+   * (`[flight_path] mean_ascent_rate_mps`).
+   */
+  ascent_rate_source: string;
+  /**
+   * Where the balloon bursts (at the drone's `MIS_BURST_M`, else the station config's
+   * burst altitude, or where the drone cuts it away at `MIS_CUTDOWN_M`); `null` under the
+   * round chute.
    */
   burst: PathPointView | null;
+  /**
+   * Where the burst altitude comes from: `drone` (its `MIS_BURST_M`, loaded before launch)
+   * or `station_config` (`[flight_path] burst_altitude_msl_m`).
+   */
+  burst_source: string;
   /**
    * Mission clock when it was computed, s.
    */
