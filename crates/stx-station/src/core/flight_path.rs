@@ -81,24 +81,30 @@ impl StationCore {
         }
         let configured = |key: &str| !self.config.flight_path_unset.contains(&key);
         let mut unknown = Vec::new();
-        let burst = if let Some(burst) = param("MIS_BURST_M").filter(|v| *v > 0.0) {
-            stack.burst_altitude_msl_m = burst;
-            LaunchSource::Drone
-        } else if configured("burst_altitude_msl_m") {
-            LaunchSource::StationConfig
-        } else {
-            unknown.push("the burst altitude (the drone's MIS_BURST_M, or [flight_path] burst_altitude_msl_m)");
-            LaunchSource::StationConfig
-        };
-        let ascent_rate = if let Some(rate) = param("MIS_ASCENT_MPS").filter(|v| *v > 0.0) {
-            stack.mean_ascent_rate_mps = rate;
-            LaunchSource::Drone
-        } else if configured("mean_ascent_rate_mps") {
-            LaunchSource::StationConfig
-        } else {
-            unknown.push("the ascent rate (the drone's MIS_ASCENT_MPS, or [flight_path] mean_ascent_rate_mps)");
+        let mut pick = |name: &str, key: &str, what: &str, value: &mut f64| {
+            if let Some(v) = param(name).filter(|v| *v > 0.0) {
+                *value = v;
+                return LaunchSource::Drone;
+            }
+            if !configured(key) {
+                unknown.push(format!(
+                    "{what} (the drone's {name}, or [flight_path] {key})"
+                ));
+            }
             LaunchSource::StationConfig
         };
+        let burst = pick(
+            "MIS_BURST_M",
+            "burst_altitude_msl_m",
+            "the burst altitude",
+            &mut stack.burst_altitude_msl_m,
+        );
+        let ascent_rate = pick(
+            "MIS_ASCENT_MPS",
+            "mean_ascent_rate_mps",
+            "the ascent rate",
+            &mut stack.mean_ascent_rate_mps,
+        );
         if !unknown.is_empty() {
             return Err(format!(
                 "neither the drone nor the station config gives {}",
