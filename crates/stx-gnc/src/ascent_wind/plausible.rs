@@ -83,15 +83,15 @@ pub fn max_plausible_wind_mps(config: &AscentWindConfig, height_m: f64) -> f64 {
 pub fn judge(band: &WindBand, config: &AscentWindConfig) -> Option<Implausible> {
     let speed_mps = band.speed_mps();
     let limit_mps = max_plausible_wind_mps(config, band.altitude_max_m);
-    // A NaN is refused too: `!(x <= limit)` holds for it.
-    if !(speed_mps <= limit_mps) {
+    // A NaN is refused too: it is not within the bound.
+    if speed_mps.is_nan() || speed_mps > limit_mps {
         return Some(Implausible::TooFast {
             speed_mps,
             limit_mps,
         });
     }
     let sigma_mps = band.sigma_north_mps.max(band.sigma_east_mps);
-    if !(sigma_mps <= config.max_sigma_mps) {
+    if sigma_mps.is_nan() || sigma_mps > config.max_sigma_mps {
         return Some(Implausible::TooUncertain {
             sigma_mps,
             limit_mps: config.max_sigma_mps,
