@@ -13,7 +13,7 @@ import { join } from "node:path";
 import { OPERATOR, VIEWER, out, check, newContext, startStation, apiOf, until, text, attr, watchErrors, runFlights, registerRest } from "./harness.mjs";
 
 registerRest("GET", /^\/api\/plan\/defaults$/, null, "PreflightDefaults");
-registerRest("POST", /^\/api\/plan$/, "PreflightBody", "PlanReport");
+registerRest("POST", /^\/api\/plan$/, "PreflightBody", "PreflightReport");
 
 const WIND = 10;
 const RATE = 5;
@@ -94,4 +94,4 @@ async function flight() {
   await ctx.close();
 }
 
-await runFlights(flight, ["Session", "PreflightDefaults", "RecordingsBody", "PlanReport", "ErrorBody"]);
+await runFlights(flight, ["Session", "PreflightDefaults", "RecordingsBody", "PreflightReport", "ErrorBody"]);

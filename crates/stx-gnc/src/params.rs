@@ -89,6 +89,12 @@ pub struct MissionSettings {
     /// Estimated altitude above mean sea level at which the drone cuts the balloon away
     /// itself if it has not burst, m; 0 = no automatic cutdown.
     pub cutdown_altitude_msl_m: f64,
+    /// Expected burst altitude above mean sea level, m, as loaded before launch; 0 = not
+    /// loaded. For the station's predictions only: the drone does nothing at it.
+    pub expected_burst_msl_m: f64,
+    /// Expected mean ascent rate from launch to burst, m/s, as loaded before launch; 0 = not
+    /// loaded. For the station's predictions only.
+    pub expected_ascent_rate_mps: f64,
 }
 
 impl Default for MissionSettings {
@@ -97,6 +103,8 @@ impl Default for MissionSettings {
             deploy_height_m: 2500.0,
             settle_s: 8.0,
             cutdown_altitude_msl_m: 0.0,
+            expected_burst_msl_m: 0.0,
+            expected_ascent_rate_mps: 0.0,
         }
     }
 }
@@ -517,6 +525,24 @@ pub const CATALOG: &[ParamDef] = &[
         Mission,
         "estimated altitude above sea level at which the drone cuts the balloon away itself; 0 = never",
         |s| s.mission.cutdown_altitude_msl_m
+    ),
+    real!(
+        "MIS_BURST_M",
+        "m",
+        0.0,
+        50000.0,
+        Mission,
+        "expected burst altitude above sea level, loaded before launch for the station's flight-path prediction; 0 = not loaded",
+        |s| s.mission.expected_burst_msl_m
+    ),
+    real!(
+        "MIS_ASCENT_MPS",
+        "m/s",
+        0.0,
+        20.0,
+        Mission,
+        "expected mean ascent rate from launch to burst, loaded before launch for the station's flight-path prediction; 0 = not loaded",
+        |s| s.mission.expected_ascent_rate_mps
     ),
 ];
 

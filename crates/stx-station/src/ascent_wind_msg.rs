@@ -56,4 +56,31 @@ pub struct AscentBandView {
     pub time_start_s: f64,
     /// Last fix used, s on the drone's clock.
     pub time_end_s: f64,
+    /// Why the band is not believed (faster than any wind a balloon meets at its height, or
+    /// too uncertain; `stx_gnc::ascent_wind::Implausible`): it is shown but not used for any
+    /// prediction or plan. `null`: believed, and used.
+    pub refused: Option<String>,
+}
+
+impl AscentBandView {
+    /// The view of `b`, whose altitudes are above an origin `origin_msl_m` above sea level.
+    pub fn of(b: &stx_gnc::ascent_wind::WindBand, origin_msl_m: f64) -> Self {
+        let msl = |a: f64| a + origin_msl_m;
+        Self {
+            alt_msl_m: msl(b.altitude_m),
+            alt_min_msl_m: msl(b.altitude_min_m),
+            alt_max_msl_m: msl(b.altitude_max_m),
+            speed_mps: b.speed_mps(),
+            from_deg: b.from_deg(),
+            wind_north_mps: b.wind_north_mps,
+            wind_east_mps: b.wind_east_mps,
+            sigma_north_mps: b.sigma_north_mps,
+            sigma_east_mps: b.sigma_east_mps,
+            samples: b.samples,
+            method: b.method,
+            time_start_s: b.time_start_s,
+            time_end_s: b.time_end_s,
+            refused: b.refused.map(|r| r.to_string()),
+        }
+    }
 }

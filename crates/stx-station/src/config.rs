@@ -202,10 +202,15 @@ pub struct StationConfig {
     pub ascent_wind: AscentWindConfig,
     /// The stack's balloon, round chute and deployment as the live flight path flies them
     /// (`[flight_path]`: mean ascent rate m/s, burst altitude m MSL, chute Cd·A m² and mass kg,
-    /// deploy height m above the origin, …; see [`StackConfig`]). The drone's `MIS_DEPLOY_M`
-    /// and `MIS_CUTDOWN_M` win once its parameters are read.
+    /// deploy height m above the origin, …; see [`StackConfig`]). The drone's `MIS_DEPLOY_M`,
+    /// `MIS_CUTDOWN_M`, `MIS_BURST_M` and `MIS_ASCENT_MPS` win once its parameters are read.
     #[serde(default)]
     pub flight_path: StackConfig,
+    /// The launch profile's `[flight_path]` settings ([`LAUNCH_PROFILE_KEYS`]) the file left
+    /// out: the live flight path does not fly their defaults silently (`core/flight_path.rs`).
+    /// Empty for a configuration built in code, whose values were chosen there.
+    #[serde(skip)]
+    pub flight_path_unset: Vec<&'static str>,
     /// The guidance replica's settings (the same defaults as onboard).
     #[serde(default)]
     pub guidance: GuidanceConfig,
@@ -229,6 +234,10 @@ fn default_cutdown_window_s() -> f64 {
     5.0
 }
 
+/// The `[flight_path]` settings that describe this flight's balloon rather than a model: the
+/// drone's `MIS_BURST_M` and `MIS_ASCENT_MPS` give them when loaded.
+pub const LAUNCH_PROFILE_KEYS: [&str; 2] = ["burst_altitude_msl_m", "mean_ascent_rate_mps"];
+
 /// The shipped configuration: the simulated drone on loopback, demo tokens.
 pub const DEFAULT_STATION_TOML: &str = include_str!("../../../config/station.toml");
 
@@ -245,6 +254,12 @@ impl StationConfig {
         env: impl Fn(&str) -> Option<OsString>,
     ) -> Result<Self, ConfigError> {
         let mut config: StationConfig = toml::from_str(text)?;
+        let table: toml::Table = toml::from_str(text)?;
+        let given = |key: &str| table.get("flight_path").and_then(|f| f.get(key)).is_some();
+        config.flight_path_unset = LAUNCH_PROFILE_KEYS
+            .into_iter()
+            .filter(|k| !given(k))
+            .collect();
         config.apply_environment(env)?;
         config.validate()?;
         Ok(config)

@@ -26,7 +26,7 @@ use crate::lab::vehicle_fields::VehicleFieldsBody;
 use crate::messages::{
     AscentWindMsg, CommandResultMsg, ErrorBody, EventMsg, ParamsMsg, ReplayView, Session, StateMsg,
 };
-use crate::preflight::{PreflightBody, PreflightDefaults};
+use crate::preflight::{PreflightBody, PreflightDefaults, PreflightReport};
 use crate::replies::{
     ClientsBody, CommandAccepted, EventsBody, HelloMsg, HistoryMsg, LaggedMsg, PongMsg,
     RecordingsBody, ReplayOpened, TrackBody,
@@ -35,7 +35,6 @@ use crate::requests::{
     ClientMessage, ConfirmBody, CourseBody, HeadingBody, LocalizerBody, ModeBody, ParamBody,
     PlanBody, ReplayBody, TargetBody,
 };
-use stx_gnc::flight_path::PlanReport;
 
 /// Where the schema is committed, from the workspace root.
 pub const SCHEMA_PATH: &str = "web/src/generated/api.schema.json";
@@ -152,7 +151,7 @@ pub fn schema() -> Result<Value, ContractError> {
         sent.subschema_for::<RecordingsBody>(),
         sent.subschema_for::<ReplayOpened>(),
         sent.subschema_for::<KeepOutMsg>(),
-        sent.subschema_for::<PlanReport>(),
+        sent.subschema_for::<PreflightReport>(),
         sent.subschema_for::<PreflightDefaults>(),
         sent.subschema_for::<LabStatusBody>(),
         sent.subschema_for::<LabStartedBody>(),
@@ -216,7 +215,7 @@ pub fn schema() -> Result<Value, ContractError> {
     Ok(json!({
         "$schema": "http://json-schema.org/draft-07/schema#",
         "title": "stx station API",
-        "description": "Every message of the stx station's HTTP and WebSocket API (crates/stx-station/API.md), generated from the daemon's Rust types by `cargo run -p stx-station --example api_schema`: do not edit. The root is any one of them: on the WebSocket ServerMessage (station to page) and ClientMessage (page to station); over REST the bodies the station answers (Session, StateMsg, ParamsMsg, AscentWindMsg, EventsBody, TrackBody, ClientsBody, CommandResultMsg, CommandAccepted, CutdownArm, ErrorBody, ReplayView, RecordingsBody, ReplayOpened, KeepOutMsg, PlanReport, PreflightDefaults, the Lab's Lab*Body and VehicleFieldsBody) and the bodies of the commands (*Body).",
+        "description": "Every message of the stx station's HTTP and WebSocket API (crates/stx-station/API.md), generated from the daemon's Rust types by `cargo run -p stx-station --example api_schema`: do not edit. The root is any one of them: on the WebSocket ServerMessage (station to page) and ClientMessage (page to station); over REST the bodies the station answers (Session, StateMsg, ParamsMsg, AscentWindMsg, EventsBody, TrackBody, ClientsBody, CommandResultMsg, CommandAccepted, CutdownArm, ErrorBody, ReplayView, RecordingsBody, ReplayOpened, KeepOutMsg, PreflightReport, PreflightDefaults, the Lab's Lab*Body and VehicleFieldsBody) and the bodies of the commands (*Body).",
         "anyOf": messages,
         "definitions": definitions,
     }))

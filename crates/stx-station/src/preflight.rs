@@ -1,8 +1,9 @@
 //! The dashboard's Plan page over the API (`API.md`): `POST /api/plan` asks for a pre-flight
 //! plan ([`PreflightBody`]: the request of `stx plan`, and optionally one of the station's
 //! recordings whose measured ascent wind replaces the forecast where it measured, as
-//! `stx plan --from-recording`), answered with the plan (`stx_gnc::flight_path::PlanReport`,
-//! what `stx plan --json` prints); `GET /api/plan/defaults` gives the page the station's own
+//! `stx plan --from-recording`), answered with the plan ([`PreflightReport`]: the
+//! `stx_gnc::flight_path::PlanReport` and the recording's measured bands, each merged or
+//! refused with its reason; what `stx plan --json` prints); `GET /api/plan/defaults` gives the page the station's own
 //! launch site, forecast and target to start from ([`PreflightDefaults`]).
 //!
 //! Pure: the HTTP adapter finds the recording's file, runs [`preflight_plan`] off the async
@@ -16,6 +17,7 @@ use stx_gnc::flight_path::plan::MAX_RUNS;
 use stx_gnc::flight_path::{ForecastRow, PlanError, PlanReport, PlanRequest, plan};
 
 use crate::config::StationConfig;
+use crate::messages::AscentBandView;
 use crate::recording::ascent::{MeasuredAscentError, measured_forecast};
 
 /// `POST /api/plan`.
@@ -29,6 +31,27 @@ pub struct PreflightBody {
     /// alone.
     #[serde(default)]
     pub from_recording: Option<String>,
+}
+
+/// The answer of `POST /api/plan` (and `stx plan --json`): the plan, and what the recording's
+/// ascent measured.
+#[derive(Debug, Clone, Serialize, JsonSchema)]
+pub struct PreflightReport {
+    /// The plan (its `request.forecast` is the forecast it flew: the measured bands merged).
+    #[serde(flatten)]
+    pub plan: PlanReport,
+    /// The wind measured on the recording's ascent; `null` without `from_recording`.
+    pub measured_ascent: Option<MeasuredAscentView>,
+}
+
+/// The wind bands a recording's ascent measured.
+#[derive(Debug, Clone, Serialize, JsonSchema)]
+pub struct MeasuredAscentView {
+    /// The recording (its name, or the file `stx plan` was given).
+    pub recording: String,
+    /// Every band, lowest first: those with `refused` null are merged into the forecast the
+    /// plan flew, the others are not (the forecast, or the neighbouring bands, stand in).
+    pub bands: Vec<AscentBandView>,
 }
 
 /// `GET /api/plan/defaults`: the station's own settings, to start a plan from.
@@ -92,7 +115,8 @@ pub enum PreflightError {
 pub fn preflight_plan(
     mut request: PlanRequest,
     recording: Option<(&str, &Path)>,
-) -> Result<PlanReport, PreflightError> {
+) -> Result<PreflightReport, PreflightError> {
+    let mut measured_ascent = None;
     if let Some((name, file)) = recording {
         let mut reader =
             stx_record::Recording::open(file).map_err(|e| PreflightError::Unreadable {
@@ -106,6 +130,17 @@ pub fn preflight_plan(
             }
         })?;
         request.forecast = measured.forecast.rows().to_vec();
+        measured_ascent = Some(MeasuredAscentView {
+            recording: name.to_string(),
+            bands: measured
+                .bands
+                .iter()
+                .map(|b| AscentBandView::of(b, measured.origin_msl_m))
+                .collect(),
+        });
     }
-    Ok(plan(&request)?)
+    Ok(PreflightReport {
+        plan: plan(&request)?,
+        measured_ascent,
+    })
 }

@@ -11,8 +11,9 @@ use std::time::Duration;
 use common::*;
 use serde_json::{Value, json};
 use stx_gnc::geo::LocalFrame;
-use stx_record::foxglove::{self, LocationFix, PositionCovarianceType, Timestamp};
+use stx_link::telemetry::{GlobalPosition, GpsFix, GpsRaw, Telemetry};
 use stx_record::{CoreOptions, RecorderCore, RecordingInfo};
+use stx_station::recording::telemetry::TelemetryChannels;
 
 const T0: u64 = 1_767_225_600_000_000_000;
 
@@ -270,41 +271,63 @@ async fn one_plan_at_a_time_and_the_station_answers_meanwhile() {
     assert_eq!(status, 200);
 }
 
-/// A recording whose GPS track sits 60 s on the pad, rises at `rate_mps` for 600 s (5 m/s:
-/// to 3 km above it) while drifting east at `wind_mps`, then falls.
-fn write_ascent(path: &Path, wind_mps: f64, rate_mps: f64) {
+/// A recording whose drone sits 60 s on the pad, rises at `rate_mps` for 600 s (5 m/s: to
+/// 3 km above it) while drifting east at `wind_mps`, then falls: GPS_RAW_INT at 1 Hz of the
+/// drone's clock, each after a GLOBAL_POSITION_INT that stamps it, recorded by a station whose
+/// clock runs `1/speed` as fast (a rehearsal at `speed`×). With `decoded` false, only the
+/// `/vehicle/gps` positions, which carry the station's clock alone.
+fn write_ascent(path: &Path, wind_mps: f64, rate_mps: f64, speed: u64, decoded: bool) {
     let o = launch();
     let info = RecordingInfo::new("test", "straplex-2", "plan test");
     let mut core = RecorderCore::new(CoreOptions::default(), info, Duration::ZERO).unwrap();
-    let ch = core
-        .add_channel(
-            Duration::ZERO,
-            foxglove::location_fix_channel("/vehicle/gps").unwrap(),
-        )
-        .unwrap();
+    let channels = TelemetryChannels::register(&mut core, Duration::ZERO).unwrap();
     let (mut east, mut height) = (0.0, 0.0);
     for i in 0..800u64 {
         let t = i as f64;
-        if (60.0..660.0).contains(&t) {
+        let climb = if (60.0..660.0).contains(&t) {
             east += wind_mps;
             height += rate_mps;
+            rate_mps
         } else if t >= 660.0 && height > 0.0 {
             height -= 20.0;
-        }
-        let (lat, lon, alt) = o.to_geodetic(&nalgebra::Vector3::new(0.0, east, -height));
-        let fix = LocationFix {
-            timestamp: Timestamp::from_nanos(T0 + i * 1_000_000_000),
-            frame_id: "vehicle".into(),
-            latitude: lat,
-            longitude: lon,
-            altitude: alt,
-            position_covariance: [0.0; 9],
-            position_covariance_type: PositionCovarianceType::Unknown,
+            -20.0
+        } else {
+            0.0
         };
-        let data = serde_json::to_vec(&fix).unwrap();
-        let log = T0 + i * 1_000_000_000;
-        core.write(Duration::from_secs(i), ch, log, log, &data)
-            .unwrap();
+        let (lat, lon, alt) = o.to_geodetic(&nalgebra::Vector3::new(0.0, east, -height));
+        let position = GlobalPosition {
+            time_boot_ms: (i * 1000) as u32,
+            lat_deg: lat,
+            lon_deg: lon,
+            alt_msl_m: alt,
+            alt_rel_m: height,
+            v_north_mps: 0.0,
+            v_east_mps: wind_mps,
+            v_down_mps: -climb,
+            heading_deg: None,
+        };
+        let gps = GpsRaw {
+            time_usec: i * 1_000_000,
+            fix: GpsFix::Fix3d,
+            lat_deg: lat,
+            lon_deg: lon,
+            alt_msl_m: alt,
+            ground_speed_mps: None,
+            course_deg: None,
+            satellites: Some(12),
+            h_acc_m: None,
+            v_acc_m: None,
+        };
+        let station = Duration::from_millis(i * 1000 / speed);
+        let log = T0 + station.as_nanos() as u64;
+        for telemetry in [Telemetry::Position(position), Telemetry::GpsRaw(gps)] {
+            let records = channels.records(log, &telemetry);
+            // Without the decoded telemetry: only the LocationFix a GPS_RAW_INT also gives.
+            let skip = usize::from(!decoded);
+            for (id, data) in records.into_iter().skip(skip) {
+                core.write(station, id, log, log, &data).unwrap();
+            }
+        }
     }
     std::fs::write(path, finished_recording(core)).unwrap();
 }
@@ -312,9 +335,14 @@ fn write_ascent(path: &Path, wind_mps: f64, rate_mps: f64) {
 #[tokio::test]
 async fn a_recordings_measured_ascent_replaces_the_forecast_where_it_measured() {
     let dir = temp_dir("measured");
-    write_ascent(&dir.join("ascent-1.mcap"), 10.0, 5.0);
+    // Recorded at 10×: the drift is timed by the drone's clock, not the recording's.
+    write_ascent(&dir.join("ascent-1.mcap"), 10.0, 5.0, 10, true);
     // A track that never rises measures nothing.
-    write_ascent(&dir.join("grounded.mcap"), 0.0, 0.0);
+    write_ascent(&dir.join("grounded.mcap"), 0.0, 0.0, 1, true);
+    // Positions alone have no drone clock.
+    write_ascent(&dir.join("positions.mcap"), 10.0, 5.0, 1, false);
+    // 80 m/s from the west: faster than any wind near the ground, refused.
+    write_ascent(&dir.join("storm.mcap"), 80.0, 5.0, 1, true);
     let recordings = dir.clone();
     let station = start_station(config(move |c| c.recording.dir = Some(recordings))).await;
     // The forecast says calm at 30 km; the recording measured 10 m/s from the west up to 3 km.
@@ -344,6 +372,33 @@ async fn a_recordings_measured_ascent_replaces_the_forecast_where_it_measured() 
         assert!((num(&r["speed_mps"]) - 10.0).abs() < 0.5, "{r}");
         assert!((num(&r["from_deg"]) - 270.0).abs() < 3.0, "{r}");
     }
+    // The page is told which bands were merged: all of them, here.
+    let bands = plan["measured_ascent"]["bands"].as_array().unwrap();
+    assert_eq!(plan["measured_ascent"]["recording"], json!("ascent-1.mcap"));
+    assert_eq!(bands.len(), rows.len() - 1, "{bands:?}");
+    assert!(bands.iter().all(|b| b["refused"].is_null()), "{bands:?}");
+    assert!(calm["measured_ascent"].is_null(), "{calm}");
+    // The storm's bands are listed with the reason, and the plan flies the forecast.
+    let body = json!({"request": request, "from_recording": "storm.mcap"});
+    let (status, stormy) = post_plan(station.http(), VIEWER, &body).await;
+    assert_eq!(status, 200, "{stormy}");
+    let bands = stormy["measured_ascent"]["bands"].as_array().unwrap();
+    assert!(bands.len() >= 5, "{bands:?}");
+    for b in bands {
+        let reason = b["refused"].as_str().unwrap_or_default();
+        assert!(reason.contains("faster than any wind"), "{b}");
+    }
+    assert!(num(&stormy["burst"]["east_m"]).abs() < 1e-6, "{stormy}");
+    let body = json!({"request": request, "from_recording": "positions.mcap"});
+    let (status, answer) = post_plan(station.http(), VIEWER, &body).await;
+    assert_eq!(status, 400, "{answer}");
+    assert!(
+        answer["reason"]
+            .as_str()
+            .unwrap_or_default()
+            .contains("drone's clock"),
+        "{answer}"
+    );
     let body = json!({"request": request, "from_recording": "grounded.mcap"});
     let (status, answer) = post_plan(station.http(), VIEWER, &body).await;
     assert_eq!(status, 400, "{answer}");

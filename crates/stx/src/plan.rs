@@ -1,18 +1,17 @@
 //! `stx plan --launch LAT,LON[,ALT] --forecast FILE …`: the pre-flight plan (burst, deploy
 //! and landing regions, the target's reachability) from a forecast file and, if given, the
 //! wind an earlier recording measured on its ascent. Argument parsing and files only; the plan
-//! is `stx_gnc::flight_path::plan`, the recording's wind
-//! `stx_station::recording::ascent::measured_forecast` (as the station's `POST /api/plan`).
+//! and the recording's wind are `stx_station::preflight::preflight_plan`, as the station's
+//! `POST /api/plan`.
 
 use std::path::PathBuf;
 
 use anyhow::Context;
 use clap::Args;
 use stx_gnc::flight_path::plan::{MAX_RUNS, PlannedPoint};
-use stx_gnc::flight_path::{Forecast, PlanRequest, plan};
+use stx_gnc::flight_path::{Forecast, PlanRequest};
 use stx_gnc::geo::LocalFrame;
-use stx_record::Recording;
-use stx_station::recording::ascent::measured_forecast;
+use stx_station::preflight::{MeasuredAscentView, preflight_plan};
 
 use crate::BadInput;
 
@@ -86,38 +85,21 @@ fn parse_target(text: &str) -> Result<[f64; 2], String> {
 }
 
 pub fn run(args: PlanArgs) -> anyhow::Result<()> {
-    let mut forecast = match &args.forecast {
+    let forecast = match &args.forecast {
         Some(path) => {
             let text = std::fs::read_to_string(path)
                 .with_context(|| format!("cannot read the forecast {}", path.display()))
                 .map_err(BadInput)?;
-            Some(
-                Forecast::parse(&text)
-                    .with_context(|| format!("forecast {}", path.display()))
-                    .map_err(BadInput)?,
-            )
+            Forecast::parse(&text)
+                .with_context(|| format!("forecast {}", path.display()))
+                .map_err(BadInput)?
+                .rows()
+                .to_vec()
         }
-        None => None,
+        // clap requires --from-recording then, whose bands make the forecast.
+        None => Vec::new(),
     };
-    if let Some(path) = &args.from_recording {
-        let mut recording = Recording::open(path)
-            .with_context(|| format!("cannot read the recording {}", path.display()))
-            .map_err(BadInput)?;
-        let base = forecast.as_ref().map_or(&[][..], Forecast::rows);
-        let measured = measured_forecast(&mut recording, base)
-            .with_context(|| format!("the recording {}", path.display()))
-            .map_err(BadInput)?;
-        eprintln!(
-            "{}: {} measured wind bands from {:.0} to {:.0} m MSL",
-            path.display(),
-            measured.bands,
-            measured.lowest_msl_m,
-            measured.highest_msl_m
-        );
-        forecast = Some(measured.forecast);
-    }
-    let forecast = forecast.expect("clap requires --forecast or --from-recording");
-    let mut request = PlanRequest::new(args.launch, forecast.rows().to_vec());
+    let mut request = PlanRequest::new(args.launch, forecast);
     request.ascent_rate_mps = args.ascent_rate;
     request.ascent_rate_sigma_mps = args.ascent_rate_sigma;
     request.burst_altitude_msl_m = args.burst_alt;
@@ -129,11 +111,26 @@ pub fn run(args: PlanArgs) -> anyhow::Result<()> {
     request.target_lat_lon_deg = args.target;
     request.runs = args.runs;
     request.seed = args.seed;
-    let report = plan(&request).map_err(|e| BadInput(e.into()))?;
+    let recording = args
+        .from_recording
+        .as_ref()
+        .map(|p| (p.display().to_string(), p.clone()));
+    let report = preflight_plan(
+        request,
+        recording
+            .as_ref()
+            .map(|(name, path)| (name.as_str(), path.as_path())),
+    )
+    .map_err(|e| BadInput(e.into()))?;
+    if let Some(measured) = &report.measured_ascent {
+        print_measured(measured);
+    }
     if args.json {
         println!("{}", serde_json::to_string_pretty(&report)?);
         return Ok(());
     }
+    let request = &report.plan.request;
+    let report = &report.plan;
     let line = |name: &str, p: &PlannedPoint| {
         println!(
             "{name:<26} {:>10.5} {:>10.5} {:>7.0} m MSL  {:>6.0} m N {:>7.0} m E  T+{} ±{:.0} s  1σ {:.0} × {:.0} m at {:.0}°",
@@ -175,6 +172,31 @@ pub fn run(args: PlanArgs) -> anyhow::Result<()> {
         );
     }
     Ok(())
+}
+
+/// The recording's bands on stderr, each merged or refused with its reason.
+fn print_measured(measured: &MeasuredAscentView) {
+    let merged = measured
+        .bands
+        .iter()
+        .filter(|b| b.refused.is_none())
+        .count();
+    eprintln!(
+        "{}: {} measured wind bands, {merged} merged into the forecast:",
+        measured.recording,
+        measured.bands.len()
+    );
+    for b in &measured.bands {
+        let sigma = b.sigma_north_mps.max(b.sigma_east_mps);
+        let verdict = b
+            .refused
+            .as_ref()
+            .map_or("merged".to_string(), |r| format!("REFUSED: {r}"));
+        eprintln!(
+            "  {:>6.0}–{:<6.0} m MSL  {:>6.1} m/s from {:>3.0}°  1σ {:.2} m/s  {verdict}",
+            b.alt_min_msl_m, b.alt_max_msl_m, b.speed_mps, b.from_deg, sigma
+        );
+    }
 }
 
 /// `h:mm:ss`.

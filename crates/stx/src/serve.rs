@@ -118,6 +118,7 @@ pub fn run(args: ServeArgs) -> anyhow::Result<()> {
         config.flight_path = options
             .mission
             .stack_config(&stx_dynamics::vehicle::Vehicle::straplex());
+        config.flight_path_unset.clear();
         Some(options)
     } else {
         None

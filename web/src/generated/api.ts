@@ -2,7 +2,7 @@
 // the daemon's Rust types by `cargo run -p stx-station --example api_schema`): do not edit.
 
 /**
- * Every message of the stx station's HTTP and WebSocket API (crates/stx-station/API.md), generated from the daemon's Rust types by `cargo run -p stx-station --example api_schema`: do not edit. The root is any one of them: on the WebSocket ServerMessage (station to page) and ClientMessage (page to station); over REST the bodies the station answers (Session, StateMsg, ParamsMsg, AscentWindMsg, EventsBody, TrackBody, ClientsBody, CommandResultMsg, CommandAccepted, CutdownArm, ErrorBody, ReplayView, RecordingsBody, ReplayOpened, KeepOutMsg, PlanReport, PreflightDefaults, the Lab's Lab*Body and VehicleFieldsBody) and the bodies of the commands (*Body).
+ * Every message of the stx station's HTTP and WebSocket API (crates/stx-station/API.md), generated from the daemon's Rust types by `cargo run -p stx-station --example api_schema`: do not edit. The root is any one of them: on the WebSocket ServerMessage (station to page) and ClientMessage (page to station); over REST the bodies the station answers (Session, StateMsg, ParamsMsg, AscentWindMsg, EventsBody, TrackBody, ClientsBody, CommandResultMsg, CommandAccepted, CutdownArm, ErrorBody, ReplayView, RecordingsBody, ReplayOpened, KeepOutMsg, PreflightReport, PreflightDefaults, the Lab's Lab*Body and VehicleFieldsBody) and the bodies of the commands (*Body).
  */
 export type StxStationAPI =
   | ServerMessage
@@ -19,7 +19,7 @@ export type StxStationAPI =
   | RecordingsBody
   | ReplayOpened
   | KeepOutMsg
-  | PlanReport
+  | PreflightReport
   | PreflightDefaults
   | LabStatusBody
   | LabStartedBody
@@ -830,10 +830,21 @@ export interface EstimateView {
  */
 export interface FlightPathView {
   /**
-   * Where the balloon bursts (or the drone cuts it away at `MIS_CUTDOWN_M`); `null` under
-   * the round chute.
+   * Where the ascent rate comes from: `drone` (`MIS_ASCENT_MPS`) or `station_config`
+   * (`[flight_path] mean_ascent_rate_mps`).
+   */
+  ascent_rate_source: string;
+  /**
+   * Where the balloon bursts (at the drone's `MIS_BURST_M`, else the station config's
+   * burst altitude, or where the drone cuts it away at `MIS_CUTDOWN_M`); `null` under the
+   * round chute.
    */
   burst: PathPointView | null;
+  /**
+   * Where the burst altitude comes from: `drone` (its `MIS_BURST_M`, loaded before launch)
+   * or `station_config` (`[flight_path] burst_altitude_msl_m`).
+   */
+  burst_source: string;
   /**
    * Mission clock when it was computed, s.
    */
@@ -1719,6 +1730,12 @@ export interface AscentBandView {
    */
   method: BandMethod;
   /**
+   * Why the band is not believed (faster than any wind a balloon meets at its height, or
+   * too uncertain; `stx_gnc::ascent_wind::Implausible`): it is shown but not used for any
+   * prediction or plan. `null`: believed, and used.
+   */
+  refused: string | null;
+  /**
    * GPS fixes used.
    */
   samples: number;
@@ -2147,9 +2164,10 @@ export interface ReplayOpened {
   scheme: string;
 }
 /**
- * The plan.
+ * The answer of `POST /api/plan` (and `stx plan --json`): the plan, and what the recording's
+ * ascent measured.
  */
-export interface PlanReport {
+export interface PreflightReport {
   /**
    * Where the balloon bursts.
    */
@@ -2166,6 +2184,10 @@ export interface PlanReport {
    * Where the parafoil lands unsteered (servos neutral).
    */
   landing_unsteered: PlannedPoint;
+  /**
+   * The wind measured on the recording's ascent; `null` without `from_recording`.
+   */
+  measured_ascent: MeasuredAscentView | null;
   /**
    * How steering's reach is computed.
    */
@@ -2248,6 +2270,20 @@ export interface Ellipse {
    * Semi-minor axis, m.
    */
   semi_minor_m: number;
+}
+/**
+ * The wind bands a recording's ascent measured.
+ */
+export interface MeasuredAscentView {
+  /**
+   * Every band, lowest first: those with `refused` null are merged into the forecast the
+   * plan flew, the others are not (the forecast, or the neighbouring bands, stand in).
+   */
+  bands: AscentBandView[];
+  /**
+   * The recording (its name, or the file `stx plan` was given).
+   */
+  recording: string;
 }
 /**
  * What the plan is asked for. Every field but the launch site and the forecast has a default.

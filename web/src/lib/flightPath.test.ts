@@ -13,6 +13,8 @@ const PATH = {
   reach_radius_m: 3900,
   measured_bands: 12,
   measured_to_msl_m: 6245,
+  burst_source: "station_config",
+  ascent_rate_source: "station_config",
 };
 
 describe("the flight path of the state", () => {
@@ -21,7 +23,7 @@ describe("the flight path of the state", () => {
     expect(p?.burst?.alt_msl_m).toBe(35000);
     expect(p?.reach_centre).toEqual({ lat_deg: 38.62, lon_deg: -7.27 });
     const text = flightPathSummary(p!);
-    expect(text).toContain("burst in 1 h 30 min");
+    expect(text).toContain("burst in 1 h 30 min at 35.0 km (station config)");
     expect(text).toContain("12 measured bands to 6.2 km");
   });
   it("has no burst under the round chute, and says when only the forecast was flown", () => {
@@ -29,6 +31,11 @@ describe("the flight path of the state", () => {
     expect(p?.burst).toBeNull();
     expect(flightPathSummary(p!)).toContain("forecast only");
     expect(flightPathSummary(p!)).not.toContain("burst");
+  });
+  it("says the burst altitude is the drone's when the drone gave it", () => {
+    const p = parseFlightPath({ ...PATH, burst: P(38.6, -7.5, 3000, 600), burst_source: "drone" });
+    expect(flightPathSummary(p!)).toContain("burst in 10 min 00 s at 3.0 km (drone)");
+    expect(flightPathSummary(parseFlightPath({ ...PATH, burst_source: undefined })!)).toContain("(source not given)");
   });
   it("leaves out a path with a point it cannot read", () => {
     expect(parseFlightPath({ ...PATH, deploy: { lat_deg: 95, lon_deg: 0, alt_msl_m: 0, in_s: 0 } })).toBeNull();

@@ -2,7 +2,8 @@
  * The unsteered flight path the station predicts while the balloon rises and the round chute
  * falls (`state.flight_path`): its parsing, lenient like the rest of the state (a point that
  * does not parse leaves the whole path out rather than drawing it wrong), and the one-line
- * summary the map's badge shows.
+ * summary the map's badge shows, the burst with where its altitude comes from (the drone's
+ * parameters or the station config).
  */
 import { fmt, fmtDuration } from "./format";
 import type { LatLon } from "./types";
@@ -24,7 +25,12 @@ export interface FlightPath {
   reach_radius_m: number;
   measured_bands: number;
   measured_to_msl_m: number | null;
+  /** Where the burst altitude comes from: "drone", "station_config", or null if not said. */
+  burst_source: string | null;
 }
+
+/** How the badge names a source of the launch profile. */
+const SOURCES: Record<string, string> = { drone: "drone", station_config: "station config" };
 
 type Obj = Record<string, unknown>;
 const isObj = (v: unknown): v is Obj => typeof v === "object" && v !== null && !Array.isArray(v);
@@ -57,13 +63,18 @@ export function parseFlightPath(o: Obj): FlightPath | null {
     reach_radius_m: o.reach_radius_m,
     measured_bands: finite(o.measured_bands) ? o.measured_bands : 0,
     measured_to_msl_m: finite(o.measured_to_msl_m) ? o.measured_to_msl_m : null,
+    burst_source: typeof o.burst_source === "string" ? o.burst_source : null,
   };
 }
 
 /** The badge: when and how high the burst and the deployment come, and which winds say so. */
 export function flightPathSummary(p: FlightPath): string {
   const parts: string[] = [];
-  if (p.burst) parts.push(`burst in ${fmtDuration(p.burst.in_s)} at ${fmt(p.burst.alt_msl_m / 1000, "km")}`);
+  if (p.burst) {
+    // Never a number without its origin: a station that is not told cannot tell.
+    const source = p.burst_source === null ? "source not given" : (SOURCES[p.burst_source] ?? p.burst_source);
+    parts.push(`burst in ${fmtDuration(p.burst.in_s)} at ${fmt(p.burst.alt_msl_m / 1000, "km")} (${source})`);
+  }
   parts.push(`deploy in ${fmtDuration(p.deploy.in_s)} at ${fmt(p.deploy.alt_msl_m, "m", 0)}`);
   parts.push(`unsteered landing in ${fmtDuration(p.landing.in_s)}`);
   parts.push(

@@ -549,6 +549,7 @@ function parseAscentBand(v: unknown): AscentBand | null {
     method: oneOf(v, "method", METHODS),
     time_start_s: num(v, "time_start_s"),
     time_end_s: num(v, "time_end_s"),
+    refused: str(v, "refused"),
   };
 }
 

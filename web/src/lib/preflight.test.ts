@@ -1,6 +1,6 @@
 import { describe, expect, it } from "vitest";
 import type * as Wire from "../generated/api";
-import { buildRequest, ellipsePolygon, forecastText, formOf, parseForecast } from "./preflight";
+import { buildRequest, ellipsePolygon, forecastText, formOf, measuredLines, parseForecast } from "./preflight";
 
 const request: Wire.PlanRequest = {
   launch_lat_deg: 38.5333,
@@ -87,5 +87,20 @@ describe("an ellipse as a polygon", () => {
 
   it("is a point for a zero ellipse", () => {
     for (const p of ellipsePolygon([1, 2], { semi_major_m: 0, semi_minor_m: 0, major_axis_rad: 0 })) expect(p).toEqual([1, 2]);
+  });
+});
+
+describe("the measured bands", () => {
+  const band = (alt: number, east: number, refused: string | null): Wire.AscentBandView => ({
+    alt_msl_m: alt + 250, alt_min_msl_m: alt, alt_max_msl_m: alt + 499, speed_mps: Math.abs(east), from_deg: 270,
+    wind_north_mps: 0, wind_east_mps: east, sigma_north_mps: 0.12, sigma_east_mps: 0.2, samples: 400,
+    method: "gps_velocity", time_start_s: 0, time_end_s: 100, refused,
+  });
+  it("says which bands were merged and why the others were refused", () => {
+    const lines = measuredLines({ recording: "a.mcap", bands: [band(245, 2.4, null), band(745, 88, "88.0 m/s is faster than any wind a balloon meets at this height (at most 55 m/s)")] });
+    expect(lines).toEqual([
+      { text: "245–744 m MSL: 2.4 m/s from 270°, 1σ 0.20 m/s · merged", refused: false },
+      { text: "745–1244 m MSL: 88.0 m/s from 270°, 1σ 0.20 m/s · refused: 88.0 m/s is faster than any wind a balloon meets at this height (at most 55 m/s)", refused: true },
+    ]);
   });
 });

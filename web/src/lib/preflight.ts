@@ -1,7 +1,8 @@
 // The Plan page's pure parts: the form's text to a `POST /api/plan` body (each number checked
 // here so the person is told which box is wrong before anything is sent; the station checks the
 // rules again and its reasons are shown as it gives them), the forecast table as the CSV of
-// `stx plan` forecast files, and a 1-σ ellipse as a polygon for the map.
+// `stx plan` forecast files, the recording's measured wind bands as lines saying which were
+// merged and which refused, and a 1-σ ellipse as a polygon for the map.
 
 import type * as Wire from "../generated/api";
 
@@ -137,4 +138,14 @@ export function ellipsePolygon(centre: [number, number], e: Wire.Ellipse, n = 48
     points.push([lat0 + (north / EARTH_RADIUS_M) * (180 / Math.PI), lon0 + (east / perLonM) * (180 / Math.PI)]);
   }
   return points;
+}
+
+/** One line per band a recording's ascent measured, lowest first: its altitudes, wind, 1-σ (the
+ * larger component's) and whether the plan merged it or why it was refused. */
+export function measuredLines(m: Wire.MeasuredAscentView): { text: string; refused: boolean }[] {
+  return m.bands.map((b) => {
+    const sigma = Math.max(b.sigma_north_mps, b.sigma_east_mps);
+    const wind = `${b.alt_min_msl_m.toFixed(0)}–${b.alt_max_msl_m.toFixed(0)} m MSL: ${b.speed_mps.toFixed(1)} m/s from ${b.from_deg.toFixed(0)}°, 1σ ${sigma.toFixed(2)} m/s`;
+    return b.refused === null ? { text: `${wind} · merged`, refused: false } : { text: `${wind} · refused: ${b.refused}`, refused: true };
+  });
 }

@@ -18,6 +18,7 @@ const band = (over: Partial<AscentBand> = {}): AscentBand => ({
   sigma_east_mps: 0.1,
   samples: 200,
   method: "gps_velocity",
+  refused: null,
   time_start_s: 0,
   time_end_s: 100,
   ...over,

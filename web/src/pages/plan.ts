@@ -3,7 +3,8 @@
 // (`POST /api/plan`, the same plan as `stx plan`). The form starts from the station's own launch
 // site, forecast and target (`GET /api/plan/defaults`); the result is the burst, deploy and
 // landing points with their 1-σ ellipses on the station's map, the unsteered landings, the region
-// steering likely reaches and the target's reachability. Errors, the page's or the station's,
+// steering likely reaches and the target's reachability, and with a recording the wind bands its
+// ascent measured, each merged into the forecast or refused with the reason. Errors, the page's or the station's,
 // are shown beside the form.
 
 import "../styles/common.css";
@@ -11,7 +12,7 @@ import "../styles/plan.css";
 import type * as Wire from "../generated/api";
 import { Api, ApiError } from "../lib/api";
 import { parseSession } from "../lib/parse";
-import { type PlanForm, buildRequest, formOf } from "../lib/preflight";
+import { type PlanForm, buildRequest, formOf, measuredLines } from "../lib/preflight";
 import { resolveToken, searchWithoutToken } from "../lib/token";
 import { h, setText } from "../ui/dom";
 import { PreflightMap } from "../ui/preflightMap";
@@ -67,7 +68,8 @@ const out = {
   reach: h("div", { class: "line", "data-testid": "plan-reach" }),
   target: h("div", { class: "line", "data-testid": "plan-target" }),
 };
-const result = h("section", { class: "plan-lines", "data-testid": "plan-result", hidden: true }, ...Object.values(out));
+const measured = h("section", { class: "plan-lines", "data-testid": "plan-measured", hidden: true });
+const result = h("section", { class: "plan-lines", "data-testid": "plan-result", hidden: true }, ...Object.values(out), measured);
 const mapSlot = h("div", {});
 const app = document.getElementById("app")!;
 app.replaceChildren(
@@ -88,7 +90,7 @@ function pointLine(name: string, p: Wire.PlannedPoint): string {
   return `${name}: ${p.lat_deg.toFixed(5)}, ${p.lon_deg.toFixed(5)}, ${p.alt_msl_m.toFixed(0)} m MSL · N ${p.north_m.toFixed(0)} m, E ${p.east_m.toFixed(0)} m of launch · T+${clock(p.time_s)} ±${p.time_sigma_s.toFixed(0)} s · 1σ ${e.semi_major_m.toFixed(0)} × ${e.semi_minor_m.toFixed(0)} m at ${axis.toFixed(0)}°`;
 }
 
-function showPlan(plan: Wire.PlanReport): void {
+function showPlan(plan: Wire.PreflightReport): void {
   setText(out.burst, pointLine("Burst", plan.burst));
   setText(out.deploy, pointLine("Parafoil deploy", plan.deploy));
   setText(out.landing, pointLine("Landing, unsteered", plan.landing_unsteered));
@@ -96,6 +98,16 @@ function showPlan(plan: Wire.PlanReport): void {
   setText(out.reach, `Steering reaches ${plan.steered_reach_radius_m.toFixed(0)} m around the drifted air mass on average; the green region is reached in ${(100 * plan.steered_region_probability).toFixed(0)} % of the samples (${plan.landing_samples_lat_lon_deg.length} landings drawn)`);
   const t = plan.target;
   setText(out.target, t ? `Target ${t.lat_deg.toFixed(5)}, ${t.lon_deg.toFixed(5)}: reachable in ${(100 * t.reachable_probability).toFixed(0)} % of the samples, ${t.from_unsteered_landing_m.toFixed(0)} m from the unsteered landing` : "No target given");
+  const m = plan.measured_ascent;
+  measured.hidden = m === null;
+  measured.replaceChildren(
+    ...(m === null
+      ? []
+      : [
+          h("div", { class: "line" }, `Measured ascent of ${m.recording}: ${m.bands.filter((b) => b.refused === null).length} of ${m.bands.length} bands merged into the forecast`),
+          ...measuredLines(m).map((l) => h("div", { class: l.refused ? "line plan-refused" : "line", "data-testid": "plan-measured-band" }, l.text)),
+        ]),
+  );
   result.hidden = false;
   map?.show(plan);
 }
@@ -123,7 +135,7 @@ async function plan(): Promise<void> {
   setText(status, "computing…");
   const started = performance.now();
   try {
-    const report = await api.post<Wire.PlanReport>("/api/plan", built.body);
+    const report = await api.post<Wire.PreflightReport>("/api/plan", built.body);
     showPlan(report);
     setText(status, `planned ${report.request.runs} samples in ${((performance.now() - started) / 1000).toFixed(1)} s`);
   } catch (e) {

@@ -14,7 +14,7 @@ const dot = (color: string, testid: string, label: string): L.DivIcon =>
   L.divIcon({ className: "plan-mk", html: `<div data-testid="${testid}" title="${label}" style="width:14px;height:14px;border-radius:50%;background:${color};border:2px solid #fff;box-shadow:0 0 0 1px #000"></div>`, iconSize: [18, 18], iconAnchor: [9, 9] });
 
 /** Each planned point: its name on the page, colour and test id. */
-const POINTS: [keyof Pick<Wire.PlanReport, "burst" | "deploy" | "landing_unsteered">, string, string][] = [
+const POINTS: [keyof Pick<Wire.PreflightReport, "burst" | "deploy" | "landing_unsteered">, string, string][] = [
   ["burst", "#b00000", "burst"],
   ["deploy", "#7a4b00", "deploy"],
   ["landing_unsteered", "#0b2f8a", "landing"],
@@ -36,7 +36,7 @@ export class PreflightMap {
   }
 
   /** Draws `plan` and frames it. */
-  show(plan: Wire.PlanReport): void {
+  show(plan: Wire.PreflightReport): void {
     this.map.invalidateSize();
     this.layers.clearLayers();
     const r = plan.request;

@@ -64,6 +64,16 @@ pub struct AscentWindConfig {
     /// leaves the standard error more degrees of freedom. Longer-lived errors belong to
     /// `velocity_floor_mps`.
     pub correlation_window_s: f64,
+    /// Fastest wind believed at the frame's ground, m/s (> 0); a band faster than the bound
+    /// at its height is refused (see `plausible.rs` for the rule and why).
+    pub max_wind_ground_mps: f64,
+    /// Growth of that bound with height, m/s per km (≥ 0).
+    pub max_wind_gain_mps_per_km: f64,
+    /// Fastest wind believed at any height, m/s (> 0).
+    pub max_wind_mps: f64,
+    /// Largest component 1-σ of a band that is used, m/s (> 0); a less certain band is
+    /// refused.
+    pub max_sigma_mps: f64,
 }
 
 impl Default for AscentWindConfig {
@@ -77,6 +87,10 @@ impl Default for AscentWindConfig {
             velocity_floor_mps: 0.05,
             pendulum_amplitude_m: 2.0,
             correlation_window_s: 45.0,
+            max_wind_ground_mps: 40.0,
+            max_wind_gain_mps_per_km: 10.0,
+            max_wind_mps: 120.0,
+            max_sigma_mps: 3.0,
         }
     }
 }
@@ -112,6 +126,10 @@ impl AscentWindConfig {
         non_negative("velocity_floor_mps", self.velocity_floor_mps)?;
         non_negative("pendulum_amplitude_m", self.pendulum_amplitude_m)?;
         positive("correlation_window_s", self.correlation_window_s)?;
+        positive("max_wind_ground_mps", self.max_wind_ground_mps)?;
+        non_negative("max_wind_gain_mps_per_km", self.max_wind_gain_mps_per_km)?;
+        positive("max_wind_mps", self.max_wind_mps)?;
+        positive("max_sigma_mps", self.max_sigma_mps)?;
         Ok(())
     }
 }

@@ -4,8 +4,9 @@ use stx_dynamics::wind::{ProfileRow, WindError, WindProfile};
 
 use super::WindBand;
 
-/// A [`WindProfile`] of the measured `bands` (as [`super::AscentWindEstimator::profile`]
-/// returns them, lowest first) with the `forecast` rows (altitude above the local origin,
+/// A [`WindProfile`] of the believed measured `bands` (as
+/// [`super::AscentWindEstimator::profile`] returns them, lowest first; refused ones are left
+/// out) with the `forecast` rows (altitude above the local origin,
 /// strictly increasing) strictly below the lowest band's lowest fix and strictly above the
 /// highest band's highest fix; forecast rows inside the measured span are dropped. With no
 /// band, the forecast alone; with neither, [`WindError::EmptyProfile`].
@@ -20,6 +21,7 @@ pub fn merge_with_forecast(
     if !forecast.is_empty() {
         WindProfile::new(forecast.to_vec())?;
     }
+    let bands: Vec<&WindBand> = bands.iter().filter(|b| b.is_believed()).collect();
     let (Some(lowest), Some(highest)) = (bands.first(), bands.last()) else {
         return WindProfile::new(forecast.to_vec());
     };
@@ -31,7 +33,7 @@ pub fn merge_with_forecast(
         .filter(|r| r.altitude_m > highest.altitude_max_m);
     let rows = below
         .copied()
-        .chain(bands.iter().map(WindBand::profile_row))
+        .chain(bands.iter().map(|b| b.profile_row()))
         .chain(above.copied())
         .collect();
     WindProfile::new(rows)

@@ -52,7 +52,11 @@
 //! convention of [`stx_dynamics::wind::WindProfile`]. A forecast given above mean sea level is
 //! brought to it by subtracting the origin's `alt_msl_m`.
 //!
-//! **Merging** ([`merge_with_forecast`]): measured bands wherever the ascent measured, the
+//! **Believed or refused** (`plausible.rs`): a band faster than any wind a balloon meets at
+//! its height, or with a σ too large to be of use, is reported with the reason
+//! ([`WindBand::refused`]) and never merged.
+//!
+//! **Merging** ([`merge_with_forecast`]): believed bands wherever the ascent measured, the
 //! forecast outside. Forecast rows strictly above the top of the highest measured band and
 //! strictly below the bottom of the lowest one are kept (the latter matters when tracking
 //! started above the ground, or for a surface row under the first band); forecast rows within
@@ -63,6 +67,7 @@
 mod config;
 mod fit;
 mod merge;
+mod plausible;
 
 use std::collections::{BTreeMap, VecDeque};
 
@@ -73,6 +78,7 @@ use thiserror::Error;
 
 pub use config::{AscentWindConfig, AscentWindConfigError};
 pub use merge::merge_with_forecast;
+pub use plausible::{Implausible, judge, max_plausible_wind_mps};
 
 use crate::geo::LocalFrame;
 use crate::measurement::GpsFix;
@@ -216,9 +222,18 @@ pub struct WindBand {
     pub samples: u32,
     /// Velocities or positions.
     pub method: BandMethod,
+    /// Why the band is not believed (see `plausible.rs`); `None`: it is, and it is merged
+    /// into the profile the predictions fly.
+    #[serde(default)]
+    pub refused: Option<Implausible>,
 }
 
 impl WindBand {
+    /// Believed: merged into the profiles (see [`Implausible`]).
+    pub fn is_believed(&self) -> bool {
+        self.refused.is_none()
+    }
+
     /// Wind speed, m/s.
     pub fn speed_mps(&self) -> f64 {
         self.wind_north_mps.hypot(self.wind_east_mps)
@@ -467,7 +482,7 @@ impl AscentWindEstimator {
             low = low.min(s.altitude_m);
             high = high.max(s.altitude_m);
         }
-        Some(WindBand {
+        let mut measured = WindBand {
             band,
             altitude_m: 0.5 * (low + high),
             altitude_min_m: low,
@@ -480,7 +495,10 @@ impl AscentWindEstimator {
             sigma_east_mps: (east.variance + extra).sqrt(),
             samples: u32::try_from(used.len()).unwrap_or(u32::MAX),
             method,
-        })
+            refused: None,
+        };
+        measured.refused = plausible::judge(&measured, &self.config);
+        Some(measured)
     }
 }
 

@@ -67,6 +67,7 @@ fn band(wind_north_mps: f64, wind_east_mps: f64) -> WindBand {
         sigma_east_mps: 0.1,
         samples: 100,
         method: BandMethod::GpsVelocity,
+        refused: None,
     }
 }
 
@@ -331,4 +332,99 @@ fn merge_refuses_a_bad_forecast_even_where_measured() {
         merge_with_forecast(&[measured], &nan),
         Err(WindError::ProfileRowNotFinite { row: 0, .. })
     ));
+}
+
+#[test]
+fn the_believed_wind_grows_from_the_ground_to_the_jet_streams_bound() {
+    let c = AscentWindConfig::default();
+    for (height_m, limit) in [
+        (-50.0, 40.0),
+        (0.0, 40.0),
+        (1000.0, 50.0),
+        (8000.0, 120.0),
+        (30_000.0, 120.0),
+    ] {
+        assert!(
+            (max_plausible_wind_mps(&c, height_m) - limit).abs() < 1e-9,
+            "{height_m}"
+        );
+    }
+}
+
+#[test]
+fn a_band_too_fast_or_too_uncertain_is_refused_with_its_reason_and_not_merged() {
+    let c = AscentWindConfig::default();
+    let believed = band(-2.0, 5.0);
+    assert_eq!(judge(&believed, &c), None);
+    // 88 m/s at 1000–1499 m: the bound there is 55 m/s.
+    let fast = band(0.0, 88.0);
+    match judge(&fast, &c) {
+        Some(Implausible::TooFast {
+            speed_mps,
+            limit_mps,
+        }) => {
+            assert!((speed_mps - 88.0).abs() < 1e-9 && (limit_mps - 54.99).abs() < 1e-9);
+        }
+        other => panic!("{other:?}"),
+    }
+    let uncertain = WindBand {
+        sigma_east_mps: 3.5,
+        ..believed
+    };
+    assert!(matches!(
+        judge(&uncertain, &c),
+        Some(Implausible::TooUncertain { sigma_mps, .. }) if sigma_mps == 3.5
+    ));
+    let nan = band(f64::NAN, 0.0);
+    assert!(matches!(judge(&nan, &c), Some(Implausible::TooFast { .. })));
+    assert!(
+        Implausible::TooFast {
+            speed_mps: 88.0,
+            limit_mps: 55.0
+        }
+        .to_string()
+        .contains("88.0 m/s is faster than any wind")
+    );
+    // Merged: the refused band is left out, the forecast takes its place.
+    let refused = WindBand {
+        refused: judge(&fast, &c),
+        ..fast
+    };
+    let forecast = [row(0.0, 3.0, 270.0), row(5000.0, 3.0, 270.0)];
+    let merged = merge_with_forecast(&[refused], &forecast).expect("valid");
+    assert_eq!(merged.rows(), &forecast[..]);
+    let measured = crate::flight_path::merge_measured(&[], &[refused], 0.0);
+    assert_eq!(measured, Err(crate::flight_path::ForecastError::Empty));
+}
+
+/// Issue 28: a recording of a 20× rehearsal read with the station's clock gave 88–176 m/s
+/// between 840 and 2,223 m. The same ascent's fixes timed 20 times too fast are all refused.
+#[test]
+fn regression_absurd_measured_winds_from_a_20x_rehearsal_on_the_stations_clock_are_refused() {
+    let on_the_drones_clock: Vec<AscentFix> = ascent(0.0, 0.0, 5.0, 500, false);
+    let mut est = estimator();
+    feed(&mut est, &on_the_drones_clock);
+    let believed = est.profile();
+    assert_eq!(believed.len(), 5);
+    assert!(believed.iter().all(WindBand::is_believed), "{believed:#?}");
+    let on_the_stations_clock: Vec<AscentFix> = on_the_drones_clock
+        .iter()
+        .map(|f| AscentFix {
+            time_s: f.time_s / 20.0,
+            velocity_ned_mps: None,
+            ..*f
+        })
+        .collect();
+    let mut est = estimator();
+    feed(&mut est, &on_the_stations_clock);
+    let bands = est.profile();
+    assert!(bands.len() >= 4, "{bands:#?}");
+    for b in &bands {
+        assert!(b.speed_mps() > 80.0, "{b:?}");
+        assert!(
+            matches!(b.refused, Some(Implausible::TooFast { .. })),
+            "{b:?}"
+        );
+    }
+    assert_eq!(est.merged_with_forecast(&[]), Err(WindError::EmptyProfile));
 }

@@ -163,13 +163,14 @@ impl Forecast {
 /// (`bands` above an origin `origin_msl_m` above sea level, lowest first, as
 /// [`crate::ascent_wind::AscentWindEstimator::profile`] gives them) in place of the forecast
 /// rows over the span the measurement covers — the rule of
-/// [`crate::ascent_wind::merge_with_forecast`] — each band's sigma the larger of its two
-/// components'.
+/// [`crate::ascent_wind::merge_with_forecast`], refused bands left out — each band's sigma the
+/// larger of its two components'.
 pub fn merge_measured(
     forecast: &[ForecastRow],
     bands: &[WindBand],
     origin_msl_m: f64,
 ) -> Result<Forecast, ForecastError> {
+    let bands: Vec<&WindBand> = bands.iter().filter(|b| b.is_believed()).collect();
     let (Some(lowest), Some(highest)) = (bands.first(), bands.last()) else {
         return Forecast::new(forecast.to_vec());
     };

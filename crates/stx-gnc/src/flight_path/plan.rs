@@ -380,30 +380,3 @@ pub fn plan(request: &PlanRequest) -> Result<PlanReport, PlanError> {
         landing_samples_lat_lon_deg: samples.iter().map(|s| geo(s.landing_ne_m)).collect(),
     })
 }
-
-/// The wind an earlier flight measured on its ascent, from its GPS track: `(time s, latitude
-/// degrees, longitude degrees, altitude m MSL)` in time order. The frame's origin is the first
-/// fix (on the pad); the bands are above it, as [`super::Forecast::merged_with_bands`] takes
-/// them with the frame's altitude. Fixes the estimator refuses (non-finite, out of order) are
-/// skipped; its own rules decide which fixes belong to the ascent.
-pub fn measured_ascent(
-    track: &[(f64, f64, f64, f64)],
-) -> (Vec<crate::ascent_wind::WindBand>, LocalFrame) {
-    use crate::ascent_wind::{AscentFix, AscentWindConfig, AscentWindEstimator};
-    let Some(&(_, lat_deg, lon_deg, alt_msl_m)) = track.first() else {
-        return (Vec::new(), LocalFrame::default());
-    };
-    let frame = LocalFrame {
-        lat_deg,
-        lon_deg,
-        alt_msl_m,
-    };
-    let Ok(mut estimator) = AscentWindEstimator::new(AscentWindConfig::default()) else {
-        return (Vec::new(), frame);
-    };
-    for &(t, lat, lon, alt) in track {
-        // A refused fix is one the estimator cannot use; the rest still measure the wind.
-        let _ = estimator.push_fix(&AscentFix::from_geodetic(&frame, t, lat, lon, alt, None));
-    }
-    (estimator.profile(), frame)
-}

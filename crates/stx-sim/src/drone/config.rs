@@ -305,6 +305,16 @@ impl MissionConfig {
             })?;
         config.estimator.ground_altitude_msl_m = config.site.alt_msl_m;
         config.validate()?;
+        // The drone is loaded with its balloon's expected burst and ascent rate before launch
+        // (MIS_BURST_M, MIS_ASCENT_MPS), unless the scenario loads other values.
+        let (balloon, mission) = (&config.balloon, &mut config.onboard.mission);
+        if mission.expected_burst_msl_m == 0.0 {
+            mission.expected_burst_msl_m = balloon.burst_altitude_msl_m;
+        }
+        if mission.expected_ascent_rate_mps == 0.0 {
+            mission.expected_ascent_rate_mps = balloon.mean_ascent_rate_mps;
+        }
+        config.validate()?;
         Ok(config)
     }
 
@@ -543,6 +553,13 @@ mod tests {
                 MissionConfig::from_toml_str(name, text).unwrap_or_else(|e| panic!("{name}: {e}"));
             assert_eq!(&m.name, name);
         }
+    }
+
+    #[test]
+    fn the_drone_is_loaded_with_its_balloons_burst_and_ascent_rate() {
+        let m = MissionConfig::builtin("mission-short").expect("built in");
+        assert_eq!(m.onboard.mission.expected_burst_msl_m, 3000.0);
+        assert_eq!(m.onboard.mission.expected_ascent_rate_mps, 5.0);
     }
 
     #[test]

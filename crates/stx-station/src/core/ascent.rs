@@ -2,7 +2,9 @@
 //! pure [`AscentWindEstimator`]; the bands it measures are refitted at most every
 //! [`REFIT_EVERY_S`], sent to the pages (`ascent_wind`) when they change, and joined to the
 //! forecast into the profile every descent prediction flies in
-//! ([`StationCore::wind_profile`]).
+//! ([`StationCore::wind_profile`]). A band the estimator refuses as implausible (faster than
+//! any wind a balloon meets at its height, or too uncertain: `stx_gnc::ascent_wind`'s
+//! `plausible.rs`) is sent with its reason and logged once, but never merged.
 //!
 //! **Clock.** Fixes are timed on the drone's clock (radio delays and accelerated rehearsals
 //! do not distort it), continued across a restart of the drone: the estimator needs times
@@ -18,7 +20,9 @@
 //! (the estimator has latched the end of that ascent): restart the station between flights.
 
 use stx_dynamics::wind::{ProfileRow, WindProfile};
-use stx_gnc::ascent_wind::{AscentFix, AscentWindConfig, AscentWindEstimator, WindBand};
+use stx_gnc::ascent_wind::{
+    AscentFix, AscentWindConfig, AscentWindEstimator, Implausible, WindBand,
+};
 
 use super::StationCore;
 use crate::messages::{AscentBandView, AscentWindMsg, Level};
@@ -40,6 +44,8 @@ pub(crate) struct AscentWinds {
     clock_offset_s: f64,
     /// The estimator's clock and the station's of the last fix handed in, s.
     last_fix: Option<(f64, f64)>,
+    /// Refused bands already logged: band index, and whether too fast (else too uncertain).
+    said_refused: std::collections::BTreeSet<(i64, bool)>,
 }
 
 impl AscentWinds {
@@ -58,6 +64,7 @@ impl AscentWinds {
             next_refit_s: 0.0,
             clock_offset_s: 0.0,
             last_fix: None,
+            said_refused: Default::default(),
         }
     }
 
@@ -122,40 +129,20 @@ impl AscentWinds {
 impl StationCore {
     /// A fix for the ascent winds from a GPS_RAW_INT with a 3-D fix; its velocity when the
     /// receiver gives speed and course and GLOBAL_POSITION_INT a vertical speed younger than
-    /// a second (GPS_RAW_INT carries none), else positions alone.
+    /// a second (GPS_RAW_INT carries none), else positions alone. Built as a recording's
+    /// fixes are ([`crate::recording::ascent::fix_from_gps`]); the time is set by
+    /// `AscentWinds::push`.
     pub(crate) fn ascent_fix(
         &self,
         now_s: f64,
         g: &stx_link::telemetry::GpsRaw,
     ) -> Option<AscentFix> {
-        if !super::navigation::has_3d_fix(g) {
-            return None;
-        }
         let down = self
             .latest
             .position
             .filter(|(_, t)| now_s - t < 1.0)
             .map(|(p, _)| p.v_down_mps);
-        let velocity = match (g.ground_speed_mps, g.course_deg, down) {
-            (Some(speed), Some(course), Some(down)) => {
-                let c = course.to_radians();
-                Some(nalgebra::Vector3::new(
-                    speed * c.cos(),
-                    speed * c.sin(),
-                    down,
-                ))
-            }
-            _ => None,
-        };
-        // The time is set by `AscentWinds::push`.
-        Some(AscentFix::from_geodetic(
-            &self.frame,
-            0.0,
-            g.lat_deg,
-            g.lon_deg,
-            g.alt_msl_m,
-            velocity,
-        ))
+        crate::recording::ascent::fix_from_gps(&self.frame, 0.0, g, down)
     }
 
     /// Tells the ascent winds that the drone restarted, and the operators what became of
@@ -177,6 +164,30 @@ impl StationCore {
     pub(crate) fn refit_ascent_winds(&mut self, now_s: f64) {
         if self.ascent.refit(now_s) {
             let msg = self.ascent_wind_msg(now_s);
+            let refused: Vec<(i64, Implausible, f64, f64)> = self
+                .ascent
+                .bands()
+                .iter()
+                .filter_map(|b| Some((b.band, b.refused?, b.altitude_min_m, b.altitude_max_m)))
+                .collect();
+            for (band, why, low, high) in refused {
+                // Said once a band and kind of refusal: a refit every few seconds would
+                // repeat it with numbers a little different.
+                let kind = matches!(why, Implausible::TooFast { .. });
+                if self.ascent.said_refused.insert((band, kind)) {
+                    let msl = self.frame.alt_msl_m;
+                    self.log(
+                        now_s,
+                        Level::Warning,
+                        "station",
+                        format!(
+                            "ascent winds: the band {:.0}–{:.0} m MSL is refused, not used for predictions: {why}",
+                            low + msl,
+                            high + msl
+                        ),
+                    );
+                }
+            }
             self.outbound.push(super::Outbound::AscentWind(msg));
         }
     }
@@ -217,7 +228,6 @@ impl StationCore {
 
     /// The `ascent_wind` message: the measured bands as the pages show them.
     pub fn ascent_wind_msg(&self, now_s: f64) -> AscentWindMsg {
-        let msl = |a: f64| a + self.frame.alt_msl_m;
         AscentWindMsg {
             kind: "ascent_wind",
             time_s: now_s,
@@ -228,21 +238,7 @@ impl StationCore {
                 .ascent
                 .bands()
                 .iter()
-                .map(|b| AscentBandView {
-                    alt_msl_m: msl(b.altitude_m),
-                    alt_min_msl_m: msl(b.altitude_min_m),
-                    alt_max_msl_m: msl(b.altitude_max_m),
-                    speed_mps: b.speed_mps(),
-                    from_deg: b.from_deg(),
-                    wind_north_mps: b.wind_north_mps,
-                    wind_east_mps: b.wind_east_mps,
-                    sigma_north_mps: b.sigma_north_mps,
-                    sigma_east_mps: b.sigma_east_mps,
-                    samples: b.samples,
-                    method: b.method,
-                    time_start_s: b.time_start_s,
-                    time_end_s: b.time_end_s,
-                })
+                .map(|b| AscentBandView::of(b, self.frame.alt_msl_m))
                 .collect(),
         }
     }

@@ -8,7 +8,11 @@
 //!
 //! The stack's settings come from the station config (`[flight_path]`), except those the
 //! drone holds as parameters, which win once its table is read: `MIS_DEPLOY_M` (the deploy
-//! height) and `MIS_CUTDOWN_M` (a cutdown below the burst altitude ends the ascent there).
+//! height), `MIS_CUTDOWN_M` (a cutdown below the burst altitude ends the ascent there), and the
+//! launch profile loaded before launch, `MIS_BURST_M` and `MIS_ASCENT_MPS` (0: not loaded).
+//! The launch profile is never a silent default: the view says where the burst altitude and
+//! the ascent rate came from (`drone` or `station_config`), and with neither a loaded parameter
+//! nor a value in the configuration file there is no path, and the operators are told why.
 //!
 //! A path costs well under a millisecond (10 m altitude steps to 35 km, a 0.5 s glide), so
 //! it runs on the core's tick rather than as a detached job.
@@ -25,6 +29,31 @@ use crate::messages::{FlightPathView, Level, PathPointView};
 /// Seconds of the drone's clock between two flight paths, s.
 pub const FLIGHT_PATH_EVERY_S: f64 = 2.0;
 
+/// Where a launch-profile setting the path flies comes from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum LaunchSource {
+    /// The drone's parameter, loaded before launch.
+    Drone,
+    /// The station config's `[flight_path]`.
+    StationConfig,
+}
+
+impl LaunchSource {
+    fn name(self) -> &'static str {
+        match self {
+            Self::Drone => "drone",
+            Self::StationConfig => "station_config",
+        }
+    }
+}
+
+/// Where the path's burst altitude and ascent rate come from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct LaunchSources {
+    burst: LaunchSource,
+    ascent_rate: LaunchSource,
+}
+
 /// The latest path and when the next is due.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct LivePath {
@@ -35,8 +64,10 @@ pub(crate) struct LivePath {
 }
 
 impl StationCore {
-    /// The stack as the path flies it: the configured one, with the drone's parameters.
-    pub(crate) fn stack_config(&self) -> StackConfig {
+    /// The stack as the path flies it: the configured one, with the drone's parameters, and
+    /// where its burst altitude and ascent rate come from; the reason when one is known to
+    /// neither the drone nor the configuration.
+    pub(crate) fn stack_config(&self) -> Result<(StackConfig, LaunchSources), String> {
         let mut stack = self.config.flight_path;
         let param = |name: &str| {
             self.params
@@ -48,10 +79,42 @@ impl StationCore {
         if let Some(deploy) = param("MIS_DEPLOY_M").filter(|v| *v >= 0.0) {
             stack.deploy_height_m = deploy;
         }
+        let configured = |key: &str| !self.config.flight_path_unset.contains(&key);
+        let mut unknown = Vec::new();
+        let mut pick = |name: &str, key: &str, what: &str, value: &mut f64| {
+            if let Some(v) = param(name).filter(|v| *v > 0.0) {
+                *value = v;
+                return LaunchSource::Drone;
+            }
+            if !configured(key) {
+                unknown.push(format!(
+                    "{what} (the drone's {name}, or [flight_path] {key})"
+                ));
+            }
+            LaunchSource::StationConfig
+        };
+        let burst = pick(
+            "MIS_BURST_M",
+            "burst_altitude_msl_m",
+            "the burst altitude",
+            &mut stack.burst_altitude_msl_m,
+        );
+        let ascent_rate = pick(
+            "MIS_ASCENT_MPS",
+            "mean_ascent_rate_mps",
+            "the ascent rate",
+            &mut stack.mean_ascent_rate_mps,
+        );
+        if !unknown.is_empty() {
+            return Err(format!(
+                "neither the drone nor the station config gives {}",
+                unknown.join(" nor ")
+            ));
+        }
         if let Some(cutdown) = param("MIS_CUTDOWN_M").filter(|v| *v > 0.0) {
             stack.burst_altitude_msl_m = stack.burst_altitude_msl_m.min(cutdown);
         }
-        stack
+        Ok((stack, LaunchSources { burst, ascent_rate }))
     }
 
     /// Recomputes the path when one is due.
@@ -95,10 +158,16 @@ impl StationCore {
             atmosphere: &StandardAtmosphere,
             ground_msl_m: self.frame.alt_msl_m,
         };
-        let stack = self.stack_config();
+        let (stack, sources) = match self.stack_config() {
+            Ok(s) => s,
+            Err(reason) => {
+                self.flight_path_failed(now_s, &reason);
+                return;
+            }
+        };
         match propagate(start, &stack, air, &self.config.guidance.performance) {
             Ok(path) => {
-                let view = self.flight_path_view(now_s, stage, &path);
+                let view = self.flight_path_view(now_s, stage, &path, sources);
                 self.live_path.view = Some(view);
                 self.live_path.said = None;
             }
@@ -124,6 +193,7 @@ impl StationCore {
         now_s: f64,
         stage: FlightStage,
         path: &FlightPath,
+        sources: LaunchSources,
     ) -> FlightPathView {
         let point = |p: &PathPoint| {
             let ned = Vector3::from(p.position_ned_m);
@@ -137,7 +207,12 @@ impl StationCore {
         };
         let [n, e] = path.reach.centre_ne_m;
         let (lat, lon, _) = self.frame.to_geodetic(&Vector3::new(n, e, 0.0));
-        let bands = self.ascent.bands();
+        let bands: Vec<_> = self
+            .ascent
+            .bands()
+            .iter()
+            .filter(|b| b.is_believed())
+            .collect();
         FlightPathView {
             computed_s: now_s,
             stage: match stage {
@@ -157,6 +232,8 @@ impl StationCore {
                 .iter()
                 .map(|b| b.altitude_max_m + self.frame.alt_msl_m)
                 .reduce(f64::max),
+            burst_source: sources.burst.name().to_string(),
+            ascent_rate_source: sources.ascent_rate.name().to_string(),
         }
     }
 
@@ -195,7 +272,23 @@ mod tests {
         config.flight_path.ascent_density_exponent = 0.0;
         config.flight_path.mean_ascent_rate_mps = 5.0;
         config.flight_path.burst_altitude_msl_m = 30_000.0;
+        // Set here rather than in the file: the station's config gives both.
+        config.flight_path_unset.clear();
         StationCore::new(config, 0)
+    }
+
+    fn set_param(core: &mut StationCore, name: &str, value: f32) {
+        core.on_link_event(
+            0.0,
+            GroundEvent::Param(stx_link::param::ParamEvent::Value {
+                param: ParamValue {
+                    name: name.into(),
+                    value,
+                    index: 0,
+                    count: 50,
+                },
+            }),
+        );
     }
 
     fn hear(core: &mut StationCore, now_s: f64, stage: FlightStage, height_m: f64) {
@@ -252,23 +345,92 @@ mod tests {
         assert!((deploy_height - core.config.flight_path.deploy_height_m).abs() < 11.0);
         assert!(east_of_origin(&core, &path.round_chute_landing) > deploy);
         assert_eq!(path.measured_bands, 0, "the forecast alone");
+        assert_eq!(
+            (path.burst_source.as_str(), path.ascent_rate_source.as_str()),
+            ("station_config", "station_config")
+        );
+    }
+
+    /// Issue 28: the map said "burst in 1 h 45 min at 35.0 km" while the drone, loaded for
+    /// mission-short, bursts at 3,000 m. The drone's MIS_BURST_M and MIS_ASCENT_MPS win over
+    /// the station config's, and the view says so.
+    #[test]
+    fn regression_the_drones_burst_altitude_and_ascent_rate_win_and_the_view_says_so() {
+        let mut core = core();
+        set_param(&mut core, "MIS_BURST_M", 3_000.0);
+        set_param(&mut core, "MIS_ASCENT_MPS", 4.0);
+        hear(&mut core, 10.0, FlightStage::Ascent, 1_000.0);
+        let path = core.flight_path_view_now().expect("path");
+        let burst = path.burst.as_ref().expect("burst");
+        assert!(
+            (burst.alt_msl_m - 3_000.0).abs() < 1.0,
+            "{}",
+            burst.alt_msl_m
+        );
+        let climb_s = (3_000.0 - (core.frame.alt_msl_m + 1_000.0)) / 4.0;
+        assert!((burst.in_s - climb_s).abs() < 1.0, "{} s", burst.in_s);
+        assert_eq!(
+            (path.burst_source.as_str(), path.ascent_rate_source.as_str()),
+            ("drone", "drone")
+        );
+        // 0 is "not loaded": the station config's value again.
+        set_param(&mut core, "MIS_BURST_M", 0.0);
+        hear(
+            &mut core,
+            10.0 + FLIGHT_PATH_EVERY_S,
+            FlightStage::Ascent,
+            1_000.0,
+        );
+        let path = core.flight_path_view_now().expect("path");
+        assert!((path.burst.expect("burst").alt_msl_m - 30_000.0).abs() < 1.0);
+        assert_eq!(path.burst_source, "station_config");
+    }
+
+    #[test]
+    fn with_no_burst_altitude_from_the_drone_or_the_config_file_there_is_no_path_and_it_is_said() {
+        let mut config = StationConfig::from_toml_str(DEFAULT_STATION_TOML).expect("config");
+        // The shipped file has a forecast-free [flight_path]-free station: give it a wind.
+        config.forecast_wind = vec![ForecastRow {
+            alt_msl_m: 0.0,
+            speed_mps: 5.0,
+            from_deg: 270.0,
+            sigma_mps: None,
+        }];
+        assert_eq!(
+            config.flight_path_unset,
+            vec!["burst_altitude_msl_m", "mean_ascent_rate_mps"]
+        );
+        let mut core = StationCore::new(config, 0);
+        hear(&mut core, 10.0, FlightStage::Ascent, 1_000.0);
+        assert!(core.flight_path_view_now().is_none(), "no silent default");
+        let said: Vec<String> = core.events_since(0.0).into_iter().map(|e| e.text).collect();
+        assert!(
+            said.iter().any(|t| t
+                .contains("neither the drone nor the station config gives the burst altitude")
+                && t.contains("MIS_BURST_M")
+                && t.contains("the ascent rate")),
+            "{said:?}"
+        );
+        // The drone's parameters are enough.
+        set_param(&mut core, "MIS_BURST_M", 3_000.0);
+        set_param(&mut core, "MIS_ASCENT_MPS", 5.0);
+        hear(
+            &mut core,
+            10.0 + FLIGHT_PATH_EVERY_S,
+            FlightStage::Ascent,
+            1_000.0,
+        );
+        let path = core
+            .flight_path_view_now()
+            .expect("a path from the drone's launch profile");
+        assert_eq!(path.burst_source, "drone");
     }
 
     #[test]
     fn the_drones_deploy_and_cutdown_parameters_win_and_the_round_chute_has_no_burst() {
         let mut core = core();
         for (name, value) in [("MIS_DEPLOY_M", 1_500.0), ("MIS_CUTDOWN_M", 20_000.0)] {
-            core.on_link_event(
-                0.0,
-                GroundEvent::Param(stx_link::param::ParamEvent::Value {
-                    param: ParamValue {
-                        name: name.into(),
-                        value,
-                        index: 0,
-                        count: 50,
-                    },
-                }),
-            );
+            set_param(&mut core, name, value);
         }
         hear(&mut core, 10.0, FlightStage::Ascent, 5_000.0);
         let path = core.flight_path_view_now().expect("path");

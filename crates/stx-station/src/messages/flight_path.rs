@@ -12,8 +12,9 @@ pub struct FlightPathView {
     pub computed_s: f64,
     /// The stage it was computed in: `ascent` (or `pre_launch`) or `round_chute`.
     pub stage: String,
-    /// Where the balloon bursts (or the drone cuts it away at `MIS_CUTDOWN_M`); `null` under
-    /// the round chute.
+    /// Where the balloon bursts (at the drone's `MIS_BURST_M`, else the station config's
+    /// burst altitude, or where the drone cuts it away at `MIS_CUTDOWN_M`); `null` under the
+    /// round chute.
     pub burst: Option<PathPointView>,
     /// Where the round chute is released and the parafoil deploys (`MIS_DEPLOY_M`).
     pub deploy: PathPointView,
@@ -31,6 +32,12 @@ pub struct FlightPathView {
     /// Altitude of the highest measured band's top, m above mean sea level: above it the
     /// path flies the forecast; `null` without bands.
     pub measured_to_msl_m: Option<f64>,
+    /// Where the burst altitude comes from: `drone` (its `MIS_BURST_M`, loaded before launch)
+    /// or `station_config` (`[flight_path] burst_altitude_msl_m`).
+    pub burst_source: String,
+    /// Where the ascent rate comes from: `drone` (`MIS_ASCENT_MPS`) or `station_config`
+    /// (`[flight_path] mean_ascent_rate_mps`).
+    pub ascent_rate_source: String,
 }
 
 /// A point of the flight path.
