@@ -283,9 +283,11 @@ pub struct StateMsg {
     pub kind: &'static str,
     /// The station's clock: s since it started (its timers and ages run on it).
     pub time_s: f64,
-    /// The mission clock: the drone's (s since its boot) at its newest time-stamped telemetry;
-    /// plots, the T+ clock, countdowns and the log show it, at any rehearsal speed. `null`
-    /// before the drone is heard.
+    /// The mission clock: the drone's (s since its boot) at its newest time-stamped telemetry,
+    /// carried forward at the rate it has been running against the station's clock (1 in a
+    /// real flight, 20 in a rehearsal at 20×), so it runs on through a silent link. Plots, the
+    /// T+ clock, countdowns and the log show it, at any speed. `null` before the drone is
+    /// heard.
     pub mission_time_s: Option<f64>,
     /// Unix time, ms.
     pub wall_ms: u64,

@@ -701,6 +701,14 @@ export interface StateMsg {
    */
   mission: MissionView;
   /**
+   * The mission clock: the drone's (s since its boot) at its newest time-stamped telemetry,
+   * carried forward at the rate it has been running against the station's clock (1 in a
+   * real flight, 20 in a rehearsal at 20×), so it runs on through a silent link. Plots, the
+   * T+ clock, countdowns and the log show it, at any speed. `null` before the drone is
+   * heard.
+   */
+  mission_time_s: number | null;
+  /**
    * Prediction.
    */
   prediction: PredictionView | null;
@@ -714,7 +722,7 @@ export interface StateMsg {
    */
   replay: ReplayView | null;
   /**
-   * Mission clock, s.
+   * The station's clock: s since it started (its timers and ages run on it).
    */
   time_s: number;
   /**
@@ -846,7 +854,12 @@ export interface FlightPathView {
    */
   burst_source: string;
   /**
-   * Mission clock when it was computed, s.
+   * The mission clock (the drone's) of the fix it started from, s: its `in_s` count from
+   * there, so a countdown is `in_s − (mission_time_s − computed_mission_s)`.
+   */
+  computed_mission_s: number;
+  /**
+   * The station's clock when it was computed, s.
    */
   computed_s: number;
   /**
@@ -1002,6 +1015,11 @@ export interface GuidanceView {
    */
   commands: CommandsView;
   /**
+   * The replica disagrees with the drone (or did, a few seconds ago): an alarm for every
+   * page; `null` while they agree.
+   */
+  disagreement: DisagreementView | null;
+  /**
    * The localizer line, once known.
    */
   localizer: LocalizerView | null;
@@ -1044,6 +1062,39 @@ export interface CommandsView {
    * Main line, −1…1 of its travel.
    */
   main_line: number;
+}
+/**
+ * The guidance replica and the drone disagree (or did, a few seconds ago).
+ */
+export interface DisagreementView {
+  /**
+   * It ended with the replica taking the drone's value.
+   */
+  adopted: boolean;
+  /**
+   * The drone's.
+   */
+  drone: string;
+  /**
+   * How long it has lasted (or lasted), s.
+   */
+  for_s: number;
+  /**
+   * The replica's value.
+   */
+  replica: string;
+  /**
+   * It is over.
+   */
+  resolved: boolean;
+  /**
+   * The mission clock when it began, s.
+   */
+  since_s: number;
+  /**
+   * What they disagree on.
+   */
+  what: "phase";
 }
 /**
  * The localizer line the replica follows.
@@ -1199,13 +1250,45 @@ export interface RadioView {
  */
 export interface MissionView {
   /**
-   * When an armed cutdown expires, s.
+   * When an armed cutdown expires, s of the station's clock.
    */
   cutdown_armed_until_s: number | null;
+  /**
+   * Where the drone landed and how far from its target, once it has.
+   */
+  landing: LandingView | null;
   /**
    * Stage.
    */
   stage: FlightStage | null;
+}
+/**
+ * The landing, as the station measured it: one figure for every page, the log, the recording
+ * and its replay.
+ */
+export interface LandingView {
+  /**
+   * Which body the position is of: `drone` (its GPS receiver is on the drone; the capsule
+   * and the transponder hang a few metres below it).
+   */
+  body: string;
+  /**
+   * Horizontal distance from `target`, m (`null` without a target).
+   */
+  miss_m: number | null;
+  /**
+   * Where: the drone's GPS receiver at its first 3-D fix after it reported `landed`.
+   */
+  position: LatLonAlt;
+  /**
+   * The landing target the miss is measured from: the drone's, as the station holds it
+   * (`null`: none known).
+   */
+  target: LatLonAlt | null;
+  /**
+   * The drone's clock at the first GPS fix on the ground, s (the mission clock).
+   */
+  time_s: number;
 }
 /**
  * Both predictions of the station.
@@ -1562,6 +1645,10 @@ export interface EventMsg {
    */
   level: Level;
   /**
+   * The mission clock (the drone's, s) when it happened; `null` before the drone is heard.
+   */
+  mission_time_s: number | null;
+  /**
    * Where it comes from: guidance, link, command, station, vehicle, keep_out (the keep-out
    * zones: loaded, edited, a landing predicted in one).
    */
@@ -1571,7 +1658,7 @@ export interface EventMsg {
    */
   text: string;
   /**
-   * Mission clock, s.
+   * The station's clock, s since it started.
    */
   time_s: number;
   /**
@@ -1629,7 +1716,7 @@ export interface ParamsMsg {
    */
   params: ParamView[];
   /**
-   * Mission clock, s.
+   * The station's clock, s.
    */
   time_s: number;
   /**
@@ -1813,7 +1900,11 @@ export interface TrackPoint {
    */
   lon_deg: number;
   /**
-   * Mission clock, s.
+   * The mission clock (the drone's), s.
+   */
+  mission_time_s: number;
+  /**
+   * The station's clock, s.
    */
   time_s: number;
 }
@@ -2121,7 +2212,8 @@ export interface RecordingSummary {
  */
 export interface LandingSummary {
   /**
-   * Latitude, degrees (the drone's GPS, else the station's estimate).
+   * Latitude, degrees: the landing the station measured (`state.mission.landing`); in
+   * recordings made before it did, the drone's last GPS, else the station's estimate.
    */
   lat_deg: number;
   /**
@@ -2129,7 +2221,8 @@ export interface LandingSummary {
    */
   lon_deg: number;
   /**
-   * Horizontal distance to guidance's target, m (`null` without a target).
+   * Horizontal distance to the drone's target, m, as the station measured it (`null`
+   * without a target): the figure every page shows.
    */
   miss_m: number | null;
 }

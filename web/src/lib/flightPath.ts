@@ -27,6 +27,8 @@ export interface FlightPath {
   measured_to_msl_m: number | null;
   /** Where the burst altitude comes from: "drone", "station_config", or null if not said. */
   burst_source: string | null;
+  /** The mission clock (the drone's) its `in_s` count from, s; null from an older station. */
+  computed_mission_s: number | null;
 }
 
 /** How the badge names a source of the launch profile. */
@@ -64,19 +66,26 @@ export function parseFlightPath(o: Obj): FlightPath | null {
     measured_bands: finite(o.measured_bands) ? o.measured_bands : 0,
     measured_to_msl_m: finite(o.measured_to_msl_m) ? o.measured_to_msl_m : null,
     burst_source: typeof o.burst_source === "string" ? o.burst_source : null,
+    computed_mission_s: finite(o.computed_mission_s) ? o.computed_mission_s : null,
   };
 }
 
-/** The badge: when and how high the burst and the deployment come, and which winds say so. */
-export function flightPathSummary(p: FlightPath): string {
+/**
+ * The badge: when and how high the burst and the deployment come, and which winds say so. The
+ * times count down on the mission clock `mission_time_s` (the drone's) from when the path was
+ * computed, at any rehearsal speed.
+ */
+export function flightPathSummary(p: FlightPath, mission_time_s: number | null = null): string {
+  const elapsed = mission_time_s !== null && p.computed_mission_s !== null ? Math.max(0, mission_time_s - p.computed_mission_s) : 0;
+  const left = (pt: PathPoint): number => Math.max(0, pt.in_s - elapsed);
   const parts: string[] = [];
   if (p.burst) {
     // Never a number without its origin: a station that is not told cannot tell.
     const source = p.burst_source === null ? "source not given" : (SOURCES[p.burst_source] ?? p.burst_source);
-    parts.push(`burst in ${fmtDuration(p.burst.in_s)} at ${fmt(p.burst.alt_msl_m / 1000, "km")} (${source})`);
+    parts.push(`burst in ${fmtDuration(left(p.burst))} at ${fmt(p.burst.alt_msl_m / 1000, "km")} (${source})`);
   }
-  parts.push(`deploy in ${fmtDuration(p.deploy.in_s)} at ${fmt(p.deploy.alt_msl_m, "m", 0)}`);
-  parts.push(`unsteered landing in ${fmtDuration(p.landing.in_s)}`);
+  parts.push(`deploy in ${fmtDuration(left(p.deploy))} at ${fmt(p.deploy.alt_msl_m, "m", 0)}`);
+  parts.push(`unsteered landing in ${fmtDuration(left(p.landing))}`);
   parts.push(
     p.measured_bands > 0 && p.measured_to_msl_m !== null
       ? `winds: ${p.measured_bands} measured bands to ${fmt(p.measured_to_msl_m / 1000, "km")}, forecast above`

@@ -11,21 +11,21 @@ const at = (north_m: number, east_m: number) => ({ lat_deg: O.lat_deg + north_m 
 function state(stage: FlightStage, extra: Partial<State> = {}): State {
   const v = at(-600, -500);
   return {
-    type: "state", time_s: 10, wall_ms: null,
+    type: "state", time_s: 10, mission_time_s: 200, wall_ms: null,
     link: { connected: true, stale: false, age_s: 0.1, rate_hz: 30, loss_percent: 0, crc_errors: 0, parse_errors: 0, signature_errors: 0, ages_s: {}, radios: [] },
     vehicle: null,
     estimate: { lat_deg: v.lat_deg, lon_deg: v.lon_deg, alt_msl_m: 900, height_m: 655, velocity_ned_mps: null, ground_speed_mps: null, course_deg: null, heading_deg: null, heading_rate_dps: null, airspeed_mps: null, sink_rate_mps: null, glide_ratio_air: null, glide_ratio_ground: null, wind_ned_mps: null, wind_speed_mps: null, wind_from_deg: null, wind_sigma_mps: null, position_sigma_m: null, gps_ok: true, age_s: 0.1, stale: false },
     guidance: {
       mode: "spiral_landing", phase: "branch2", target: { ...at(0, 0), alt_msl_m: 245 }, target_source: "drone_plan", localizer: null,
       pattern: { corners: [pair(100, 100), pair(100, -100), pair(-100, -100), pair(-100, 100)], final_entry: pair(200, 300), final_course_deg: 250, final_approach_height_m: 100, target_reachable: true, reach_ratio: 0.5 },
-      commands: null, age_s: 0.1, stale: false,
+      commands: null, age_s: 0.1, stale: false, disagreement: null,
     },
     prediction: { planned: { ...at(10, 5), time_to_land_s: 100, semi_major_m: 50, semi_minor_m: 20, major_axis_deg: 0 }, uncontrolled: { ...at(900, 1200), time_to_land_s: 90, semi_major_m: 150, semi_minor_m: 100, major_axis_deg: 30 }, age_s: 0.5, stale: false },
     footprint: null,
     flight_path: null,
     keep_out_alarms: [],
     forecast_wind: [],
-    mission: { stage, cutdown_armed_until_s: null },
+    mission: { stage, cutdown_armed_until_s: null, landing: null },
     recording: null,
     replay: null,
     ...extra,

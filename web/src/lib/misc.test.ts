@@ -7,6 +7,7 @@ import { resolveToken, searchWithoutToken, TOKEN_KEY, withToken } from "./token"
 import { breakWraps, MAX_GAP_S, Series, staleSpans } from "./series";
 import { directionPieces, forecastAt, MeasuredProfile } from "./wind";
 import { isLanded, landingBadge, phaseLabel, recoveryPoint } from "./recovery";
+import { flightPathSummary } from "./flightPath";
 import { planBody } from "./plan";
 import { all, parseLat, parseNumber } from "./inputs";
 import { decodeMessage } from "./parse";
@@ -163,23 +164,47 @@ describe("recoveryPoint", () => {
     expect(recoveryPoint(base({ prediction: null }))).toBeNull();
   });
 
-  it("landing badge: a live countdown", () => {
-    expect(landingBadge(base({}), false, 0.2)).toEqual({ state: "live", text: "landing in 100 s" });
-    expect(landingBadge(base({ guidance: { mode: "uncontrolled" } }), false, 0.2).text).toBe("landing in 110 s (uncontrolled)");
+  it("landing badge: a live countdown under the parafoil", () => {
+    expect(landingBadge(base({}), false, 0.2)).toEqual({ state: "live", text: "landing in 1 min 40 s" });
+    expect(landingBadge(base({ guidance: { mode: "uncontrolled" } }), false, 0.2).text).toBe("landing in 1 min 50 s (uncontrolled)");
     expect(landingBadge(null, false, null).state).toBe("none");
   });
   // Regression: a stale link left "landing in N s" in the header as if it were current.
   it("landing badge: stale data say so and how old they are", () => {
-    expect(landingBadge(base({}), true, 12)).toEqual({ state: "stale", text: "landing in 100 s as of 12 s ago — STALE" });
+    expect(landingBadge(base({}), true, 12)).toEqual({ state: "stale", text: "landing in 1 min 40 s as of 12 s ago — STALE" });
   });
-  // Regression: after touchdown the header said "phase flare · landing in 0 s".
-  it("landed: the badge says where it landed, the phase says landed", () => {
-    const s = base({ mission: { stage: "landed" }, guidance: { mode: "spiral_landing", phase: "flare", target: { lat_deg: 38.6, lon_deg: -7.9001 } } });
+  // Regression: "landing in 342 s" while the balloon climbed at 988 m.
+  it("landing badge: no countdown on the pad or under the balloon, whatever the station predicted", () => {
+    for (const stage of ["pre_launch", "ascent"]) {
+      expect(landingBadge(base({ mission: { stage }, vehicle: { stage } }), false, 0.2)).toEqual({ state: "none", text: "landing —" });
+    }
+  });
+  // Regression: "landing in 938 s" under the round chute beside the map's "unsteered landing in 9 min 43 s".
+  it("landing badge: under the round chute, the map's unsteered landing counted down on the mission clock", () => {
+    const path = {
+      computed_s: 30, computed_mission_s: 600, stage: "round_chute", burst: null,
+      deploy: { lat_deg: 38.5, lon_deg: -7.8, alt_msl_m: 1445, in_s: 200 },
+      landing: { lat_deg: 38.51, lon_deg: -7.81, alt_msl_m: 245, in_s: 613 },
+      round_chute_landing: { lat_deg: 38.52, lon_deg: -7.82, alt_msl_m: 245, in_s: 500 },
+      reach_centre_lat_lon_deg: [38.51, -7.81], reach_radius_m: 2000, measured_bands: 3, measured_to_msl_m: 3000,
+      burst_source: "drone", ascent_rate_source: "drone",
+    };
+    // 30 s of flight since the path was computed (at 20×, 1.5 s of the station's clock).
+    const s = base({ mission: { stage: "round_chute" }, vehicle: { stage: "round_chute" }, mission_time_s: 630, flight_path: path });
+    expect(landingBadge(s, false, 0.2)).toEqual({ state: "live", text: "landing in 9 min 43 s (unsteered)" });
+    expect(s.flight_path && flightPathSummary(s.flight_path, s.mission_time_s)).toContain("unsteered landing in 9 min 43 s");
+  });
+  // Regression: four screens showed 1, 2, 3 and 10 m for one landing, each working it out itself.
+  it("landed: the badge shows the station's one figure, the phase says landed", () => {
+    const landing = { time_s: 1180.25, body: "drone", position: { lat_deg: 38.6, lon_deg: -7.9, alt_msl_m: 245 }, target: { lat_deg: 38.6, lon_deg: -7.9001, alt_msl_m: 245 }, miss_m: 2.34 };
+    const s = base({ mission: { stage: "landed", landing }, guidance: { mode: "spiral_landing", phase: "flare", target: { lat_deg: 38.6, lon_deg: -7.9002 } } });
     const b = landingBadge(s, false, 0.1);
     expect(b.state).toBe("landed");
-    expect(b.text).toBe("LANDED · 9 m from the target");
+    expect(b.text).toBe("LANDED · 2.3 m from the target");
+    expect(recoveryPoint(s)).toMatchObject({ kind: "actual", lat_deg: 38.6, lon_deg: -7.9 });
     expect(phaseLabel(s)).toBe("landed");
     expect(phaseLabel(base({ vehicle: { phase: "branch2" }, guidance: { phase: "flare" } }))).toBe("branch2");
+    expect(landingBadge(base({ mission: { stage: "landed" } }), false, 0.1).text).toBe("LANDED · measuring the touchdown");
   });
 });
 

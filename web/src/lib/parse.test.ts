@@ -5,7 +5,7 @@ import { decodeMessage, MessageStats, parseSession } from "./parse";
 // The state example of API.md, with its elided values filled in: a message the contract accepts
 // (checked below), so the fixture cannot drift from what the daemon sends.
 const STATE = {
-  type: "state", time_s: 123.25, wall_ms: 1700000000000,
+  type: "state", time_s: 123.25, mission_time_s: 1104.5, wall_ms: 1700000000000,
   link: { connected: true, stale: false, age_s: 0.21, rate_hz: 31.5, loss_percent: 0.4, crc_errors: 0, parse_errors: 0, signature_errors: 0,
     ages_s: { HEARTBEAT: 0.4, GPS_RAW_INT: 0.2, ATTITUDE: 0.2, SCALED_PRESSURE: 0.2, SERVO_OUTPUT_RAW: 0.2, WIND_COV: 0.2 },
     radios: [{ address: "udpin:127.0.0.1:14550", transmitting: true, stale: false, age_s: 0.2, rate_hz: 31.5, loss_percent: 0.4, duplicates: 0 }] },
@@ -27,12 +27,13 @@ const STATE = {
     localizer: { point: [38.5333, -7.8889], course_deg: 80.0, glide_slope: 0.3 },
     pattern: { corners: [[38.531, -7.889], [38.532, -7.887], [38.534, -7.888], [38.533, -7.890]], final_entry: [38.531, -7.889], final_course_deg: 161.6,
       final_approach_height_m: 172.0, target_reachable: true, reach_ratio: 0.41 },
-    commands: { main_line: 0.35, brake: 0.0 }, age_s: 0.05, stale: false },
+    commands: { main_line: 0.35, brake: 0.0 }, age_s: 0.05, stale: false,
+    disagreement: { what: "phase", replica: "branch3", drone: "branch2", since_s: 1102.25, for_s: 2.25, resolved: false, adopted: false } },
   prediction: { planned: { lat_deg: 38.5334, lon_deg: -7.8888, time_to_land_s: 187.0, semi_major_m: 12.1, semi_minor_m: 6.0, major_axis_deg: 40.0 },
     uncontrolled: { lat_deg: 38.52, lon_deg: -7.87, time_to_land_s: 190.0, semi_major_m: 80, semi_minor_m: 40, major_axis_deg: 100 }, age_s: 0.6, stale: false },
   footprint: { computed_s: 800.0, age_s: 1.5, stale: false, height_m: 567.4, draws: 200, contours: [{ level: 0.5, polygons: [[[[38.52, -7.9], [38.54, -7.9], [38.54, -7.87], [38.52, -7.9]]]] }, { level: 0.95, polygons: [] }], zone_hits: [{ zone: "Pond", level: 0.95 }] },
   forecast_wind: [{ alt_msl_m: 300, speed_mps: 2.0, from_deg: 270 }, { alt_msl_m: 1000, speed_mps: 4, from_deg: 280 }],
-  mission: { stage: "parafoil", cutdown_armed_until_s: null },
+  mission: { stage: "parafoil", cutdown_armed_until_s: null, landing: null },
   flight_path: null,
   keep_out_alarms: [{ prediction: "uncontrolled", zone: "Pond", since_s: 790.5 }],
   recording: { state: "on", file: "/var/lib/stx/recordings/stx-20261124T100000Z-001.mcap", bytes_written: 1200000, messages_written: 9000, messages_lost: 0, problem: null, failing_since_ms: null, next_try_in_s: null, failed_tries: 0, resumed_ms: null, resumed_after_s: null },
@@ -52,7 +53,7 @@ describe("the fixtures are messages of the contract", () => {
     expect(api.check("StateMsg", STATE)).toBeNull();
     expect(api.check("Session", SESSION)).toBeNull();
     expect(api.check("ServerMessage", { type: "hello", session: SESSION, role: SESSION.role, name: SESSION.name })).toBeNull();
-    expect(api.check("ServerMessage", { type: "event", time_s: 1, wall_ms: 1700000000000, level: "info", source: "link", text: "ok" })).toBeNull();
+    expect(api.check("ServerMessage", { type: "event", time_s: 1, mission_time_s: 1180.5, wall_ms: 1700000000000, level: "info", source: "link", text: "ok" })).toBeNull();
     expect(api.check("ServerMessage", { type: "command_result", request_id: "r1", command: "set_param", outcome: "accepted", attempts: 2, detail: "HK1", value: 0.015 })).toBeNull();
     expect(api.check("StateMsg", { ...STATE, extra: 1 })).toMatch(/additional/);
   });

@@ -22,7 +22,9 @@ import type {
   ForecastWind,
   Gps,
   GpsFix,
+  Disagreement,
   Guidance,
+  Landing,
   GuidancePhase,
   History,
   Lagged,
@@ -282,6 +284,19 @@ function parseLocalizer(o: Obj): Localizer | null {
   return point === null ? null : { point, course_deg: num(o, "course_deg"), glide_slope: num(o, "glide_slope") };
 }
 
+function parseDisagreement(o: Obj): Disagreement | null {
+  const replica = str(o, "replica");
+  const drone = str(o, "drone");
+  if (o.what !== "phase" || replica === null || drone === null) return null;
+  return { what: "phase", replica, drone, since_s: num(o, "since_s"), for_s: num(o, "for_s"), resolved: bool(o, "resolved"), adopted: bool(o, "adopted") };
+}
+
+function parseMissionLanding(o: Obj): Landing | null {
+  const p = position(o.position);
+  if (p === null) return null;
+  return { time_s: num(o, "time_s"), body: str(o, "body") ?? "drone", position: p, target: position(o.target), miss_m: num(o, "miss_m") };
+}
+
 const parseGuidance = (o: Obj): Guidance => ({
   mode: oneOf(o, "mode", MODES),
   phase: oneOf(o, "phase", PHASES),
@@ -292,6 +307,7 @@ const parseGuidance = (o: Obj): Guidance => ({
   commands: sub(o, "commands", (c) => ({ main_line: num(c, "main_line"), brake: num(c, "brake") })),
   age_s: num(o, "age_s"),
   stale: bool(o, "stale"),
+  disagreement: sub(o, "disagreement", parseDisagreement),
 });
 
 function parseLanding(v: unknown): LandingPrediction | null {
@@ -419,10 +435,15 @@ export function parseState(v: Obj): Parsed<State> {
   const time_s = num(v, "time_s");
   if (time_s === null) return bad("state without a numeric time_s");
   const mission = obj(v, "mission");
-  const m: Mission = { stage: mission ? oneOf(mission, "stage", STAGES) : null, cutdown_armed_until_s: mission ? num(mission, "cutdown_armed_until_s") : null };
+  const m: Mission = {
+    stage: mission ? oneOf(mission, "stage", STAGES) : null,
+    cutdown_armed_until_s: mission ? num(mission, "cutdown_armed_until_s") : null,
+    landing: mission ? sub(mission, "landing", parseMissionLanding) : null,
+  };
   return ok({
     type: "state",
     time_s,
+    mission_time_s: num(v, "mission_time_s"),
     wall_ms: num(v, "wall_ms"),
     link: parseLink(obj(v, "link")),
     vehicle: sub(v, "vehicle", parseVehicle),
@@ -485,6 +506,7 @@ export function parseEvent(v: Obj): Parsed<EventMsg> {
   return ok({
     type: "event",
     time_s: num(v, "time_s"),
+    mission_time_s: num(v, "mission_time_s"),
     wall_ms: num(v, "wall_ms"),
     // An unknown level is shown as a warning rather than dropped: the text may matter.
     level: oneOf(v, "level", LEVELS) ?? "warning",
@@ -571,7 +593,7 @@ export function parseTrackPoint(v: unknown): TrackPoint | null {
   if (!isObj(v)) return null;
   const t = num(v, "time_s");
   if (t === null || !isLat(v.lat_deg) || !isLon(v.lon_deg)) return null;
-  return { time_s: t, lat_deg: v.lat_deg, lon_deg: v.lon_deg, alt_msl_m: num(v, "alt_msl_m") };
+  return { time_s: t, mission_time_s: num(v, "mission_time_s"), lat_deg: v.lat_deg, lon_deg: v.lon_deg, alt_msl_m: num(v, "alt_msl_m") };
 }
 
 /** Parses each element with `f`, keeping the good ones; returns how many were dropped. */

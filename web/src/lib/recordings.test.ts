@@ -28,7 +28,7 @@ describe("recordings list", () => {
     expect(startText(null)).toBe("—");
   });
   it("says where a flight landed and its miss, or the stage it ended in", () => {
-    expect(landingText({ ...base, landing: { lat_deg: 50.1, lon_deg: 14.2, miss_m: 3.4 } })).toContain("3 m from target");
+    expect(landingText({ ...base, landing: { lat_deg: 50.1, lon_deg: 14.2, miss_m: 3.4 } })).toContain("3.4 m from the target");
     expect(landingText({ ...base, landing: { lat_deg: 50.1, lon_deg: 14.2, miss_m: null } })).toContain("no target");
     expect(landingText({ ...base, last_stage: "round_chute" })).toBe("not landed (round chute)");
     expect(landingText(base)).toBe("—");

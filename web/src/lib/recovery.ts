@@ -1,8 +1,10 @@
-// Which point the recovery team should drive to: once landed, where the vehicle is; before, the
-// landing predicted for the way it is flying (guided modes → planned; uncontrolled → uncontrolled).
+// Which point the recovery team should drive to: once landed, where the station measured the
+// touchdown; before, the landing predicted for the way it is flying (guided modes → planned;
+// uncontrolled → uncontrolled). And the header's landing badge: the countdown only while a landing
+// is predicted (under the round chute, the map's unsteered landing; under the parafoil, the flown
+// prediction), on the mission's clock; once landed, the station's one miss figure.
 
-import { fmt, fmtDistance, fmtDuration } from "./format";
-import { distanceM } from "./geo";
+import { fmtDistance, fmtDuration } from "./format";
 import type { LatLon, N, State } from "./types";
 
 export type RecoveryKind = "actual" | "planned" | "uncontrolled";
@@ -20,6 +22,8 @@ export function isLanded(s: State): boolean {
 
 export function recoveryPoint(s: State): RecoveryPoint | null {
   if (isLanded(s)) {
+    const l = s.mission.landing;
+    if (l !== null) return { kind: "actual", lat_deg: l.position.lat_deg, lon_deg: l.position.lon_deg, time_to_land_s: 0, semi_major_m: s.estimate?.position_sigma_m ?? null };
     const lat = s.estimate?.lat_deg ?? s.vehicle?.gps?.lat_deg ?? null;
     const lon = s.estimate?.lon_deg ?? s.vehicle?.gps?.lon_deg ?? null;
     if (lat !== null && lon !== null) return { kind: "actual", lat_deg: lat, lon_deg: lon, time_to_land_s: 0, semi_major_m: s.estimate?.position_sigma_m ?? null };
@@ -41,20 +45,54 @@ export interface LandingBadge {
   text: string;
 }
 
+/** When the stack is predicted to land, in mission seconds from now, and by which prediction. */
+export interface LandingCountdown {
+  in_s: number;
+  kind: "planned" | "uncontrolled" | "unsteered";
+}
+
+const PARAFOIL_STAGES: readonly string[] = ["parafoil_deploy", "parafoil"];
+
+/**
+ * The landing the map shows, as a countdown: under the parafoil the prediction flown (planned in
+ * guided modes, else uncontrolled); under the round chute the flight path's unsteered landing,
+ * counted down on the mission clock from when it was computed; before (pad, balloon) none — a
+ * "landing in" during the climb counted the balloon's descent it had not begun.
+ */
+export function landingCountdown(s: State): LandingCountdown | null {
+  const stage = s.mission.stage ?? s.vehicle?.stage ?? null;
+  if (stage !== null && PARAFOIL_STAGES.includes(stage)) {
+    const pt = recoveryPoint(s);
+    if (pt === null || pt.kind === "actual" || pt.time_to_land_s === null) return null;
+    return { in_s: pt.time_to_land_s, kind: pt.kind };
+  }
+  const p = s.flight_path;
+  if (stage === "round_chute" && p !== null) {
+    const elapsed = s.mission_time_s !== null && p.computed_mission_s !== null ? Math.max(0, s.mission_time_s - p.computed_mission_s) : 0;
+    return { in_s: Math.max(0, p.landing.in_s - elapsed), kind: "unsteered" };
+  }
+  return null;
+}
+
+/** The landing figure as every page words it: the station's, measured once. */
+export function landedText(s: State): string {
+  const l = s.mission.landing;
+  if (l === null) return "LANDED · measuring the touchdown";
+  if (l.miss_m === null) return "LANDED · no target";
+  // To the decimetre: the same figure, to 0.1 m, as the log, the recordings list and a replay.
+  return `LANDED · ${l.miss_m < 1000 ? `${l.miss_m.toFixed(1)} m` : fmtDistance(l.miss_m)} from the target`;
+}
+
 /**
  * `stale`/`age_s`: the page's verdict on the data (staleness.ts). A stale countdown is not
  * counted down by the page — the drone may have done anything since — but says how old it is.
  */
 export function landingBadge(s: State | null, stale: boolean, age_s: N): LandingBadge {
   if (s === null) return { state: "none", text: "landing —" };
-  const pt = recoveryPoint(s);
-  if (pt?.kind === "actual") {
-    const t = s.guidance?.target ?? null;
-    const miss = t === null ? "" : ` · ${fmtDistance(distanceM(pt, t))} from the target`;
-    return { state: "landed", text: `LANDED${miss}${stale ? " (link stale)" : ""}` };
-  }
-  if (pt === null || pt.time_to_land_s === null) return { state: stale ? "stale" : "none", text: "landing —" };
-  const n = `landing in ${fmt(pt.time_to_land_s, "s", 0)}${pt.kind === "uncontrolled" ? " (uncontrolled)" : ""}`;
+  if (isLanded(s)) return { state: "landed", text: `${landedText(s)}${stale ? " (link stale)" : ""}` };
+  const c = landingCountdown(s);
+  if (c === null) return { state: stale ? "stale" : "none", text: "landing —" };
+  const n = `landing in ${fmtDuration(c.in_s)}${c.kind === "planned" ? "" : ` (${c.kind})`}`;
   if (!stale) return { state: "live", text: n };
   return { state: "stale", text: `${n} as of ${age_s === null ? "an unknown time" : fmtDuration(age_s)} ago — STALE` };
 }

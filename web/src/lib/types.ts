@@ -84,10 +84,14 @@ export type Pattern = Lenient<Wire.PatternView, "corners">;
 
 export type Localizer = Lenient<Wire.LocalizerView, "point">;
 
-export type Guidance = Omit<Lenient<Wire.GuidanceView>, "target" | "localizer" | "pattern"> & {
+/** The guidance replica and the drone disagree (or did a few seconds ago). */
+export type Disagreement = Lenient<Wire.DisagreementView, "what" | "replica" | "drone">;
+
+export type Guidance = Omit<Lenient<Wire.GuidanceView>, "target" | "localizer" | "pattern" | "disagreement"> & {
   target: Position | null;
   localizer: Localizer | null;
   pattern: Pattern | null;
+  disagreement: Disagreement | null;
 };
 
 export type LandingPrediction = Lenient<Wire.TouchdownView, "lat_deg" | "lon_deg">;
@@ -99,7 +103,13 @@ export type Prediction = Omit<Lenient<Wire.PredictionView>, "planned" | "uncontr
 
 export type ForecastWind = Lenient<Wire.ForecastRow, "alt_msl_m" | "speed_mps">;
 
-export type Mission = Lenient<Wire.MissionView>;
+/** The landing as the station measured it: the one figure every page shows. */
+export type Landing = Omit<Lenient<Wire.LandingView, "body">, "position" | "target"> & {
+  position: Position;
+  target: Position | null;
+};
+
+export type Mission = Omit<Lenient<Wire.MissionView>, "landing"> & { landing: Landing | null };
 
 /** The station's recording of this run. */
 export type Recording = Lenient<Wire.RecordingView, "state">;
@@ -109,8 +119,9 @@ export type Replay = Lenient<Wire.ReplayView, "file" | "mode">;
 
 export type State = Omit<
   Lenient<Wire.StateMsg, "type" | "time_s" | "link" | "forecast_wind" | "mission">,
-  "link" | "vehicle" | "guidance" | "prediction" | "forecast_wind" | "recording" | "replay" | "footprint" | "keep_out_alarms" | "flight_path"
+  "link" | "vehicle" | "guidance" | "prediction" | "forecast_wind" | "recording" | "replay" | "footprint" | "keep_out_alarms" | "flight_path" | "mission"
 > & {
+  mission: Mission;
   recording: Recording | null;
   replay: Replay | null;
   link: Link;

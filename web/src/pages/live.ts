@@ -10,6 +10,7 @@ import { fmt, fmtMissionTime, label } from "../lib/format";
 import { parseAscentWind, parseKeepOut, parseParams, parseSession, isObj } from "../lib/parse";
 import { LiveSocket, type SocketStatus } from "../lib/socket";
 import { landingBadge, phaseLabel } from "../lib/recovery";
+import { replicaAlarm } from "../lib/replica";
 import { SeekEpoch } from "../lib/replaySeek";
 import { judgeStaleness, type StaleVerdict } from "../lib/staleness";
 import { resolveToken, searchWithoutToken, withToken } from "../lib/token";
@@ -106,7 +107,7 @@ function build(session: Session): void {
   const tracker = new CommandTracker((e) => onCommand(e));
 
   const localEvent = (level: Level, text: string): void =>
-    events.add({ type: "event", time_s: latest?.time_s ?? null, wall_ms: Date.now(), level, source: "page", text });
+    events.add({ type: "event", time_s: latest?.time_s ?? null, mission_time_s: latest?.mission_time_s ?? null, wall_ms: Date.now(), level, source: "page", text });
 
   const runCommand = <P extends CommandPath>(command: string, text: string, path: P, body: CommandBodies[P]): number => {
     const id = tracker.begin(command, text, Date.now());
@@ -204,6 +205,7 @@ function build(session: Session): void {
   const hdrPhase = h("span", { class: "badge", "data-testid": "hdr-phase" });
   const hdrLink = h("span", { class: "badge", "data-testid": "hdr-link", title: "drone link: message rate, share lost, age of the last message" });
   const hdrLanding = h("span", { class: "badge", "data-testid": "hdr-landing" });
+  const hdrReplica = h("span", { class: "badge alarm", "data-testid": "hdr-replica", role: "alert", hidden: true, title: "the station's guidance replica and the drone disagree" });
   const kml = h("a", { href: withToken("/kml", token), "data-testid": "kml-link", class: "linkbtn", title: "open in Google Earth: a network link that refreshes every 2 s" }, "KML");
   // The recovery page opens in a new tab, which does not share this tab's sessionStorage: the
   // token goes in its address (the page takes it out of the address bar at once, as this one does).
@@ -213,7 +215,7 @@ function build(session: Session): void {
   const header = h("header", { class: "top" },
     h("strong", { class: "station" }, station.name), clock, conn, roleBadge,
     h("span", { class: "hdr-group" }, h("small", {}, "mode "), hdrMode, h("small", {}, " stage "), hdrStage, h("small", {}, " phase "), hdrPhase),
-    hdrLink, hdrLanding, h("span", { class: "spacer" }), kml, recovery, planLink, lab);
+    hdrLink, hdrLanding, hdrReplica, h("span", { class: "spacer" }), kml, recovery, planLink, lab);
   const banner = h("div", { class: "banner", role: "alert", "data-testid": "banner", hidden: true });
   const viewerNote = h("div", { class: "viewer-note", "data-testid": "viewer-note" }, `Viewer: you can watch everything; commanding needs the operator role (${OPERATOR_REQUIRED}).`);
 
@@ -278,7 +280,7 @@ function build(session: Session): void {
     if (!s.link.stale && e?.lat_deg != null && e.lon_deg != null) {
       const last = track[track.length - 1];
       if (last === undefined || s.time_s - last.time_s >= TRACK_EVERY_S) {
-        const p = { time_s: s.time_s, lat_deg: e.lat_deg, lon_deg: e.lon_deg, alt_msl_m: e.alt_msl_m };
+        const p = { time_s: s.time_s, mission_time_s: s.mission_time_s, lat_deg: e.lat_deg, lon_deg: e.lon_deg, alt_msl_m: e.alt_msl_m };
         if (last !== undefined && s.time_s < last.time_s) track = []; // mission clock restarted
         track.push(p);
         if (track.length > 20_000) track = track.slice(-18_000);
@@ -324,7 +326,15 @@ function build(session: Session): void {
     plan.update(s);
     cutdown.update(s.mission.cutdown_armed_until_s, s.time_s);
     joystick.setVehicleMode(s.vehicle?.mode ?? null);
-    setText(clock, fmtMissionTime(s.time_s));
+    // The mission's clock (the drone's), at any rehearsal speed; the station's only before the drone is heard.
+    setText(clock, fmtMissionTime(s.mission_time_s));
+    clock.title = "mission time: the drone's clock (T+ since its start)";
+    const d = s.guidance?.disagreement ?? null;
+    hdrReplica.hidden = d === null;
+    if (d !== null) {
+      setText(hdrReplica, replicaAlarm(d));
+      hdrReplica.dataset.state = d.resolved ? "resolved" : "active";
+    }
     setText(hdrMode, label(s.vehicle?.mode ?? s.guidance?.mode));
     setText(hdrStage, label(s.mission.stage ?? s.vehicle?.stage));
     setText(hdrPhase, label(phaseLabel(s)));

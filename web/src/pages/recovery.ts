@@ -13,7 +13,7 @@ import { bearingDeg, distanceM } from "../lib/geo";
 import { cardinal, fmtDir, fmtDistance, fmtDuration, fmtLatLon, fmtWallUtc, wrap360 } from "../lib/format";
 import { isObj, parseSession, parseState, parseStation } from "../lib/parse";
 import { parsePosition, positionUnavailable } from "../lib/position";
-import { recoveryPoint } from "../lib/recovery";
+import { landedText, recoveryPoint } from "../lib/recovery";
 import { resolveToken, searchWithoutToken } from "../lib/token";
 import type { LatLon, State, Station } from "../lib/types";
 import { h, setText } from "../ui/dom";
@@ -257,7 +257,7 @@ function render(): void {
     el.copy.disabled = true;
   } else {
     el.copy.disabled = false;
-    setText(el.kind, pt.kind === "actual" ? "LANDED — actual position" : pt.kind === "planned" ? "Predicted landing (guided)" : "Predicted landing (uncontrolled)");
+    setText(el.kind, pt.kind === "actual" && state ? landedText(state) : pt.kind === "planned" ? "Predicted landing (guided)" : "Predicted landing (uncontrolled)");
     el.kind.dataset.kind = pt.kind;
     setText(el.point, fmtLatLon(pt.lat_deg, pt.lon_deg));
     setText(el.decimal, decimal(pt));

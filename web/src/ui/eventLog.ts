@@ -37,7 +37,9 @@ export class EventLog {
 
   add(e: EventMsg): void {
     const li = h("li", { class: `ev lv-${e.level}`, "data-level": e.level, "data-testid": "event-item" },
-      h("span", { class: "ev-time", title: fmtWallUtc(e.wall_ms) }, fmtMissionTime(e.time_s)),
+      // The mission's clock (the drone's), as the header and the plots; the station's only for
+      // events from before the drone was heard.
+      h("span", { class: "ev-time", title: fmtWallUtc(e.wall_ms) }, fmtMissionTime(e.mission_time_s ?? e.time_s)),
       h("span", { class: "ev-level" }, e.level.toUpperCase()),
       h("span", { class: "ev-source" }, e.source),
       h("span", { class: "ev-text" }, e.text));

@@ -35,7 +35,7 @@ export class FlightPathLayer {
   }
 
   /** Draws `p` from the vehicle at `from`; null clears it (under the parafoil, on the ground). */
-  update(p: FlightPath | null, from: LatLon | null, stale: boolean): void {
+  update(p: FlightPath | null, from: LatLon | null, stale: boolean, mission_time_s: number | null = null): void {
     this.group.clearLayers();
     this.badge.hidden = p === null;
     if (p === null) return;
@@ -56,7 +56,7 @@ export class FlightPathLayer {
         el.dataset.alt = pt.alt_msl_m.toFixed(0);
       }
     }
-    setText(this.badge, flightPathSummary(p));
+    setText(this.badge, flightPathSummary(p, mission_time_s));
     this.badge.classList.toggle("stale", stale);
   }
 }

@@ -14,7 +14,7 @@ import { FlightPathLayer } from "./flightPathLayer";
 import { distanceM, ellipsePoints, fromLocal, gridValues, niceStep, toLocal } from "../lib/geo";
 import { fmt, fmtDir, fmtDistance } from "../lib/format";
 import { boxAround, keyPoints, needsFraming, type Box } from "../lib/framing";
-import { isLanded } from "../lib/recovery";
+import { isLanded, landedText } from "../lib/recovery";
 import { packNote, tilesBadge } from "../lib/tiles";
 import { ZoneEditor } from "./zoneEditor";
 import type { Footprint, KeepOutAlarm, KeepOutMsg, LandingPrediction, LatLon, Ring, State, Station, TrackPoint } from "../lib/types";
@@ -248,15 +248,14 @@ export class MapView {
     }
     const pred = landed ? null : s.prediction;
     this.showFootprint(landed ? null : s.footprint, stale);
-    this.flightPath.update(landed ? null : s.flight_path, lat !== null && lon !== null ? { lat_deg: lat, lon_deg: lon } : null, stale);
+    this.flightPath.update(landed ? null : s.flight_path, lat !== null && lon !== null ? { lat_deg: lat, lon_deg: lon } : null, stale, s.mission_time_s);
     this.showAlarms(landed ? [] : s.keep_out_alarms);
     this.showPrediction(this.planned, this.ellPlanned, pred?.planned ?? null, "planned", stale);
     this.showPrediction(this.uncontrolled, this.ellUncontrolled, pred?.uncontrolled ?? null, "uncontrolled", stale);
     for (const [layer, color] of [[this.pattern, "#c000c0"], [this.final, "#c000c0"]] as const) layer.setStyle({ color: stale ? "#888" : color });
     this.landedText.hidden = !landed;
-    if (landed && lat !== null && lon !== null) {
-      setText(this.landedText, `LANDED${g?.target ? ` ${fmtDistance(distanceM({ lat_deg: lat, lon_deg: lon }, g.target))} from the target` : ""}`);
-    }
+    // The station's figure, measured once: the same in the header, the log and the recordings.
+    if (landed) setText(this.landedText, landedText(s));
     if (e?.wind_from_deg != null) {
       this.windArrow.style.transform = `rotate(${(e.wind_from_deg + 90).toFixed(0)}deg)`;
       setText(this.windText, `wind ${fmt(e.wind_speed_mps, "m/s")} from ${fmtDir(e.wind_from_deg)}`);

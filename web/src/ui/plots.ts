@@ -84,7 +84,10 @@ export class Plots {
 
   push(s: State): void {
     const stale = linkStale(s.link);
-    for (const c of this.charts) if (c.data.push(s.time_s, c.def.pick(s), stale)) this.dirty = true;
+    // On the mission clock (the drone's), as the T+ clock: at 20× a minute of flight is a
+    // minute on the axis. The station's clock only before the drone is heard.
+    const t = s.mission_time_s ?? s.time_s;
+    for (const c of this.charts) if (c.data.push(t, c.def.pick(s), stale)) this.dirty = true;
   }
 
   private redraw(): void {

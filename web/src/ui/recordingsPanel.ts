@@ -26,7 +26,8 @@ export function startText(ms: number | null): string {
 /** Where it came down and how far from the target, or the stage it ended in. */
 export function landingText(r: Wire.RecordingSummary): string {
   if (r.landing !== null) {
-    const miss = r.landing.miss_m === null ? "no target" : `${fmtDistance(r.landing.miss_m)} from target`;
+    // The station's figure as measured at the landing, to 0.1 m as every page shows it.
+    const miss = r.landing.miss_m === null ? "no target" : `${r.landing.miss_m < 1000 ? `${r.landing.miss_m.toFixed(1)} m` : fmtDistance(r.landing.miss_m)} from the target`;
     return `${fmtLatLon(r.landing.lat_deg, r.landing.lon_deg)} · ${miss}`;
   }
   return r.last_stage === null ? "—" : `not landed (${label(r.last_stage)})`;

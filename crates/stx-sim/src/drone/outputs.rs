@@ -218,13 +218,18 @@ impl Drone {
             }
             FlightStage::ParafoilDeploy | FlightStage::Parafoil => {
                 let g = self.onboard.guidance();
+                // The glide learned in flight, as guidance plans with it, and the stack's
+                // own hang height: the station predicts the same way.
                 let p = predict(
                     e,
                     g,
-                    &g.config().performance,
+                    &g.learned_performance(),
                     &StandardAtmosphere,
                     self.frame.alt_msl_m,
-                    &PredictorConfig::default(),
+                    &PredictorConfig {
+                        hang_height_m: g.config().spiral.hang_height_m,
+                        ..PredictorConfig::default()
+                    },
                 );
                 let manual = g.mode() == FlightMode::Manual;
                 if manual || g.mode() == FlightMode::Uncontrolled || stage != FlightStage::Parafoil

@@ -109,15 +109,20 @@ impl Drone {
                     lat_deg,
                     lon_deg,
                 });
-                let from_target = miss
-                    .map(|m| format!(", {m:.0} m from the target"))
+                // What the drone itself knows of where it is: its estimate (the truth's
+                // distance from the target is the simulator's, not the drone's, to tell).
+                let place = self
+                    .estimate
+                    .map(|e| {
+                        format!(
+                            " at {:.0} m N {:.0} m E of the site by its estimate",
+                            e.position_ned_m.x, e.position_ned_m.y
+                        )
+                    })
                     .unwrap_or_default();
                 (
                     Severity::Notice,
-                    format!(
-                        "landed at {:.0} m N {:.0} m E{from_target}, {:.1} m/s down",
-                        t.position_ne_m[0], t.position_ne_m[1], t.vertical_speed_mps
-                    ),
+                    format!("landed{place}, {:.1} m/s down", t.vertical_speed_mps),
                 )
             }
         };

@@ -167,7 +167,7 @@ impl StationCore {
         };
         match propagate(start, &stack, air, &self.config.guidance.performance) {
             Ok(path) => {
-                let view = self.flight_path_view(now_s, stage, &path, sources);
+                let view = self.flight_path_view([now_s, t], stage, &path, sources);
                 self.live_path.view = Some(view);
                 self.live_path.said = None;
             }
@@ -188,9 +188,11 @@ impl StationCore {
         }
     }
 
+    /// The view of `path`, computed at the station's `now_s` from a fix of the mission clock
+    /// `mission_s` (`[now_s, mission_s]`).
     fn flight_path_view(
         &self,
-        now_s: f64,
+        [now_s, mission_s]: [f64; 2],
         stage: FlightStage,
         path: &FlightPath,
         sources: LaunchSources,
@@ -215,6 +217,7 @@ impl StationCore {
             .collect();
         FlightPathView {
             computed_s: now_s,
+            computed_mission_s: mission_s,
             stage: match stage {
                 FlightStage::PreLaunch => "pre_launch",
                 FlightStage::RoundChute => "round_chute",

@@ -30,6 +30,7 @@ mod footprint;
 mod keep_out;
 mod landing;
 mod manual;
+mod mission_clock;
 mod navigation;
 mod operator;
 mod params;
@@ -122,6 +123,8 @@ pub struct StationCore {
     /// The drone's clock (s since its boot) from the newest time-stamped telemetry:
     /// navigation runs on it, so radio delays and accelerated rehearsals do not distort it.
     pub(crate) drone_time_s: Option<f64>,
+    /// The drone's clock carried forward between its readings, for the pages.
+    pub(crate) mission_clock: mission_clock::MissionClock,
     pub(crate) estimate: Option<Estimate>,
     pub(crate) guidance: Guidance,
     pub(crate) prediction: Option<LandingPrediction>,
@@ -186,6 +189,7 @@ impl StationCore {
             estimator,
             ascent: ascent::AscentWinds::new(config.ascent_wind),
             drone_time_s: None,
+            mission_clock: Default::default(),
             estimate: None,
             guidance,
             prediction: None,
@@ -237,7 +241,7 @@ impl StationCore {
         let event = EventMsg {
             kind: "event",
             time_s: now_s,
-            mission_time_s: self.drone_time_s,
+            mission_time_s: self.mission_clock.at(now_s),
             wall_ms: self.wall_ms(now_s),
             level,
             source,

@@ -38,9 +38,10 @@ impl StationCore {
         self.estimate
     }
 
-    /// The mission clock: the drone's, s since its boot, at its newest time-stamped telemetry.
-    pub fn mission_time_s(&self) -> Option<f64> {
-        self.drone_time_s
+    /// The mission clock at the station's `now_s`: the drone's (s since its boot) carried
+    /// forward from its newest time-stamped telemetry.
+    pub fn mission_time_s(&self, now_s: f64) -> Option<f64> {
+        self.mission_clock.at(now_s)
     }
 
     /// The stage the drone reports, if it has reported one.

@@ -254,7 +254,7 @@ impl StationCore {
         StateMsg {
             kind: "state",
             time_s: now_s,
-            mission_time_s: self.drone_time_s,
+            mission_time_s: self.mission_clock.at(now_s),
             wall_ms: self.wall_ms(now_s),
             link,
             vehicle,

@@ -168,7 +168,7 @@ fn refusal(state: &Shared, text: &str) -> Message {
     let now = state.now_s();
     let (wall_ms, mission_time_s) = {
         let core = state.core();
-        (core.wall_ms(now), core.mission_time_s())
+        (core.wall_ms(now), core.mission_time_s(now))
     };
     let reply = EventMsg {
         kind: "event",

@@ -8,8 +8,11 @@ use serde::Serialize;
 /// The latest flight-path prediction.
 #[derive(Debug, Clone, Serialize, JsonSchema)]
 pub struct FlightPathView {
-    /// Mission clock when it was computed, s.
+    /// The station's clock when it was computed, s.
     pub computed_s: f64,
+    /// The mission clock (the drone's) of the fix it started from, s: its `in_s` count from
+    /// there, so a countdown is `in_s − (mission_time_s − computed_mission_s)`.
+    pub computed_mission_s: f64,
     /// The stage it was computed in: `ascent` (or `pre_launch`) or `round_chute`.
     pub stage: String,
     /// Where the balloon bursts (at the drone's `MIS_BURST_M`, else the station config's

@@ -53,11 +53,13 @@ pub struct RecordingSummary {
 /// Where a recorded flight came down.
 #[derive(Debug, Clone, PartialEq, Serialize, JsonSchema)]
 pub struct LandingSummary {
-    /// Latitude, degrees (the drone's GPS, else the station's estimate).
+    /// Latitude, degrees: the landing the station measured (`state.mission.landing`); in
+    /// recordings made before it did, the drone's last GPS, else the station's estimate.
     pub lat_deg: f64,
     /// Longitude, degrees.
     pub lon_deg: f64,
-    /// Horizontal distance to guidance's target, m (`null` without a target).
+    /// Horizontal distance to the drone's target, m, as the station measured it (`null`
+    /// without a target): the figure every page shows.
     pub miss_m: Option<f64>,
 }
 
@@ -147,6 +149,15 @@ fn lat_lon(v: Option<&Value>) -> Option<(f64, f64, f64)> {
 }
 
 fn landing(state: &Value) -> Option<LandingSummary> {
+    if let Some(l) = state.pointer("/mission/landing").filter(|l| !l.is_null()) {
+        // The station's own figure: the same everywhere, not worked out again here.
+        let (lat, lon, _) = lat_lon(l.get("position"))?;
+        return Some(LandingSummary {
+            lat_deg: lat,
+            lon_deg: lon,
+            miss_m: l.get("miss_m").and_then(Value::as_f64),
+        });
+    }
     let (lat, lon, alt) =
         lat_lon(state.pointer("/vehicle/gps")).or_else(|| lat_lon(state.get("estimate")))?;
     let miss_m = lat_lon(state.pointer("/guidance/target")).map(|(t_lat, t_lon, t_alt)| {
@@ -245,6 +256,24 @@ mod tests {
         let miss = landing.miss_m.expect("a target");
         let expected = (11.12_f64.powi(2) + 7.17_f64.powi(2)).sqrt();
         assert!((miss - expected).abs() < 0.1, "{miss} vs {expected}");
+    }
+
+    #[test]
+    fn the_list_shows_the_landing_the_station_measured_not_its_own() {
+        // The station's figure (from the GPS fix on the ground) is 2.3 m; the last state's
+        // drone position and target would give another: the list shows the station's.
+        let mut last = state("landed", (50.0001, 14.0001), Some((50.0, 14.0)));
+        last["mission"]["landing"] = json!({
+            "time_s": 1180.25,
+            "body": "drone",
+            "position": {"lat_deg": 50.00002, "lon_deg": 14.00001, "alt_msl_m": 300.0},
+            "target": {"lat_deg": 50.0, "lon_deg": 14.0, "alt_msl_m": 300.0},
+            "miss_m": 2.3,
+        });
+        let s = summary(recording(&[last], true));
+        let landing = s.landing.expect("landed");
+        assert_eq!(landing.miss_m, Some(2.3));
+        assert_eq!((landing.lat_deg, landing.lon_deg), (50.00002, 14.00001));
     }
 
     #[test]

@@ -95,8 +95,11 @@ fn track_point(state: &Value) -> Option<TrackPoint> {
     }
     let estimate = state.get("estimate")?;
     let number = |v: &Value, key: &str| v.get(key).and_then(Value::as_f64);
+    let time_s = number(state, "time_s")?;
     Some(TrackPoint {
-        time_s: number(state, "time_s")?,
+        time_s,
+        // Recordings older than the mission clock have only the station's.
+        mission_time_s: number(state, "mission_time_s").unwrap_or(time_s),
         lat_deg: number(estimate, "lat_deg")?,
         lon_deg: number(estimate, "lon_deg")?,
         alt_msl_m: number(estimate, "alt_msl_m")?,

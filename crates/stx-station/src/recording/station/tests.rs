@@ -44,6 +44,7 @@ fn an_event_goes_to_the_station_channel_and_foxglove_s_log() {
     let event = EventMsg {
         kind: "event",
         time_s: 2.0,
+        mission_time_s: Some(12.0),
         wall_ms: 1_700_000_000_250,
         level: Level::Warning,
         source: "link",
