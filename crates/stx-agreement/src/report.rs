@@ -200,17 +200,10 @@ impl MissionReport {
             }
             target_missing += u64::from(s.target_missing);
             if s.spiral_flying() {
-                within_5.count(
-                    s.final_course_error_deg
-                        .is_some_and(|e| e.abs() <= 5.0),
-                );
+                within_5.count(s.final_course_error_deg.is_some_and(|e| e.abs() <= 5.0));
             }
         }
         let parafoil: Vec<&Sample> = samples.iter().filter(|s| s.under_parafoil()).collect();
-        let period = samples
-            .windows(2)
-            .map(|w| w[1].truth.time_s - w[0].truth.time_s)
-            .fold(f64::INFINITY, f64::min);
         let wind = [
             FlightStage::Ascent,
             FlightStage::RoundChute,
@@ -258,7 +251,12 @@ impl MissionReport {
             dispersions: name.dispersions,
             speed: name.speed,
             flight_s: samples.last().map_or(0.0, |s| s.truth.time_s),
-            parafoil_s: parafoil.len() as f64 * if period.is_finite() { period } else { 0.0 },
+            // From the first sample under the parafoil to the last: the samples' spacing is not
+            // even (the pair steps the drone at its own rate).
+            parafoil_s: match (parafoil.first(), parafoil.last()) {
+                (Some(a), Some(b)) => b.truth.time_s - a.truth.time_s,
+                _ => 0.0,
+            },
             predictions,
             stage,
             mode,

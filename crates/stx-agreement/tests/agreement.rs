@@ -18,7 +18,10 @@ fn the_station_agrees_with_the_drone_over_whole_missions() {
         Err(f) => eprintln!("FAILED {f:?}"),
     });
     let summary = summarise(&results);
-    eprintln!("{}", serde_json::to_string_pretty(&summary).unwrap_or_default());
+    eprintln!(
+        "{}",
+        serde_json::to_string_pretty(&summary).unwrap_or_default()
+    );
     let unmet: Vec<_> = summary.goals.iter().filter(|g| !g.met).collect();
     assert!(unmet.is_empty(), "goals not met: {unmet:#?}");
 }

@@ -124,6 +124,7 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
             }
             if let Some(s) = seeds {
                 campaign.seeds = s;
+                campaign.seeds_of.clear();
             }
             if let Some(s) = speeds {
                 campaign.speeds = s;

@@ -30,7 +30,9 @@ pub fn parse_speed(s: &str) -> Result<f64, String> {
     }
     match s.parse::<f64>() {
         Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
-        _ => Err(format!("`{s}` is not a positive factor of real time or `max`")),
+        _ => Err(format!(
+            "`{s}` is not a positive factor of real time or `max`"
+        )),
     }
 }
 
@@ -49,8 +51,10 @@ pub fn run_bench(options: AgreementBenchOptions) -> anyhow::Result<()> {
         .map_err(BadInput)?;
     let bar = ProgressBar::new(specs.len() as u64);
     bar.set_style(
-        ProgressStyle::with_template("{bar:40} {pos}/{len} missions, {elapsed} elapsed, ~{eta} left")
-            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+        ProgressStyle::with_template(
+            "{bar:40} {pos}/{len} missions, {elapsed} elapsed, ~{eta} left",
+        )
+        .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
     let started = std::time::Instant::now();
     let results = run(&specs, options.threads, &|_| bar.inc(1));

@@ -42,6 +42,9 @@ fn serve(record_dir: &Path) -> Daemon {
         .args([
             "serve",
             "--sim",
+            // Under the parafoil from the start: the station predicts landings only there.
+            "--sim-scenario",
+            "rehearsal",
             "--sim-speed",
             "10",
             "--listen",

@@ -2212,6 +2212,11 @@ export interface RecordingSummary {
  */
 export interface LandingSummary {
   /**
+   * Which body the position is of, as the station measured it (`drone`: its GPS
+   * receiver); `null` in recordings made before the station said.
+   */
+  body: string | null;
+  /**
    * Latitude, degrees: the landing the station measured (`state.mission.landing`); in
    * recordings made before it did, the drone's last GPS, else the station's estimate.
    */

@@ -9,6 +9,7 @@ import { directionPieces, forecastAt, MeasuredProfile } from "./wind";
 import { isLanded, landingBadge, phaseLabel, recoveryPoint } from "./recovery";
 import { flightPathSummary } from "./flightPath";
 import { planBody } from "./plan";
+import { replicaAlarm } from "./replica";
 import { all, parseLat, parseNumber } from "./inputs";
 import { decodeMessage } from "./parse";
 import type { State } from "./types";
@@ -178,6 +179,8 @@ describe("recoveryPoint", () => {
     for (const stage of ["pre_launch", "ascent"]) {
       expect(landingBadge(base({ mission: { stage }, vehicle: { stage } }), false, 0.2)).toEqual({ state: "none", text: "landing —" });
     }
+    // A silent link while climbing: still no countdown, but the badge says the data are old.
+    expect(landingBadge(base({ mission: { stage: "ascent" }, vehicle: { stage: "ascent" } }), true, 12)).toEqual({ state: "stale", text: "landing — · data 12 s old — STALE" });
   });
   // Regression: "landing in 938 s" under the round chute beside the map's "unsteered landing in 9 min 43 s".
   it("landing badge: under the round chute, the map's unsteered landing counted down on the mission clock", () => {
@@ -200,7 +203,7 @@ describe("recoveryPoint", () => {
     const s = base({ mission: { stage: "landed", landing }, guidance: { mode: "spiral_landing", phase: "flare", target: { lat_deg: 38.6, lon_deg: -7.9002 } } });
     const b = landingBadge(s, false, 0.1);
     expect(b.state).toBe("landed");
-    expect(b.text).toBe("LANDED · 2.3 m from the target");
+    expect(b.text).toBe("LANDED · drone 2.3 m from the target");
     expect(recoveryPoint(s)).toMatchObject({ kind: "actual", lat_deg: 38.6, lon_deg: -7.9 });
     expect(phaseLabel(s)).toBe("landed");
     expect(phaseLabel(base({ vehicle: { phase: "branch2" }, guidance: { phase: "flare" } }))).toBe("branch2");
@@ -234,5 +237,16 @@ describe("the replay bar's clock", () => {
     expect(clockText(61_999)).toBe("1:01");
     expect(clockText(3 * 3600_000 + 5_000)).toBe("3:00:05");
     expect(clockText(-5)).toBe("0:00");
+  });
+});
+
+describe("replica alarm", () => {
+  const d = { what: "phase" as const, replica: "branch3", drone: "final_approach", since_s: 812.4, for_s: 1.6, resolved: false, adopted: false };
+  it("says which value, each side's, for how long and since when on the mission clock", () => {
+    expect(replicaAlarm(d)).toBe("REPLICA ≠ DRONE: phase (station branch3, drone final approach) for 1.6 s, since T+00:13:32.4");
+  });
+  it("says how a resolved one ended", () => {
+    expect(replicaAlarm({ ...d, for_s: 2, resolved: true, adopted: true })).toBe("replica and drone disagreed on the phase for 2.0 s (station branch3, drone final approach, since T+00:13:32.4): the replica took the drone's");
+    expect(replicaAlarm({ ...d, resolved: true })).toMatch(/: they agree again$/);
   });
 });

@@ -28,8 +28,9 @@ describe("recordings list", () => {
     expect(startText(null)).toBe("—");
   });
   it("says where a flight landed and its miss, or the stage it ended in", () => {
-    expect(landingText({ ...base, landing: { lat_deg: 50.1, lon_deg: 14.2, miss_m: 3.4 } })).toContain("3.4 m from the target");
-    expect(landingText({ ...base, landing: { lat_deg: 50.1, lon_deg: 14.2, miss_m: null } })).toContain("no target");
+    expect(landingText({ ...base, landing: { lat_deg: 50.1, lon_deg: 14.2, miss_m: 3.44, body: "drone" } })).toContain("drone 3.4 m from the target");
+    expect(landingText({ ...base, landing: { lat_deg: 50.1, lon_deg: 14.2, miss_m: 3.4, body: null } })).toContain("· 3.4 m from the target");
+    expect(landingText({ ...base, landing: { lat_deg: 50.1, lon_deg: 14.2, miss_m: null, body: "drone" } })).toContain("no target");
     expect(landingText({ ...base, last_stage: "round_chute" })).toBe("not landed (round chute)");
     expect(landingText(base)).toBe("—");
   });

@@ -78,9 +78,18 @@ export function landingCountdown(s: State): LandingCountdown | null {
 export function landedText(s: State): string {
   const l = s.mission.landing;
   if (l === null) return "LANDED · measuring the touchdown";
-  if (l.miss_m === null) return "LANDED · no target";
-  // To the decimetre: the same figure, to 0.1 m, as the log, the recordings list and a replay.
-  return `LANDED · ${l.miss_m < 1000 ? `${l.miss_m.toFixed(1)} m` : fmtDistance(l.miss_m)} from the target`;
+  return `LANDED · ${missPhrase(l.miss_m, l.body)}`;
+}
+
+/**
+ * The station's one miss figure as every page words it: which body, how far, from the target —
+ * to the decimetre, so that the header, map, log, recordings list and a replay read the same.
+ * `body` is `null` for recordings made before the station named it.
+ */
+export function missPhrase(miss_m: number | null, body: string | null): string {
+  const who = body === null ? "" : `${body} `;
+  if (miss_m === null) return `${who}down, no target`;
+  return `${who}${miss_m < 1000 ? `${miss_m.toFixed(1)} m` : fmtDistance(miss_m)} from the target`;
 }
 
 /**
@@ -91,7 +100,10 @@ export function landingBadge(s: State | null, stale: boolean, age_s: N): Landing
   if (s === null) return { state: "none", text: "landing —" };
   if (isLanded(s)) return { state: "landed", text: `${landedText(s)}${stale ? " (link stale)" : ""}` };
   const c = landingCountdown(s);
-  if (c === null) return { state: stale ? "stale" : "none", text: "landing —" };
+  if (c === null) {
+    if (!stale) return { state: "none", text: "landing —" };
+    return { state: "stale", text: `landing — · data ${age_s === null ? "of an unknown age" : `${fmtDuration(age_s)} old`} — STALE` };
+  }
   const n = `landing in ${fmtDuration(c.in_s)}${c.kind === "planned" ? "" : ` (${c.kind})`}`;
   if (!stale) return { state: "live", text: n };
   return { state: "stale", text: `${n} as of ${age_s === null ? "an unknown time" : fmtDuration(age_s)} ago — STALE` };

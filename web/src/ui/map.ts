@@ -296,6 +296,12 @@ export class MapView {
   private showPrediction(m: L.Marker, ell: L.Polygon, p: LandingPrediction | null, name: string, stale: boolean): void {
     this.show(m, p);
     m.getElement()?.classList.toggle("stale", stale);
+    const dot = m.getElement()?.querySelector<HTMLElement>("[data-testid]");
+    if (dot && p) {
+      // Where the page drew the prediction, for tests and for people reading the DOM.
+      dot.dataset.lat = p.lat_deg.toFixed(7);
+      dot.dataset.lon = p.lon_deg.toFixed(7);
+    }
     if (p === null || p.semi_major_m === null || p.semi_minor_m === null) {
       ell.setLatLngs([]);
       return;

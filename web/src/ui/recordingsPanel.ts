@@ -5,7 +5,8 @@
 
 import type * as Wire from "../generated/api";
 import { ApiError, type Api } from "../lib/api";
-import { fmtDistance, fmtLatLon, label } from "../lib/format";
+import { fmtLatLon, label } from "../lib/format";
+import { missPhrase } from "../lib/recovery";
 import { isObj } from "../lib/parse";
 import { withToken } from "../lib/token";
 import { h, setText } from "./dom";
@@ -27,8 +28,7 @@ export function startText(ms: number | null): string {
 export function landingText(r: Wire.RecordingSummary): string {
   if (r.landing !== null) {
     // The station's figure as measured at the landing, to 0.1 m as every page shows it.
-    const miss = r.landing.miss_m === null ? "no target" : `${r.landing.miss_m < 1000 ? `${r.landing.miss_m.toFixed(1)} m` : fmtDistance(r.landing.miss_m)} from the target`;
-    return `${fmtLatLon(r.landing.lat_deg, r.landing.lon_deg)} · ${miss}`;
+    return `${fmtLatLon(r.landing.lat_deg, r.landing.lon_deg)} · ${missPhrase(r.landing.miss_m, r.landing.body)}`;
   }
   return r.last_stage === null ? "—" : `not landed (${label(r.last_stage)})`;
 }

@@ -45,7 +45,11 @@ pub struct GpsSolution {
 }
 
 /// A known, finite value as f32, or the field marked ignored.
-fn field(v: Option<f64>, flag: mc::GpsInputIgnoreFlags, ignored: &mut mc::GpsInputIgnoreFlags) -> f32 {
+fn field(
+    v: Option<f64>,
+    flag: mc::GpsInputIgnoreFlags,
+    ignored: &mut mc::GpsInputIgnoreFlags,
+) -> f32 {
     match v {
         Some(v) if v.is_finite() => v as f32,
         _ => {
@@ -175,7 +179,10 @@ mod tests {
         assert_eq!(b.fix, GpsFix::Fix3d);
         assert!((b.lat_deg - s.lat_deg).abs() < 1e-7 && (b.lon_deg - s.lon_deg).abs() < 1e-7);
         assert!((b.alt_msl_m - s.alt_msl_m).abs() < 1e-3);
-        let (v, bv) = (s.velocity_ned_mps.unwrap(), b.velocity_ned_mps.expect("velocity"));
+        let (v, bv) = (
+            s.velocity_ned_mps.unwrap(),
+            b.velocity_ned_mps.expect("velocity"),
+        );
         for k in 0..3 {
             assert!((v[k] - bv[k]).abs() < 1e-6, "component {k}");
         }

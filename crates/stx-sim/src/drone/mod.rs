@@ -415,6 +415,15 @@ impl Drone {
                 .iter()
                 .map(|e| start((phase_name(e.to), e.time_s)))
                 .collect(),
+            final_course_deg: {
+                let g = self.onboard.guidance();
+                g.spiral_has_run().then(|| {
+                    g.spiral_status()
+                        .final_course_rad
+                        .to_degrees()
+                        .rem_euclid(360.0)
+                })
+            },
             texts: self.texts_sent,
             outputs_dropped: self.outputs_dropped,
         }

@@ -67,6 +67,9 @@ pub struct MissionSummary {
     pub landing: Option<Landing>,
     /// Guidance phases entered, with their mission time.
     pub phases: Vec<StageStart>,
+    /// The course of the final approach the onboard guidance last planned, degrees from north
+    /// (`None`: no spiral flew).
+    pub final_course_deg: Option<f64>,
     /// Status texts sent.
     pub texts: u64,
     /// Outputs dropped because nobody drained them.

@@ -80,7 +80,8 @@ impl StationCore {
             d.x.hypot(d.y)
         });
         let text = match miss_m {
-            Some(m) => format!("landed {m:.1} m from the target (the drone's GPS on the ground)"),
+            // Worded as every page words it: the body, the figure to 0.1 m, the target.
+            Some(m) => format!("landed: drone {m:.1} m from the target (its GPS on the ground)"),
             None => "landed (no target known: no miss)".to_string(),
         };
         self.landing.landing = Some(LandingView {
@@ -96,5 +97,48 @@ impl StationCore {
     /// The landing, once measured.
     pub fn landing(&self) -> Option<&LandingView> {
         self.landing.landing.as_ref()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use nalgebra::Vector3;
+    use stx_gnc::mission::FlightStage as S;
+
+    use crate::core::TargetSource;
+    use crate::core::tests::core;
+
+    #[test]
+    fn the_landing_is_the_first_fix_measured_after_the_landed_report_and_measured_once() {
+        let mut c = core();
+        let mut plan = *c.guidance.plan();
+        plan.target_ned_m = Vector3::new(300.0, 400.0, 0.0);
+        c.guidance.set_plan(plan, 0.0);
+        c.sync.target = Some(TargetSource::DronePlan);
+        let at = |north: f64, east: f64| c.frame.to_geodetic(&Vector3::new(north, east, 0.0));
+        let (air, down, later) = (at(330.0, 400.0), at(303.0, 404.0), at(310.0, 420.0));
+
+        c.landing_on_stage(Some(S::Parafoil), S::Landed, 1000.0);
+        // Measured at the report's instant: maybe still in the air.
+        c.landing_fix(50.0, 1000.0, air.0, air.1, air.2);
+        assert!(c.landing().is_none());
+        c.landing_fix(50.1, 1000.2, down.0, down.1, down.2);
+        let l = c.landing().cloned().expect("measured");
+        assert_eq!((l.time_s, l.body.as_str()), (1000.2, "drone"));
+        let miss = l.miss_m.expect("a target");
+        assert!((miss - 5.0).abs() < 0.01, "3-4-5 m: {miss}");
+        // The GPS wanders on the ground: the figure does not.
+        c.landing_fix(50.2, 1000.4, later.0, later.1, later.2);
+        assert_eq!(c.landing(), Some(&l));
+        let said: Vec<String> = c.events_since(0.0).into_iter().map(|e| e.text).collect();
+        assert_eq!(
+            said.iter()
+                .filter(|t| t.contains("from the target"))
+                .collect::<Vec<_>>(),
+            vec!["landed: drone 5.0 m from the target (its GPS on the ground)"]
+        );
+        // Flying again (a rehearsal restarted): the old landing is history.
+        c.landing_on_stage(Some(S::Landed), S::PreLaunch, 0.0);
+        assert!(c.landing().is_none());
     }
 }

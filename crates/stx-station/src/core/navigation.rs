@@ -303,7 +303,11 @@ impl StationCore {
     /// A GPS measurement from GPS_RAW_INT, for a drone that sends no GPS_INPUT. GPS_RAW_INT
     /// carries no vertical velocity: the drone's own estimate (GLOBAL_POSITION_INT) stands in
     /// for it when it is of the same second of the drone's clock.
-    fn gps_measurement(&self, drone_s: f64, g: &stx_link::telemetry::GpsRaw) -> Option<Measurement> {
+    fn gps_measurement(
+        &self,
+        drone_s: f64,
+        g: &stx_link::telemetry::GpsRaw,
+    ) -> Option<Measurement> {
         if !has_3d_fix(g) {
             return None;
         }
@@ -424,7 +428,11 @@ impl StationCore {
             // configured polar, a stack 20 % off it was predicted 10–18 m long at 100 m.
             performance: self.guidance.learned_performance(),
             ground_altitude_msl_m: self.frame.alt_msl_m,
-            wind_profile: if std::env::var_os("STX_NO_PROFILE").is_some() { None } else { self.wind_profile() },
+            wind_profile: if std::env::var_os("STX_NO_PROFILE").is_some() {
+                None
+            } else {
+                self.wind_profile()
+            },
             config: PredictorConfig {
                 hang_height_m: self.config.guidance.spiral.hang_height_m,
                 ..PredictorConfig::default()

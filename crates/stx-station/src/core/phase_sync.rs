@@ -153,3 +153,97 @@ impl StationCore {
         })
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use stx_gnc::mission::{FlightMode, FlightStage, GuidancePhase as P};
+    use stx_link::telemetry::{SystemState, VehicleStatus};
+
+    use super::*;
+    use crate::core::tests::core;
+
+    /// A station whose replica flies spiral landing, in the approximation, and a drone whose
+    /// heartbeat says `phase`.
+    fn apart(phase: P) -> StationCore {
+        let mut c = core();
+        c.guidance.set_mode(FlightMode::SpiralLanding, 0.0);
+        says(&mut c, phase);
+        c
+    }
+
+    fn says(c: &mut StationCore, phase: P) {
+        let status = VehicleStatus {
+            mode: FlightMode::SpiralLanding,
+            stage: FlightStage::Parafoil,
+            phase,
+            state: SystemState::Active,
+        };
+        c.latest.status = Some((status, 0.0));
+    }
+
+    #[test]
+    fn a_disagreement_is_shown_after_a_second_and_the_drones_phase_adopted_after_two() {
+        let mut c = apart(P::Branch2);
+        assert_eq!(c.guidance.phase(), P::Approximation);
+        c.sync_phase(100.0, 500.0, true);
+        c.sync_phase(100.5, 500.5, true);
+        assert_eq!(
+            c.disagreement_view(Some(500.5)),
+            None,
+            "a transition is not an alarm"
+        );
+        c.sync_phase(101.2, 501.2, true);
+        let shown = c.disagreement_view(Some(501.2)).expect("the alarm");
+        assert_eq!(
+            (shown.replica.as_str(), shown.drone.as_str(), shown.resolved),
+            ("approximation", "branch2", false)
+        );
+        assert!(
+            shown.since_s == 500.0 && (shown.for_s - 1.2).abs() < 1e-9,
+            "{shown:?}"
+        );
+        c.sync_phase(102.0, 502.0, true);
+        assert_eq!(
+            c.guidance.phase(),
+            P::Branch2,
+            "the replica takes the drone's phase"
+        );
+        let shown = c.disagreement_view(Some(503.0)).expect("still shown");
+        assert!(shown.resolved && shown.adopted && shown.for_s == 2.0);
+        let said: Vec<String> = c.events_since(0.0).into_iter().map(|e| e.text).collect();
+        assert!(
+            said.iter().any(|t| t.contains("disagreed for 2.0 s (replica approximation, drone branch2, since T+500.0 s): the replica takes the drone's phase")),
+            "{said:?}"
+        );
+        assert_eq!(
+            c.disagreement_view(Some(502.0 + SHOW_RESOLVED_S + 0.1)),
+            None
+        );
+    }
+
+    #[test]
+    fn a_transition_seen_a_period_apart_is_neither_shown_nor_logged() {
+        let mut c = apart(P::Branch2);
+        c.sync_phase(10.0, 50.0, true);
+        says(&mut c, P::Approximation);
+        c.sync_phase(10.1, 50.2, true);
+        assert_eq!(c.disagreement_view(Some(50.2)), None);
+        assert!(c.phase_sync.apart.is_none());
+        assert_eq!(c.phase_sync.adopted, 0);
+        assert!(
+            !c.events_since(0.0)
+                .iter()
+                .any(|e| e.text.contains("disagreed")),
+        );
+    }
+
+    #[test]
+    fn with_a_stale_link_the_replica_flies_on_by_itself() {
+        let mut c = apart(P::Branch2);
+        for i in 0..50 {
+            c.sync_phase(f64::from(i), 100.0 + f64::from(i), false);
+        }
+        assert_eq!(c.guidance.phase(), P::Approximation);
+        assert_eq!(c.disagreement_view(Some(150.0)), None);
+    }
+}

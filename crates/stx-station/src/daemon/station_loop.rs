@@ -153,7 +153,11 @@ pub(super) async fn station_loop(mut io: StationLoop) {
         let now = shared.now_s();
         let (actions, outbound, prediction) = {
             let mut core = shared.core();
-            let prediction = if predicting { None } else { core.prediction_job() };
+            let prediction = if predicting {
+                None
+            } else {
+                core.prediction_job()
+            };
             let actions = if shared.replay.is_none() {
                 core.take_link_actions(now)
             } else {

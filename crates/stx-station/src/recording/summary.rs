@@ -61,6 +61,9 @@ pub struct LandingSummary {
     /// Horizontal distance to the drone's target, m, as the station measured it (`null`
     /// without a target): the figure every page shows.
     pub miss_m: Option<f64>,
+    /// Which body the position is of, as the station measured it (`drone`: its GPS
+    /// receiver); `null` in recordings made before the station said.
+    pub body: Option<String>,
 }
 
 /// Why a recording could not be summarised.
@@ -156,6 +159,7 @@ fn landing(state: &Value) -> Option<LandingSummary> {
             lat_deg: lat,
             lon_deg: lon,
             miss_m: l.get("miss_m").and_then(Value::as_f64),
+            body: l.get("body").and_then(Value::as_str).map(String::from),
         });
     }
     let (lat, lon, alt) =
@@ -172,6 +176,7 @@ fn landing(state: &Value) -> Option<LandingSummary> {
         lat_deg: lat,
         lon_deg: lon,
         miss_m,
+        body: None,
     })
 }
 
