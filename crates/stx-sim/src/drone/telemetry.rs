@@ -274,12 +274,17 @@ fn course_deg(north: f64, east: f64) -> Option<f64> {
     (north.hypot(east) > 0.2).then(|| east.atan2(north).to_degrees().rem_euclid(360.0))
 }
 
+/// The receiver's time of a fix, µs on the drone's clock (GPS_RAW_INT and GPS_INPUT alike).
+fn fix_time_usec(fix: &Fix) -> u64 {
+    (fix.time_s.max(0.0) * 1e6).round() as u64
+}
+
 /// GPS_RAW_INT of a fix.
 pub fn gps_raw(frame: &LocalFrame, fix: &Fix) -> GpsRaw {
     let (lat_deg, lon_deg, alt_msl_m) = frame.to_geodetic(&fix.position_ned_m);
     let v = fix.velocity_ned_mps;
     GpsRaw {
-        time_usec: (fix.time_s.max(0.0) * 1e6).round() as u64,
+        time_usec: fix_time_usec(fix),
         fix: GpsFix::Fix3d,
         lat_deg,
         lon_deg,
@@ -297,7 +302,7 @@ pub fn gps_solution(frame: &LocalFrame, fix: &Fix) -> GpsSolution {
     let (lat_deg, lon_deg, alt_msl_m) = frame.to_geodetic(&fix.position_ned_m);
     let v = fix.velocity_ned_mps;
     GpsSolution {
-        time_usec: (fix.time_s.max(0.0) * 1e6).round() as u64,
+        time_usec: fix_time_usec(fix),
         fix: GpsFix::Fix3d,
         lat_deg,
         lon_deg,
