@@ -10,8 +10,9 @@
 //    round chute it agrees with the map's unsteered landing;
 //  - the final-course chip is the course the drone's guidance flew (within 5°), and shown only
 //    while the parafoil flies a pattern;
-//  - the planned dot from 150 to 50 m above the ground is the station's prediction and within 20 m
-//    of where the drone touched down (median; the campaign's p95 is `stx bench agreement`'s);
+//  - the planned dot from 200 to 50 m above the ground is the station's prediction, within 20 m
+//    of where the drone touched down and within 5 m of the drone's own prediction's figure
+//    (medians; the campaign's p95 is `stx bench agreement`'s);
 //  - one landing figure, to 0.1 m, naming the body: header, map, event log, a viewer's page, the
 //    recordings list of the next day's station and the flight's replay — and it is the drone's
 //    real miss give or take its GPS error.
@@ -95,11 +96,15 @@ async function wholeMission() {
     s.apiPlanned = st.body?.prediction?.planned ?? null;
     s.onboard = st.body?.vehicle?.predicted_landing ?? null;
     s.apiTime = st.body?.mission_time_s ?? null;
+    // Under the parafoil the whole state is kept: a departure of the station's picture from the
+    // drone's is then diagnosable from tests/output/browser/truth-samples.json alone.
+    if (s.apiStage === "parafoil") s.state = st.body;
     samples.push(s);
-    await sleep(100);
+    await sleep(50);
   }
   await exited;
   await writeFile(join(out, "truth-samples.json"), JSON.stringify(samples));
+  await writeFile(join(out, "truth-events.json"), JSON.stringify((await api("/api/events")).body));
   const truth = JSON.parse(drone.out.trim().split("\n").pop() || "null");
   check("the drone flew mission-short to a landing and said so", truth?.landing?.miss_m != null && truth?.final_course_deg != null,
     truth?.landing ? `landed at ${truth.landing.time_s.toFixed(1)} s, ${truth.landing.miss_m.toFixed(1)} m from the target` : drone.err.slice(-300));
@@ -152,18 +157,20 @@ async function wholeMission() {
   const ground = st?.mission?.landing?.position?.alt_msl_m ?? null;
   const touchdown = { lat_deg: truth.landing.lat_deg, lon_deg: truth.landing.lon_deg };
   // One flight, sampled every ~2 s of its clock: where a sample falls against the turn onto final
-  // (in this band) and against the station's once-a-second prediction moves its figure by several
-  // metres (medians of 6–14 m over runs, the drone's own prediction alike). So: the median over
-  // 150–50 m within 20 m — the issue's page drew it 70–100 m off — and the dot exactly on the
-  // station's prediction. The campaign's statistics (p95 within 15 m, never worse than the drone's
-  // own by over 5 m, over 40 missions) are `stx bench agreement`'s and the short test's.
-  const band = beforeLanding.filter((s) => s.apiStage === "parafoil" && s.planned && s.alt_msl_m !== null && ground !== null && Math.abs(s.alt_msl_m - ground - 100) <= 50);
+  // (in this band) and against the station's once-a-second prediction moves its figure by a few
+  // metres (medians of 3.5–5.8 m over six runs, the drone's own 3.3–5.7 m). So: the median over
+  // 200–50 m within 20 m — the issue's page drew it 70–100 m off — no more than 5 m beyond the
+  // drone's own at the same instants — a replica updated once per telemetry burst was 7–14 m
+  // beyond it in three runs of six — and the dot exactly on the station's prediction. The
+  // campaign's statistics (p95 within 15 m, never worse than the drone's own by over 5 m) are
+  // `stx bench agreement`'s and the short test's.
+  const band = beforeLanding.filter((s) => s.apiStage === "parafoil" && s.planned && s.alt_msl_m !== null && ground !== null && Math.abs(s.alt_msl_m - ground - 125) <= 75);
   const median = (xs) => (xs.length ? [...xs].sort((x, y) => x - y)[Math.floor(xs.length / 2)] : NaN);
   const offs = band.map((s) => distanceM(s.planned, touchdown));
   const onboardOffs = band.filter((s) => s.onboard).map((s) => distanceM(s.onboard, touchdown));
   const drawn = median(band.filter((s) => s.apiPlanned).map((s) => distanceM(s.planned, s.apiPlanned)));
-  check("the planned dot from 150 to 50 m above the ground is the station's prediction and within 20 m of the drone's touchdown (median)",
-    offs.length >= 5 && median(offs) <= 20 && drawn < 1,
+  check("the planned dot from 200 to 50 m above the ground is the station's prediction, within 20 m of the drone's touchdown and within 5 m of the drone's own prediction's figure (medians)",
+    offs.length >= 5 && median(offs) <= 20 && median(offs) <= median(onboardOffs) + 5 && drawn < 1,
     `${offs.length} samples: the dot ${offs.map((o) => o.toFixed(1)).join(", ")} m from the touchdown (median ${median(offs).toFixed(1)} m; the drone's own prediction at the same instants: median ${median(onboardOffs).toFixed(1)} m); the dot from the station's prediction: median ${drawn.toFixed(2)} m`);
 
   // ---------------------------------------------------------------- one landing figure, live

@@ -37,6 +37,9 @@ pub struct Sample {
     pub final_course_error_deg: Option<f64>,
     /// While the drone flies a spiral, the station shows no pattern.
     pub final_course_missing: bool,
+    /// The replica's learned main-line trim minus the drone's, m (see
+    /// [`Sample::with_replica_trim`]); `None` before it is set.
+    pub trim_error_m: Option<f64>,
     /// The station's planned landing (north, east), m.
     pub planned_ne_m: Option<[f64; 2]>,
     /// Seconds the station's planned landing says are left.
@@ -77,6 +80,7 @@ impl Sample {
             target_missing: station_target.is_some() != truth.target_ne_m.is_some(),
             final_course_error_deg,
             final_course_missing: truth.final_course_rad.is_some() && pattern.is_none(),
+            trim_error_m: None,
             planned_ne_m: planned.map(|p| ne(p.lat_deg, p.lon_deg)),
             planned_time_to_land_s: planned.map(|p| p.time_to_land_s),
             wind_error_mps: estimate.map(|e| {
@@ -89,6 +93,15 @@ impl Sample {
             }),
             truth,
         }
+    }
+
+    /// With the replica's learned main-line trim, `trim_m`. The station does not publish it,
+    /// but everything the replica plans and predicts flies with it: a replica updated at other
+    /// instants than the drone's guidance learns another trim, and its predicted landing drifts
+    /// from the drone's without any phase or course disagreeing.
+    pub fn with_replica_trim(mut self, trim_m: f64) -> Self {
+        self.trim_error_m = Some(trim_m - self.truth.trim_m);
+        self
     }
 
     /// The station shows the drone's stage.

@@ -132,6 +132,14 @@ impl Pair {
         Duration::from_secs_f64(self.station_s())
     }
 
+    /// Flies one control period the station does not hear yet: its telemetry waits on the
+    /// link until the next [`Pair::step`], as it waits in a loaded station's socket.
+    pub fn step_unheard(&mut self) -> Result<(), PairError> {
+        let now = self.link_now();
+        self.drone.step(now)?;
+        Ok(())
+    }
+
     /// Flies one control period and lets the station hear and answer it.
     pub fn step(&mut self) -> Result<(), PairError> {
         let now = self.link_now();

@@ -132,6 +132,8 @@ pub struct MissionReport {
     pub dispersions: String,
     /// Mission time per station time.
     pub speed: f64,
+    /// How the station heard the drone.
+    pub delivery: &'static str,
     /// Mission time flown, s.
     pub flight_s: f64,
     /// Of which under the parafoil, s.
@@ -158,6 +160,8 @@ pub struct MissionReport {
     pub wind_error_mps: Vec<(String, Spread)>,
     /// The station's position against the truth, under the parafoil, m.
     pub position_error_m: Spread,
+    /// The replica's learned main-line trim against the drone's, under the parafoil, mm.
+    pub trim_error_mm: Spread,
     /// The predicted landing at [`PREDICTION_HEIGHTS_M`].
     pub predictions_at: Vec<PredictionAtHeight>,
     /// The landing; `None` if it did not land.
@@ -175,6 +179,8 @@ pub struct MissionName {
     pub dispersions: String,
     /// Mission time per station time.
     pub speed: f64,
+    /// How the station heard the drone.
+    pub delivery: &'static str,
 }
 
 impl MissionReport {
@@ -250,6 +256,7 @@ impl MissionReport {
             seed: name.seed,
             dispersions: name.dispersions,
             speed: name.speed,
+            delivery: name.delivery,
             flight_s: samples.last().map_or(0.0, |s| s.truth.time_s),
             // From the first sample under the parafoil to the last: the samples' spacing is not
             // even (the pair steps the drone at its own rate).
@@ -273,6 +280,11 @@ impl MissionReport {
             final_course_within_5_deg: within_5,
             wind_error_mps: wind,
             position_error_m: Spread::of(parafoil.iter().filter_map(|s| s.position_error_m)),
+            trim_error_mm: Spread::of(
+                parafoil
+                    .iter()
+                    .filter_map(|s| s.trim_error_m.map(|e| 1000.0 * e.abs())),
+            ),
             predictions_at,
             landing,
         }

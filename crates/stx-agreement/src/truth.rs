@@ -29,6 +29,8 @@ pub struct TruthSample {
     pub position_ned_m: Vector3<f64>,
     /// The true wind at the drone, NED, m/s.
     pub wind_ned_mps: Vector3<f64>,
+    /// The main-line trim the onboard guidance has learned, m.
+    pub trim_m: f64,
 }
 
 impl TruthSample {
@@ -53,6 +55,7 @@ impl TruthSample {
             onboard_prediction_ne_m: drone.predicted_landing_ne_m(),
             position_ned_m: truth.position_ned_m,
             wind_ned_mps: truth.wind_ned_mps,
+            trim_m: onboard.guidance().learned_trim_m(),
         }
     }
 

@@ -25,7 +25,7 @@ use crate::summary::{Landing, PhaseStart, StepRecord, summarise};
 /// < 0.08 s), five per control period; [`GuidedFlight::advance`] refines it where it fails.
 pub const STEP_S: f64 = 0.05;
 /// Control period: the drone's measurement and control rate, 4 Hz (seed §3.3.2).
-pub const CONTROL_PERIOD_S: f64 = 0.25;
+pub use stx_gnc::guidance::CONTROL_PERIOD_S;
 
 /// Runs a scenario that has a `[guidance]` section.
 pub fn run(scenario: &Scenario, vehicle: &Vehicle) -> Result<Run, RunError> {

@@ -38,6 +38,10 @@ enum BenchWhat {
         /// Dispersion set: `nominal`, `realistic` or a file; default: realistic.
         #[arg(long)]
         dispersions: Option<String>,
+        /// Fly no flight with the station hearing the drone in bursts of several control
+        /// periods (by default each flight is also flown so at 20×).
+        #[arg(long)]
+        no_bursts: bool,
         /// The station's keep-out zones.
         #[arg(long, default_value = "config/keep-out/sample.geojson")]
         keep_out: std::path::PathBuf,
@@ -111,6 +115,7 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
             seeds,
             speeds,
             dispersions,
+            no_bursts,
             keep_out,
             threads,
         } => {
@@ -132,6 +137,7 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
             if let Some(d) = dispersions {
                 campaign.dispersions = Some(d);
             }
+            campaign.bursts &= !no_bursts;
             crate::bench_agreement::run_bench(crate::bench_agreement::AgreementBenchOptions {
                 campaign,
                 keep_out: Some(keep_out),

@@ -105,16 +105,18 @@ fn print_mission(r: &MissionReport) {
         .collect::<Vec<_>>()
         .join(", ");
     println!(
-        "{} seed {} ({}) at {}x: phase agreed {:.2} % of {:.0} s under the parafoil (longest apart {:.2} s), final course within {:.1}°, target {:.3} m; predicted landing off (station / drone, m) {predictions}; landed {} s: drone {} m, payload {} m from the target, the station says {} m",
+        "{} seed {} ({}) at {}x, heard {}: phase agreed {:.2} % of {:.0} s under the parafoil (longest apart {:.2} s), final course within {:.1}°, target {:.3} m, trim within {:.3} mm; predicted landing off (station / drone, m) {predictions}; landed {} s: drone {} m, payload {} m from the target, the station says {} m",
         r.mission,
         r.seed,
         r.dispersions,
         r.speed,
+        r.delivery,
         100.0 * r.phase.agreed(),
         r.parafoil_s,
         r.longest_phase_span_s(),
         r.final_course_error_deg.max,
         r.target_error_m.max,
+        r.trim_error_mm.max,
         fmt(landing.map(|l| l.time_s)),
         fmt(landing.and_then(|l| l.drone_miss_m)),
         fmt(landing.and_then(|l| l.payload_miss_m)),
@@ -134,8 +136,8 @@ fn print_summary(s: &Summary, wall_s: f64) {
     );
     for f in &s.failed {
         println!(
-            "  FAILED {} seed {} at {}x: {}",
-            f.mission, f.seed, f.speed, f.error
+            "  FAILED {} seed {} at {}x, heard {}: {}",
+            f.mission, f.seed, f.speed, f.delivery, f.error
         );
     }
     for p in &s.predictions {

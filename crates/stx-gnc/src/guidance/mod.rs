@@ -25,6 +25,12 @@ use crate::estimate::Estimate;
 use crate::keep_out::KeepOutZones;
 use crate::mission::{FlightMode, GuidancePhase};
 
+/// The drone's control period, s: [`Guidance::update`] runs at each whole multiple of it on the
+/// drone's boot clock (4 Hz, seed §3.3.2). The station's replica updates at the same instants:
+/// what guidance learns in flight (the trim, the glide) is summed per update, so a replica
+/// updated at other instants, or fewer times, learns something else.
+pub const CONTROL_PERIOD_S: f64 = 0.25;
+
 /// A change of guidance phase, with why.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct PhaseEvent {
@@ -212,6 +218,12 @@ impl Guidance {
             FlightMode::SpiralLanding => self.spiral.learned_performance(&self.config.performance),
             _ => self.config.performance,
         }
+    }
+
+    /// The main-line trim learned in flight, m: the offset the stack flies with (the command
+    /// that flies straight is its negative).
+    pub fn learned_trim_m(&self) -> f64 {
+        self.trim.offset_m
     }
 
     /// The spiral's planning state for display (pattern, final-approach height, reach).

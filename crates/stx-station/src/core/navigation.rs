@@ -5,7 +5,7 @@
 //! predictions run as detached jobs, off the telemetry path.
 
 use nalgebra::Vector3;
-use stx_dynamics::atmosphere::{Atmosphere, StandardAtmosphere};
+use stx_dynamics::atmosphere::StandardAtmosphere;
 use stx_dynamics::wind::{WindField, WindProfile};
 use stx_gnc::estimate::Estimate;
 use stx_gnc::estimator::{Estimator, EstimatorConfig};
@@ -16,6 +16,7 @@ use stx_gnc::predict::{LandingPrediction, PredictorConfig, predict_in_wind};
 use stx_link::telemetry::Telemetry;
 
 use super::StationCore;
+use super::replica::Stamp;
 use crate::messages::{Level, StateMsg, TrackPoint};
 
 /// States kept for the plots of a newly connected page: 5 minutes at 1 Hz.
@@ -246,10 +247,12 @@ impl StationCore {
                 }
             }
             Telemetry::Position(p) => {
+                self.replica_catch_up(now_s, p.time_boot_ms, Stamp::AfterControl);
                 self.observe_drone_clock(now_s, p.time_boot_ms);
                 self.latest.position = Some((p, now_s));
             }
             Telemetry::Attitude(a) => {
+                self.replica_catch_up(now_s, a.time_boot_ms, Stamp::Measured);
                 let t = self.observe_drone_clock(now_s, a.time_boot_ms);
                 self.latest.attitude = Some((a, now_s));
                 self.latest.sensors_s = Some(now_s);
@@ -262,6 +265,7 @@ impl StationCore {
                 self.estimator.handle(self.drone_time_s.unwrap_or(t), &m);
             }
             Telemetry::AirData(a) => {
+                self.replica_catch_up(now_s, a.time_boot_ms, Stamp::Measured);
                 let t = self.observe_drone_clock(now_s, a.time_boot_ms);
                 self.latest.air = Some((a, now_s));
                 self.latest.sensors_s = Some(now_s);
@@ -282,6 +286,7 @@ impl StationCore {
                 self.on_guidance_status(now_s, g);
             }
             Telemetry::PredictedLanding(p) => {
+                self.replica_catch_up(now_s, p.time_boot_ms, Stamp::AfterControl);
                 self.observe_drone_clock(now_s, p.time_boot_ms);
                 self.latest.predicted_landing = Some((p, now_s));
             }
@@ -337,35 +342,13 @@ impl StationCore {
         let est = self.drone_time_s.map(|t| self.estimator.estimate(t));
         let usable = est.filter(|e| e.position_sigma_m.iter().all(|s| s.is_finite()));
         if let Some(est) = usable {
-            let mode = self.guidance.mode();
             if !self.replica_flies() {
                 // The drone holds its servos neutral before its parafoil flies.
                 self.replica_command = stx_dynamics::state::Controls::default();
-            } else if !self.plan_known_for(mode) {
-                // Flying towards a target the drone may not have would draw and log a
-                // pattern that does not exist.
-                self.replica_command = stx_dynamics::state::Controls::default();
-            } else if self.guided_at_s.is_none_or(|t| est.time_s > t) {
-                // Only new navigation data move guidance on: a stale link does not make
-                // the replica fly on by itself.
-                self.guided_at_s = Some(est.time_s);
-                let density = StandardAtmosphere
-                    .air_at(self.frame.alt_msl_m - est.position_ned_m.z)
-                    .density_kg_per_m3;
-                self.replica_command = self.guidance.update(&est, density).controls;
-                let fresh = self.latest.status.is_some_and(|(_, at)| {
-                    now_s - at <= self.config.link.stale_after_s && self.link.connected
-                });
-                self.sync_phase(now_s, est.time_s, fresh);
             }
-            for e in self.guidance.drain_events() {
-                self.log(
-                    now_s,
-                    Level::Info,
-                    "guidance",
-                    format!("{:?} → {:?}: {}", e.from, e.to, e.reason),
-                );
-            }
+            // The replica itself is stepped as telemetry arrives, at the drone's control
+            // instants ([`StationCore::replica_catch_up`]); mode and plan changes log here.
+            self.log_guidance_events(now_s);
             // One point per second of flight, also when a rehearsal runs faster than real time.
             if est.time_s >= self.next_track_s {
                 self.next_track_s = est.time_s + TRACK_PERIOD_S;
@@ -428,11 +411,7 @@ impl StationCore {
             // configured polar, a stack 20 % off it was predicted 10–18 m long at 100 m.
             performance: self.guidance.learned_performance(),
             ground_altitude_msl_m: self.frame.alt_msl_m,
-            wind_profile: if std::env::var_os("STX_NO_PROFILE").is_some() {
-                None
-            } else {
-                self.wind_profile()
-            },
+            wind_profile: self.wind_profile(),
             config: PredictorConfig {
                 hang_height_m: self.config.guidance.spiral.hang_height_m,
                 ..PredictorConfig::default()

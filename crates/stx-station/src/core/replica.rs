@@ -16,9 +16,21 @@
 //! - **parameters**: the replica flies with the drone's gains and spiral settings, read from its
 //!   parameter table (`GN_*`, `SP_*`), not with the station's configured defaults.
 //!
+//! - **instants**: the drone updates its guidance at each control instant (whole multiples of
+//!   [`CONTROL_PERIOD_S`] on its boot clock), with every measurement that reached it by then,
+//!   and what guidance learns (the main-line trim, the glide) is summed per update. The replica
+//!   updates at the same instants with the same measurements, whenever the telemetry arrives:
+//!   an instant is flown as soon as a message shows the drone has passed it (its periodic
+//!   telemetry, sent after the update and stamped with the instant, or a measurement taken
+//!   after it), before that message is taken in. (Updated once per telemetry burst, the replica
+//!   skipped instants whenever a loaded station read two control periods' telemetry at once —
+//!   at 20× in one live rehearsal in three or so — and its trim drifted from the drone's until
+//!   its predicted landing lay 10–40 m from the drone's through the whole final approach.)
+//!
 //! Where the replica's own decisions part from the drone's, [`super::phase_sync`] brings it back.
 
-use stx_gnc::guidance::Guidance;
+use stx_dynamics::atmosphere::{Atmosphere, StandardAtmosphere};
+use stx_gnc::guidance::{CONTROL_PERIOD_S, Guidance};
 use stx_gnc::mission::FlightStage;
 use stx_gnc::params::{OnboardSettings, find};
 use stx_link::telemetry::VehicleStatus;
@@ -27,7 +39,85 @@ use super::StationCore;
 use super::navigation::new_estimator;
 use crate::messages::Level;
 
+/// The drone's control period in its clock's unit (ms).
+const CONTROL_PERIOD_MS: u32 = (CONTROL_PERIOD_S * 1000.0) as u32;
+
+/// Control instants passed unheard that the replica still flies one by one: past this (a
+/// silent link), it flies only the newest, since the drone's own updates in the gap were made
+/// with measurements the station never got.
+const MAX_CATCH_UP: u32 = 8;
+
+/// What a telemetry message's time stamp says about the drone's control instants.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Stamp {
+    /// A measurement, stamped when it was taken: the drone updated its guidance at every
+    /// instant before it without it.
+    Measured,
+    /// Periodic telemetry, sent after the update of the instant it is stamped with.
+    AfterControl,
+}
+
 impl StationCore {
+    /// Flies the replica through the drone's control instants that a message stamped
+    /// `stamp_ms` (drone clock) shows it has passed, before the message is taken in.
+    pub(crate) fn replica_catch_up(&mut self, now_s: f64, stamp_ms: u32, stamp: Stamp) {
+        let last = match stamp {
+            Stamp::AfterControl => stamp_ms / CONTROL_PERIOD_MS,
+            Stamp::Measured if stamp_ms == 0 => return,
+            Stamp::Measured => (stamp_ms - 1) / CONTROL_PERIOD_MS,
+        };
+        let instant_s = |k: u32| f64::from(k) * CONTROL_PERIOD_S;
+        let first = match self.guided_at_s {
+            // The next instant after the last one flown.
+            Some(t) if t >= 0.0 => (t / CONTROL_PERIOD_S + 1e-6).floor() as u32 + 1,
+            _ => last,
+        };
+        if first > last {
+            // Nothing passed (or the first stamp from a drone that restarted).
+            return;
+        }
+        let first = first.max(last.saturating_sub(MAX_CATCH_UP - 1));
+        for k in first..=last {
+            self.guide_replica_at(now_s, instant_s(k));
+        }
+    }
+
+    /// One update of the replica at the drone's control instant `t_s`, from the estimate then.
+    fn guide_replica_at(&mut self, now_s: f64, t_s: f64) {
+        self.guided_at_s = Some(t_s);
+        let est = self.estimator.estimate(t_s);
+        if !est.position_sigma_m.iter().all(|s| s.is_finite()) {
+            return;
+        }
+        if !self.replica_flies() || !self.plan_known_for(self.guidance.mode()) {
+            // Before its parafoil flies the drone holds its servos neutral; and flying towards
+            // a target the drone may not have would draw and log a pattern that does not exist.
+            self.replica_command = stx_dynamics::state::Controls::default();
+            return;
+        }
+        let density = StandardAtmosphere
+            .air_at(self.frame.alt_msl_m - est.position_ned_m.z)
+            .density_kg_per_m3;
+        self.replica_command = self.guidance.update(&est, density).controls;
+        let fresh = self.latest.status.is_some_and(|(_, at)| {
+            now_s - at <= self.config.link.stale_after_s && self.link.connected
+        });
+        self.sync_phase(now_s, est.time_s, fresh);
+        self.log_guidance_events(now_s);
+    }
+
+    /// Logs the replica's phase changes since the last call.
+    pub(crate) fn log_guidance_events(&mut self, now_s: f64) {
+        for e in self.guidance.drain_events() {
+            self.log(
+                now_s,
+                Level::Info,
+                "guidance",
+                format!("{:?} → {:?}: {}", e.from, e.to, e.reason),
+            );
+        }
+    }
+
     /// The guidance replica (its plan, phase and spiral status).
     pub fn replica(&self) -> &Guidance {
         &self.guidance
@@ -142,5 +232,49 @@ impl StationCore {
             self.guidance.set_gains(settings.guidance.gains);
             self.guidance.set_spiral_config(settings.guidance.spiral);
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::core::tests::core;
+
+    #[test]
+    fn the_replica_flies_each_control_instant_the_drone_has_passed() {
+        let mut c = core();
+        // A measurement taken at 1.0 s: the drone updated at 0.75 s without it, and will at
+        // 1.0 s with it.
+        c.replica_catch_up(0.0, 1000, Stamp::Measured);
+        assert_eq!(c.guided_at_s, Some(0.75));
+        c.replica_catch_up(0.0, 1000, Stamp::AfterControl);
+        assert_eq!(c.guided_at_s, Some(1.0));
+        // Three periods' telemetry read at once: each instant is flown, none twice.
+        let mut flown = Vec::new();
+        for (stamp, kind) in [
+            (1100, Stamp::Measured),
+            (1250, Stamp::AfterControl),
+            (1350, Stamp::Measured),
+            (1500, Stamp::AfterControl),
+            (1750, Stamp::Measured),
+            (1750, Stamp::AfterControl),
+            (1750, Stamp::AfterControl),
+        ] {
+            c.replica_catch_up(0.0, stamp, kind);
+            flown.push(c.guided_at_s);
+        }
+        let expected = [1.0, 1.25, 1.25, 1.5, 1.5, 1.75, 1.75];
+        assert_eq!(flown, expected.map(Some));
+    }
+
+    #[test]
+    fn a_drone_that_restarted_does_not_fly_the_replica_back_in_time() {
+        let mut c = core();
+        c.replica_catch_up(0.0, 61_000, Stamp::AfterControl);
+        assert_eq!(c.guided_at_s, Some(61.0));
+        // Stamps from zero again: nothing is flown before the restart resets the replica's clock
+        // (`observe_drone_clock`).
+        c.replica_catch_up(0.0, 500, Stamp::AfterControl);
+        assert_eq!(c.guided_at_s, Some(61.0));
     }
 }
