@@ -1,6 +1,6 @@
 // Key flight data: speeds, sink, glide, altitudes, position, GPS, power; and the actuators as bars.
 
-import { h, panel, readout, setText, setAttr } from "./dom";
+import { h, panel, readout, setStyle, setText } from "./dom";
 import { vehiclePosition } from "../lib/fix";
 import { fmt, fmtLatLon, label } from "../lib/format";
 import type { N, State } from "../lib/types";
@@ -74,11 +74,11 @@ class Bar {
   update(v: N, commanded: N): void {
     const x = v === null ? 0 : Math.max(this.bipolar ? -1 : 0, Math.min(1, v));
     const [left, width] = this.bipolar ? [50 + Math.min(0, x) * 50, Math.abs(x) * 50] : [0, x * 100];
-    setAttr(this.fill, "style", `left:${left.toFixed(1)}%;width:${width.toFixed(1)}%`);
-    if (commanded === null) setAttr(this.cmd, "style", "display:none");
+    setStyle(this.fill, `left:${left.toFixed(1)}%;width:${width.toFixed(1)}%`);
+    if (commanded === null) setStyle(this.cmd, "display:none");
     else {
       const c = Math.max(this.bipolar ? -1 : 0, Math.min(1, commanded));
-      setAttr(this.cmd, "style", `left:${(this.bipolar ? 50 + c * 50 : c * 100).toFixed(1)}%`);
+      setStyle(this.cmd, `left:${(this.bipolar ? 50 + c * 50 : c * 100).toFixed(1)}%`);
     }
     setText(this.text, v === null ? "—" : `${v >= 0 && this.bipolar ? "+" : ""}${v.toFixed(2)}`);
   }
