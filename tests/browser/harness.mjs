@@ -141,7 +141,34 @@ export function watchContract(ctx, label) {
 export async function newContext(label, options) {
   const ctx = await browser.newContext(options);
   watchContract(ctx, label);
+  await watchPolicy(ctx, label);
   return ctx;
+}
+
+// ------------------------------------------------------------------ the security headers
+const policyErrors = [];
+let policedPages = 0;
+/**
+ * Every page of `ctx` under the station's Content-Security-Policy and security headers, and none
+ * breaking the policy: a page served without them, or any violation (a script, style, image,
+ * socket or frame the policy blocked), fails the test, whether or not the test watches the
+ * page's console.
+ */
+async function watchPolicy(ctx, label) {
+  await ctx.addInitScript(() => {
+    document.addEventListener("securitypolicyviolation", (e) =>
+      console.error(`CSP violation: ${e.effectiveDirective} blocked ${e.blockedURI || "inline"} at ${e.sourceFile}:${e.lineNumber}`));
+  });
+  ctx.on("page", (page) => page.on("console", (m) => {
+    if (/Content Security Policy|CSP violation/.test(m.text())) policyErrors.push(`${label}: ${m.text()}`);
+  }));
+  ctx.on("response", (r) => {
+    if (r.request().resourceType() !== "document") return;
+    policedPages += 1;
+    const h = r.headers();
+    const ok = (h["content-security-policy"] ?? "").includes("frame-ancestors 'none'") && h["x-frame-options"] === "DENY" && h["x-content-type-options"] === "nosniff" && h["referrer-policy"] === "no-referrer";
+    if (!ok) policyErrors.push(`${label}: ${r.url()} came without the security headers: ${JSON.stringify(h)}`);
+  });
 }
 
 // ------------------------------------------------------------------ geodesy for the checks
@@ -281,6 +308,9 @@ export function stopChildren() {
  */
 export async function finish(expected) {
   check("no page errors", pageErrors.length === 0, pageErrors.slice(0, 5).join(" | "));
+  check("every page under the station's Content-Security-Policy and security headers, none breaking it", policedPages > 0 && policyErrors.length === 0,
+    // Our listener's lines first: they name the directive and where the page broke it.
+    policyErrors.length > 0 ? [...new Set(policyErrors)].sort((a, b) => Number(b.includes("CSP violation:")) - Number(a.includes("CSP violation:"))).slice(0, 5).join(" | ") : `${policedPages} pages`);
   await Promise.allSettled(pendingBodies);
   const missing = expected.filter((k) => !seen.has(k));
   check("every message between the station and the pages matches the contract (web/src/generated/api.schema.json)", broken === null && missing.length === 0,

@@ -78,6 +78,20 @@ pub struct LocationFix {
     pub position_covariance_type: PositionCovarianceType,
 }
 
+impl LocationFix {
+    /// Whether this can be a vehicle's position: finite, within ±90° and ±180°, and not
+    /// exactly 0°, 0°, where a GNSS receiver without a fix (or an autopilot before its
+    /// estimator has an origin) puts its zeros. stx writes no such point since it checks the
+    /// fix type (`stx_link::telemetry::has_position_fix`, the same coordinate rule; this
+    /// crate stands below stx-link); readers drop them from older recordings and other tools'.
+    pub fn is_position(&self) -> bool {
+        self.latitude.abs() <= 90.0
+            && self.longitude.abs() <= 180.0
+            && self.altitude.is_finite()
+            && !(self.latitude == 0.0 && self.longitude == 0.0)
+    }
+}
+
 /// Severity of a [`Log`] message.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[repr(u8)]

@@ -6,7 +6,7 @@
 
 use std::collections::HashMap;
 use std::ffi::OsString;
-use std::net::SocketAddr;
+use std::net::{IpAddr, SocketAddr};
 use std::path::PathBuf;
 use subtle::ConstantTimeEq;
 
@@ -224,6 +224,10 @@ pub struct StationConfig {
     /// pages at once); the defaults suit a field laptop.
     #[serde(default)]
     pub limits: LimitSettings,
+    /// Test-only: loopback addresses treated as not loopback, from the environment's
+    /// [`NOT_LOOPBACK_ENV`] (see [`crate::exposure`]); empty in the field.
+    #[serde(skip)]
+    pub not_loopback: Vec<IpAddr>,
 }
 
 fn default_web_dir() -> PathBuf {
@@ -237,6 +241,27 @@ fn default_cutdown_window_s() -> f64 {
 /// The `[flight_path]` settings that describe this flight's balloon rather than a model: the
 /// drone's `MIS_BURST_M` and `MIS_ASCENT_MPS` give them when loaded.
 pub const LAUNCH_PROFILE_KEYS: [&str; 2] = ["burst_altitude_msl_m", "mean_ascent_rate_mps"];
+
+/// Test-only: loopback addresses (comma-separated, e.g. `127.0.0.2`) the station treats as
+/// not loopback, so a test on one machine sees what a station on the field network does
+/// ([`crate::exposure`]).
+pub const NOT_LOOPBACK_ENV: &str = "STX_TEST_NOT_LOOPBACK";
+
+/// The loopback addresses [`NOT_LOOPBACK_ENV`] names in `env`; `Err` names what is not an
+/// address.
+pub fn not_loopback_from_env(
+    env: impl Fn(&str) -> Option<OsString>,
+) -> Result<Vec<IpAddr>, String> {
+    let Some(text) = env(NOT_LOOPBACK_ENV) else {
+        return Ok(Vec::new());
+    };
+    let text = text.to_string_lossy().into_owned();
+    text.split(',')
+        .map(str::trim)
+        .filter(|a| !a.is_empty())
+        .map(|a| a.parse().map_err(|_| format!("`{a}` is not an IP address")))
+        .collect()
+}
 
 /// The shipped configuration: the simulated drone on loopback, demo tokens.
 pub const DEFAULT_STATION_TOML: &str = include_str!("../../../config/station.toml");
@@ -267,7 +292,8 @@ impl StationConfig {
 
     /// Takes the signing key from `STX_SIGNING_KEY` in `env` when it is set (a key in the file
     /// as well is refused: one source only), and, with signing on and no
-    /// `link.signing_timestamp_file`, the default one in the state directory.
+    /// `link.signing_timestamp_file`, the default one in the state directory; and a test's
+    /// addresses that are not loopback ([`NOT_LOOPBACK_ENV`]).
     pub fn apply_environment(
         &mut self,
         env: impl Fn(&str) -> Option<OsString>,
@@ -289,6 +315,10 @@ impl StationConfig {
             self.link.signing_timestamp_file = stx_link::signing::persist::default_state_dir(&env)
                 .map(|dir| dir.join(SIGNING_TIMESTAMP_FILE_NAME));
         }
+        self.not_loopback = not_loopback_from_env(&env).map_err(|rule| ConfigError::Invalid {
+            field: NOT_LOOPBACK_ENV.into(),
+            rule,
+        })?;
         if self.recording.enabled && self.recording.dir.is_none() {
             self.recording.dir = stx_link::signing::persist::default_state_dir(&env)
                 .map(|dir| stx_record::file::recordings_dir(&dir));

@@ -3,7 +3,9 @@
 //! dashboard and the API described in `API.md`.
 //!
 //! The pure station (no tokio, no sockets; `--no-default-features` builds only this):
-//! - [`config`]: the station's TOML, validated before anything starts;
+//! - [`config`]: the station's TOML, validated before anything starts; [`exposure`]: what it
+//!   lets through beyond this machine (rehearsal tokens on loopback only, plain HTTP only when
+//!   asked for);
 //! - [`core`]: the station's state and logic: telemetry, link events and operators' requests
 //!   in, with the mission clock; messages for the dashboards and link actions (with ids and
 //!   deadlines) out; the link's outcome of each action back in; retries and time-outs are its
@@ -35,6 +37,7 @@ pub mod contract;
 pub mod core;
 #[cfg(feature = "daemon")]
 pub mod daemon;
+pub mod exposure;
 #[cfg(feature = "daemon")]
 pub mod http;
 pub mod keep_out;

@@ -37,6 +37,12 @@ pub fn run(args: ExportArgs) -> anyhow::Result<()> {
         for (path, rows) in &report.files {
             println!("{}: {rows} rows", path.display());
         }
+        if report.not_positions > 0 {
+            eprintln!(
+                "{} positions at 0°, 0° (a GPS without a fix) were no positions: left out",
+                report.not_positions
+            );
+        }
         if report.skipped > 0 {
             eprintln!(
                 "{} messages were not JSON objects: left out",

@@ -10,7 +10,7 @@ use stx_station::daemon::{PreparedReplay, serve_replay};
 use stx_station::replay::{MAX_SPEED, MIN_SPEED, ReplayMode};
 
 use crate::BadInput;
-use crate::serve::{announce, load_config, shutdown_signal};
+use crate::serve::{announce, check_exposure, load_config, shutdown_signal};
 
 #[derive(Clone, Copy, ValueEnum)]
 enum Mode {
@@ -28,9 +28,13 @@ pub struct ReplayArgs {
     /// × real time, 0.25–64 (the page can change it).
     #[arg(long, default_value_t = 1.0)]
     speed: f64,
-    /// Where the dashboard listens (default: the configuration's).
+    /// Where the dashboard listens (default: the configuration's). Beyond loopback the
+    /// shipped rehearsal tokens are refused, and plain HTTP needs --insecure-http.
     #[arg(long)]
     listen: Option<std::net::SocketAddr>,
+    /// Serve plain HTTP beyond loopback without `[tls]`: tokens cross the network in clear.
+    #[arg(long)]
+    insecure_http: bool,
     /// Re-run the station on the recorded link bytes, or show what was recorded.
     #[arg(long, value_enum, default_value = "rerun")]
     mode: Mode,
@@ -57,6 +61,7 @@ pub fn run(args: ReplayArgs) -> anyhow::Result<()> {
     if let Some(listen) = args.listen {
         config.listen = listen;
     }
+    check_exposure(&config, args.insecure_http)?;
     let runtime = tokio::runtime::Builder::new_multi_thread()
         .enable_all()
         .build()

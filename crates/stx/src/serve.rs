@@ -23,9 +23,13 @@ pub struct ServeArgs {
     /// Station configuration (default: the shipped config/station.toml).
     #[arg(long)]
     config: Option<PathBuf>,
-    /// Listen on this address instead of the configuration's (e.g. 127.0.0.1:8080).
+    /// Listen on this address instead of the configuration's (e.g. 127.0.0.1:8080). Beyond
+    /// loopback the shipped rehearsal tokens are refused, and plain HTTP needs --insecure-http.
     #[arg(long)]
     listen: Option<std::net::SocketAddr>,
+    /// Serve plain HTTP beyond loopback without `[tls]`: tokens cross the network in clear.
+    #[arg(long)]
+    insecure_http: bool,
     /// The drone link instead of the configuration's (e.g. udpin:0.0.0.0:14550,
     /// serial:/dev/ttyUSB0:57600, tcpout:192.168.1.20:5760).
     #[arg(long)]
@@ -99,6 +103,7 @@ pub fn run(args: ServeArgs) -> anyhow::Result<()> {
     if args.no_record {
         config.recording.enabled = false;
     }
+    check_exposure(&config, args.insecure_http)?;
     if !config.web_dir.join("index.html").exists() {
         tracing::warn!(
             dir = %config.web_dir.display(),
@@ -166,6 +171,19 @@ pub fn run(args: ServeArgs) -> anyhow::Result<()> {
         }
         station
     })
+}
+
+/// Refuses (exit code 2) to listen beyond loopback with a rehearsal token, or over plain HTTP
+/// without `insecure_http` (`stx_station::exposure`); going on in clear is said in the log.
+pub(crate) fn check_exposure(config: &StationConfig, insecure_http: bool) -> anyhow::Result<()> {
+    stx_station::exposure::check_listen(config, insecure_http).map_err(|e| BadInput(e.into()))?;
+    if config.tls.is_none() && !config.is_loopback(config.listen.ip()) {
+        tracing::warn!(
+            listen = %config.listen,
+            "plain HTTP beyond loopback (--insecure-http): the tokens and all the dashboard shows cross the network in clear"
+        );
+    }
+    Ok(())
 }
 
 /// The simulated drone's options from the command line, checked before anything starts.

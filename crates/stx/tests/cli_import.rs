@@ -1,6 +1,7 @@
 //! `stx import` on a tlog written with pymavlink's own encoder (as MAVProxy writes them): every
 //! message pymavlink reads back is in the recording's raw frames, with its time, and the ones
-//! the station decodes are on their telemetry channels; bad input is refused clearly.
+//! the station decodes are on their telemetry channels, while reports without a GPS fix (at
+//! 0°, 0°) never become positions; bad input is refused clearly.
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -102,6 +103,18 @@ fn a_pymavlink_tlog_becomes_a_recording_with_every_message() {
             "{topic}"
         );
     }
+    // The pad's reports without a fix (at 0°, 0°) are telemetry, never positions: the map's
+    // channel and the exported track hold the fixes alone.
+    let positions = theirs["gps_positions"].as_u64().expect("gps_positions");
+    assert!(
+        positions > 0 && positions < counts["GPS_RAW_INT"].as_u64().unwrap(),
+        "{theirs}"
+    );
+    assert_eq!(
+        rec.channel(stx_station::recording::VEHICLE_GPS)
+            .map(|c| c.message_count),
+        Some(positions)
+    );
     // It exports as a station's recording does.
     let gpx = dir.join("flight.gpx");
     let exported = stx(&[
@@ -116,10 +129,8 @@ fn a_pymavlink_tlog_becomes_a_recording_with_every_message() {
         String::from_utf8_lossy(&exported.stderr)
     );
     let text = std::fs::read_to_string(&gpx).expect("gpx");
-    assert_eq!(
-        text.matches("<trkpt ").count() as u64,
-        counts["GPS_RAW_INT"].as_u64().unwrap()
-    );
+    assert_eq!(text.matches("<trkpt ").count() as u64, positions);
+    assert!(!text.contains(r#"lat="0.0000000""#), "{text}");
     let _ = std::fs::remove_dir_all(&dir);
 }
 

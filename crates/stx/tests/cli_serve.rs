@@ -21,10 +21,7 @@ fn get(address: &str, path: &str, token: &str) -> String {
 #[test]
 fn serve_prints_its_url_answers_and_stops_on_sigterm() {
     let mut child = spawn_serve(&["--listen", "127.0.0.1:0", "--link", "udpin:127.0.0.1:0"]);
-    let mut line = String::new();
-    BufReader::new(child.stdout.take().expect("stdout"))
-        .read_line(&mut line)
-        .expect("a line");
+    let line = banner(&mut child);
     // "stx station: open http://127.0.0.1:PORT/?token=TOKEN"
     let url = line.trim().rsplit(' ').next().expect("a URL").to_string();
     let rest = url.strip_prefix("http://").expect("http URL");
@@ -33,12 +30,7 @@ fn serve_prints_its_url_answers_and_stops_on_sigterm() {
     assert!(session.starts_with("HTTP/1.1 200"), "{session}");
     assert!(session.contains(r#""role":"operator""#), "{session}");
 
-    let pid = child.id().to_string();
-    let killed = Command::new("kill")
-        .args(["-TERM", &pid])
-        .status()
-        .expect("kill");
-    assert!(killed.success());
+    sigterm(&child);
     let deadline = Instant::now() + Duration::from_secs(10);
     loop {
         if let Some(status) = child.try_wait().expect("wait") {
@@ -82,6 +74,92 @@ fn a_bad_station_config_exits_2_and_names_the_field() {
     assert_eq!(missing.status.code(), Some(2));
 }
 
+/// Regression: `stx serve --listen 0.0.0.0:8140` with the shipped config started without a
+/// word and printed `?token=operator-token`, which anyone on the field's Wi-Fi who had read the
+/// README could use to cut the payload down, over plain HTTP. 127.0.0.2 stands for the field
+/// network (the test switch `STX_TEST_NOT_LOOPBACK`).
+#[test]
+fn beyond_loopback_the_rehearsal_tokens_and_plain_http_are_refused_with_exit_2() {
+    let serve_on_the_field = |config: Option<&std::path::Path>, more: &[&str]| {
+        let mut command = Command::new(env!("CARGO_BIN_EXE_stx"));
+        command
+            .args(["serve", "--no-record", "--listen", "127.0.0.2:0"])
+            .args(["--link", "udpin:127.0.0.1:0"])
+            .args(more)
+            .env(stx_station::exposure::NOT_LOOPBACK_ENV, "127.0.0.2");
+        if let Some(config) = config {
+            command.arg("--config").arg(config);
+        }
+        command
+    };
+    for more in [&[][..], &["--insecure-http"][..]] {
+        let out = serve_on_the_field(None, more).output().expect("stx runs");
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{more:?}: {stderr}");
+        assert!(
+            stderr.contains("stx token new") && stderr.contains("`tokens[0].token`"),
+            "{stderr}"
+        );
+        assert!(out.stdout.is_empty(), "no URL with a token printed");
+    }
+
+    // With the station's own tokens, plain HTTP needs to be asked for by name.
+    let dir = std::env::temp_dir().join(format!("stx-cli-serve-field-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("dir");
+    let path = dir.join("station.toml");
+    let shipped = stx_station::config::DEFAULT_STATION_TOML;
+    let own = shipped
+        .replace(
+            r#""operator-token""#,
+            r#""6d0c2a9f4b8e1735c6a2f0d9e4b7183a""#,
+        )
+        .replace(r#""viewer-token""#, r#""e5a1f7c3092b6d48a1e7c5f3b9d02468""#);
+    assert_ne!(own, shipped);
+    std::fs::write(&path, own).expect("write");
+    let out = serve_on_the_field(Some(&path), &[])
+        .output()
+        .expect("stx runs");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("in clear")
+            && stderr.contains("--insecure-http")
+            && stderr.contains("[tls]"),
+        "{stderr}"
+    );
+    let mut child = serve_on_the_field(Some(&path), &["--insecure-http"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("stx serve starts");
+    let line = banner(&mut child);
+    assert!(line.contains("http://127.0.0.2:"), "{line}");
+    sigterm(&child);
+    let out = child.wait_with_output().expect("exits");
+    assert!(out.status.success());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("cross the network in clear"), "{stderr}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The first line `child` prints: the start banner with the dashboard's URL.
+fn banner(child: &mut std::process::Child) -> String {
+    let mut line = String::new();
+    BufReader::new(child.stdout.take().expect("stdout"))
+        .read_line(&mut line)
+        .expect("a line");
+    line
+}
+
+/// Asks `child` to stop as systemd does.
+fn sigterm(child: &std::process::Child) {
+    let killed = Command::new("kill")
+        .args(["-TERM", &child.id().to_string()])
+        .status()
+        .expect("kill");
+    assert!(killed.success());
+}
+
 /// Starts `stx serve` with `args`, its stdout piped.
 fn spawn_serve(args: &[&str]) -> std::process::Child {
     Command::new(env!("CARGO_BIN_EXE_stx"))
@@ -97,10 +175,7 @@ fn spawn_serve(args: &[&str]) -> std::process::Child {
 /// Starts `stx serve` with `args` and returns the child and the address and token it printed.
 fn serve(args: &[&str]) -> (std::process::Child, String, String) {
     let mut child = spawn_serve(args);
-    let mut line = String::new();
-    BufReader::new(child.stdout.take().expect("stdout"))
-        .read_line(&mut line)
-        .expect("a line");
+    let line = banner(&mut child);
     let url = line.trim().rsplit(' ').next().expect("a URL").to_string();
     let rest = url.strip_prefix("http://").expect("http URL");
     let (address, token) = rest.split_once("/?token=").expect("address and token");

@@ -4,6 +4,7 @@
 // it — not at every 4 Hz state, which would make the map jitter and fight the eye.
 
 import { fromLocal, toLocal } from "./geo";
+import { vehiclePosition } from "./fix";
 import { isLanded } from "./recovery";
 import type { LatLon, State } from "./types";
 
@@ -25,10 +26,8 @@ export const SHRUNK_BELOW = 0.3;
 /** The points to keep in view: vehicle, target, pattern, final entry, predictions ±1σ. */
 export function keyPoints(s: State): LatLon[] {
   const out: LatLon[] = [];
-  const e = s.estimate;
-  const lat = e?.lat_deg ?? s.vehicle?.gps?.lat_deg ?? null;
-  const lon = e?.lon_deg ?? s.vehicle?.gps?.lon_deg ?? null;
-  if (lat !== null && lon !== null) out.push({ lat_deg: lat, lon_deg: lon });
+  const at = vehiclePosition(s);
+  if (at !== null) out.push({ lat_deg: at.lat_deg, lon_deg: at.lon_deg });
   const g = s.guidance;
   if (g?.target) out.push(g.target);
   // On the ground the plan and the predictions are history: frame where it is and where it aimed.

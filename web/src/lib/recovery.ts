@@ -4,6 +4,7 @@
 // is predicted (under the round chute, the map's unsteered landing; under the parafoil, the flown
 // prediction), on the mission's clock; once landed, the station's one miss figure.
 
+import { vehiclePosition } from "./fix";
 import { fmtDistance, fmtDuration } from "./format";
 import type { LatLon, N, State } from "./types";
 
@@ -24,9 +25,8 @@ export function recoveryPoint(s: State): RecoveryPoint | null {
   if (isLanded(s)) {
     const l = s.mission.landing;
     if (l !== null) return { kind: "actual", lat_deg: l.position.lat_deg, lon_deg: l.position.lon_deg, time_to_land_s: 0, semi_major_m: s.estimate?.position_sigma_m ?? null };
-    const lat = s.estimate?.lat_deg ?? s.vehicle?.gps?.lat_deg ?? null;
-    const lon = s.estimate?.lon_deg ?? s.vehicle?.gps?.lon_deg ?? null;
-    if (lat !== null && lon !== null) return { kind: "actual", lat_deg: lat, lon_deg: lon, time_to_land_s: 0, semi_major_m: s.estimate?.position_sigma_m ?? null };
+    const at = vehiclePosition(s);
+    if (at !== null) return { kind: "actual", lat_deg: at.lat_deg, lon_deg: at.lon_deg, time_to_land_s: 0, semi_major_m: s.estimate?.position_sigma_m ?? null };
   }
   const p = s.prediction;
   if (p === null) return null;

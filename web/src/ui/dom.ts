@@ -3,12 +3,16 @@
 type Attrs = Record<string, string | number | boolean | null | undefined | EventListener>;
 type Child = Node | string | null | undefined | false;
 
-/** `h("div", {class: "x", "data-testid": "y", onclick: f}, child…)`. */
+/**
+ * `h("div", {class: "x", "data-testid": "y", onclick: f}, child…)`. A `style` is set through the
+ * CSSOM: the station's Content-Security-Policy refuses `style` attributes (no 'unsafe-inline').
+ */
 export function h<K extends keyof HTMLElementTagNameMap>(tag: K, attrs: Attrs = {}, ...children: Child[]): HTMLElementTagNameMap[K] {
   const el = document.createElement(tag);
   for (const [k, v] of Object.entries(attrs)) {
     if (v === null || v === undefined || v === false) continue;
     if (k.startsWith("on") && typeof v === "function") el.addEventListener(k.slice(2), v);
+    else if (k === "style") el.style.cssText = String(v);
     else if (v === true) el.setAttribute(k, "");
     else el.setAttribute(k, String(v));
   }
@@ -32,6 +36,19 @@ export function setText(el: Element, text: string): void {
 
 export function setAttr(el: Element, name: string, value: string): void {
   if (el.getAttribute(name) !== value) el.setAttribute(name, value);
+}
+
+/** The style text each element was last given by `setStyle`. */
+const lastStyle = new WeakMap<HTMLElement, string>();
+
+/**
+ * Sets `css` as an element's style only when it changed (readouts repeat at 4 Hz), through the
+ * CSSOM: the station's Content-Security-Policy refuses `style` attributes (no 'unsafe-inline').
+ */
+export function setStyle(el: HTMLElement, css: string): void {
+  if (lastStyle.get(el) === css) return;
+  lastStyle.set(el, css);
+  el.style.cssText = css;
 }
 
 /** A labelled readout: the value element carries the test id, so its text is the value alone. */

@@ -1,6 +1,7 @@
 // Key flight data: speeds, sink, glide, altitudes, position, GPS, power; and the actuators as bars.
 
-import { h, panel, readout, setText, setAttr } from "./dom";
+import { h, panel, readout, setStyle, setText } from "./dom";
+import { vehiclePosition } from "../lib/fix";
 import { fmt, fmtLatLon, label } from "../lib/format";
 import type { N, State } from "../lib/types";
 
@@ -27,11 +28,14 @@ export class FlightData {
     add("Heading rate", "ro-heading-rate", (s) => fmt(s.estimate?.heading_rate_dps, "°/s"));
     add("Glide air", "ro-glide-air", (s) => fmt(s.estimate?.glide_ratio_air, ": 1", 2), "horizontal air distance per metre of height");
     add("Glide gnd", "ro-glide-ground", (s) => fmt(s.estimate?.glide_ratio_ground, ": 1", 2), "horizontal ground distance per metre of height");
-    add("Altitude MSL", "ro-alt-msl", (s) => fmt(s.estimate?.alt_msl_m ?? s.vehicle?.gps?.alt_msl_m, "m", 0));
+    add("Altitude MSL", "ro-alt-msl", (s) => fmt(vehiclePosition(s)?.alt_msl_m, "m", 0));
     add("Height AGL", "ro-height", (s) => fmt(s.estimate?.height_m, "m", 0), "height above the ground at the station origin");
     add("Position σ", "ro-pos-sigma", (s) => fmt(s.estimate?.position_sigma_m, "m"));
     into = list;
-    add("Position", "ro-position", (s) => fmtLatLon(s.estimate?.lat_deg ?? s.vehicle?.gps?.lat_deg, s.estimate?.lon_deg ?? s.vehicle?.gps?.lon_deg));
+    add("Position", "ro-position", (s) => {
+      const at = vehiclePosition(s);
+      return fmtLatLon(at?.lat_deg, at?.lon_deg);
+    });
     add("GPS", "ro-gps", (s) => {
       const g = s.vehicle?.gps;
       return g ? `${label(g.fix)} · ${fmt(g.satellites, "sats", 0)} · ±${fmt(g.h_acc_m, "m")}` : "—";
@@ -70,11 +74,11 @@ class Bar {
   update(v: N, commanded: N): void {
     const x = v === null ? 0 : Math.max(this.bipolar ? -1 : 0, Math.min(1, v));
     const [left, width] = this.bipolar ? [50 + Math.min(0, x) * 50, Math.abs(x) * 50] : [0, x * 100];
-    setAttr(this.fill, "style", `left:${left.toFixed(1)}%;width:${width.toFixed(1)}%`);
-    if (commanded === null) setAttr(this.cmd, "style", "display:none");
+    setStyle(this.fill, `left:${left.toFixed(1)}%;width:${width.toFixed(1)}%`);
+    if (commanded === null) setStyle(this.cmd, "display:none");
     else {
       const c = Math.max(this.bipolar ? -1 : 0, Math.min(1, commanded));
-      setAttr(this.cmd, "style", `left:${(this.bipolar ? 50 + c * 50 : c * 100).toFixed(1)}%`);
+      setStyle(this.cmd, `left:${(this.bipolar ? 50 + c * 50 : c * 100).toFixed(1)}%`);
     }
     setText(this.text, v === null ? "—" : `${v >= 0 && this.bipolar ? "+" : ""}${v.toFixed(2)}`);
   }

@@ -15,6 +15,7 @@ import { distanceM, ellipsePoints, fromLocal, gridValues, niceStep, toLocal } fr
 import { fmt, fmtDir, fmtDistance } from "../lib/format";
 import { boxAround, keyPoints, needsFraming, type Box } from "../lib/framing";
 import { isLanded, landedText } from "../lib/recovery";
+import { trackPositions, vehiclePosition } from "../lib/fix";
 import { packNote, tilesBadge } from "../lib/tiles";
 import { ZoneEditor } from "./zoneEditor";
 import type { Footprint, KeepOutAlarm, KeepOutMsg, LandingPrediction, LatLon, Ring, State, Station, TrackPoint } from "../lib/types";
@@ -180,7 +181,7 @@ export class MapView {
     // What the track holds, for the end-to-end test (a replay's seek cuts it at that moment).
     this.root.dataset.trackPoints = String(points.length);
     this.root.dataset.trackLastS = last === undefined ? "" : String(last.time_s);
-    this.track.setLatLngs(points.slice(-MAX_TRACK).map((p) => [p.lat_deg, p.lon_deg] as L.LatLngTuple));
+    this.track.setLatLngs(trackPositions(points.slice(-MAX_TRACK)).map((p) => [p.lat_deg, p.lon_deg] as L.LatLngTuple));
   }
 
   /** The keep-out zones in force (drawn at once unless an operator is editing them). */
@@ -212,10 +213,10 @@ export class MapView {
   update(s: State, stale: boolean): void {
     const e = s.estimate;
     const landed = isLanded(s);
-    const lat = e?.lat_deg ?? s.vehicle?.gps?.lat_deg ?? null;
-    const lon = e?.lon_deg ?? s.vehicle?.gps?.lon_deg ?? null;
-    if (lat !== null && lon !== null) {
-      this.vehicle.setLatLng([lat, lon]);
+    // Never a GPS without a fix: its zeros would put the vehicle in the Gulf of Guinea.
+    const at = vehiclePosition(s);
+    if (at !== null) {
+      this.vehicle.setLatLng([at.lat_deg, at.lon_deg]);
       if (!this.map.hasLayer(this.vehicle)) this.vehicle.addTo(this.map);
       const hd = e?.heading_deg ?? s.vehicle?.attitude?.yaw_deg ?? 0;
       const el = this.vehicle.getElement()?.querySelector<HTMLElement>("[data-testid=map-vehicle]");
@@ -248,7 +249,7 @@ export class MapView {
     }
     const pred = landed ? null : s.prediction;
     this.showFootprint(landed ? null : s.footprint, stale);
-    this.flightPath.update(landed ? null : s.flight_path, lat !== null && lon !== null ? { lat_deg: lat, lon_deg: lon } : null, stale, s.mission_time_s);
+    this.flightPath.update(landed ? null : s.flight_path, at, stale, s.mission_time_s);
     this.showAlarms(landed ? [] : s.keep_out_alarms);
     this.showPrediction(this.planned, this.ellPlanned, pred?.planned ?? null, "planned", stale);
     this.showPrediction(this.uncontrolled, this.ellUncontrolled, pred?.uncontrolled ?? null, "uncontrolled", stale);

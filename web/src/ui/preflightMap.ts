@@ -11,7 +11,8 @@ import { h } from "./dom";
 import { stationTileLayer } from "./tileLayer";
 
 const dot = (color: string, testid: string, label: string): L.DivIcon =>
-  L.divIcon({ className: "plan-mk", html: `<div data-testid="${testid}" title="${label}" style="width:14px;height:14px;border-radius:50%;background:${color};border:2px solid #fff;box-shadow:0 0 0 1px #000"></div>`, iconSize: [18, 18], iconAnchor: [9, 9] });
+  // An element, not HTML text: its style goes through the CSSOM, which the CSP allows.
+  L.divIcon({ className: "plan-mk", html: h("div", { "data-testid": testid, title: label, style: `width:14px;height:14px;border-radius:50%;background:${color};border:2px solid #fff;box-shadow:0 0 0 1px #000` }), iconSize: [18, 18], iconAnchor: [9, 9] });
 
 /** Each planned point: its name on the page, colour and test id. */
 const POINTS: [keyof Pick<Wire.PreflightReport, "burst" | "deploy" | "landing_unsteered">, string, string][] = [

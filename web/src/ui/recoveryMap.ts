@@ -12,7 +12,8 @@ import { stationTileLayer } from "./tileLayer";
 
 const ll = (p: LatLon): L.LatLngExpression => [p.lat_deg, p.lon_deg];
 const dot = (color: string, testid: string): L.DivIcon =>
-  L.divIcon({ className: "rec-mk", html: `<div data-testid="${testid}" style="width:16px;height:16px;border-radius:50%;background:${color};border:2px solid #fff;box-shadow:0 0 0 1px #000"></div>`, iconSize: [20, 20], iconAnchor: [10, 10] });
+  // An element, not HTML text: its style goes through the CSSOM, which the CSP allows.
+  L.divIcon({ className: "rec-mk", html: h("div", { "data-testid": testid, style: `width:16px;height:16px;border-radius:50%;background:${color};border:2px solid #fff;box-shadow:0 0 0 1px #000` }), iconSize: [20, 20], iconAnchor: [10, 10] });
 
 export class RecoveryMap {
   readonly root: HTMLElement;

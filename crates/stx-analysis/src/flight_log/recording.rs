@@ -86,7 +86,14 @@ impl LogBuilder {
             })
         }
         match topic {
-            POSITION => self.positions.push((t, parse(topic, t, data)?)),
+            POSITION => {
+                // An autopilot sends 0°, 0° before its estimator has an origin: no position,
+                // and as the log's first it would put the frame's origin in the Gulf of Guinea.
+                let p: GlobalPosition = parse(topic, t, data)?;
+                if p.has_position() {
+                    self.positions.push((t, p));
+                }
+            }
             ATTITUDE => self.attitudes.push((t, parse(topic, t, data)?)),
             HUD => self
                 .airspeeds
@@ -346,6 +353,38 @@ mod tests {
         assert_eq!(
             LogBuilder::default().finish(),
             Err(FlightLogError::MissingTelemetry("GLOBAL_POSITION_INT"))
+        );
+    }
+
+    /// Regression: GLOBAL_POSITION_INT at 0°, 0° (an autopilot's before its estimator has an
+    /// origin) was the log's first position, its frame's origin, 4,000 km from the flight.
+    #[test]
+    fn positions_at_zero_zero_are_left_out() {
+        let mut b = LogBuilder::default();
+        with_attitude_and_commands(&mut b);
+        let nowhere = r#"{"time_boot_ms":1000,"lat_deg":0,"lon_deg":0,"alt_msl_m":0,"alt_rel_m":0,"v_north_mps":0,"v_east_mps":0,"v_down_mps":0,"heading_deg":null}"#;
+        b.add(POSITION, 1_000_000_000, nowhere.as_bytes()).unwrap();
+        for i in 0..3u32 {
+            let msg = position(2000 + 250 * i, 2.5 * f64::from(i));
+            b.add(
+                POSITION,
+                2_000_000_000 + u64::from(i) * 250_000_000,
+                msg.as_bytes(),
+            )
+            .unwrap();
+        }
+        let log = b.finish().unwrap();
+        let s = log.samples();
+        assert_eq!(s.len(), 3);
+        assert!(
+            s[0].position_ned_m[0].abs() < 1e-6,
+            "{:?}",
+            s[0].position_ned_m
+        );
+        assert!(
+            (s[2].position_ned_m[0] - 5.0).abs() < 0.1,
+            "{:?}",
+            s[2].position_ned_m
         );
     }
 

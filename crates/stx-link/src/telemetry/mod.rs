@@ -46,6 +46,7 @@
 //! [`Telemetry`], which dispatches to them.
 //! - `system.rs`: [`VehicleStatus`] (HEARTBEAT), [`SystemStatus`], [`BatteryStatus`].
 //! - `gps_solution.rs`: [`GpsSolution`] (GPS_INPUT).
+//! - `fix.rs`: when a GNSS report is a position ([`has_position_fix`]: a fix, and not 0°, 0°).
 //! - `navigation.rs`: [`GpsRaw`], [`GlobalPosition`], [`Attitude`], [`AirData`], [`Hud`].
 //! - `actuators.rs`: [`Actuators`] and the servo pulse mapping.
 //! - `status_text.rs`: [`StatusText`], [`Severity`], splitting and re-assembly.
@@ -53,6 +54,7 @@
 //! - `units.rs`: the scaled integers of the wire.
 
 mod actuators;
+mod fix;
 mod gps_solution;
 mod guidance;
 mod navigation;
@@ -63,6 +65,7 @@ mod units;
 pub use actuators::{
     Actuators, pwm_us_to_signed, pwm_us_to_unit, signed_to_pwm_us, unit_to_pwm_us,
 };
+pub use fix::{has_position_fix, is_position};
 pub use gps_solution::GpsSolution;
 pub use guidance::{GuidanceStatus, PredictedLanding, Wind};
 pub use navigation::{AirData, Attitude, GlobalPosition, GpsFix, GpsRaw, Hud};

@@ -4,7 +4,8 @@
 //! channel's JSON Schema states one at the end of the field's description (stx's documents
 //! end "…, m/s." — schemars copies them into the schema) or the field's name ends in one
 //! (`_m`, `_mps`, `_deg`, …), is in its header: `alt_msl_m [m]`. Files are named after the
-//! topic (`/station/state` → `station_state.csv`).
+//! topic (`/station/state` → `station_state.csv`). A `foxglove.LocationFix` that is no
+//! position (at 0°, 0°: [`LocationFix::is_position`]) gets no row, and is counted.
 
 use std::collections::{BTreeMap, HashMap};
 use std::fs::File;
@@ -15,6 +16,7 @@ use serde_json::Value;
 
 use super::{ExportError, utc};
 use crate::Recording;
+use crate::foxglove::{LOCATION_FIX, LocationFix};
 
 /// What an export wrote: each file and its rows.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -23,6 +25,10 @@ pub struct CsvReport {
     pub files: Vec<(PathBuf, u64)>,
     /// Messages that were not JSON objects (skipped).
     pub skipped: u64,
+    /// `foxglove.LocationFix` messages that are no position (at 0°, 0°: a receiver without a
+    /// fix, in a recording made before stx checked the fix type or by another tool), left out
+    /// so no spreadsheet or GIS tool plots them.
+    pub not_positions: u64,
 }
 
 /// The file name of `topic`'s CSV.
@@ -83,11 +89,24 @@ pub fn export_csv<R: Read + Seek>(
         writers.insert(topic.clone(), (path, w, 0));
     }
     // Pass 2: the rows.
+    let positions: Vec<String> = recording
+        .channels()
+        .iter()
+        .filter(|c| c.schema_name == LOCATION_FIX)
+        .map(|c| c.topic.to_string())
+        .collect();
+    let mut not_positions = 0;
     for message in recording.messages()? {
         let message = message?;
         let Ok(v @ Value::Object(_)) = serde_json::from_slice::<Value>(&message.data) else {
             continue;
         };
+        if positions.iter().any(|t| **t == *message.topic)
+            && serde_json::from_value::<LocationFix>(v.clone()).is_ok_and(|f| !f.is_position())
+        {
+            not_positions += 1;
+            continue;
+        }
         let (Some(cols), Some((path, w, rows))) = (
             columns.get(&*message.topic),
             writers.get_mut(&*message.topic),
@@ -115,7 +134,11 @@ pub fn export_csv<R: Read + Seek>(
         files.push((path, rows));
     }
     files.sort();
-    Ok(CsvReport { files, skipped })
+    Ok(CsvReport {
+        files,
+        skipped,
+        not_positions,
+    })
 }
 
 #[derive(Default)]

@@ -25,8 +25,8 @@ pub struct TrackPoint {
 /// The preferred positions channel.
 pub const PREFERRED_TOPIC: &str = "/vehicle/gps";
 
-/// The track of `recording`: its topic and points in time order (fixes with non-finite or
-/// out-of-range coordinates left out).
+/// The track of `recording`: its topic and points in time order (fixes that are no position,
+/// [`LocationFix::is_position`], left out: out of range, or at 0°, 0° without a fix).
 pub fn track<R: Read + Seek>(
     recording: &mut Recording<R>,
 ) -> Result<(String, Vec<TrackPoint>), ExportError> {
@@ -49,9 +49,7 @@ pub fn track<R: Read + Seek>(
             continue;
         }
         if let Ok(f) = serde_json::from_slice::<LocationFix>(&message.data)
-            && f.latitude.abs() <= 90.0
-            && f.longitude.abs() <= 180.0
-            && f.altitude.is_finite()
+            && f.is_position()
         {
             points.push(TrackPoint {
                 time_ns: message.log_time,

@@ -21,7 +21,6 @@ use nalgebra::Vector3;
 use stx_dynamics::atmosphere::StandardAtmosphere;
 use stx_gnc::flight_path::{Air, FlightPath, PathPoint, StackConfig, Start, propagate};
 use stx_gnc::mission::FlightStage;
-use stx_link::telemetry::GpsFix;
 
 use super::StationCore;
 use crate::messages::{FlightPathView, Level, PathPointView};
@@ -130,10 +129,7 @@ impl StationCore {
         }
         self.live_path.next_s = t + FLIGHT_PATH_EVERY_S;
         let stage = self.latest.status.map(|(s, _)| s.stage);
-        let fix = self
-            .latest
-            .gps
-            .filter(|(g, _)| !matches!(g.fix, GpsFix::NoGps | GpsFix::NoFix | GpsFix::Fix2d));
+        let fix = self.latest.gps.filter(|(g, _)| g.has_3d_fix());
         let (Some(stage), Some((gps, _))) = (stage, fix) else {
             self.live_path.view = None;
             return;

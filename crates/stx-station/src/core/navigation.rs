@@ -40,15 +40,6 @@ pub(crate) fn thin_track(track: &mut Vec<TrackPoint>) {
     });
 }
 
-/// The fix places the receiver in three dimensions (3-D, differential, RTK, static, PPP).
-pub(crate) fn has_3d_fix(g: &stx_link::telemetry::GpsRaw) -> bool {
-    use stx_link::telemetry::GpsFix as Fix;
-    matches!(
-        g.fix,
-        Fix::Fix3d | Fix::Dgps | Fix::RtkFloat | Fix::RtkFixed | Fix::Static | Fix::Ppp
-    )
-}
-
 /// Seconds of the drone's clock between two landing predictions.
 pub const PREDICTION_EVERY_S: f64 = 1.0;
 
@@ -58,17 +49,14 @@ const SOLUTION_FRESH_S: f64 = 2.0;
 
 /// A GPS measurement from the receiver's solution (GPS_INPUT), as the onboard estimator takes
 /// it: at the time the receiver measured it when its stamp is on the drone's clock (`drone_s`,
-/// within 10 s before it), else at `drone_s`; `None` without a 3-D fix or a velocity.
+/// within 10 s before it), else at `drone_s`; `None` without a 3-D fix (at a position:
+/// `stx_link::telemetry::has_position_fix`) or a velocity.
 fn solution_measurement(
     frame: &stx_gnc::geo::LocalFrame,
     drone_s: f64,
     g: &stx_link::telemetry::GpsSolution,
 ) -> Option<Measurement> {
-    use stx_link::telemetry::GpsFix as Fix;
-    if !matches!(
-        g.fix,
-        Fix::Fix3d | Fix::Dgps | Fix::RtkFloat | Fix::RtkFixed | Fix::Static | Fix::Ppp
-    ) {
+    if !g.has_3d_fix() {
         return None;
     }
     let [vn, ve, vd] = g.velocity_ned_mps?;
@@ -223,7 +211,7 @@ impl StationCore {
                 // GPS_RAW_INT's time may be the receiver's (Unix) clock: it is stamped with
                 // the drone's clock of the burst it came in.
                 if let Some(t) = self.drone_time_s {
-                    if has_3d_fix(&g) {
+                    if g.has_3d_fix() {
                         let measured_s = receiver_time_s(g.time_usec, t);
                         self.landing_fix(now_s, measured_s, g.lat_deg, g.lon_deg, g.alt_msl_m);
                     }
@@ -313,7 +301,7 @@ impl StationCore {
         drone_s: f64,
         g: &stx_link::telemetry::GpsRaw,
     ) -> Option<Measurement> {
-        if !has_3d_fix(g) {
+        if !g.has_3d_fix() {
             return None;
         }
         let position = self.frame.to_ned(g.lat_deg, g.lon_deg, g.alt_msl_m);

@@ -1,6 +1,6 @@
 //! Who is calling: the token from `Authorization: Bearer …` or `?token=` (the WebSocket and
-//! Google Earth cannot set headers), its name and role from the station config; and the
-//! percent-encoding of tokens in URLs.
+//! Google Earth cannot set headers), its name and role from the station config (a rehearsal
+//! token only from loopback, `crate::exposure`); and the percent-encoding of tokens in URLs.
 
 use std::net::SocketAddr;
 
@@ -123,7 +123,21 @@ impl FromRequestParts<AppState> for Caller {
                 "a token is needed: Authorization: Bearer <token> or ?token=",
             ));
         };
-        match state.config.authenticate(&token) {
+        let known = state.config.authenticate(&token);
+        if let Some((name, _)) = known
+            && !crate::exposure::accepted_from(&state.config, &token, address)
+        {
+            // Everyone who read the README knows it: from the network it is a wrong token.
+            tracing::warn!(token = name, address = ?address, "a rehearsal token from beyond loopback: refused");
+            return Err(wrong_token(
+                state,
+                now,
+                address,
+                "rehearsal tokens work on the station's own machine only (loopback): \
+                 make a token with `stx token new` for the station's config",
+            ));
+        }
+        match known {
             Some((name, role)) => match state.limits().requests.take(now, &name.to_string()) {
                 Verdict::Allowed => Ok(Caller {
                     name: name.to_string(),
@@ -141,25 +155,27 @@ impl FromRequestParts<AppState> for Caller {
                 }
             },
             None => {
-                if let Some(ip) = address
-                    && let Verdict::Refused { retry, first } =
-                        state.limits().bad_tokens.take(now, &ip)
-                {
-                    if first {
-                        tracing::warn!(%ip, "wrong tokens: address locked out for {} s", retry.0);
-                    }
-                    return Err(HttpError::too_many(
-                        "too many wrong tokens from this address",
-                        retry,
-                    ));
-                }
                 tracing::info!(address = ?address, "request with an unknown token");
-                Err(error(
-                    StatusCode::UNAUTHORIZED,
-                    "unauthorized",
-                    "unknown token",
-                ))
+                Err(wrong_token(state, now, address, "unknown token"))
             }
         }
     }
+}
+
+/// The answer to a wrong token (`reason`): 401, or 429 once `address` has sent too many.
+fn wrong_token(
+    state: &AppState,
+    now: f64,
+    address: Option<std::net::IpAddr>,
+    reason: &'static str,
+) -> HttpError {
+    if let Some(ip) = address
+        && let Verdict::Refused { retry, first } = state.limits().bad_tokens.take(now, &ip)
+    {
+        if first {
+            tracing::warn!(%ip, "wrong tokens: address locked out for {} s", retry.0);
+        }
+        return HttpError::too_many("too many wrong tokens from this address", retry);
+    }
+    error(StatusCode::UNAUTHORIZED, "unauthorized", reason)
 }

@@ -2,7 +2,7 @@
 //! offline tiles and the built dashboard.
 //!
 //! - `shared`: what every handler shares ([`Shared`]) and the `{error, reason}` answers;
-//! - `auth`: tokens, names and roles;
+//! - `auth`: tokens, names and roles; `headers`: the security headers on every answer;
 //! - `rest`: the reading endpoints; `commands`: the commanding ones (operators only);
 //! - `keep_out`: the keep-out zones, read by anyone, edited by operators;
 //! - `plan`: the Plan page's pre-flight plans, for anyone, one at a time, off the async
@@ -19,6 +19,7 @@
 
 mod auth;
 mod commands;
+mod headers;
 mod keep_out;
 mod kml;
 mod lab;
@@ -104,6 +105,9 @@ pub fn router(state: std::sync::Arc<Shared>) -> Router {
     } else if let Some(tiles) = &state.config.tiles_dir {
         app = app.nest_service("/tiles", ServeDir::new(tiles));
     }
+    let security = std::sync::Arc::new(headers::SecurityHeaders::new(&state.config));
     app.fallback_service(ServeDir::new(web_dir).fallback(ServeFile::new(index)))
         .with_state(state)
+        // Outermost, so every answer has them: pages, assets, tiles, the API and its errors.
+        .layer(axum::middleware::from_fn_with_state(security, headers::add))
 }

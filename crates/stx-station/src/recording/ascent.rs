@@ -22,7 +22,7 @@ use serde::Deserialize;
 use stx_gnc::ascent_wind::{AscentFix, AscentWindConfig, AscentWindEstimator, WindBand};
 use stx_gnc::flight_path::{Forecast, ForecastError, ForecastRow, merge_measured};
 use stx_gnc::geo::LocalFrame;
-use stx_link::telemetry::{GlobalPosition, GpsFix, GpsRaw};
+use stx_link::telemetry::{GlobalPosition, GpsRaw};
 use stx_record::{ReadError, Recording};
 
 use super::telemetry_topic;
@@ -92,7 +92,7 @@ pub(crate) fn fix_from_gps(
     g: &GpsRaw,
     down_mps: Option<f64>,
 ) -> Option<AscentFix> {
-    if matches!(g.fix, GpsFix::NoGps | GpsFix::NoFix | GpsFix::Fix2d) {
+    if !g.has_3d_fix() {
         return None;
     }
     let velocity = match (g.ground_speed_mps, g.course_deg, down_mps) {

@@ -12,6 +12,7 @@ use schemars::JsonSchema;
 use serde::Serialize;
 use serde_json::Value;
 use stx_gnc::geo::LocalFrame;
+use stx_link::telemetry::{GpsFix, has_position_fix};
 use stx_record::{IndexSource, ReadError, Recording};
 
 use super::STATE;
@@ -151,6 +152,14 @@ fn lat_lon(v: Option<&Value>) -> Option<(f64, f64, f64)> {
     Some((lat, lon, alt))
 }
 
+/// The drone's GPS in a recorded state, when it is a position (a fix, not 0°, 0°:
+/// [`has_position_fix`]).
+fn gps_position(state: &Value) -> Option<(f64, f64, f64)> {
+    let gps = state.pointer("/vehicle/gps")?;
+    let fix: GpsFix = serde_json::from_value(gps.get("fix")?.clone()).ok()?;
+    lat_lon(Some(gps)).filter(|&(lat, lon, _)| has_position_fix(fix, lat, lon))
+}
+
 fn landing(state: &Value) -> Option<LandingSummary> {
     if let Some(l) = state.pointer("/mission/landing").filter(|l| !l.is_null()) {
         // The station's own figure: the same everywhere, not worked out again here.
@@ -162,8 +171,7 @@ fn landing(state: &Value) -> Option<LandingSummary> {
             body: l.get("body").and_then(Value::as_str).map(String::from),
         });
     }
-    let (lat, lon, alt) =
-        lat_lon(state.pointer("/vehicle/gps")).or_else(|| lat_lon(state.get("estimate")))?;
+    let (lat, lon, alt) = gps_position(state).or_else(|| lat_lon(state.get("estimate")))?;
     let miss_m = lat_lon(state.pointer("/guidance/target")).map(|(t_lat, t_lon, t_alt)| {
         let target = LocalFrame {
             lat_deg: t_lat,
@@ -227,7 +235,7 @@ mod tests {
         json!({
             "type": "state",
             "mission": {"stage": stage},
-            "vehicle": {"gps": {"lat_deg": at.0, "lon_deg": at.1, "alt_msl_m": 300.0}},
+            "vehicle": {"gps": {"fix": "fix3d", "lat_deg": at.0, "lon_deg": at.1, "alt_msl_m": 300.0}},
             "guidance": target.map(|t| json!({"target": {"lat_deg": t.0, "lon_deg": t.1, "alt_msl_m": 300.0}})),
         })
     }
@@ -279,6 +287,24 @@ mod tests {
         let landing = s.landing.expect("landed");
         assert_eq!(landing.miss_m, Some(2.3));
         assert_eq!((landing.lat_deg, landing.lon_deg), (50.00002, 14.00001));
+    }
+
+    #[test]
+    fn a_gps_without_a_fix_is_no_landing_place() {
+        let mut last = state("landed", (0.0, 0.0), Some((50.0, 14.0)));
+        last["vehicle"]["gps"]["fix"] = json!("no_fix");
+        last["estimate"] = json!({"lat_deg": 50.0001, "lon_deg": 14.0, "alt_msl_m": 300.0});
+        let landing = summary(recording(&[last.clone()], true))
+            .landing
+            .expect("landed");
+        assert_eq!((landing.lat_deg, landing.lon_deg), (50.0001, 14.0));
+        last["vehicle"]["gps"]["fix"] = json!("fix3d");
+        let landing = summary(recording(&[last], true)).landing.expect("landed");
+        assert_eq!(
+            (landing.lat_deg, landing.lon_deg),
+            (50.0001, 14.0),
+            "0°, 0° is no fix"
+        );
     }
 
     #[test]

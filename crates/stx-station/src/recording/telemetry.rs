@@ -2,7 +2,8 @@
 //! typed value on `/telemetry/<MAVLINK_NAME>` (schema `stx.telemetry.<MAVLINK_NAME>`, from the
 //! types themselves), and for Foxglove's map and 3-D panels the drone's GPS
 //! ([`super::VEHICLE_GPS`], from GPS_RAW_INT: the receiver's own fix with its stated
-//! accuracy, rather than the drone's filtered GLOBAL_POSITION_INT) and its attitude
+//! accuracy, rather than the drone's filtered GLOBAL_POSITION_INT; only reports that are
+//! positions, `stx_link::telemetry::has_position_fix`) and its attitude
 //! ([`super::VEHICLE_ATTITUDE`], body in the local NED frame, from ATTITUDE).
 
 use std::time::Duration;
@@ -85,7 +86,11 @@ impl TelemetryChannels {
         }
         let ts = Timestamp::from_nanos(log_time_ns);
         match telemetry {
-            Telemetry::GpsRaw(g) => out.push((self.gps, compact_json(&gps_fix(ts, g)))),
+            // A report without a fix is kept on its telemetry channel as received, but it is
+            // no position: as a LocationFix it would put the vehicle at 0°, 0° on the map.
+            Telemetry::GpsRaw(g) if g.has_position_fix() => {
+                out.push((self.gps, compact_json(&gps_fix(ts, g))))
+            }
             Telemetry::Attitude(a) => {
                 out.push((self.attitude, compact_json(&attitude_transform(ts, a))))
             }

@@ -88,7 +88,7 @@ impl RecordedTimeline {
 }
 
 /// Where the station's estimate put the stack, unless the link was stale (as the pages
-/// draw the track).
+/// draw the track) or it is no position (0°, 0°, `stx_link::telemetry::is_position`).
 fn track_point(state: &Value) -> Option<TrackPoint> {
     if state.pointer("/link/stale").and_then(Value::as_bool) != Some(false) {
         return None;
@@ -96,12 +96,16 @@ fn track_point(state: &Value) -> Option<TrackPoint> {
     let estimate = state.get("estimate")?;
     let number = |v: &Value, key: &str| v.get(key).and_then(Value::as_f64);
     let time_s = number(state, "time_s")?;
+    let (lat_deg, lon_deg) = (number(estimate, "lat_deg")?, number(estimate, "lon_deg")?);
+    if !stx_link::telemetry::is_position(lat_deg, lon_deg) {
+        return None;
+    }
     Some(TrackPoint {
         time_s,
         // Recordings older than the mission clock have only the station's.
         mission_time_s: number(state, "mission_time_s").unwrap_or(time_s),
-        lat_deg: number(estimate, "lat_deg")?,
-        lon_deg: number(estimate, "lon_deg")?,
+        lat_deg,
+        lon_deg,
         alt_msl_m: number(estimate, "alt_msl_m")?,
     })
 }
@@ -141,5 +145,16 @@ mod tests {
         assert_eq!(states.last().unwrap()["time_s"], 99.75);
         assert_eq!(history["events"][0]["text"], "stage: Balloon -> Parafoil");
         assert_eq!(history["track"][0]["lat_deg"], 38.5);
+    }
+
+    #[test]
+    fn a_recorded_point_at_zero_zero_is_no_track_point() {
+        let nowhere = json!({
+            "type": "state", "time_s": 1.0, "link": {"stale": false},
+            "estimate": {"lat_deg": 0.0, "lon_deg": 0.0, "alt_msl_m": 0.0},
+        });
+        assert!(track_point(&nowhere).is_none());
+        let somewhere: Value = serde_json::from_slice(&state(1.0, false)).unwrap();
+        assert!(track_point(&somewhere).is_some());
     }
 }

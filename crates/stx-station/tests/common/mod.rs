@@ -244,7 +244,35 @@ pub async fn http_text(
     token: Option<&str>,
     body: Option<&str>,
 ) -> (u16, String) {
-    let mut stream = TcpStream::connect(addr).await.expect("connect");
+    let stream = TcpStream::connect(addr).await.expect("connect");
+    let (status, _, body) = http_on(stream, method, path, token, body).await;
+    (status, body)
+}
+
+/// `GET path` with `token` from the local address `from` (another loopback address stands for
+/// another machine): the status, the head (lower-case) and the body.
+pub async fn get_from(
+    from: std::net::IpAddr,
+    addr: SocketAddr,
+    path: &str,
+    token: Option<&str>,
+) -> (u16, String, String) {
+    let socket = tokio::net::TcpSocket::new_v4().expect("socket");
+    socket.bind(SocketAddr::new(from, 0)).expect("bind");
+    let stream = socket.connect(addr).await.expect("connect");
+    let (status, head, body) = http_on(stream, "GET", path, token, None).await;
+    (status, head.to_ascii_lowercase(), body)
+}
+
+/// One HTTP/1.1 request on `stream`: the status, the head and the body.
+async fn http_on(
+    mut stream: TcpStream,
+    method: &str,
+    path: &str,
+    token: Option<&str>,
+    body: Option<&str>,
+) -> (u16, String, String) {
+    let addr = stream.peer_addr().expect("peer");
     let body = body.unwrap_or("");
     let auth = token.map_or(String::new(), |t| format!("Authorization: Bearer {t}\r\n"));
     let request = format!(
@@ -261,7 +289,7 @@ pub async fn http_text(
         .nth(1)
         .and_then(|s| s.parse().ok())
         .expect("a status code");
-    (status, body.to_string())
+    (status, head.to_string(), body.to_string())
 }
 
 pub type Ws =

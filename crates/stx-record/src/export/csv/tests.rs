@@ -11,6 +11,12 @@ const T0: u64 = 1_795_576_246_000_000_000;
 
 /// A recording with a GPS channel and a `state`-like channel whose schema documents units.
 fn recording(dir: &Path) -> PathBuf {
+    recording_after_no_fix(dir, 0)
+}
+
+/// [`recording`], its GPS channel opened by `no_fix` points at 0°, 0° (a receiver without a
+/// fix, as recordings made before stx checked the fix type hold them).
+fn recording_after_no_fix(dir: &Path, no_fix: u64) -> PathBuf {
     let mut core = RecorderCore::new(
         CoreOptions::default(),
         RecordingInfo::default(),
@@ -42,6 +48,26 @@ fn recording(dir: &Path) -> PathBuf {
             ChannelSpec::json("/station/state", "stx.StateMsg", &schema).unwrap(),
         )
         .unwrap();
+    for i in 0..no_fix {
+        let t = T0 - (no_fix - i) * 1_000_000_000;
+        let nowhere = foxglove::LocationFix {
+            timestamp: Timestamp::from_nanos(t),
+            frame_id: "gps".into(),
+            latitude: 0.0,
+            longitude: 0.0,
+            altitude: 0.0,
+            position_covariance: [0.0; 9],
+            position_covariance_type: PositionCovarianceType::Unknown,
+        };
+        core.write(
+            Duration::ZERO,
+            gps,
+            t,
+            t,
+            &serde_json::to_vec(&nowhere).unwrap(),
+        )
+        .unwrap();
+    }
     for i in 0..10u64 {
         let now = Duration::from_millis(i * 500);
         let t = T0 + i * 500_000_000;
@@ -140,6 +166,29 @@ fn the_track_is_well_formed_kml_and_gpx_with_every_point() {
     }
     assert!(gpx("f", &points).contains("<time>2026-11-25T03:10:50.500Z</time>"));
     assert!(kml("f", &points).contains("-7.9000000,38.5009000,891.0"));
+}
+
+/// Regression: a tlog imported from an ArduPilot vehicle held LocationFix points at 0°, 0°
+/// from before the GPS had a fix, and every export drew the track from the Gulf of Guinea.
+#[test]
+fn points_at_zero_zero_are_no_positions_in_any_export() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut rec = Recording::open(&recording_after_no_fix(dir.path(), 3)).unwrap();
+    let (_, points) = track(&mut rec).unwrap();
+    assert_eq!(points.len(), 10);
+    assert!(points.iter().all(|p| p.lat_deg > 38.0), "{points:?}");
+    let out = dir.path().join("csv");
+    let report = export_csv(&mut rec, &out).unwrap();
+    assert_eq!(report.not_positions, 3);
+    let gps = std::fs::read_to_string(out.join("vehicle_gps.csv")).unwrap();
+    assert_eq!(gps.lines().count(), 11, "a header and the 10 fixes: {gps}");
+    assert!(
+        !gps.contains(",gps,0.0,0.0,"),
+        "no latitude and longitude 0: {gps}"
+    );
+    for doc in [gpx("f", &points), kml("f", &points)] {
+        assert!(!doc.contains("0.0000000,0.0000000"), "{doc}");
+    }
 }
 
 #[test]

@@ -83,6 +83,39 @@ fn a_gps_fix_is_recorded_as_itself_and_on_the_map_with_its_accuracy() {
     );
 }
 
+/// Regression: a tlog from an ArduPilot vehicle put LocationFix points at 0°, 0° (the receiver's
+/// zeros before its first fix), and Foxglove drew the track from the Gulf of Guinea.
+#[test]
+fn a_report_without_a_fix_is_kept_as_telemetry_but_is_no_location_fix() {
+    let ch = channels();
+    for (fix, lat_deg, lon_deg) in [
+        (GpsFix::NoGps, 0.0, 0.0),
+        (GpsFix::NoFix, 0.0, 0.0),
+        (GpsFix::NoFix, 38.5, -7.9),
+        (GpsFix::Fix3d, 0.0, 0.0),
+    ] {
+        let g = GpsRaw {
+            fix,
+            lat_deg,
+            lon_deg,
+            ..gps(None, None)
+        };
+        let out = ch.records(1_000, &Telemetry::GpsRaw(g));
+        assert_eq!(
+            out.len(),
+            1,
+            "{fix:?} at {lat_deg}, {lon_deg}: telemetry only"
+        );
+        let raw: Value = serde_json::from_slice(&out[0].1).expect("JSON");
+        assert_eq!(raw["lat_deg"], lat_deg);
+    }
+    let fix2d = GpsRaw {
+        fix: GpsFix::Fix2d,
+        ..gps(None, None)
+    };
+    assert_eq!(ch.records(1_000, &Telemetry::GpsRaw(fix2d)).len(), 2);
+}
+
 #[test]
 fn the_attitude_quaternion_turns_the_body_as_roll_pitch_and_yaw_say() {
     let ts = Timestamp::from_nanos(0);
