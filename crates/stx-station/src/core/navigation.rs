@@ -16,7 +16,6 @@ use stx_gnc::predict::{LandingPrediction, PredictorConfig, predict_in_wind};
 use stx_link::telemetry::Telemetry;
 
 use super::StationCore;
-use super::replica::Stamp;
 use crate::messages::{Level, StateMsg, TrackPoint};
 
 /// States kept for the plots of a newly connected page: 5 minutes at 1 Hz.
@@ -100,6 +99,16 @@ pub(crate) fn new_estimator(ground_altitude_msl_m: f64) -> Estimator {
         // station's origin by its configuration's.
         Err(e) => panic!("the station's estimator configuration is invalid: {e}"),
     }
+}
+
+/// What a telemetry message's time stamp says about the drone's control instants.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Stamp {
+    /// A measurement, stamped when it was taken: the drone updated its guidance at every
+    /// instant before it without it.
+    Measured,
+    /// Periodic telemetry, sent after the update of the instant it is stamped with.
+    AfterControl,
 }
 
 /// Everything a landing prediction needs, detached from the station so it can run on another

@@ -36,7 +36,7 @@ use stx_gnc::params::{OnboardSettings, find};
 use stx_link::telemetry::VehicleStatus;
 
 use super::StationCore;
-use super::navigation::new_estimator;
+use super::navigation::{Stamp, new_estimator};
 use crate::messages::Level;
 
 /// The drone's control period in its clock's unit (ms).
@@ -46,16 +46,6 @@ const CONTROL_PERIOD_MS: u32 = (CONTROL_PERIOD_S * 1000.0) as u32;
 /// silent link), it flies only the newest, since the drone's own updates in the gap were made
 /// with measurements the station never got.
 const MAX_CATCH_UP: u32 = 8;
-
-/// What a telemetry message's time stamp says about the drone's control instants.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) enum Stamp {
-    /// A measurement, stamped when it was taken: the drone updated its guidance at every
-    /// instant before it without it.
-    Measured,
-    /// Periodic telemetry, sent after the update of the instant it is stamped with.
-    AfterControl,
-}
 
 impl StationCore {
     /// Flies the replica through the drone's control instants that a message stamped
