@@ -313,9 +313,10 @@ pub fn summarise(results: &[Result<MissionReport, Failed>]) -> Summary {
 
 /// The largest difference between the replica's learned trim and the drone's, mm. Updated at
 /// the drone's instants, the replica's sums part from the drone's only by the two estimates'
-/// differences (0.018 mm at most in the short campaign); updated once per telemetry burst, it
-/// was 0.64 mm off and its prediction at 100 m 6 m further from the touchdown.
-const TRIM_BOUND_MM: f64 = 0.05;
+/// differences: 0.10 mm at most over the full campaign's 60 missions, however heard. Updated
+/// once per telemetry burst, it was 0.64 mm off in the short campaign heard in bursts, and its
+/// prediction at 100 m 6 m further from the touchdown. The bound lies between the two.
+const TRIM_BOUND_MM: f64 = 0.2;
 
 /// The goals, checked on `s`; a failed mission fails them all.
 fn goals(s: &Summary) -> Vec<Goal> {
