@@ -85,7 +85,7 @@ use crate::guided::CONTROL_PERIOD_S;
 use crate::sensors::{DeliveryQueue, SensorSuite};
 pub use config::MissionConfig;
 pub use config_error::MissionError;
-pub use dispersed::{DispersedDroneError, dispersed_inputs};
+pub use dispersed::{DispersedDroneError, dispersed_inputs, truth_inputs};
 use failures::{LinkFaults, Servo, ServoFault};
 use mission::{MissionPhysics, PhysicsError};
 use onboard::{HardwareRequest, Onboard, mode_name};

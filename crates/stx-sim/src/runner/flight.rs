@@ -146,20 +146,24 @@ impl Flight {
     /// for a drone that cannot be built.
     pub async fn start(options: FlyOptions) -> Result<Self, FlyError> {
         let mission = options.mission.name.clone();
-        // A dispersed drone flies a vehicle and sensors drawn from the mission's seed; its
-        // onboard software keeps the nominal vehicle, as on a real flight.
-        let drone = Drone::dispersed(&options.mission, options.dispersions.as_ref()).map_err(
-            |e| match e {
-                DispersedDroneError::Vehicle(source) => FlyError::Dispersed {
-                    mission: mission.clone(),
-                    source,
-                },
-                DispersedDroneError::Drone(source) => FlyError::Drone {
-                    mission: mission.clone(),
-                    source,
-                },
+        // The drone's truth is the options' vehicle, or a draw around it (vehicle and sensors,
+        // from the mission's seed); its onboard software keeps the mission's own polar, as on a
+        // real flight.
+        let drone = Drone::with_truth(
+            &options.mission,
+            &options.vehicle,
+            options.dispersions.as_ref(),
+        )
+        .map_err(|e| match e {
+            DispersedDroneError::Vehicle(source) => FlyError::Dispersed {
+                mission: mission.clone(),
+                source,
             },
-        )?;
+            DispersedDroneError::Drone(source) => FlyError::Drone {
+                mission: mission.clone(),
+                source,
+            },
+        })?;
         let transport = Transport::open_str(&options.connect)
             .await
             .map_err(|source| FlyError::Open {

@@ -78,14 +78,19 @@ pub struct FlyOptions {
     /// How long to keep answering on the ground after landing, real time; `None`: until the
     /// shutdown future resolves (what a station running the drone beside it wants).
     pub linger: Option<Duration>,
+    /// The vehicle the drone truly flies (a vehicle file, e.g. one the Lab identified); the
+    /// shipped STRAPLEX vehicle by default. The onboard guidance keeps the mission's own polar
+    /// and gains whatever it is.
+    pub vehicle: stx_dynamics::vehicle::Vehicle,
     /// Fly a vehicle and sensors drawn from this dispersion set (with the mission's seed)
-    /// instead of the nominal ones; the servos stay perfect.
+    /// around [`Self::vehicle`] instead of it and the mission's sensors; the servos stay
+    /// perfect.
     pub dispersions: Option<crate::dispersions::Dispersions>,
 }
 
 impl FlyOptions {
-    /// `mission` towards `connect` in real time, system id 1, no signing, stopping as soon as
-    /// it has landed.
+    /// `mission` towards `connect` in real time, system id 1, no signing, the shipped vehicle,
+    /// stopping as soon as it has landed.
     pub fn new(connect: &str, mission: MissionConfig) -> Self {
         Self {
             connect: connect.to_string(),
@@ -94,6 +99,7 @@ impl FlyOptions {
             link: LinkConfig::vehicle(),
             signing: None,
             linger: Some(Duration::ZERO),
+            vehicle: stx_dynamics::vehicle::Vehicle::straplex(),
             dispersions: None,
         }
     }
