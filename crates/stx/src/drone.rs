@@ -19,6 +19,10 @@
 //! `--gains FILE` (a gains file as `stx tune` writes it) sets the onboard guidance's control
 //! gains, which are also its parameters: the station reads and sets them over PARAM_*.
 //!
+//! `--vehicle FILE` (a vehicle file, as `stx sim --vehicle` reads it) is the truth the drone
+//! flies; the onboard guidance keeps the mission's polar, so an operator rehearses guidance
+//! as it is against the stack they identified ([`stx_sim::drone::Drone::with_truth`]).
+//!
 //! A server address with port 0 (`udpin:…:0`, `tcpin:…:0`) is logged with the port actually
 //! bound. Socket errors are counted in the report's `io` and logged by the transport at most
 //! every few seconds with their count (a `tcpin:` link with no station yet fails every frame).
@@ -40,7 +44,7 @@ use stx_sim::runner::{
 };
 
 use crate::BadInput;
-use crate::inputs::{load_gains, load_mission};
+use crate::inputs::{load_gains, load_mission, load_vehicle};
 
 #[derive(Args, Debug)]
 pub struct DroneArgs {
@@ -53,6 +57,11 @@ pub struct DroneArgs {
     /// `stx montecarlo --dispersions` does. Without it, the nominal vehicle.
     #[arg(long, value_name = "nominal|realistic|FILE")]
     dispersions: Option<String>,
+    /// Fly this vehicle file as the truth (e.g. one `stx identify` or the Lab wrote) instead of
+    /// the shipped STRAPLEX vehicle; with --dispersions, the draw is centred on it. The onboard
+    /// guidance still starts from the mission's own polar and gains.
+    #[arg(long, value_name = "FILE")]
+    vehicle: Option<PathBuf>,
     /// A built-in mission (mission, mission-short) or a path to a mission TOML file.
     #[arg(long, default_value = "mission")]
     scenario: String,
@@ -106,6 +115,18 @@ pub fn mission(
 ) -> anyhow::Result<stx_sim::drone::MissionConfig> {
     overrides.apply(load_mission(scenario)?).map_err(|e| {
         BadInput(anyhow::Error::from(e).context("with the command line's failures")).into()
+    })
+}
+
+/// The vehicle file given with `flag`; unreadable, not TOML or a field out of range is
+/// [`BadInput`] naming the flag, the file and the field.
+pub fn load_vehicle_flag(
+    flag: &str,
+    path: &Path,
+) -> anyhow::Result<stx_dynamics::vehicle::Vehicle> {
+    load_vehicle(Some(path)).map_err(|e| match e.downcast::<BadInput>() {
+        Ok(BadInput(e)) => BadInput(e.context(flag.to_string())).into(),
+        Err(e) => e.context(flag.to_string()),
     })
 }
 
@@ -194,6 +215,9 @@ impl DroneArgs {
         options.link.system_id = self.system_id;
         options.signing = signing;
         options.linger = Some(Duration::from_secs_f64(self.linger));
+        if let Some(path) = &self.vehicle {
+            options.vehicle = load_vehicle_flag("--vehicle", path)?;
+        }
         options.dispersions = self
             .dispersions
             .as_deref()

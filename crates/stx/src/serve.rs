@@ -15,7 +15,7 @@ use stx_sim::runner::{FlyOptions, ProgressLog, Signing, Speed};
 use stx_station::config::{DEFAULT_STATION_TOML, StationConfig};
 
 use crate::BadInput;
-use crate::drone::{fly_error, mission};
+use crate::drone::{fly_error, load_vehicle_flag, mission};
 use crate::inputs::load_gains;
 
 #[derive(Args)]
@@ -52,6 +52,10 @@ pub struct ServeArgs {
     /// writes it).
     #[arg(long, value_name = "FILE", requires = "sim")]
     sim_gains: Option<PathBuf>,
+    /// The vehicle file the simulated drone flies as the truth (default: the shipped STRAPLEX
+    /// vehicle); its onboard guidance still starts from the mission's own polar.
+    #[arg(long, value_name = "FILE", requires = "sim")]
+    sim_vehicle: Option<PathBuf>,
     /// Record this run (MCAP) into this directory instead of the configuration's
     /// `recording.dir` (default: `recordings/` in the state directory).
     #[arg(long, value_name = "DIR", conflicts_with = "no_record")]
@@ -120,9 +124,8 @@ pub fn run(args: ServeArgs) -> anyhow::Result<()> {
         let options = sim_options(&config, &args)?;
         // The rehearsal's station knows the balloon it flies with: its burst, ascent rate and
         // round chute are the scenario's (the drone's parameters give the deploy height).
-        config.flight_path = options
-            .mission
-            .stack_config(&stx_dynamics::vehicle::Vehicle::straplex());
+        // Its mass is the vehicle flown (--sim-vehicle), as an operator's configuration would say.
+        config.flight_path = options.mission.stack_config(&options.vehicle);
         config.flight_path_unset.clear();
         Some(options)
     } else {
@@ -206,6 +209,9 @@ fn sim_options(config: &StationConfig, args: &ServeArgs) -> anyhow::Result<FlyOp
         mission(&args.sim_scenario, &overrides)?,
     );
     options.speed = args.sim_speed;
+    if let Some(path) = &args.sim_vehicle {
+        options.vehicle = load_vehicle_flag("--sim-vehicle", path)?;
+    }
     // On the ground it keeps answering (parameters, replay of the landing) until the station stops.
     options.linger = None;
     if let Some(key) = config.link.signing_key().map_err(|e| BadInput(e.into()))? {
@@ -336,5 +342,52 @@ mod sim_gains_tests {
         let err = sim_options(&config, &args("/nonexistent/gains.toml")).expect_err("refused");
         assert!(err.downcast_ref::<BadInput>().is_some(), "{err}");
         let _ = std::fs::remove_file(&path);
+    }
+}
+
+#[cfg(test)]
+mod sim_vehicle_tests {
+    use super::*;
+    use clap::Parser;
+
+    #[derive(Parser)]
+    struct Cli {
+        #[command(flatten)]
+        serve: ServeArgs,
+    }
+
+    #[test]
+    fn sim_vehicle_is_the_simulated_drones_truth_and_a_bad_file_is_bad_input() {
+        let config = load_config(None).expect("shipped config");
+        let options = |flags: &[&str]| {
+            let cli = Cli::try_parse_from(["stx-serve", "--sim"].iter().chain(flags))
+                .expect("flags parse");
+            sim_options(&config, &cli.serve)
+        };
+        let shipped = stx_dynamics::vehicle::Vehicle::straplex();
+        assert_eq!(options(&[]).expect("valid").vehicle, shipped);
+        let dir = std::env::temp_dir().join(format!("stx-sim-vehicle-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).expect("dir");
+        let text = include_str!("../../../config/vehicle/straplex.toml");
+        let (good, bad) = (dir.join("good.toml"), dir.join("bad.toml"));
+        std::fs::write(
+            &good,
+            text.replacen("cl_alpha = 2.300", "cl_alpha = 1.840", 1),
+        )
+        .expect("write");
+        std::fs::write(&bad, text.replacen("cl_alpha = 2.300", "cl_alpha = nan", 1))
+            .expect("write");
+        let flown = options(&["--sim-vehicle", good.to_str().expect("utf-8")])
+            .expect("valid")
+            .vehicle;
+        assert_eq!(flown.config.canopy.aero.cl_alpha, 1.84);
+        let err = options(&["--sim-vehicle", bad.to_str().expect("utf-8")]).expect_err("refused");
+        assert!(err.downcast_ref::<BadInput>().is_some(), "{err}");
+        let said = format!("{err:#}");
+        assert!(
+            said.contains("--sim-vehicle") && said.contains("canopy.aero.cl_alpha"),
+            "{said}"
+        );
+        let _ = std::fs::remove_dir_all(&dir);
     }
 }
