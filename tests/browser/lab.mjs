@@ -31,6 +31,7 @@ registerRest("POST", /^\/api\/lab\/vehicle\/check$/, "LabVehicleBody", "VehicleF
 registerRest("POST", /^\/api\/lab\/vehicle\/save$/, "LabVehicleBody", "LabSavedBody");
 registerRest("GET", /^\/api\/lab\/gains$/, null, "LabGainsListBody");
 registerRest("POST", /^\/api\/lab\/gains\/(save|send)$/, "LabGainsBody", "LabSavedBody");
+registerRest("POST", /^\/api\/lab\/rehearse$/, "LabVehicleBody", "LabRehearsalBody");
 
 const labDir = await mkdtemp(join(tmpdir(), "stx-browser-lab-"));
 const outcome = (page) => text(page, "job-outcome").catch(() => "");
@@ -220,12 +221,22 @@ async function lab() {
   await page.click('[data-testid="vehicle-check"]');
   const checked = await until(() => text(page, "vehicle-msg"), (t) => t.startsWith("valid"), 5000);
   check("identify: the fitted value goes into the vehicle form on a click, and the station accepts the vehicle", Math.abs(inForm - fitted) <= 5e-4 * Math.abs(fitted) && checked.includes("1 changed"), `form ${inForm}, table ${fitted}; "${checked}"`);
+  // Rehearse with the fitted vehicle: the simulated drone flies its mission again from the start.
+  const viewerRehearse = await api("/api/lab/rehearse", VIEWER, { method: "POST", body: JSON.stringify({ vehicle: {} }) });
+  await page.click('[data-testid="vehicle-rehearse"]');
+  const rehearsing = await until(() => text(page, "vehicle-msg"), (t) => t.includes("again from its start"), 15000);
+  const restarted = await until(async () => (await api("/api/events", OPERATOR)).body?.events ?? [], (es) => es.some((e) => /it restarted; navigation starts over/.test(e.text)), 15000, 250);
+  const rehearsalLine = await until(() => text(page, "rehearsal-status"), (t) => t.includes("canopy.aero.cl_alpha"), 5000);
+  const rehearsedSlope = (await api("/api/lab", OPERATOR)).body?.rehearsal?.vehicle?.["canopy.aero.cl_alpha"];
+  check("rehearse: the fitted vehicle is flown by the simulated drone from its mission's start (the station sees it restart); a viewer's request is 403",
+    rehearsing.includes("rehearsal again") && restarted.some((e) => /restarted/.test(e.text)) && Math.abs(rehearsedSlope / fitted - 1) < 5e-4 && rehearsalLine.includes(`canopy.aero.cl_alpha ${rehearsedSlope}`) && viewerRehearse.status === 403,
+    `"${rehearsing}"; "${rehearsalLine}"; flown ${rehearsedSlope}, fitted ${fitted}; viewer ${viewerRehearse.status}`);
   const viewerIdentify = await api("/api/lab/jobs", VIEWER, { method: "POST", body: JSON.stringify({ kind: "identify", recording: recorded, params: ["cl_alpha"] }) });
   await vpage.reload();
   await vpage.locator('[data-testid="identify-params"] tr[data-param]').first().waitFor({ timeout: 10000 }).catch(() => {});
   const viewerRows = await vpage.locator('[data-testid="identify-params"] tr[data-param]').count();
-  check("identify: a viewer sees the fit but cannot start one (button disabled, 403)",
-    viewerRows === 1 && (await vpage.locator('[data-testid="identify-start"]').isDisabled()) && viewerIdentify.status === 403, `${viewerRows} rows for the viewer; viewer ${viewerIdentify.status}`);
+  check("identify: a viewer sees the fit but cannot start one nor rehearse (buttons disabled, 403)",
+    viewerRows === 1 && (await vpage.locator('[data-testid="identify-start"]').isDisabled()) && (await vpage.locator('[data-testid="vehicle-rehearse"]').isDisabled()) && viewerIdentify.status === 403, `${viewerRows} rows for the viewer; viewer ${viewerIdentify.status}`);
 
   // A window of the recording: a bad one is refused on the page, a good one compared alone.
   await page.fill('[data-testid="window-from"]', "8");
@@ -247,4 +258,4 @@ async function lab() {
   await ctx.close();
 }
 
-await runFlights(lab, ["Session", "LabStatusBody", "LabStartedBody", "VehicleFieldsBody", "LabSavedBody", "RecordingsBody"]);
+await runFlights(lab, ["Session", "LabStatusBody", "LabStartedBody", "VehicleFieldsBody", "LabSavedBody", "RecordingsBody", "LabRehearsalBody"]);

@@ -19,7 +19,7 @@ use crate::core::CutdownArm;
 use crate::keep_out::{KeepOutBody, KeepOutMsg};
 use crate::lab::LabJobBody;
 use crate::lab::bodies::{
-    LabGainsBody, LabGainsListBody, LabSavedBody, LabStartedBody, LabVehicleBody,
+    LabGainsBody, LabGainsListBody, LabRehearsalBody, LabSavedBody, LabStartedBody, LabVehicleBody,
 };
 use crate::lab::jobs::LabStatusBody;
 use crate::lab::vehicle_fields::VehicleFieldsBody;
@@ -158,6 +158,7 @@ pub fn schema() -> Result<Value, ContractError> {
         sent.subschema_for::<VehicleFieldsBody>(),
         sent.subschema_for::<LabGainsListBody>(),
         sent.subschema_for::<LabSavedBody>(),
+        sent.subschema_for::<LabRehearsalBody>(),
     ];
     let read_messages = vec![
         read.subschema_for::<ClientMessage>(),

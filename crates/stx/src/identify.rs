@@ -37,6 +37,10 @@ pub struct IdentifyArgs {
     /// Print the report as JSON instead of the table.
     #[arg(long)]
     json: bool,
+    /// Also fit each flight's air-data scale: for recordings whose airspeed (and so whose
+    /// wind estimate) reads a few per cent off, as the simulated drone's do.
+    #[arg(long)]
+    fit_air_scale: bool,
 }
 
 /// The parameters, their correlations and the fit's figures.
@@ -87,6 +91,12 @@ pub fn table(report: &IdentifyReport) -> String {
             "correlation: not determined (the flights do not tell the parameters apart)\n",
         ),
     }
+    for (i, s) in report.air_scale_percent.iter().enumerate() {
+        out.push_str(&format!(
+            "flight {}: the air went {s:+.2} % faster than its recorded air data say (fitted)\n",
+            i + 1
+        ));
+    }
     out
 }
 
@@ -126,7 +136,10 @@ pub fn run(args: IdentifyArgs) -> anyhow::Result<()> {
         &logs,
         &params,
         &vehicle.config,
-        &IdentifyOptions::default(),
+        &IdentifyOptions {
+            fit_air_scale: args.fit_air_scale,
+            ..IdentifyOptions::default()
+        },
         &AtomicBool::new(false),
         &mut |p| {
             if !quiet {

@@ -13,6 +13,7 @@ use clap::Args;
 use stx_sim::drone::MissionOverrides;
 use stx_sim::runner::{FlyOptions, ProgressLog, Signing, Speed};
 use stx_station::config::{DEFAULT_STATION_TOML, StationConfig};
+use stx_station::http::{RehearsalRequest, Rehearsals};
 
 use crate::BadInput;
 use crate::drone::{fly_error, load_vehicle_flag, mission};
@@ -157,7 +158,13 @@ pub fn run(args: ServeArgs) -> anyhow::Result<()> {
             announce(&banner);
             if let (Some(mut options), Some(link)) = (sim, running.link_local) {
                 options.connect = format!("udpout:{}", loopback_if_unspecified(link));
-                drone_task = Some(tokio::spawn(fly_beside(options, stopped(stop_rx))));
+                let (requests, incoming) = tokio::sync::mpsc::channel(1);
+                // Set once, on a station just started: it cannot have one already.
+                let _ = running.shared.rehearsal.set(Rehearsals {
+                    requests,
+                    last: std::sync::Mutex::new(None),
+                });
+                drone_task = Some(tokio::spawn(fly_rehearsals(options, incoming, stop_rx)));
             }
         })
         .await
@@ -165,7 +172,7 @@ pub fn run(args: ServeArgs) -> anyhow::Result<()> {
         if let Some(mut task) = drone_task {
             // After a shutdown the drone finishes its step and reports; if the station stopped
             // on its own (an error), nobody listens to the drone any more.
-            if tokio::time::timeout(std::time::Duration::from_secs(2), &mut task)
+            if tokio::time::timeout(std::time::Duration::from_secs(3), &mut task)
                 .await
                 .is_err()
             {
@@ -234,6 +241,46 @@ fn sim_options(config: &StationConfig, args: &ServeArgs) -> anyhow::Result<FlyOp
         });
     }
     Ok(options)
+}
+
+/// The simulated drone beside the station, flown again from its mission's start with another
+/// vehicle as its truth whenever the Lab asks (`POST /api/lab/rehearse`), until the shutdown.
+async fn fly_rehearsals(
+    mut options: FlyOptions,
+    mut requests: tokio::sync::mpsc::Receiver<RehearsalRequest>,
+    stop: tokio::sync::watch::Receiver<bool>,
+) {
+    loop {
+        let (halt, halted) = tokio::sync::watch::channel(false);
+        let either = {
+            let stop = stop.clone();
+            async move {
+                tokio::select! {
+                    () = stopped(stop) => {}
+                    () = stopped(halted) => {}
+                }
+            }
+        };
+        let mut flight = tokio::spawn(fly_beside(options.clone(), either));
+        let request = tokio::select! {
+            () = stopped(stop.clone()) => None,
+            request = requests.recv() => request,
+        };
+        let _ = halt.send(true);
+        // The drone finishes its step and saves its signing timestamp before the next one
+        // starts from the same file.
+        if tokio::time::timeout(std::time::Duration::from_secs(2), &mut flight)
+            .await
+            .is_err()
+        {
+            flight.abort();
+        }
+        let Some(request) = request else {
+            return;
+        };
+        options.vehicle = request.vehicle;
+        let _ = request.answer.send(Ok(options.mission.name.clone()));
+    }
 }
 
 /// The drone's flight, its outcome logged: a simulated drone that fails does not stop the

@@ -26,6 +26,7 @@ export type StxStationAPI =
   | VehicleFieldsBody
   | LabGainsListBody
   | LabSavedBody
+  | LabRehearsalBody
   | ClientMessage
   | ModeBody
   | HeadingBody
@@ -2503,6 +2504,15 @@ export interface LabStatusBody {
    */
   last: LabOutcomeView | null;
   /**
+   * The rehearsal the Lab last started, if any.
+   */
+  rehearsal: LabRehearsalBody | null;
+  /**
+   * The station flies a simulated drone that `POST /api/lab/rehearse` restarts with a
+   * vehicle (`stx serve --sim`).
+   */
+  rehearse: boolean;
+  /**
    * A job's longest run, s.
    */
   time_cap_s: number;
@@ -2640,6 +2650,26 @@ export interface IdentifiedParam {
    * Standard error (`null` when the flight does not determine it).
    */
   std_error: number | null;
+}
+/**
+ * `POST /api/lab/rehearse`'s answer, and the rehearsal the Lab last started: the simulated
+ * drone flies its mission again from the start with this vehicle as the truth.
+ */
+export interface LabRehearsalBody {
+  /**
+   * The simulated drone's mission (`rehearsal`, `mission-short`, …).
+   */
+  mission: string;
+  /**
+   * Who started it.
+   */
+  started_by: string;
+  /**
+   * The vehicle flown: its parameters changed from the seed's.
+   */
+  vehicle: {
+    [k: string]: number | undefined;
+  };
 }
 /**
  * `POST /api/lab/jobs`' answer: the job started.
@@ -2930,7 +2960,7 @@ export interface PlanRequestInput {
   target_lat_lon_deg?: [number, number] | null;
 }
 /**
- * `POST /api/lab/vehicle/check` and `/save`: a vehicle as edited.
+ * `POST /api/lab/vehicle/check`, `/save` and `POST /api/lab/rehearse`: a vehicle as edited.
  */
 export interface LabVehicleBody {
   /**

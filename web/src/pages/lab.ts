@@ -4,7 +4,8 @@
 // with the model (recorded and modelled side by side per channel, with the error table) or fit
 // chosen coefficients to it (table with intervals, correlation matrix, the fitted values into
 // the form or as a file), follow its progress (cancel a batch, a comparison or a fit), and see
-// the plots; save a vehicle or gains file, send tuned gains to the drone after a confirmation.
+// the plots; save a vehicle or gains file, send tuned gains to the drone after a confirmation;
+// fly the simulated drone's mission again with the vehicle as edited or fitted (`--sim` only).
 // Operators run and save; viewers see the results only (the station refuses them anyway).
 // The status is polled: twice a second while a job runs, every 3 s otherwise.
 
@@ -43,6 +44,8 @@ const el = {
   vehicleRows: h("tbody"),
   vehicleMsg: h("div", { "data-testid": "vehicle-msg", role: "status" }),
   vehicleName: h("input", { type: "text", "data-testid": "vehicle-name", placeholder: "file name" }),
+  rehearse: h("button", { type: "button", "data-testid": "vehicle-rehearse", "data-role": "operator" }, "Rehearse with this vehicle"),
+  rehearsal: h("div", { "data-testid": "rehearsal-status", class: "note", role: "status" }),
   kind: h("select", { "data-testid": "job-kind" }, ...["scenario", "monte_carlo", "stability", "tune"].map((k) => h("option", { value: k }, k.replace("_", " ")))),
   scenario: h("select", { "data-testid": "job-scenario" }, ...SCENARIOS.map((n) => h("option", { value: n }, n))),
   runs: num("mc-runs", "20", "1", "500", "1"),
@@ -128,6 +131,28 @@ async function saveVehicle(): Promise<void> {
   if (!body) return;
   const saved = await post(api, "/api/lab/vehicle/save", { ...body, name: el.vehicleName.value }, el.vehicleMsg);
   if (isObj(saved) && typeof saved.path === "string") setText(el.vehicleMsg, `saved ${saved.path}`);
+}
+
+/** The simulated drone flies its mission again from the start with the vehicle as edited (or
+ * as fitted, once a fit's values are in the form) as its truth. */
+async function rehearse(): Promise<void> {
+  const body = vehicleRequest();
+  if (!body) return;
+  setText(el.vehicleMsg, "");
+  const r = await post(api, "/api/lab/rehearse", body, el.vehicleMsg);
+  if (isObj(r) && typeof r.mission === "string") {
+    setText(el.vehicleMsg, `the simulated drone flies ${r.mission} again from its start with this vehicle (${Object.keys(body.vehicle).length} changed from the seed)`);
+    void poll();
+  }
+}
+
+/** What the simulated drone flies, as the Lab last set it. */
+function rehearsalLine(st: Wire.LabStatusBody): string {
+  if (!st.rehearse) return "this station flies no simulated drone to rehearse with (stx serve --sim)";
+  const r = st.rehearsal;
+  if (!r) return "the simulated drone flies the vehicle it was started with";
+  const changed = Object.entries(r.vehicle).map(([k, v]) => `${k} ${v}`).join(", ");
+  return `the simulated drone flies ${r.mission} with ${changed === "" ? "the seed's vehicle" : changed} (restarted by ${r.started_by})`;
 }
 
 /** POSTs; a refusal is shown in `where` and, naming a vehicle field, on its row. */
@@ -358,6 +383,8 @@ function render(st: Wire.LabStatusBody): void {
   el.cancel.disabled = !operator || job === null;
   el.compare.disabled = el.start.disabled;
   el.identify.disabled = el.start.disabled;
+  el.rehearse.disabled = !operator || !st.rehearse;
+  setText(el.rehearsal, rehearsalLine(st));
   if (job) {
     const p = progressOf(job);
     if (p.fraction === null) el.progress.removeAttribute("value");
@@ -392,6 +419,7 @@ async function main(): Promise<void> {
   const save = h("button", { type: "button", "data-testid": "vehicle-save", "data-role": "operator" }, "Save vehicle file");
   check.addEventListener("click", () => void checkVehicle());
   save.addEventListener("click", () => void saveVehicle());
+  el.rehearse.addEventListener("click", () => void rehearse());
   el.start.addEventListener("click", () => void start());
   el.cancel.addEventListener("click", () => void cancel());
   el.compare.addEventListener("click", () => void compare());
@@ -404,7 +432,7 @@ async function main(): Promise<void> {
       h("div", {},
         h("section", {}, h("h2", {}, "Vehicle (seed: STRAPLEX, config/vehicle/straplex.toml)"),
           h("table", { class: "vehicle-table" }, h("thead", {}, h("tr", {}, h("th", {}, "parameter"), h("th", {}, "value"), h("th", {}, "unit"), h("th", {}, "seed"), h("th", {}, ""))), el.vehicleRows),
-          h("div", { class: "row" }, check, el.vehicleName, save), el.vehicleMsg),
+          h("div", { class: "row" }, check, el.vehicleName, save, el.rehearse), el.vehicleMsg, el.rehearsal),
         h("section", {}, h("h2", {}, "Run"),
           h("div", { class: "row" }, h("label", {}, "job ", el.kind)),
           h("div", { class: "row" }, h("label", {}, "scenario ", el.scenario)),

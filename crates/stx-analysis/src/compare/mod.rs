@@ -13,7 +13,7 @@ use serde::{Deserialize, Serialize};
 use stx_dynamics::vehicle::Vehicle;
 
 use crate::flight_log::{FlightLog, LogSample};
-pub use replay::{Flown, ReplayError, fly, fly_turned, fly_watched, initial_state};
+pub use replay::{Flown, Nuisance, ReplayError, fly, fly_corrected, fly_watched, initial_state};
 
 /// Default integration step of a replay, s: RK4 at 20 ms follows the stack's fastest modes
 /// (the servo and pendulum poles, a few rad/s) to well under a centimetre over minutes.

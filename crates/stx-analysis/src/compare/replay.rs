@@ -14,6 +14,12 @@
 //! integration (fixed-step RK4) steps land on the log's instants, so no step straddles a
 //! command change. The wind is the
 //! estimate interpolated in time, uniform in space: what the drone knew.
+//!
+//! Identification also corrects what the drone knew ([`Nuisance`]): its start's heading, and
+//! the scale of its air data. An estimator whose airspeed reads a few per cent low puts the
+//! missing air speed into the wind, along the drone's heading; a replay through that wind
+//! flies a model that must be draggier to match the recorded ground track (the simulated
+//! drone's recordings gave a drag 33 % high that way, see `stx_analysis::identify`).
 
 use std::sync::Arc;
 
@@ -28,7 +34,7 @@ use stx_dynamics::wind::WindField;
 use stx_sim::sensors::Truth;
 use thiserror::Error;
 
-use crate::flight_log::FlightLog;
+use crate::flight_log::{FlightLog, LogSample};
 use crate::trim::{TrimError, trim};
 
 /// Why the model could not fly a log.
@@ -92,6 +98,38 @@ impl WindField for LogWind {
     }
 }
 
+/// What a replay corrects in a recorded flight besides the vehicle: fitted per flight by
+/// identification, zero for a plain comparison.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Nuisance {
+    /// Turn of the start from the recorded heading, rad (one noisy heading sample sets the
+    /// course of the whole replay).
+    pub turn_rad: f64,
+    /// How much faster the air went past the drone than its recorded air data say, as a
+    /// fraction `s`: the horizontal air velocity the drone estimated (its ground velocity less
+    /// its wind) is taken as `1 + s` times too small, so the wind flown is `w − s·(v − w)` and
+    /// the airspeed compared is `(1 + s)·a`.
+    pub air_scale: f64,
+}
+
+impl Nuisance {
+    /// The wind flown at a recorded instant, NED, m/s.
+    pub fn wind_ned_mps(&self, s: &LogSample) -> [f64; 3] {
+        let w = s.wind_ned_mps;
+        let v = s.velocity_ned_mps;
+        [
+            w[0] - self.air_scale * (v[0] - w[0]),
+            w[1] - self.air_scale * (v[1] - w[1]),
+            w[2],
+        ]
+    }
+
+    /// A recorded airspeed as corrected, m/s.
+    pub fn airspeed_mps(&self, recorded_mps: f64) -> f64 {
+        (1.0 + self.air_scale) * recorded_mps
+    }
+}
+
 fn controls(log: &FlightLog, vehicle: &Vehicle, time_s: f64) -> Controls {
     let [main_line, brake_right, brake_left] = log.commands_at(time_s);
     Controls {
@@ -102,13 +140,12 @@ fn controls(log: &FlightLog, vehicle: &Vehicle, time_s: f64) -> Controls {
     .saturated(vehicle.main_line_travel_m)
 }
 
-/// The stack's state at the log's first sample (see the module doc), turned by `turn_rad`
-/// from the recorded heading (identification fits that turn: one noisy heading sample sets
-/// the course of the whole replay).
+/// The stack's state at the log's first sample (see the module doc), corrected by
+/// `nuisance` (its start turned from the recorded heading, its wind as corrected).
 pub fn initial_state(
     log: &FlightLog,
     vehicle: &Vehicle,
-    turn_rad: f64,
+    nuisance: Nuisance,
 ) -> Result<StateVector, ReplayError> {
     let first = log.samples()[0];
     let c = controls(log, vehicle, first.time_s);
@@ -122,13 +159,14 @@ pub fn initial_state(
     let drone = Body::Drone as usize;
     let kin = Kinematics::new(vehicle, &x, 0.0);
     let drone_yaw = euler_from_t(&kin.t_i_body[drone]).z;
-    x[idx::CANOPY_EULER + 2] += first.euler_rad[2] + turn_rad - drone_yaw;
+    x[idx::CANOPY_EULER + 2] += first.euler_rad[2] + nuisance.turn_rad - drone_yaw;
     x[idx::MAIN_LINE] = c.main_line_m;
     x[idx::BRAKE_RIGHT] = c.brake_right;
     x[idx::BRAKE_LEFT] = c.brake_left;
     let kin = Kinematics::new(vehicle, &x, c.main_line_m);
     let shift = Vector3::from(first.position_ned_m) - kin.position_ned_m[drone];
-    let wind_canopy = kin.t_i_body[Body::Canopy as usize] * Vector3::from(first.wind_ned_mps);
+    let wind_canopy =
+        kin.t_i_body[Body::Canopy as usize] * Vector3::from(nuisance.wind_ned_mps(&first));
     for k in 0..3 {
         x[idx::POSITION + k] += shift[k];
         x[idx::CANOPY_VELOCITY + k] += wind_canopy[k];
@@ -139,17 +177,17 @@ pub fn initial_state(
 /// Flies `vehicle` through `log` with RK4 steps of at most `step_s`, and returns what its
 /// drone did at each of the log's instants.
 pub fn fly(log: &FlightLog, vehicle: &Vehicle, step_s: f64) -> Result<Vec<Flown>, ReplayError> {
-    fly_turned(log, vehicle, step_s, 0.0)
+    fly_corrected(log, vehicle, step_s, Nuisance::default())
 }
 
-/// [`fly`] from a start turned by `turn_rad` from the recorded heading.
-pub fn fly_turned(
+/// [`fly`] with the recorded flight corrected by `nuisance`.
+pub fn fly_corrected(
     log: &FlightLog,
     vehicle: &Vehicle,
     step_s: f64,
-    turn_rad: f64,
+    nuisance: Nuisance,
 ) -> Result<Vec<Flown>, ReplayError> {
-    fly_from(log, vehicle, step_s, turn_rad, |_, _| true)
+    fly_from(log, vehicle, step_s, nuisance, |_, _| true)
 }
 
 /// [`fly`], telling `go(done, total)` the samples flown after each one; it stops with
@@ -161,14 +199,14 @@ pub fn fly_watched(
     step_s: f64,
     go: impl FnMut(usize, usize) -> bool,
 ) -> Result<Vec<Flown>, ReplayError> {
-    fly_from(log, vehicle, step_s, 0.0, go)
+    fly_from(log, vehicle, step_s, Nuisance::default(), go)
 }
 
 fn fly_from(
     log: &FlightLog,
     vehicle: &Vehicle,
     step_s: f64,
-    turn_rad: f64,
+    nuisance: Nuisance,
     mut go: impl FnMut(usize, usize) -> bool,
 ) -> Result<Vec<Flown>, ReplayError> {
     if !(step_s.is_finite() && step_s > 0.0) {
@@ -177,7 +215,7 @@ fn fly_from(
     let samples = log.samples();
     let wind = LogWind {
         times: samples.iter().map(|s| s.time_s).collect(),
-        winds: samples.iter().map(|s| s.wind_ned_mps).collect(),
+        winds: samples.iter().map(|s| nuisance.wind_ned_mps(s)).collect(),
     };
     let mut model = ParafoilModel::new(
         vehicle.clone(),
@@ -187,7 +225,7 @@ fn fly_from(
             ground_altitude_msl_m: 0.0,
         },
     );
-    let mut x = initial_state(log, vehicle, turn_rad)?;
+    let mut x = initial_state(log, vehicle, nuisance)?;
     let mut out = Vec::with_capacity(samples.len());
     let mut t = samples[0].time_s;
     for (k, s) in samples.iter().enumerate() {

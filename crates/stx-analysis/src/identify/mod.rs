@@ -18,7 +18,19 @@
 //!   the track drifts across by 9 cm/s, metres over a minute. Each flight's turn is fitted
 //!   as an extra parameter (degrees) and not reported.
 //!
-//! Without them the fitted coefficients soaked up these errors: over 10 seeds the truth was
+//! - optionally (`fit_air_scale`), the flight's air data: an estimator whose airspeed reads a
+//!   few per cent low puts the missing air speed into its wind, along the heading, and a
+//!   replay through that wind wants a draggier, lower-lift canopy. Each flight's scale `s` is
+//!   fitted ([`Nuisance::air_scale`](crate::compare::Nuisance)): the wind flown becomes
+//!   `w − s·(v − w)`, the airspeed compared `(1 + s)·a`. On the simulated drone's recording of a
+//!   stack with `cl_alpha` 1.840 (`crates/stx/tests/identify_rehearsal.rs`) it moved the fitted
+//!   lift slope from 1.943 (interval 1.908 … 1.977) to 1.899 (1.823 … 1.974) and the drag from
+//!   0.200 to 0.189 (truth 0.150). It is off by default: the scale and the drag both set the
+//!   airspeed's level, which then only turns tell apart, so on flights whose air data are right
+//!   it costs precision and can pull the drag (with the true wind written into the same
+//!   recording, cl_alpha/cd0 came out 1.828/0.157 without it and 1.888/0.182 with it).
+//!
+//! Without the first two the fitted coefficients soaked up these errors: over 10 seeds the truth was
 //! inside the 95 % interval in 2, 0 and 0 of 10 trials for cl_alpha, cd0 and cn_da, with the
 //! residuals slow and correlated. With them: 20, 19 and 20 of 20 (29, 28, 29 of 30), worst
 //! errors 0.5 %, 0.5 % and 0.0002 (cn_da, about 2 % of it) against a dispersion of 20–30 %.
@@ -69,7 +81,7 @@ use serde::{Deserialize, Serialize};
 use stx_dynamics::vehicle::{VehicleConfig, VehicleError};
 use thiserror::Error;
 
-use crate::compare::{DEFAULT_STEP_S, ReplayError, fly_turned, wrap_deg};
+use crate::compare::{DEFAULT_STEP_S, Nuisance, ReplayError, fly_corrected, wrap_deg};
 use crate::flight_log::FlightLog;
 use crate::flight_log::synthetic::SensorNoise;
 pub use covariance::{Layout, sandwich};
@@ -128,6 +140,15 @@ pub struct IdentifyOptions {
     /// scores show they stay correlated (Andrews' plug-in, see [`covariance`]).
     #[serde(default = "default_automatic_lag")]
     pub automatic_lag: bool,
+    /// Whether each flight's air-data scale is fitted too (see the module doc): the recorded
+    /// wind estimate and airspeed corrected for an airspeed that read a few per cent off.
+    /// Off by default: on flights whose air data are right it only widens the intervals.
+    #[serde(default = "default_fit_air_scale")]
+    pub fit_air_scale: bool,
+}
+
+fn default_fit_air_scale() -> bool {
+    false
 }
 
 fn default_automatic_lag() -> bool {
@@ -150,6 +171,7 @@ impl Default for IdentifyOptions {
             noise: SensorNoise::default(),
             correlation_s: DEFAULT_CORRELATION_S,
             automatic_lag: true,
+            fit_air_scale: false,
         }
     }
 }
@@ -196,6 +218,10 @@ pub struct IdentifyReport {
     pub interval_t: Option<f64>,
     /// Newey–West lag of the intervals, samples.
     pub newey_west_lag: Option<usize>,
+    /// Each flight's fitted air-data scale, per cent: how much faster the air went past
+    /// the drone than its recorded airspeed and wind estimate say (empty when not fitted).
+    #[serde(default)]
+    pub air_scale_percent: Vec<f64>,
     /// The fitted vehicle file (TOML, the vehicle schema).
     pub vehicle_toml: String,
 }
@@ -211,13 +237,14 @@ pub struct Progress {
     pub residual_rms: f64,
 }
 
-/// The normalised residuals of `vehicle` over `logs`, each flight's start turned by
-/// `turns_deg` (one per flight, or none for no turn), with each flight's mean position error
-/// taken out (see the module doc), and where each instant's sit; or why it cannot fly one.
+/// The normalised residuals of `vehicle` over `logs`, each flight corrected by its
+/// `nuisances` (one per flight, or none for no correction), with each flight's mean position
+/// error taken out (see the module doc), and where each instant's sit; or why it cannot fly
+/// one.
 pub fn residuals(
     logs: &[FlightLog],
     vehicle: &VehicleConfig,
-    turns_deg: &[f64],
+    nuisances: &[Nuisance],
     options: &IdentifyOptions,
 ) -> Result<(Vec<f64>, Layout), (usize, ReplayError)> {
     let v = vehicle
@@ -236,8 +263,8 @@ pub fn residuals(
     let mut out = Vec::new();
     let mut layout = Layout::default();
     for (i, log) in logs.iter().enumerate() {
-        let turn = turns_deg.get(i).copied().unwrap_or(0.0).to_radians();
-        let flown = fly_turned(log, &v, options.step_s, turn).map_err(|e| (i, e))?;
+        let nuisance = nuisances.get(i).copied().unwrap_or_default();
+        let flown = fly_corrected(log, &v, options.step_s, nuisance).map_err(|e| (i, e))?;
         let samples = log.samples();
         let mut starts = Vec::with_capacity(samples.len());
         let mut mean = [0.0; 3];
@@ -250,7 +277,7 @@ pub fn residuals(
                 out.push(wrap_deg((f.euler_rad[k] - s.euler_rad[k]).to_degrees()) / att);
             }
             if let Some(a) = s.airspeed_mps {
-                out.push((f.airspeed_mps - a) / air);
+                out.push((f.airspeed_mps - nuisance.airspeed_mps(a)) / air);
             }
         }
         for start in &starts {
@@ -307,14 +334,29 @@ pub fn identify(
         v
     };
     let p = params.len();
-    // The fitted vector: the parameters, then each flight's turn of its start (degrees).
+    let flights = logs.len();
+    let scaled = if options.fit_air_scale { flights } else { 0 };
+    // The fitted vector: the parameters, then each flight's turn of its start (degrees),
+    // then each flight's air-data scale (per cent) when fitted.
     let x0 = DVector::from_iterator(
-        p + logs.len(),
+        p + flights + scaled,
         params
             .iter()
             .map(|q| q.get(vehicle))
-            .chain(logs.iter().map(|_| 0.0)),
+            .chain((0..flights + scaled).map(|_| 0.0)),
     );
+    let nuisances = |x: &DVector<f64>| -> Vec<Nuisance> {
+        (0..flights)
+            .map(|i| Nuisance {
+                turn_rad: x[p + i].to_radians(),
+                air_scale: if scaled > 0 {
+                    x[p + flights + i] / 100.0
+                } else {
+                    0.0
+                },
+            })
+            .collect()
+    };
     let (before, layout) = residuals(logs, vehicle, &[], options)
         .map_err(|(flight, source)| IdentifyError::Replay { flight, source })?;
     let m = before.len();
@@ -325,7 +367,7 @@ pub fn identify(
         });
     }
     let mut evaluate = |x: &DVector<f64>| {
-        residuals(logs, &with(x), &x.as_slice()[p..], options)
+        residuals(logs, &with(x), &nuisances(x), options)
             .ok()
             .map(|(r, _)| r)
             .filter(|r| r.len() == m)
@@ -335,7 +377,7 @@ pub fn identify(
         .iter()
         .zip(x0.iter())
         .map(|(p, v)| p.scale(*v))
-        .chain(logs.iter().map(|_| 1.0))
+        .chain((0..flights + scaled).map(|_| 1.0))
         .collect();
     let scale = |i: usize, _: f64| scales[i];
     let lm_options = LmOptions {
@@ -406,6 +448,7 @@ pub fn identify(
         stop: fit.stop,
         interval_t: t95,
         newey_west_lag: lag,
+        air_scale_percent: fit.x.as_slice()[p + flights..].to_vec(),
         vehicle_toml: toml::to_string(&fitted).unwrap_or_default(),
     })
 }

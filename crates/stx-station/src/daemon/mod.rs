@@ -250,6 +250,7 @@ async fn run_with(
         keep_out_edit: Default::default(),
         planning: Default::default(),
         lab: Default::default(),
+        rehearsal: Default::default(),
     });
     let (stop_tx, stop_rx) = watch::channel(false);
     let sessions_task = replay_requests_rx.map(|rx| {

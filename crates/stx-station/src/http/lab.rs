@@ -50,15 +50,29 @@ fn lab_of(state: &Shared) -> Result<Arc<LabService>, HttpError> {
 }
 
 pub(crate) async fn status(State(state): State<AppState>, _caller: Caller) -> Response {
+    Json(status_body(&state)).into_response()
+}
+
+/// The Lab's status with what the station can rehearse.
+fn status_body(state: &Shared) -> crate::lab::jobs::LabStatusBody {
     let now = state.now_s();
-    match state.lab.get() {
-        Some(lab) => Json(lab.jobs().status(now)).into_response(),
+    let mut s = match state.lab.get() {
+        Some(lab) => lab.jobs().status(now),
         None => {
             let mut s = LabJobs::new(0.0).status(now);
             s.available = false;
-            Json(s).into_response()
+            s
         }
+    };
+    if let Some(rehearsals) = state.rehearsal.get() {
+        s.rehearse = true;
+        s.rehearsal = rehearsals
+            .last
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
+            .clone();
     }
+    s
 }
 
 /// The nice value of the Lab's thread and of the threads it starts: the lowest priority. A
@@ -241,7 +255,7 @@ pub(crate) async fn cancel(
             "no Lab job is running",
         ));
     }
-    Ok(Json(lab.jobs().status(state.now_s())).into_response())
+    Ok(Json(status_body(&state)).into_response())
 }
 
 pub(crate) async fn vehicle_fields(_caller: Caller) -> Response {

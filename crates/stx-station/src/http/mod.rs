@@ -25,6 +25,7 @@ mod kml;
 mod lab;
 mod plan;
 mod recordings;
+mod rehearse;
 mod replay;
 mod rest;
 mod shared;
@@ -37,7 +38,8 @@ use tower_http::services::{ServeDir, ServeFile};
 
 pub use auth::Caller;
 pub use shared::{
-    ClientCounters, HttpError, ReplayRefusal, ReplayRequest, Shared, StateFrame, SummaryCache,
+    ClientCounters, HttpError, RehearsalRequest, Rehearsals, ReplayRefusal, ReplayRequest, Shared,
+    StateFrame, SummaryCache,
 };
 
 use crate::requests::{CourseBody, HeadingBody, LocalizerBody, ModeBody, PlanBody, TargetBody};
@@ -87,6 +89,7 @@ pub fn router(state: std::sync::Arc<Shared>) -> Router {
         .route("/api/lab", get(lab::status))
         .route("/api/lab/jobs", post(lab::start))
         .route("/api/lab/cancel", post(lab::cancel))
+        .route("/api/lab/rehearse", post(rehearse::rehearse))
         .route("/api/lab/vehicle", get(lab::vehicle_fields))
         .route("/api/lab/vehicle/check", post(lab::vehicle_check))
         .route("/api/lab/vehicle/save", post(lab::vehicle_save))

@@ -63,6 +63,26 @@ pub struct Shared {
     /// The Lab, set once by the binary that can run its jobs (`stx serve`); unset, the Lab's
     /// endpoints answer that there is none.
     pub lab: std::sync::OnceLock<Arc<crate::lab::LabService>>,
+    /// The simulated drone's restarts, set once by a binary that flies one beside the station
+    /// (`stx serve --sim`); unset, `POST /api/lab/rehearse` answers that there is none.
+    pub rehearsal: std::sync::OnceLock<Rehearsals>,
+}
+
+/// Where the Lab asks for the simulated drone to fly its mission again with another vehicle.
+pub struct Rehearsals {
+    /// The binary's side: it stops the drone flying and starts one with the vehicle.
+    pub requests: tokio::sync::mpsc::Sender<RehearsalRequest>,
+    /// The rehearsal the Lab last started.
+    pub last: Mutex<Option<crate::lab::bodies::LabRehearsalBody>>,
+}
+
+/// A request to fly the simulated drone's mission again, from its start, with `vehicle` as
+/// the truth.
+pub struct RehearsalRequest {
+    /// The vehicle, validated.
+    pub vehicle: stx_dynamics::vehicle::Vehicle,
+    /// The mission's name once the new drone flies, or why it does not.
+    pub answer: tokio::sync::oneshot::Sender<Result<String, String>>,
 }
 
 /// Why a replay could not be opened: `(status, error, reason)` of the answer.

@@ -18,7 +18,19 @@ pub struct LabStartedBody {
     pub kind: &'static str,
 }
 
-/// `POST /api/lab/vehicle/check` and `/save`: a vehicle as edited.
+/// `POST /api/lab/rehearse`'s answer, and the rehearsal the Lab last started: the simulated
+/// drone flies its mission again from the start with this vehicle as the truth.
+#[derive(Debug, Clone, PartialEq, Serialize, JsonSchema)]
+pub struct LabRehearsalBody {
+    /// The simulated drone's mission (`rehearsal`, `mission-short`, …).
+    pub mission: String,
+    /// The vehicle flown: its parameters changed from the seed's.
+    pub vehicle: VehicleEdits,
+    /// Who started it.
+    pub started_by: String,
+}
+
+/// `POST /api/lab/vehicle/check`, `/save` and `POST /api/lab/rehearse`: a vehicle as edited.
 #[derive(Debug, Clone, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct LabVehicleBody {

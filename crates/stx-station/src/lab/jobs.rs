@@ -87,6 +87,11 @@ pub struct LabStatusBody {
     pub job: Option<LabJobView>,
     /// The last job's outcome.
     pub last: Option<LabOutcomeView>,
+    /// The station flies a simulated drone that `POST /api/lab/rehearse` restarts with a
+    /// vehicle (`stx serve --sim`).
+    pub rehearse: bool,
+    /// The rehearsal the Lab last started, if any.
+    pub rehearsal: Option<super::bodies::LabRehearsalBody>,
 }
 
 /// The runner's state.
@@ -213,6 +218,8 @@ impl LabJobs {
                 cancelling: j.cancelled,
             }),
             last: self.last.clone(),
+            rehearse: false,
+            rehearsal: None,
         }
     }
 }
