@@ -1,7 +1,9 @@
 // The dashboard's TypeScript types of the station's API, generated from its contract: the JSON
 // Schema src/generated/api.schema.json, itself generated from the daemon's Rust types
 // (`cargo run -p stx-station --example api_schema`). `npm run gen:api` writes src/generated/api.ts;
-// src/generated/generated.test.ts fails while the committed file differs from what this gives.
+// scripts/gen-api.test.mjs (run by `npm test`) fails while the committed file differs from what
+// this gives, and stx-station's `contract::tests::the_committed_schema_is_the_one_the_types_give`
+// while the committed schema differs from what the Rust types give.
 
 import { readFile, writeFile } from "node:fs/promises";
 import { fileURLToPath } from "node:url";

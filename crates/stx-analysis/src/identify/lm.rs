@@ -5,8 +5,8 @@
 //! the maintained Rust LM over nalgebra, but it ties itself to its own nalgebra release (the
 //! workspace is on 0.35) and runs to completion with no way to stop it; an identification
 //! flies the model `p + 1` times per iteration over minutes of flight, so the Lab page must
-//! be able to cancel it and watch it. (The registry could not be queried from the build
-//! machine to check for a newer release.) The method is the textbook one (Marquardt 1963,
+//! be able to cancel it and watch it. (Whether a newer release lifts either limit has not been
+//! checked.) The method is the textbook one (Marquardt 1963,
 //! Nielsen's damping update): solve `(JᵀJ + λ·diag JᵀJ) δ = −Jᵀr`, accept a step that lowers
 //! the cost and shrink λ, else grow λ and try again.
 
