@@ -6,13 +6,13 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use nalgebra::Vector3;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use stx_dynamics::atmosphere::StandardAtmosphere;
-use stx_dynamics::state::Controls;
-use stx_dynamics::wind::{ProfileRow, WindProfile};
 use stx_gnc::estimate::Estimate;
 use stx_gnc::footprint::{FootprintConfig, FootprintInput, footprint};
 use stx_gnc::performance::GlidePerformance;
 use stx_gnc::pointmass::{Conditions, PointMass};
+use stx_types::atmosphere::StandardAtmosphere;
+use stx_types::controls::Controls;
+use stx_types::wind::{ProfileRow, WindProfile};
 
 fn estimate(height_m: f64) -> Estimate {
     let wind = Vector3::new(3.0, -2.0, 0.0);

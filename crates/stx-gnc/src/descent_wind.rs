@@ -13,7 +13,7 @@
 //! since the ascent), less so by air far below.
 
 use nalgebra::{Vector2, Vector3};
-use stx_dynamics::wind::WindField;
+use stx_types::wind::WindField;
 
 use crate::estimate::Estimate;
 
@@ -142,7 +142,7 @@ impl WindField for DescentWind<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use stx_dynamics::wind::{ProfileRow, WindProfile};
+    use stx_types::wind::{ProfileRow, WindProfile};
 
     fn east_profile(rows: &[(f64, f64)]) -> WindProfile {
         WindProfile::new(

@@ -2,7 +2,10 @@
 //! (simulated) drone and in the ground station.
 //!
 //! - [`mission`] names the flight stages, the operator-selectable control modes and the phases
-//!   of spiral-landing guidance: the vocabulary shared with the link and the dashboard;
+//!   of spiral-landing guidance: the vocabulary shared with the link and the dashboard, which
+//!   lives in `stx-types` (with [`geo`], the keep-out zones, the plan items, the controls, the
+//!   angle helpers, the atmosphere and the wind profiles) and is re-exported here; this crate
+//!   depends on no simulator physics and the link on no guidance;
 //! - [`measurement`] is what the drone's sensors report, [`estimate`] what the estimator makes
 //!   of it;
 //! - [`estimator`] turns measurements (late, out of order, with gaps) into that estimate: the
@@ -24,8 +27,8 @@
 //! - [`footprint`] says which ground the stack can still reach from the estimate, with the
 //!   probability of reaching each point under the wind's uncertainty (50 % and 95 % contours)
 //!   and the keep-out zones it overlaps;
-//! - [`keep_out`] reads the keep-out zones (GeoJSON polygons) into the local frame and says
-//!   whether a point lies in one and whether a leg crosses one;
+//! - [`keep_out`] reads the keep-out zones (GeoJSON polygons) into the local frame, where
+//!   `stx-types` says whether a point lies in one and whether a leg crosses one;
 //! - [`flight_path`] flies the whole stack unsteered — balloon ascent, round chute, parafoil
 //!   deployment and glide — through a forecast wind, and its Monte Carlo spread gives the
 //!   pre-flight plan: burst, deploy and landing regions and the target's reachability;
@@ -41,14 +44,14 @@ pub mod estimate;
 pub mod estimator;
 pub mod flight_path;
 pub mod footprint;
-pub mod geo;
 pub mod guidance;
 pub mod keep_out;
 pub mod measurement;
-pub mod mission;
 pub mod params;
 pub mod performance;
 pub mod plan_upload;
 pub mod pointmass;
 pub mod predict;
 pub mod stats;
+
+pub use stx_types::{geo, mission};

@@ -13,32 +13,17 @@
 //!   absent) stays as it was.
 //!
 //! Points arrive in the mission's local frame (north, east, down; m), converted from the
-//! wire's latitude and longitude by the caller with its own [`crate::geo::LocalFrame`].
-
-use nalgebra::Vector3;
+//! wire's latitude and longitude by the caller with its own [`crate::geo::LocalFrame`] (the
+//! link's plan protocol does it, into [`PlanPoint`]s).
 
 use crate::control::Localizer;
 use crate::guidance::Plan;
+// The link reads plan items off the wire without guidance, so the item type is a shared one.
+pub use stx_types::plan::PlanPoint;
+use stx_types::rotation::wrap_pi;
 
 /// Two localizer points closer than this define no line, m.
 pub const MIN_LINE_M: f64 = 1.0;
-
-/// One item of an uploaded plan, in the local frame.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum PlanPoint {
-    /// A localizer point, NED, m.
-    Waypoint {
-        /// Position, NED, m.
-        position_ned_m: Vector3<f64>,
-    },
-    /// The landing point, NED, m, with the final-approach course (rad; `None`: into the wind).
-    Land {
-        /// Position, NED, m.
-        position_ned_m: Vector3<f64>,
-        /// Course of the final approach, rad.
-        approach_course_rad: Option<f64>,
-    },
-}
 
 /// What an upload changed in the localizer.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -78,7 +63,7 @@ pub fn apply(current: &Plan, items: &[PlanPoint]) -> PlanUpdate {
     }
     if let Some((target, approach)) = land {
         plan.target_ned_m = target;
-        plan.approach_course_rad = approach.map(stx_dynamics::rotation::wrap_pi);
+        plan.approach_course_rad = approach.map(wrap_pi);
     }
     let ends = match (waypoints.as_slice(), land) {
         ([a, b, ..], _) => Some((*a, *b)),
@@ -109,6 +94,8 @@ pub fn apply(current: &Plan, items: &[PlanPoint]) -> PlanUpdate {
 
 #[cfg(test)]
 mod tests {
+    use nalgebra::Vector3;
+
     use super::*;
 
     fn waypoint(n: f64, e: f64, d: f64) -> PlanPoint {

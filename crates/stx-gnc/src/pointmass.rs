@@ -6,8 +6,8 @@
 //! tests can fly whole landings in milliseconds.
 
 use nalgebra::Vector3;
-use stx_dynamics::rotation::wrap_pi;
-use stx_dynamics::state::Controls;
+use stx_types::controls::Controls;
+use stx_types::rotation::wrap_pi;
 
 use crate::estimate::Estimate;
 use crate::performance::GlidePerformance;

@@ -9,9 +9,9 @@
 
 use nalgebra::{Matrix2, Vector2, Vector3};
 use serde::{Deserialize, Serialize};
-use stx_dynamics::atmosphere::Atmosphere;
-use stx_dynamics::state::Controls;
-use stx_dynamics::wind::WindField;
+use stx_types::atmosphere::Atmosphere;
+use stx_types::controls::Controls;
+use stx_types::wind::WindField;
 
 use crate::descent_wind::{DEFAULT_FADE_HEIGHT_M, DescentWind};
 use crate::estimate::Estimate;
@@ -285,8 +285,8 @@ fn summarise(outcomes: &[(f64, [f64; 2], f64)]) -> PredictedTouchdown {
 mod tests {
     use super::*;
     use crate::guidance::{GuidanceConfig, Plan};
-    use stx_dynamics::atmosphere::AirState;
-    use stx_dynamics::atmosphere::UniformAir;
+    use stx_types::atmosphere::AirState;
+    use stx_types::atmosphere::UniformAir;
 
     fn still_estimate(height_m: f64, wind_ne: [f64; 2], wind_sigma: f64) -> Estimate {
         let perf = GlidePerformance::default();
@@ -419,10 +419,10 @@ mod tests {
     }
 
     /// A profile blowing east (from the west) at `rows` (altitude m, speed m/s).
-    fn westerly(rows: &[(f64, f64)]) -> stx_dynamics::wind::WindProfile {
-        stx_dynamics::wind::WindProfile::new(
+    fn westerly(rows: &[(f64, f64)]) -> stx_types::wind::WindProfile {
+        stx_types::wind::WindProfile::new(
             rows.iter()
-                .map(|&(altitude_m, speed_mps)| stx_dynamics::wind::ProfileRow {
+                .map(|&(altitude_m, speed_mps)| stx_types::wind::ProfileRow {
                     altitude_m,
                     speed_mps,
                     from_deg: 270.0,
@@ -435,7 +435,7 @@ mod tests {
     /// Both predictions from `est` in `profile` (no plan), over sea-level ground and air.
     fn in_profile(
         est: &Estimate,
-        profile: &stx_dynamics::wind::WindProfile,
+        profile: &stx_types::wind::WindProfile,
         config: &PredictorConfig,
     ) -> LandingPrediction {
         let guidance = Guidance::new(GuidanceConfig::default());

@@ -15,10 +15,10 @@ use nalgebra::Vector3;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
-use stx_dynamics::wind::{ProfileRow, WindField, WindProfile};
 use stx_gnc::ascent_wind::{
     AscentFix, AscentWindConfig, AscentWindEstimator, BandMethod, WindBand,
 };
+use stx_types::wind::{ProfileRow, WindField, WindProfile};
 
 const ASCENT_RATE_MPS: f64 = 5.0;
 const BURST_ALTITUDE_M: f64 = 20_000.0;

@@ -5,11 +5,11 @@
 use std::f64::consts::PI;
 
 use nalgebra::Vector3;
-use stx_dynamics::atmosphere::{Atmosphere, StandardAtmosphere};
-use stx_dynamics::rotation::wrap_pi;
 use stx_gnc::estimate::Estimate;
 use stx_gnc::estimator::{Disposition, Estimator, EstimatorConfig, PENDING_CAPACITY};
 use stx_gnc::measurement::{AirDataSample, AttitudeSample, GpsFix, Measurement};
+use stx_types::atmosphere::{Atmosphere, StandardAtmosphere};
+use stx_types::rotation::wrap_pi;
 
 /// A flight whose air velocity turns at a constant rate in a constant wind.
 #[derive(Clone, Copy, Debug)]

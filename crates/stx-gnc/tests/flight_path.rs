@@ -7,12 +7,12 @@
 use nalgebra::Vector3;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use stx_dynamics::atmosphere::{AirState, Atmosphere, StandardAtmosphere, UniformAir};
-use stx_dynamics::wind::{ConstantWind, WindField};
 use stx_gnc::flight_path::{
     Air, Dispersion, PlanInputs, StackConfig, Start, monte_carlo, propagate,
 };
 use stx_gnc::performance::GlidePerformance;
+use stx_types::atmosphere::{AirState, Atmosphere, StandardAtmosphere, UniformAir};
+use stx_types::wind::{ConstantWind, WindField};
 
 fn uniform_sea_level() -> UniformAir {
     UniformAir(AirState::sea_level())

@@ -2,13 +2,13 @@
 //! the wind, the wind too strong to reach the target, and angles across ±180°.
 
 use nalgebra::Vector3;
-use stx_dynamics::rotation::wrap_pi;
 use stx_gnc::control::{LawPhase, Localizer};
 use stx_gnc::estimate::Estimate;
 use stx_gnc::guidance::{Guidance, GuidanceConfig, PhaseEvent, Plan};
 use stx_gnc::mission::{FlightMode, GuidancePhase};
 use stx_gnc::performance::GlidePerformance;
 use stx_gnc::pointmass::{Conditions, PointMass};
+use stx_types::rotation::wrap_pi;
 
 struct Flight {
     mass: PointMass,

@@ -12,7 +12,7 @@
 //!   frames signed under it leave.
 //!
 //! The station daemon, the simulated drone's paced runner and the tests use it; nothing pure
-//! (`stx-gnc`, the station core, the drone's onboard logic) depends on it.
+//! (`stx-types`, `stx-gnc`, the station core, the drone's onboard logic) depends on it.
 
 pub mod drive;
 pub mod transport;

@@ -3,7 +3,7 @@
 //! actuators, wind, guidance and status, in turn — with values that change from message to
 //! message as they would.
 
-use stx_gnc::mission::{FlightMode, FlightStage, GuidancePhase};
+use stx_types::mission::{FlightMode, FlightStage, GuidancePhase};
 
 use crate::telemetry::*;
 

@@ -59,7 +59,7 @@
 //! the wire; every dropped frame, lost packet or I/O error is counted and surfaced, never
 //! hidden; retries and timeouts take `now` from the caller so tests run on a fake clock.
 //!
-//! The mission vocabulary ([`stx_gnc::mission`]: flight mode, flight stage, guidance phase)
+//! The mission vocabulary ([`stx_types::mission`]: flight mode, flight stage, guidance phase)
 //! travels in HEARTBEAT's `custom_mode` as `mode | stage << 8 | phase << 16`.
 
 pub mod address;

@@ -5,7 +5,6 @@ mod common;
 use std::time::Duration;
 
 use common::{Pair, msg_id};
-use stx_gnc::mission::FlightMode;
 use stx_link::command::{Command, CommandOutcome, CommandResult, RequestId};
 use stx_link::endpoint::{
     GroundConfig, GroundEndpoint, GroundEvent, LinkConfig, LinkEvent, SenderStats, VehicleConfig,
@@ -17,6 +16,7 @@ use stx_link::param::{ParamEvent, ParamSpec};
 use stx_link::plan::{PlanEvent, PlanItem};
 use stx_link::signing::{SigningConfig, SigningKey};
 use stx_link::telemetry::{Attitude, Telemetry};
+use stx_types::mission::FlightMode;
 
 const COMMAND_LONG: u32 = 76;
 const PARAM_VALUE: u32 = 22;

@@ -8,13 +8,13 @@
 use std::path::Path;
 use std::time::Duration;
 
-use stx_gnc::mission::{FlightMode, FlightStage, GuidancePhase};
 use stx_link::command::Command;
 use stx_link::frame::{FrameDecoder, FrameEncoder};
 use stx_link::manual::Sticks;
 use stx_link::plan::PlanItem;
 use stx_link::signing::{SigningConfig, SigningKey};
 use stx_link::telemetry::*;
+use stx_types::mission::{FlightMode, FlightStage, GuidancePhase};
 
 fn messages() -> Vec<(&'static str, mavlink::dialects::common::MavMessage)> {
     let status = VehicleStatus {

@@ -5,7 +5,7 @@
 
 use stx_gnc::estimator::EstimatorConfig;
 use stx_gnc::geo::LocalFrame;
-use stx_gnc::keep_out::KeepOutZones;
+use stx_gnc::keep_out;
 use stx_sim::montecarlo::{MonteCarloConfig, RunResult, run_sensed};
 
 /// Run `index` of the 1000-run campaign of `seed` with the sample zones.
@@ -16,7 +16,7 @@ fn fly(seed: u64, index: usize) -> RunResult {
         seed,
         threads: 1,
         only_run: Some(index),
-        keep_out: KeepOutZones::from_geojson(geojson, &LocalFrame::default()).expect("zones"),
+        keep_out: keep_out::from_geojson(geojson, &LocalFrame::default()).expect("zones"),
         ..MonteCarloConfig::default()
     };
     let report = run_sensed(&config, &EstimatorConfig::default()).expect("runs");

@@ -8,7 +8,7 @@ use clap::{Args, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 use stx_gnc::estimator::EstimatorConfig;
 use stx_gnc::geo::LocalFrame;
-use stx_gnc::keep_out::KeepOutZones;
+use stx_gnc::keep_out::{self, KeepOutZones};
 use stx_sim::closed_loop::SensedNavigation;
 use stx_sim::dispersions::Dispersions;
 use stx_sim::montecarlo::{
@@ -237,7 +237,7 @@ fn load_zones(path: &std::path::Path) -> anyhow::Result<KeepOutZones> {
     let text = std::fs::read_to_string(path)
         .with_context(|| format!("--keep-out: cannot read {}", path.display()))
         .map_err(BadInput)?;
-    let zones = KeepOutZones::from_geojson(&text, &LocalFrame::default())
+    let zones = keep_out::from_geojson(&text, &LocalFrame::default())
         .map_err(|e| BadInput(anyhow::anyhow!("--keep-out {}: {e}", path.display())))?;
     if let Some(zone) = zones.zone_at([0.0, 0.0]) {
         return Err(BadInput(anyhow::anyhow!(

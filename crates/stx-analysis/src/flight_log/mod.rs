@@ -10,6 +10,7 @@
 pub mod csv;
 pub mod recording;
 pub mod synthetic;
+mod telemetry;
 pub mod window;
 
 use serde::{Deserialize, Serialize};

@@ -1,8 +1,9 @@
 //! A flight log from a station recording's decoded telemetry (`/telemetry/<MAVLINK_NAME>`
-//! topics, stx-link's typed values as JSON; see stx-station's `recording` module): GPS
-//! position and velocity from GLOBAL_POSITION_INT (the time base: one sample per message),
-//! attitude from ATTITUDE, airspeed from VFR_HUD, servo commands from SERVO_OUTPUT_RAW and
-//! the wind estimate from WIND_COV, each the latest at or before the position's time.
+//! topics, stx-link's typed values as JSON, of which `telemetry.rs` reads the fields used; see
+//! stx-station's `recording` module): GPS position and velocity from GLOBAL_POSITION_INT (the
+//! time base: one sample per message), attitude from ATTITUDE, airspeed from VFR_HUD, servo
+//! commands from SERVO_OUTPUT_RAW and the wind estimate from WIND_COV, each the latest at or
+//! before the position's time.
 //!
 //! The log's time is the drone's (GLOBAL_POSITION_INT's `time_boot_ms`), not the station's
 //! receive time (the recording's log time): a simulated drone flying faster than real time
@@ -36,8 +37,8 @@
 use serde::de::DeserializeOwned;
 use stx_gnc::geo::LocalFrame;
 use stx_gnc::mission::FlightStage;
-use stx_link::telemetry::{Actuators, Attitude, GlobalPosition, Hud, VehicleStatus, Wind};
 
+use super::telemetry::{Actuators, Attitude, GlobalPosition, Hud, VehicleStatus, Wind};
 use super::{FlightLog, FlightLogError, LogSample, RecordedPart};
 
 /// The topics read (the station's recording layout).

@@ -1,6 +1,6 @@
 //! The measured bands joined to the forecast: the profile every descent prediction uses.
 
-use stx_dynamics::wind::{ProfileRow, WindError, WindProfile};
+use stx_types::wind::{ProfileRow, WindError, WindProfile};
 
 use super::WindBand;
 

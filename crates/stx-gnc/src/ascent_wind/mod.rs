@@ -49,7 +49,7 @@
 //! the first, as one series with a gap.
 //!
 //! **Altitudes** are above the local frame's origin (`−down`, see [`crate::geo`]), the
-//! convention of [`stx_dynamics::wind::WindProfile`]. A forecast given above mean sea level is
+//! convention of [`stx_types::wind::WindProfile`]. A forecast given above mean sea level is
 //! brought to it by subtracting the origin's `alt_msl_m`.
 //!
 //! **Believed or refused** (`plausible.rs`): a band faster than any wind a balloon meets at
@@ -73,7 +73,7 @@ use std::collections::{BTreeMap, VecDeque};
 
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
-use stx_dynamics::wind::{ProfileRow, WindError, WindProfile};
+use stx_types::wind::{ProfileRow, WindError, WindProfile};
 use thiserror::Error;
 
 pub use config::{AscentWindConfig, AscentWindConfigError};

@@ -2,7 +2,7 @@
 //! many-seed coverage check is `tests/ascent_wind.rs`.
 
 use nalgebra::Vector3;
-use stx_dynamics::wind::{ProfileRow, WindError, WindField};
+use stx_types::wind::{ProfileRow, WindError, WindField};
 
 use super::*;
 

@@ -9,7 +9,7 @@
 //! positive main-line command turns right; more brake steepens the glide.
 
 use serde::{Deserialize, Serialize};
-use stx_dynamics::rotation::wrap_pi;
+use stx_types::rotation::wrap_pi;
 
 mod turn_latch;
 pub use turn_latch::{LATCH_RAD, RELEASE_RAD, RETARGET_RAD, TurnLatch};

@@ -16,7 +16,7 @@
 
 use std::f64::consts::PI;
 
-use stx_dynamics::rotation::wrap_pi;
+use stx_types::rotation::wrap_pi;
 
 /// An error larger than this (150°) takes a side.
 pub const LATCH_RAD: f64 = 5.0 * PI / 6.0;

@@ -19,7 +19,7 @@
 //! under the canopy really does jump by tens of degrees between samples.
 
 use nalgebra::{Matrix2, Vector2};
-use stx_dynamics::rotation::wrap_pi;
+use stx_types::rotation::wrap_pi;
 
 /// One angle and its rate.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -2,7 +2,7 @@
 //! state) and the air density the estimate reports.
 
 use nalgebra::SMatrix;
-use stx_dynamics::atmosphere::{Atmosphere, STANDARD_GRAVITY_MPS2, StandardAtmosphere};
+use stx_types::atmosphere::{Atmosphere, STANDARD_GRAVITY_MPS2, StandardAtmosphere};
 
 use super::config::Tuning;
 use super::ekf::{N, Nav, Outcome, ix};

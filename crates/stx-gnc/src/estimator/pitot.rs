@@ -4,7 +4,7 @@
 //! pitot keeps contradicting the state.
 
 use nalgebra::{SMatrix, Vector2, Vector3};
-use stx_dynamics::rotation::wrap_pi;
+use stx_types::rotation::wrap_pi;
 
 use super::angle::AngleFilter;
 use super::config::Tuning;
@@ -187,7 +187,7 @@ impl Pitot {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use stx_dynamics::rotation::t_from_euler;
+    use stx_types::rotation::t_from_euler;
 
     #[test]
     fn the_x_axis_is_the_first_row_of_the_models_euler_matrix() {

@@ -2,7 +2,7 @@
 //! glide ratios, the stack's heading and turn rate, and the wind, each with its 1-σ.
 
 use nalgebra::{Matrix3, SMatrix, Vector2, Vector3};
-use stx_dynamics::rotation::wrap_pi;
+use stx_types::rotation::wrap_pi;
 
 use super::ekf::{N, Nav, ix};
 use crate::estimate::Estimate;

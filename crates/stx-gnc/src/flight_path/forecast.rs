@@ -21,7 +21,7 @@
 //! row holds ([`WindProfile`]); a missing sigma takes the planner's default.
 
 use serde::{Deserialize, Serialize};
-use stx_dynamics::wind::{ProfileRow, WindError, WindProfile};
+use stx_types::wind::{ProfileRow, WindError, WindProfile};
 
 use crate::ascent_wind::WindBand;
 

@@ -35,9 +35,9 @@ pub mod spread;
 
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
-use stx_dynamics::atmosphere::Atmosphere;
-use stx_dynamics::state::Controls;
-use stx_dynamics::wind::WindField;
+use stx_types::atmosphere::Atmosphere;
+use stx_types::controls::Controls;
+use stx_types::wind::WindField;
 
 use crate::performance::GlidePerformance;
 use crate::pointmass::{Conditions, PointMass};

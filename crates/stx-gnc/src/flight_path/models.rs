@@ -13,7 +13,7 @@
 //!   35 km for the STRAPLEX stack under 4 m²).
 
 use nalgebra::Vector3;
-use stx_dynamics::atmosphere::Atmosphere;
+use stx_types::atmosphere::Atmosphere;
 
 /// The balloon's ascent model: `v = v₀·(ρ₀/ρ)^k`.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -109,7 +109,7 @@ impl RoundChute {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use stx_dynamics::atmosphere::StandardAtmosphere;
+    use stx_types::atmosphere::StandardAtmosphere;
 
     #[test]
     fn balloon_rises_faster_in_thin_air_by_the_sixth_root() {

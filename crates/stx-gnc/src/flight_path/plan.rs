@@ -11,7 +11,7 @@
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
-use stx_dynamics::atmosphere::StandardAtmosphere;
+use stx_types::atmosphere::StandardAtmosphere;
 
 use super::spread::{PlanInputs, PlanSample, PointSpread, monte_carlo};
 use super::{Air, Dispersion, Ellipse, Forecast, ForecastRow, StackConfig, Start};

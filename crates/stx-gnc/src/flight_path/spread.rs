@@ -25,7 +25,7 @@ use nalgebra::{Matrix2, Vector2, Vector3};
 use rand::Rng;
 use rand_distr::{Distribution, StandardNormal};
 use serde::{Deserialize, Serialize};
-use stx_dynamics::wind::WindField;
+use stx_types::wind::WindField;
 
 use super::{Air, FlightPath, FlightPathError, ReachDisc, StackConfig, Start, check, propagate};
 use crate::performance::GlidePerformance;

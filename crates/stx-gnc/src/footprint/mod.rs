@@ -49,8 +49,8 @@ mod reach;
 mod tests;
 
 use rand::Rng;
-use stx_dynamics::atmosphere::Atmosphere;
-use stx_dynamics::wind::WindField;
+use stx_types::atmosphere::Atmosphere;
+use stx_types::wind::WindField;
 use thiserror::Error;
 
 pub use config::{FootprintConfig, FootprintConfigError, ValidFootprintConfig};

@@ -4,8 +4,8 @@
 use nalgebra::Vector3;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use stx_dynamics::atmosphere::{AirState, UniformAir};
-use stx_dynamics::state::Controls;
+use stx_types::atmosphere::{AirState, UniformAir};
+use stx_types::controls::Controls;
 
 use super::*;
 use crate::keep_out::KeepOutZone;

@@ -18,7 +18,7 @@ pub use plan::{Plan, PlanRefused};
 pub use spiral::{FinalLaw, SpiralConfig, SpiralStatus};
 
 use serde::{Deserialize, Serialize};
-use stx_dynamics::state::Controls;
+use stx_types::controls::Controls;
 
 use crate::control::{self, ControlGains, LawPhase};
 use crate::estimate::Estimate;

@@ -82,7 +82,7 @@ impl MainLineTrim {
 #[cfg(test)]
 mod tests {
     use nalgebra::Vector3;
-    use stx_dynamics::state::Controls;
+    use stx_types::controls::Controls;
 
     use super::*;
     use crate::pointmass::{Conditions, PointMass};

@@ -54,7 +54,7 @@ fn a_pond_north_of_the_target_holds_its_points_and_blocks_legs_across_it() {
         "pond",
         &geometry("Polygon", &format!("[{}]", square([200.0, 0.0], 50.0))),
     );
-    let zones = KeepOutZones::from_geojson(&collection(&[pond]), &frame()).expect("zones");
+    let zones = from_geojson(&collection(&[pond]), &frame()).expect("zones");
     assert_eq!(zones.zones.len(), 1);
     assert_eq!(zones.zones[0].name, "pond");
     assert_eq!(
@@ -91,7 +91,7 @@ fn a_hole_is_outside_and_each_polygon_of_a_multipolygon_is_a_zone() {
             &format!("[{ring_with_hole}, {lone_tree_patch}]"),
         ),
     );
-    let zones = KeepOutZones::from_geojson(&collection(&[multi]), &frame()).expect("zones");
+    let zones = from_geojson(&collection(&[multi]), &frame()).expect("zones");
     assert_eq!(zones.zones.len(), 2);
     assert!(
         zones.zone_at([0.0, 0.0]).is_none(),
@@ -107,7 +107,7 @@ fn a_hole_is_outside_and_each_polygon_of_a_multipolygon_is_a_zone() {
 #[test]
 fn a_bare_geometry_is_a_zone_named_by_its_place_in_the_file() {
     let text = geometry("Polygon", &format!("[{}]", square([0.0, 0.0], 10.0)));
-    let zones = KeepOutZones::from_geojson(&text, &frame()).expect("zones");
+    let zones = from_geojson(&text, &frame()).expect("zones");
     assert_eq!(zones.zones[0].name, "zone 0");
 }
 
@@ -115,14 +115,14 @@ fn a_bare_geometry_is_a_zone_named_by_its_place_in_the_file() {
 fn a_simple_ring_with_a_repeated_corner_or_a_concave_notch_is_an_area() {
     // A notch (concave) and a corner given twice in a row, as some GIS exports write them.
     let notched = r#"{"type": "Polygon", "coordinates": [[[17.0, 48.0], [17.02, 48.0], [17.02, 48.0], [17.02, 48.02], [17.01, 48.005], [17.0, 48.02], [17.0, 48.0]]]}"#;
-    let zones = KeepOutZones::from_geojson(notched, &frame()).expect("a simple ring");
+    let zones = from_geojson(notched, &frame()).expect("a simple ring");
     assert_eq!(zones.zones.len(), 1);
 }
 
 #[test]
 fn files_that_are_not_areas_on_the_globe_are_refused_with_the_rule_broken() {
     let f = frame();
-    let err = |text: &str| KeepOutZones::from_geojson(text, &f).expect_err(text);
+    let err = |text: &str| from_geojson(text, &f).expect_err(text);
     assert!(matches!(err("{not json"), KeepOutError::Parse(_)));
     assert!(matches!(
         err(&collection(&[feature(

@@ -6,7 +6,7 @@
 use mavlink::dialects::common as mc;
 use mavlink::dialects::common::{MavCmd, MavMessage};
 use serde::{Deserialize, Serialize};
-use stx_gnc::mission::FlightMode;
+use stx_types::mission::FlightMode;
 
 /// What the operator asks the drone to do.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]

@@ -231,7 +231,7 @@ fn canonical(msg: &MavMessage) -> Vec<u8> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use stx_gnc::mission::FlightMode;
+    use stx_types::mission::FlightMode;
 
     #[test]
     fn unsupported_and_invalid_commands_are_refused_with_the_right_result() {

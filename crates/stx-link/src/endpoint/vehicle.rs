@@ -39,7 +39,7 @@ pub struct VehicleConfig {
 
 impl Default for VehicleConfig {
     fn default() -> Self {
-        use stx_gnc::mission::{FlightMode, FlightStage, GuidancePhase};
+        use stx_types::mission::{FlightMode, FlightStage, GuidancePhase};
         Self {
             link: LinkConfig::vehicle(),
             params: Vec::new(),

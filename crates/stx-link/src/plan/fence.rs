@@ -17,8 +17,8 @@
 use mavlink::dialects::common as mc;
 use mavlink::dialects::common::{MavCmd, MavMessage, MavMissionResult};
 use serde::{Deserialize, Serialize};
-use stx_gnc::geo::LocalFrame;
-use stx_gnc::keep_out::{KeepOutZone, KeepOutZones};
+use stx_types::geo::LocalFrame;
+use stx_types::keep_out::{KeepOutZone, KeepOutZones};
 
 use super::client::{MissionClient, TransferEvent};
 use super::mission::MissionItem;

@@ -25,10 +25,10 @@ pub enum PlanItem {
 }
 
 impl PlanItem {
-    /// The item in the mission's local frame, for [`stx_gnc::plan_upload::apply`] (the one
-    /// mapping the drone and the station's replica share).
-    pub fn to_local(&self, frame: &stx_gnc::geo::LocalFrame) -> stx_gnc::plan_upload::PlanPoint {
-        use stx_gnc::plan_upload::PlanPoint;
+    /// The item in the mission's local frame, for guidance's `stx_gnc::plan_upload::apply` (the
+    /// one mapping the drone and the station's replica share).
+    pub fn to_local(&self, frame: &stx_types::geo::LocalFrame) -> stx_types::plan::PlanPoint {
+        use stx_types::plan::PlanPoint;
         match *self {
             Self::Waypoint {
                 lat_deg,

@@ -89,8 +89,8 @@ fn unsupported_item_is_refused() {
     assert_eq!(srv.stats().uploads_failed, 1);
 }
 
-fn frame() -> stx_gnc::geo::LocalFrame {
-    stx_gnc::geo::LocalFrame {
+fn frame() -> stx_types::geo::LocalFrame {
+    stx_types::geo::LocalFrame {
         lat_deg: 41.15,
         lon_deg: -8.55,
         alt_msl_m: 90.0,
@@ -98,8 +98,8 @@ fn frame() -> stx_gnc::geo::LocalFrame {
 }
 
 /// Two zones 100 m apart: a square and a triangle, with a hole in the square (not sent).
-fn zones() -> stx_gnc::keep_out::KeepOutZones {
-    use stx_gnc::keep_out::{KeepOutZone, KeepOutZones};
+fn zones() -> stx_types::keep_out::KeepOutZones {
+    use stx_types::keep_out::{KeepOutZone, KeepOutZones};
     KeepOutZones {
         zones: vec![
             KeepOutZone {

@@ -12,6 +12,9 @@
 
 use super::gps_solution::GpsSolution;
 use super::navigation::{GlobalPosition, GpsFix, GpsRaw};
+// The coordinates' half of the rule is shared with readers of recorded positions that have no
+// link (the flight-log reader), so it lives with the local frame.
+pub use stx_types::geo::is_position;
 
 impl GpsFix {
     /// At least a 2-D fix (GPS_FIX_TYPE ≥ 2): the receiver knows where it is.
@@ -23,12 +26,6 @@ impl GpsFix {
     pub fn is_3d(self) -> bool {
         !matches!(self, Self::NoGps | Self::NoFix | Self::Fix2d)
     }
-}
-
-/// Whether coordinates can be a vehicle's position: finite, within ±90° and ±180°, and not
-/// exactly 0°, 0° (the placeholder of a report without a fix).
-pub fn is_position(lat_deg: f64, lon_deg: f64) -> bool {
-    lat_deg.abs() <= 90.0 && lon_deg.abs() <= 180.0 && !(lat_deg == 0.0 && lon_deg == 0.0)
 }
 
 /// Whether a receiver's report with fix type `fix` at `lat_deg`, `lon_deg` is a position.

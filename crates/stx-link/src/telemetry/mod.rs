@@ -9,7 +9,7 @@
 //!
 //! | stx type | MAVLink message | notes |
 //! |---|---|---|
-//! | [`VehicleStatus`] | HEARTBEAT | `custom_mode = mode \| stage << 8 \| phase << 16` (codes from `stx_gnc::mission`), `base_mode = CUSTOM_MODE_ENABLED`, `type = MAV_TYPE_PARAFOIL` (exists in the dialect, 28), autopilot `GENERIC` |
+//! | [`VehicleStatus`] | HEARTBEAT | `custom_mode = mode \| stage << 8 \| phase << 16` (codes from `stx_types::mission`), `base_mode = CUSTOM_MODE_ENABLED`, `type = MAV_TYPE_PARAFOIL` (exists in the dialect, 28), autopilot `GENERIC` |
 //! | [`GpsRaw`] | GPS_RAW_INT | extensions carry h_acc / v_acc; `UINT16_MAX` / `255` / `0` = unknown |
 //! | [`GpsSolution`] | GPS_INPUT | the receiver's whole solution beside GPS_RAW_INT: NED velocity (vertical too) and accuracies as floats, for the station's estimator (see `gps_solution.rs`) |
 //! | [`GlobalPosition`] | GLOBAL_POSITION_INT | onboard estimate; NED velocity in cm/s |

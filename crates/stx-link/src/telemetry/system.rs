@@ -5,7 +5,7 @@
 use mavlink::dialects::common as mc;
 use mavlink::dialects::common::MavMessage;
 use serde::{Deserialize, Serialize};
-use stx_gnc::mission::{FlightMode, FlightStage, GuidancePhase};
+use stx_types::mission::{FlightMode, FlightStage, GuidancePhase};
 
 use super::units::{
     amps_to_ca, c_to_cdeg, ca_to_amps, i8_to_pct, mv_to_volts, pct_to_i8, volts_to_mv,

@@ -3,7 +3,7 @@ use mavlink::dialects::common::MavMessage;
 use mavlink::{MavlinkVersion, Message};
 use proptest::prelude::*;
 use serde_json::Value;
-use stx_gnc::mission::{FlightMode, FlightStage, GuidancePhase};
+use stx_types::mission::{FlightMode, FlightStage, GuidancePhase};
 
 use super::*;
 

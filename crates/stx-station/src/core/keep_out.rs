@@ -10,7 +10,7 @@
 //! the log with pairs of messages, and the alarm is not dropped on one lucky sample.
 
 use serde_json::Value;
-use stx_gnc::keep_out::{KeepOutZone, KeepOutZones};
+use stx_gnc::keep_out::{KeepOutZone, KeepOutZones, from_geojson};
 
 use super::StationCore;
 use super::requests::ApiError;
@@ -142,8 +142,7 @@ impl StationCore {
     pub fn load_keep_out(&mut self, now_s: f64, file: &str, text: Result<String, String>) {
         let parsed = text.and_then(|text| {
             let geojson: Value = serde_json::from_str(&text).map_err(|e| e.to_string())?;
-            let zones = stx_gnc::keep_out::KeepOutZones::from_geojson(&text, &self.frame)
-                .map_err(|e| e.to_string())?;
+            let zones = from_geojson(&text, &self.frame).map_err(|e| e.to_string())?;
             Ok((zones, geojson))
         });
         match parsed {
@@ -179,8 +178,8 @@ impl StationCore {
     pub fn check_keep_out(&self, geojson: Value) -> Result<CheckedZones, ApiError> {
         check_names(&geojson)?;
         let text = serde_json::to_string(&geojson).unwrap_or_default();
-        let zones = KeepOutZones::from_geojson(&text, &self.frame)
-            .map_err(|e| ApiError::bad_request(e.to_string()))?;
+        let zones =
+            from_geojson(&text, &self.frame).map_err(|e| ApiError::bad_request(e.to_string()))?;
         Ok(CheckedZones { zones, geojson })
     }
 

@@ -3,8 +3,8 @@
 //! by the chosen [`FinalLaw`]; S-turns across the line while far too high; full brakes below
 //! the flare height.
 
-use stx_dynamics::rotation::wrap_pi;
-use stx_dynamics::state::Controls;
+use stx_types::controls::Controls;
+use stx_types::rotation::wrap_pi;
 
 use super::config::{FinalLaw, SpiralConfig};
 use super::energy::Energy;

@@ -139,7 +139,7 @@ impl ClearApproach {
         let clear =
             |legs: &[[[f64; 2]; 2]]| legs.iter().all(|[a, b]| zones.crossed_by(*a, *b).is_none());
         if let Some(held) = self.chosen_rad
-            && stx_dynamics::rotation::wrap_pi(held - into_wind).abs() <= limit + 1e-9
+            && stx_types::rotation::wrap_pi(held - into_wind).abs() <= limit + 1e-9
             && clear(&low_legs(target_ne, held, sc))
         {
             return (Some(held), None);

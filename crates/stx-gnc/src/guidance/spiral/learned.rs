@@ -188,7 +188,7 @@ mod tests {
 
     use super::*;
     use crate::pointmass::{Conditions, PointMass};
-    use stx_dynamics::state::Controls;
+    use stx_types::controls::Controls;
 
     /// A point mass flying legs of (sink scale against the polar, brake, seconds), turning
     /// if `turning`, in a 3 m/s wind; what was learned.

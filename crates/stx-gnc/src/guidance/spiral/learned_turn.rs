@@ -101,8 +101,8 @@ mod tests {
     use crate::control::{self, ControlGains};
     use crate::pointmass::{Conditions, PointMass};
     use std::f64::consts::FRAC_PI_2;
-    use stx_dynamics::rotation::wrap_pi;
-    use stx_dynamics::state::Controls;
+    use stx_types::controls::Controls;
+    use stx_types::rotation::wrap_pi;
 
     /// A point mass whose turn rate is `factor` times its polar's, steered through 90° course
     /// changes by the course law for `seconds` (or flown straight); what was learned.

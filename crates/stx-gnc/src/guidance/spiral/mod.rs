@@ -88,7 +88,7 @@ pub use config::{FinalLaw, SpiralConfig};
 pub use turn_rate::corner_turn_rate_rad_s;
 
 use serde::{Deserialize, Serialize};
-use stx_dynamics::state::Controls;
+use stx_types::controls::Controls;
 
 use self::energy::Energy;
 use self::final_approach::{FinalApproach, FinalGeometry};

@@ -2,7 +2,7 @@
 //! wind frame centred on the target, the corners, the branches scaled with the wind, and the
 //! line each branch is flown on.
 
-use stx_dynamics::rotation::wrap_pi;
+use stx_types::rotation::wrap_pi;
 
 use super::config::SpiralConfig;
 use super::wind::WindNow;

@@ -1,7 +1,7 @@
 //! What each phase flies: the line to the entry corner, the branch lines, the final approach
 //! and the flare, the heading to the best reachable point.
 
-use stx_dynamics::state::Controls;
+use stx_types::controls::Controls;
 
 use super::final_approach::FinalApproach;
 use super::pattern::branch_index;

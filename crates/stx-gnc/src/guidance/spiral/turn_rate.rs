@@ -2,7 +2,7 @@
 //! actually turn the parafoil at, found by flying a point mass through a corner.
 
 use nalgebra::Vector3;
-use stx_dynamics::state::Controls;
+use stx_types::controls::Controls;
 
 use crate::control::{self, ControlGains, TurnLatch};
 use crate::performance::GlidePerformance;

@@ -63,6 +63,13 @@ impl LocalFrame {
     }
 }
 
+/// Whether coordinates can be a vehicle's position: finite, within ±90° and ±180°, and not
+/// exactly 0°, 0° (the placeholder of a GNSS report without a fix, or of an autopilot's
+/// estimate before it has an origin: no launch site is there).
+pub fn is_position(lat_deg: f64, lon_deg: f64) -> bool {
+    lat_deg.abs() <= 90.0 && lon_deg.abs() <= 180.0 && !(lat_deg == 0.0 && lon_deg == 0.0)
+}
+
 impl Default for LocalFrame {
     /// Évora aerodrome, Portugal, the usual STRAPLEX launch site (about 38.53° N, 7.89° W,
     /// 245 m).

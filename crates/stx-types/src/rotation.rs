@@ -4,22 +4,28 @@
 //! frame B (`v_b = t_a_to_b * v_a`), as the seed's `T_{A−B}`. Euler angles follow the
 //! aerospace 3-2-1 sequence: yaw ψ about z, then pitch θ about the new y, then roll φ about the
 //! new x, so `T = Tφ·Tθ·Tψ` (eq. 4.8).
+//!
+//! The flight model calls these on its hot path from another crate (`stx-dynamics`), so the
+//! small ones are marked `#[inline]`: they inline there as they did when they lived beside it.
 
 use nalgebra::{Matrix3, Vector3};
 
 /// Plane rotation about x by `phi_rad` (eq. 4.5).
+#[inline]
 pub fn t_roll(phi_rad: f64) -> Matrix3<f64> {
     let (s, c) = phi_rad.sin_cos();
     Matrix3::new(1.0, 0.0, 0.0, 0.0, c, s, 0.0, -s, c)
 }
 
 /// Plane rotation about y by `theta_rad` (eq. 4.6).
+#[inline]
 pub fn t_pitch(theta_rad: f64) -> Matrix3<f64> {
     let (s, c) = theta_rad.sin_cos();
     Matrix3::new(c, 0.0, -s, 0.0, 1.0, 0.0, s, 0.0, c)
 }
 
 /// Plane rotation about z by `psi_rad` (eq. 4.7).
+#[inline]
 pub fn t_yaw(psi_rad: f64) -> Matrix3<f64> {
     let (s, c) = psi_rad.sin_cos();
     Matrix3::new(c, s, 0.0, -s, c, 0.0, 0.0, 0.0, 1.0)
@@ -27,6 +33,7 @@ pub fn t_yaw(psi_rad: f64) -> Matrix3<f64> {
 
 /// Parent-to-body matrix of the 3-2-1 Euler angles `[φ, θ, ψ]` (eq. 4.8), written out
 /// because it sits on the model's hot path.
+#[inline]
 pub fn t_from_euler(euler_rad: &Vector3<f64>) -> Matrix3<f64> {
     let (sf, cf) = euler_rad.x.sin_cos();
     let (st, ct) = euler_rad.y.sin_cos();
@@ -46,6 +53,7 @@ pub fn t_from_euler(euler_rad: &Vector3<f64>) -> Matrix3<f64> {
 
 /// Parent-to-body matrix of a roll–pitch pair with no relative yaw, `Tφ·Tθ` (eqs. 4.11,
 /// 4.12): the capsule and transponder hang from a point and their spin is neglected.
+#[inline]
 pub fn t_from_roll_pitch(phi_rad: f64, theta_rad: f64) -> Matrix3<f64> {
     let (sf, cf) = phi_rad.sin_cos();
     let (st, ct) = theta_rad.sin_cos();
@@ -53,6 +61,7 @@ pub fn t_from_roll_pitch(phi_rad: f64, theta_rad: f64) -> Matrix3<f64> {
 }
 
 /// The 3-2-1 Euler angles `[φ, θ, ψ]` of a parent-to-body matrix, ψ in (−π, π].
+#[inline]
 pub fn euler_from_t(t: &Matrix3<f64>) -> Vector3<f64> {
     let phi = t[(1, 2)].atan2(t[(2, 2)]);
     let theta = (-t[(0, 2)]).clamp(-1.0, 1.0).asin();
@@ -62,6 +71,7 @@ pub fn euler_from_t(t: &Matrix3<f64>) -> Vector3<f64> {
 
 /// Euler-angle rates `[φ̇, θ̇, ψ̇]` from body rates `[p, q, r]` (the inverse in eq. 4.20).
 /// Singular at θ = ±90°, as every 3-2-1 parameterisation is.
+#[inline]
 pub fn euler_rates(euler_rad: &Vector3<f64>, body_rate_rad_s: &Vector3<f64>) -> Vector3<f64> {
     let (sf, cf) = euler_rad.x.sin_cos();
     let (st, ct) = euler_rad.y.sin_cos();
@@ -71,11 +81,13 @@ pub fn euler_rates(euler_rad: &Vector3<f64>, body_rate_rad_s: &Vector3<f64>) -> 
 }
 
 /// Skew-symmetric matrix with `skew(a) * b == a × b`.
+#[inline]
 pub fn skew(a: &Vector3<f64>) -> Matrix3<f64> {
     Matrix3::new(0.0, -a.z, a.y, a.z, 0.0, -a.x, -a.y, a.x, 0.0)
 }
 
 /// Wraps an angle to (−π, π].
+#[inline]
 pub fn wrap_pi(angle_rad: f64) -> f64 {
     let wrapped =
         (angle_rad + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI;
