@@ -12,7 +12,8 @@
 //!   Dormand–Prince 5(4)) and finds events such as ground contact between steps;
 //! - [`state`] lays out the 31 states and the controls, [`rotation`] holds the frames' rotation matrices and Euler
 //!   kinematics in the seed's conventions, and [`output`] turns a state into what a run
-//!   reports (per-body positions, velocities, angles, tensions, air data, servos).
+//!   reports (per-body positions, velocities, angles, tensions, air data, servos);
+//! - [`validate`] checks one setting against its rule, for every settings type of the workspace.
 //!
 //! Nothing here does I/O beyond parsing a string, knows about wall-clock time or draws
 //! randomness it was not given a seed for: callers own time and files.
@@ -23,5 +24,6 @@ pub mod model;
 pub mod output;
 pub mod rotation;
 pub mod state;
+pub mod validate;
 pub mod vehicle;
 pub mod wind;
