@@ -2,7 +2,8 @@
 //! small, boring place.
 //!
 //! - [`SigningKey`] holds the 32-byte secret. It never prints its bytes (`Debug` shows
-//!   `SigningKey(<redacted>)`, there is no `Display` and no `Serialize`) and is wiped on drop.
+//!   `SigningKey(<redacted>)`, there is no `Display` and no `Serialize`) and is wiped on drop
+//!   (`zeroize`, a wipe the optimiser keeps).
 //!   It is read from 64 hexadecimal characters ([`SigningKey::from_hex`]), a key file
 //!   ([`SigningKey::from_file`]) or an environment variable ([`SIGNING_KEY_ENV`]) — never from
 //!   a command-line argument, which other users see in `ps` and shells keep in their history.
