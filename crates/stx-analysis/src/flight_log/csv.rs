@@ -215,7 +215,8 @@ mod tests {
         names[0] = "\"time_s [s, any origin]\"".into();
         let header = names.join(",");
         let text = format!(
-            "# exported\n{header}\n\"0\",1,2,100,5,0,2,0,5,0,,0,0,0,1,0\n1,2,3,99,5,0,2,0,5,0,,0,0,0,1,0\n"
+            "# exported\n{header}\n\"0\",1,2,100,5,0,2,0,5,0,,0,0,0,1,0\n1,2,3,99,5,0,2,0,5,0,,0,0,0,1,0\n\
+             2,3,4,98,5,0,2,0,5,0,,0,0,0,1,0\n"
         );
         let log = from_csv(&text).unwrap();
         let s = &log.samples()[1];
