@@ -1,7 +1,9 @@
 #!/usr/bin/env python3
 """The shape of the code, checked: no file of a crate's `src/` over the line budget (code
 before its first `#[cfg(test)]`) unless it is listed below with the reason it is one idea,
-and no import circle between the files of a crate.
+and no import circle between the files of a crate, nor between the dashboard's modules
+(`web/src`, relative `import … from "./x"`, type-only imports included: a circle of types
+is still a circle to read through).
 
 Why a script of our own: `cargo-modules` and similar tools need a nightly or a download; what
 is checked here is small and textual. A `use`, or a path written out in the code
@@ -161,6 +163,34 @@ def cycles(graph: dict[Path, set[Path]]) -> list[list[Path]]:
     return comps
 
 
+# `import … from "./x"`, `export … from "../y"`, `import "./z"` and `import("./w")`: every
+# relative specifier, whatever is imported (a type-only import ties two files as much).
+TS_IMPORT = re.compile(
+    r"""(?:\bfrom\s*|\bimport\s*\(?\s*)["'](\.{1,2}/[^"']+)["']"""
+)
+TS_EXTENSIONS = (".ts", ".tsx", ".mts")
+
+
+def ts_target(f: Path, spec: str) -> Path | None:
+    """The file a relative specifier of `f` names (`./x` → `x.ts`, `x/index.ts`)."""
+    base = (f.parent / spec).resolve()
+    candidates = [base] if base.suffix in TS_EXTENSIONS else []
+    candidates += [base.with_name(base.name + e) for e in TS_EXTENSIONS]
+    candidates += [base / f"index{e}" for e in TS_EXTENSIONS]
+    return next((c for c in candidates if c.is_file()), None)
+
+
+def ts_graph(src: Path) -> dict[Path, set[Path]]:
+    """The relative imports between the TypeScript files under `src`."""
+    graph = {}
+    for f in sorted(p for e in TS_EXTENSIONS for p in src.rglob(f"*{e}")):
+        f = f.resolve()
+        text = re.sub(r"/\*.*?\*/", "", f.read_text(), flags=re.S)
+        text = re.sub(r"^\s*//[^\n]*", "", text, flags=re.M)
+        graph[f] = {t for s in TS_IMPORT.findall(text) if (t := ts_target(f, s)) and t != f}
+    return graph
+
+
 def main() -> int:
     root = Path(__file__).resolve().parent.parent
     problems = []
@@ -177,12 +207,16 @@ def main() -> int:
             n = len(code_lines(f.read_text()))
             if n > BUDGET and rel not in ONE_IDEA:
                 problems.append(f"{rel}: {n} lines of code (budget {BUDGET}): split it by idea")
+    web = root / "web" / "src"
+    for comp in cycles(ts_graph(web)) if web.is_dir() else []:
+        names = " ↔ ".join(str(p.relative_to(root)) for p in comp)
+        problems.append(f"import circle: {names}")
     for p in problems:
         print(p)
     if problems:
         print(f"structure: {len(problems)} problem(s)")
         return 1
-    print("structure: every crate file within budget, no import circles")
+    print("structure: every crate file within budget, no import circles (crates, web/src)")
     return 0
 
 

@@ -5,6 +5,7 @@
 use serde::Serialize;
 use stx_dynamics::model::Body;
 use stx_gnc::mission::FlightStage;
+use stx_gnc::stats::percentile;
 
 use crate::compare::{Sample, distance};
 use crate::truth::TruthLanding;
@@ -80,15 +81,6 @@ impl Spread {
             max: v[v.len() - 1],
         }
     }
-}
-
-/// Nearest-rank percentile of sorted values.
-pub fn percentile(sorted: &[f64], q: f64) -> f64 {
-    if sorted.is_empty() {
-        return f64::NAN;
-    }
-    let rank = (q * sorted.len() as f64).ceil() as usize;
-    sorted[rank.clamp(1, sorted.len()) - 1]
 }
 
 /// The predicted landing at one height against the touchdown.
@@ -340,11 +332,7 @@ mod tests {
     use super::*;
 
     #[test]
-    fn nearest_rank_percentiles() {
-        let v: Vec<f64> = (1..=20).map(f64::from).collect();
-        assert_eq!(percentile(&v, 0.5), 10.0);
-        assert_eq!(percentile(&v, 0.95), 19.0);
-        assert_eq!(percentile(&v, 1.0), 20.0);
+    fn spreads_are_of_absolute_values() {
         let s = Spread::of([-3.0, 1.0, 2.0]);
         assert_eq!((s.p50, s.max, s.samples), (2.0, 3.0, 3));
     }

@@ -2,9 +2,12 @@
 //!
 //! Written by hand rather than with a plotting crate: the figures need axes, ticks, a grid,
 //! lines, markers and a legend, which is a page of code, and SVG text renders the same in a
-//! browser, an image viewer or `rsvg-convert` without fonts or a backend to install.
+//! browser, an image viewer or `rsvg-convert` without fonts or a backend to install. Text is
+//! escaped by `quick_xml::escape::escape`, the XML escaper of every XML stx writes.
 
 use std::fmt::Write;
+
+use quick_xml::escape::escape;
 
 /// How a series is drawn.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -108,12 +111,6 @@ fn fmt_tick(v: f64) -> String {
     let s = format!("{v:.4}");
     let s = s.trim_end_matches('0').trim_end_matches('.').to_string();
     if s == "-0" { "0".into() } else { s }
-}
-
-fn escape(s: &str) -> String {
-    s.replace('&', "&amp;")
-        .replace('<', "&lt;")
-        .replace('>', "&gt;")
 }
 
 /// Renders panels in a grid of `columns` columns, each panel `panel_w × panel_h` pixels.
@@ -388,6 +385,12 @@ mod tests {
         let svg = render("test", &[panel.clone(), panel], 2, 400.0, 300.0);
         assert!(svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"));
         assert!(svg.contains("a &lt; b &amp; c"));
+        // Quotes too (they were left as written): text is safe in an attribute as well.
+        let quoted = render("say \"hi\" & 'bye'", &[], 1, 100.0, 100.0);
+        assert!(
+            quoted.contains("say &quot;hi&quot; &amp; &apos;bye&apos;"),
+            "{quoted}"
+        );
         assert_eq!(svg.matches("<polyline").count(), 2);
         assert!(!svg.contains("NaN"), "non-finite points are skipped");
         // Every opened element is closed or self-closed.

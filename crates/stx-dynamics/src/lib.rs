@@ -30,4 +30,4 @@ pub mod state;
 pub mod vehicle;
 pub mod wind;
 
-pub use stx_types::{atmosphere, rotation};
+pub use stx_types::{atmosphere, invalid_into, rotation, validate};

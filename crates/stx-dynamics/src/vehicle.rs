@@ -9,6 +9,8 @@ use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
+use stx_types::validate::{Invalid, check};
+
 /// The STRAPLEX vehicle file shipped with stx (`config/vehicle/straplex.toml`).
 pub const STRAPLEX_TOML: &str = include_str!("../../../config/vehicle/straplex.toml");
 
@@ -361,11 +363,12 @@ const PENDANT_FIELDS: [[&str; 6]; 2] = [
     ],
 ];
 
-struct Rules(Vec<(&'static str, f64, &'static str, bool)>);
+/// Every rule's verdict, in the file's order: the first broken one is the error.
+struct Rules(Vec<Result<(), Invalid>>);
 
 impl Rules {
     fn check(&mut self, field: &'static str, value: f64, rule: &'static str, ok: bool) {
-        self.0.push((field, value, rule, ok && value.is_finite()));
+        self.0.push(check(field, value, ok, rule));
     }
     fn positive(&mut self, field: &'static str, value: f64) {
         self.check(field, value, "must be a finite number > 0", value > 0.0);
@@ -377,12 +380,11 @@ impl Rules {
         self.check(field, value, "must be a finite number", true);
     }
     fn first_broken(self) -> Result<(), VehicleError> {
-        match self.0.into_iter().find(|(_, _, _, ok)| !ok) {
-            Some((field, value, rule, _)) => Err(VehicleError::Invalid { field, value, rule }),
-            None => Ok(()),
-        }
+        Ok(self.0.into_iter().collect::<Result<(), Invalid>>()?)
     }
 }
+
+crate::invalid_into!(VehicleError);
 
 impl VehicleConfig {
     /// Parses a vehicle file (it is not validated yet).

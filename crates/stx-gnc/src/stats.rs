@@ -1,6 +1,8 @@
-//! Small statistics shared by the fits that give 95 % intervals (the ascent winds here, the
-//! identification of vehicle coefficients in `stx-analysis`). Written out rather than taken
-//! from a statistics crate: two constants and a four-term expansion are all that is needed.
+//! Small statistics shared across the workspace: the quantiles of the fits that give 95 %
+//! intervals (the ascent winds here, the identification of vehicle coefficients in
+//! `stx-analysis`) and the one percentile every report uses (Monte Carlo campaigns in
+//! `stx-sim`, agreement reports, the station benchmark). Written out rather than taken from a
+//! statistics crate: two constants, a four-term expansion and one index are all that is needed.
 
 /// The standard normal's 97.5 % quantile.
 pub const Z_975: f64 = 1.959_963_984_540_054;
@@ -15,9 +17,30 @@ pub fn student_t_975(dof: f64) -> f64 {
         + (3.0 * z7 + 19.0 * z5 + 17.0 * z3 - 15.0 * z) / (384.0 * dof.powi(3))
 }
 
+/// The nearest-rank `q`-percentile (`q` in [0, 1]) of `sorted`, ascending: the smallest value
+/// with at least a fraction `q` of the sample at or below it (rank ⌈q·n⌉, at least the first),
+/// always one of the values; NaN for an empty sample.
+pub fn percentile(sorted: &[f64], q: f64) -> f64 {
+    if sorted.is_empty() {
+        return f64::NAN;
+    }
+    let rank = (q * sorted.len() as f64).ceil() as usize;
+    sorted[rank.clamp(1, sorted.len()) - 1]
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn nearest_rank_percentiles() {
+        let v: Vec<f64> = (1..=20).map(f64::from).collect();
+        assert_eq!(percentile(&v, 0.5), 10.0);
+        assert_eq!(percentile(&v, 0.95), 19.0);
+        assert_eq!(percentile(&v, 1.0), 20.0);
+        assert_eq!(percentile(&v, 0.0), 1.0);
+        assert!(percentile(&[], 0.5).is_nan());
+    }
 
     /// Tables of Student's t (e.g. Abramowitz & Stegun, table 26.10): t(0.975) is 3.182 at 3
     /// degrees of freedom, 2.571 at 5, 2.228 at 10, 2.042 at 30; within 1 %.

@@ -2,7 +2,8 @@
 //! small, boring place.
 //!
 //! - [`SigningKey`] holds the 32-byte secret. It never prints its bytes (`Debug` shows
-//!   `SigningKey(<redacted>)`, there is no `Display` and no `Serialize`) and is wiped on drop.
+//!   `SigningKey(<redacted>)`, there is no `Display` and no `Serialize`) and is wiped on drop
+//!   (`zeroize`, a wipe the optimiser keeps).
 //!   It is read from 64 hexadecimal characters ([`SigningKey::from_hex`]), a key file
 //!   ([`SigningKey::from_file`]) or an environment variable ([`SIGNING_KEY_ENV`]) — never from
 //!   a command-line argument, which other users see in `ps` and shells keep in their history.
@@ -30,6 +31,7 @@ use std::fmt;
 use std::time::Duration;
 
 use sha2::{Digest, Sha256};
+use zeroize::Zeroize;
 
 /// Seconds from 1970-01-01 to 2015-01-01 00:00:00 UTC, the MAVLink signing epoch.
 pub const MAVLINK_SIGNING_EPOCH_UNIX_S: u64 = 1_420_070_400;
@@ -113,7 +115,8 @@ impl SigningKey {
         let key = Self::from_hex(&text).map_err(|_| KeyError::FileNotHex {
             path: path.to_path_buf(),
         });
-        wipe_string(text);
+        let mut text = text;
+        text.zeroize();
         key
     }
 
@@ -139,22 +142,9 @@ impl fmt::Debug for SigningKey {
 
 impl Drop for SigningKey {
     fn drop(&mut self) {
-        wipe(&mut self.0);
+        // `zeroize`: a wipe the optimiser keeps.
+        self.0.zeroize();
     }
-}
-
-/// Overwrites `bytes` with zeros in a way the optimiser keeps.
-fn wipe(bytes: &mut [u8]) {
-    for byte in bytes.iter_mut() {
-        // SAFETY: `byte` is a valid, aligned, exclusive reference into the slice.
-        unsafe { std::ptr::write_volatile(byte, 0) };
-    }
-    std::sync::atomic::compiler_fence(std::sync::atomic::Ordering::SeqCst);
-}
-
-fn wipe_string(text: String) {
-    let mut bytes = text.into_bytes();
-    wipe(&mut bytes);
 }
 
 /// A signing key as written in a configuration file (64 hexadecimal characters), held until
@@ -190,7 +180,7 @@ impl serde::Serialize for KeyText {
 
 impl Drop for KeyText {
     fn drop(&mut self) {
-        wipe_string(std::mem::take(&mut self.0));
+        self.0.zeroize();
     }
 }
 

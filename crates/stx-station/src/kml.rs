@@ -5,121 +5,73 @@
 //! Predicted touchdowns have no altitude of their own worth drawing (the station's predictor
 //! lands on the site's ground level, which is not the terrain under the point):
 //! they are `clampToGround`, on Google Earth's terrain wherever they fall.
+//!
+//! Written through stx-record's KML writer (`stx_record::export::kml`), the one of stx.
 
-use std::fmt::Write;
+use stx_record::export::kml::{AltitudeMode, Coordinate, Kml};
 
 use crate::messages::StateMsg;
 use crate::messages::TrackPoint;
 
-fn escape(text: &str) -> String {
-    text.replace('&', "&amp;")
-        .replace('<', "&lt;")
-        .replace('>', "&gt;")
-        .replace('"', "&quot;")
-}
-
 /// The network link Google Earth opens: it reloads `live_url` every `refresh_s` seconds.
 pub fn network_link(name: &str, live_url: &str, refresh_s: f64) -> String {
-    format!(
-        r#"<?xml version="1.0" encoding="UTF-8"?>
-<kml xmlns="http://www.opengis.net/kml/2.2">
-<NetworkLink>
-  <name>{}</name>
-  <Link>
-    <href>{}</href>
-    <refreshMode>onInterval</refreshMode>
-    <refreshInterval>{refresh_s}</refreshInterval>
-  </Link>
-</NetworkLink>
-</kml>
-"#,
-        escape(name),
-        escape(live_url)
-    )
+    stx_record::export::kml::network_link(name, live_url, refresh_s)
 }
 
-/// A point in the air (MSL) or on the ground wherever it falls.
-#[derive(Debug, Clone, Copy)]
-enum Height {
-    Msl(f64),
-    Ground,
-}
-
-fn placemark(out: &mut String, name: &str, lat: f64, lon: f64, height: Height) {
-    let (mode, alt) = match height {
-        Height::Msl(alt) => ("absolute", alt),
-        Height::Ground => ("clampToGround", 0.0),
-    };
-    let _ = writeln!(
-        out,
-        "<Placemark><name>{}</name><Point><altitudeMode>{mode}</altitudeMode>\
-         <coordinates>{lon:.7},{lat:.7},{alt:.1}</coordinates></Point></Placemark>",
-        escape(name)
-    );
+/// A point of the document (altitude MSL, or 0 for a point on the ground).
+fn coordinate(lat_deg: f64, lon_deg: f64, alt_m: f64) -> Coordinate {
+    Coordinate {
+        lat_deg,
+        lon_deg,
+        alt_m,
+    }
 }
 
 /// The live document.
 pub fn live(name: &str, track: &[TrackPoint], state: &StateMsg) -> String {
-    let mut out = String::new();
-    let _ = writeln!(
-        out,
-        "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<kml xmlns=\"http://www.opengis.net/kml/2.2\">\n<Document><name>{}</name>",
-        escape(name)
-    );
+    let mut doc = Kml::document(name);
+    let air = AltitudeMode::Absolute;
+    let ground = AltitudeMode::ClampToGround;
     if track.len() >= 2 {
-        out.push_str(
-            "<Placemark><name>track</name><LineString><altitudeMode>absolute</altitudeMode><coordinates>\n",
-        );
-        for p in track {
-            let _ = writeln!(out, "{:.7},{:.7},{:.1}", p.lon_deg, p.lat_deg, p.alt_msl_m);
-        }
-        out.push_str("</coordinates></LineString></Placemark>\n");
+        let points = track
+            .iter()
+            .map(|p| coordinate(p.lat_deg, p.lon_deg, p.alt_msl_m));
+        doc.line("track", points, air);
     }
     if let Some(e) = &state.estimate {
-        placemark(
-            &mut out,
+        doc.point(
             "vehicle",
-            e.lat_deg,
-            e.lon_deg,
-            Height::Msl(e.alt_msl_m),
+            None,
+            coordinate(e.lat_deg, e.lon_deg, e.alt_msl_m),
+            air,
         );
     }
     if let Some(g) = &state.guidance {
         if let Some(t) = &g.target {
-            placemark(
-                &mut out,
-                "landing target",
-                t.lat_deg,
-                t.lon_deg,
-                Height::Msl(t.alt_msl_m),
-            );
+            let at = coordinate(t.lat_deg, t.lon_deg, t.alt_msl_m);
+            doc.point("landing target", None, at, air);
         }
         if let Some(p) = &g.pattern {
-            out.push_str(
-                "<Placemark><name>spiral pattern</name><LineString><tessellate>1</tessellate><coordinates>\n",
+            let corners = p.corners.iter().chain(p.corners.first());
+            doc.line(
+                "spiral pattern",
+                corners.map(|c| coordinate(c[0], c[1], 0.0)),
+                ground,
             );
-            for c in p.corners.iter().chain(p.corners.first()) {
-                let _ = writeln!(out, "{:.7},{:.7},0", c[1], c[0]);
-            }
-            out.push_str("</coordinates></LineString></Placemark>\n");
         }
     }
     if let Some(p) = &state.prediction {
         if let Some(planned) = &p.planned {
-            placemark(
-                &mut out,
-                "predicted landing (station, plan)",
-                planned.lat_deg,
-                planned.lon_deg,
-                Height::Ground,
-            );
+            let at = coordinate(planned.lat_deg, planned.lon_deg, 0.0);
+            doc.point("predicted landing (station, plan)", None, at, ground);
         }
-        placemark(
-            &mut out,
+        let u = &p.uncontrolled;
+        let at = coordinate(u.lat_deg, u.lon_deg, 0.0);
+        doc.point(
             "predicted landing (station, uncontrolled)",
-            p.uncontrolled.lat_deg,
-            p.uncontrolled.lon_deg,
-            Height::Ground,
+            None,
+            at,
+            ground,
         );
     }
     if let Some(p) = state
@@ -127,16 +79,10 @@ pub fn live(name: &str, track: &[TrackPoint], state: &StateMsg) -> String {
         .as_ref()
         .and_then(|v| v.predicted_landing.as_ref())
     {
-        placemark(
-            &mut out,
-            "predicted landing (drone's own)",
-            p.lat_deg,
-            p.lon_deg,
-            Height::Ground,
-        );
+        let at = coordinate(p.lat_deg, p.lon_deg, 0.0);
+        doc.point("predicted landing (drone's own)", None, at, ground);
     }
-    out.push_str("</Document>\n</kml>\n");
-    out
+    doc.finish()
 }
 
 #[cfg(test)]

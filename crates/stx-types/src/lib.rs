@@ -19,7 +19,9 @@
 //!   seed's conventions;
 //! - [`atmosphere`] is the air over altitude (US Standard Atmosphere 1976) and [`wind`] the
 //!   air's velocity (the [`wind::WindField`] trait and the mean winds; the simulator's
-//!   turbulence stays in `stx-dynamics`).
+//!   turbulence stays in `stx-dynamics`);
+//! - [`validate`] checks one setting against its rule, for every settings type of the
+//!   workspace (the vehicle, the flight path, the estimator, the sensors, …).
 //!
 //! The crates that had these before re-export them under their old paths
 //! (`stx_gnc::mission`, `stx_gnc::geo`, `stx_dynamics::atmosphere`, …), so code above them
@@ -32,4 +34,5 @@ pub mod keep_out;
 pub mod mission;
 pub mod plan;
 pub mod rotation;
+pub mod validate;
 pub mod wind;

@@ -30,6 +30,7 @@ use std::time::{Duration, Instant};
 use anyhow::{Context, bail};
 use futures_util::StreamExt;
 use serde::Serialize;
+use stx_gnc::stats::percentile;
 use stx_link_tokio::DriverEvent;
 use stx_sim::drone::MissionConfig;
 use stx_sim::drone::link::DroneEvent;
@@ -58,7 +59,7 @@ pub struct StationBenchOptions {
     pub lab_montecarlo: Option<u32>,
 }
 
-/// Latency distribution, ms.
+/// Latency distribution, ms (nearest-rank percentiles, `stx_gnc::stats::percentile`).
 #[derive(Debug, Serialize)]
 pub struct Latency {
     pub samples: usize,
@@ -70,13 +71,7 @@ pub struct Latency {
 impl Latency {
     fn of(mut samples_ms: Vec<f64>) -> Self {
         samples_ms.sort_by(f64::total_cmp);
-        let at = |q: f64| {
-            if samples_ms.is_empty() {
-                f64::NAN
-            } else {
-                samples_ms[((samples_ms.len() - 1) as f64 * q).round() as usize]
-            }
-        };
+        let at = |q: f64| percentile(&samples_ms, q);
         Latency {
             samples: samples_ms.len(),
             p50_ms: at(0.5),
@@ -476,7 +471,7 @@ mod tests {
         let l = Latency::of((1..=100).rev().map(f64::from).collect());
         assert_eq!(
             (l.p50_ms, l.p99_ms, l.max_ms, l.samples),
-            (51.0, 99.0, 100.0, 100)
+            (50.0, 99.0, 100.0, 100)
         );
     }
 }

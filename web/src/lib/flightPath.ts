@@ -6,30 +6,10 @@
  * parameters or the station config).
  */
 import { fmt, fmtDuration } from "./format";
-import type { LatLon } from "./types";
+// The path's types live with the rest of the state's (types.ts); this file reads and summarises it.
+import type { FlightPath, PathPoint } from "./types";
 
-/** A point of the path: where, how high and in how long. */
-export interface PathPoint extends LatLon {
-  alt_msl_m: number;
-  in_s: number;
-}
-
-/** The flight path as the map draws it. */
-export interface FlightPath {
-  stage: string;
-  burst: PathPoint | null;
-  deploy: PathPoint;
-  landing: PathPoint;
-  round_chute_landing: PathPoint;
-  reach_centre: LatLon;
-  reach_radius_m: number;
-  measured_bands: number;
-  measured_to_msl_m: number | null;
-  /** Where the burst altitude comes from: "drone", "station_config", or null if not said. */
-  burst_source: string | null;
-  /** The mission clock (the drone's) its `in_s` count from, s; null from an older station. */
-  computed_mission_s: number | null;
-}
+export type { FlightPath, PathPoint };
 
 /** How the badge names a source of the launch profile. */
 const SOURCES: Record<string, string> = { drone: "drone", station_config: "station config" };

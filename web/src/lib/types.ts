@@ -1,4 +1,3 @@
-import type { FlightPath } from "./flightPath";
 // The API's messages as the page holds them. Their shapes are not written here: they come from the
 // station's contract, ../generated/api.ts (generated from api.schema.json, itself generated from
 // the daemon's Rust types; see crates/stx-station/API.md). What this file adds is the page's
@@ -133,6 +132,30 @@ export type State = Omit<
   keep_out_alarms: KeepOutAlarm[];
   forecast_wind: ForecastWind[];
 };
+
+/** `state.flight_path` as the page reads it (flightPath.ts parses and summarises it). */
+/** A point of the path: where, how high and in how long. */
+export interface PathPoint extends LatLon {
+  alt_msl_m: number;
+  in_s: number;
+}
+
+/** The flight path as the map draws it. */
+export interface FlightPath {
+  stage: string;
+  burst: PathPoint | null;
+  deploy: PathPoint;
+  landing: PathPoint;
+  round_chute_landing: PathPoint;
+  reach_centre: LatLon;
+  reach_radius_m: number;
+  measured_bands: number;
+  measured_to_msl_m: number | null;
+  /** Where the burst altitude comes from: "drone", "station_config", or null if not said. */
+  burst_source: string | null;
+  /** The mission clock (the drone's) its `in_s` count from, s; null from an older station. */
+  computed_mission_s: number | null;
+}
 
 /** A predicted landing inside a keep-out zone. */
 export type KeepOutAlarm = Wire.KeepOutAlarmView;

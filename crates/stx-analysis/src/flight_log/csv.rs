@@ -1,9 +1,10 @@
 //! The flight-log CSV: one file, one row per instant, for logs from other autopilots or
 //! spreadsheets and for handing a flight to `stx compare` / `stx identify`.
 //!
-//! Format: comma-separated, a header row naming the columns (in any order; a unit in
-//! brackets after a name, `north_m [m]`, is allowed and ignored; other columns are ignored),
-//! then one row per instant in increasing time. Lines starting with `#` are comments.
+//! Format: comma-separated (fields may be quoted, as spreadsheets write them), a header row
+//! naming the columns (in any order; a unit in brackets after a name, `north_m [m]`, is
+//! allowed and ignored; other columns are ignored), then one row per instant in increasing
+//! time. Lines starting with `#` are comments.
 //!
 //! | column | unit | meaning |
 //! |---|---|---|
@@ -47,17 +48,30 @@ const WIND_DOWN: &str = "wind_down_mps";
 
 /// Reads a flight log from CSV text.
 pub fn from_csv(text: &str) -> Result<FlightLog, FlightLogError> {
-    let mut lines = text
-        .lines()
-        .enumerate()
-        .map(|(i, l)| (i + 1, l.trim()))
-        .filter(|(_, l)| !l.is_empty() && !l.starts_with('#'));
-    let Some((_, header)) = lines.next() else {
+    // The `csv` crate reads what spreadsheets write: quoted fields, commas inside them.
+    let mut reader = csv::ReaderBuilder::new()
+        .has_headers(false)
+        .flexible(true)
+        .trim(csv::Trim::All)
+        .comment(Some(b'#'))
+        .from_reader(text.as_bytes());
+    let line_of = |p: Option<&csv::Position>| p.map_or(0, |p| p.line() as usize);
+    let mut records = reader.records().filter_map(|r| match r {
+        Err(e) => Some(Err(FlightLogError::Csv {
+            line: line_of(e.position()),
+            message: e.to_string(),
+        })),
+        // Blank and indented comment lines, which the reader's own comment rule (a `#` in
+        // the first column) does not catch.
+        Ok(r) if r.len() == 1 && (r[0].is_empty() || r[0].starts_with('#')) => None,
+        Ok(r) => Some(Ok((line_of(r.position()), r))),
+    });
+    let Some(header) = records.next().transpose()?.map(|(_, r)| r) else {
         return Err(FlightLogError::TooShort { samples: 0 });
     };
     let names: Vec<&str> = header
-        .split(',')
-        .map(|h| h.split('[').next().unwrap_or(h).trim().trim_matches('"'))
+        .iter()
+        .map(|h| h.split('[').next().unwrap_or(h).trim())
         .collect();
     let find = |c: &'static str| names.iter().position(|n| *n == c);
     let mut at = [0usize; COLUMNS.len()];
@@ -66,8 +80,9 @@ pub fn from_csv(text: &str) -> Result<FlightLog, FlightLogError> {
     }
     let wind_down = find(WIND_DOWN);
     let mut samples = Vec::new();
-    for (line, row) in lines {
-        let fields: Vec<&str> = row.split(',').map(str::trim).collect();
+    for record in records {
+        let (line, row) = record?;
+        let fields: Vec<&str> = row.iter().collect();
         let cell = |k: usize| -> Result<Option<f64>, FlightLogError> {
             let text = fields.get(k).copied().ok_or_else(|| FlightLogError::Csv {
                 line,
@@ -190,5 +205,22 @@ mod tests {
             from_csv(&bad),
             Err(FlightLogError::Csv { line: 2, .. })
         ));
+    }
+
+    /// A spreadsheet quotes a header with a comma in it (and may quote numbers): the columns
+    /// after it stay where they are (a plain split on commas moved them one to the right).
+    #[test]
+    fn quoted_fields_with_commas_are_read() {
+        let mut names = COLUMNS.map(String::from);
+        names[0] = "\"time_s [s, any origin]\"".into();
+        let header = names.join(",");
+        let text = format!(
+            "# exported\n{header}\n\"0\",1,2,100,5,0,2,0,5,0,,0,0,0,1,0\n1,2,3,99,5,0,2,0,5,0,,0,0,0,1,0\n\
+             2,3,4,98,5,0,2,0,5,0,,0,0,0,1,0\n"
+        );
+        let log = from_csv(&text).unwrap();
+        let s = &log.samples()[1];
+        assert_eq!((s.time_s, s.position_ned_m), (1.0, [2.0, 3.0, -99.0]));
+        assert_eq!(log.samples()[0].time_s, 0.0);
     }
 }

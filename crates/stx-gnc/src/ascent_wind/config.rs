@@ -2,6 +2,7 @@
 //! (which [`super::AscentWindEstimator::new`] calls).
 
 use serde::{Deserialize, Serialize};
+use stx_types::validate::{check, non_negative, positive};
 use thiserror::Error;
 
 /// Why an ascent-wind configuration was refused.
@@ -95,29 +96,16 @@ impl Default for AscentWindConfig {
     }
 }
 
-fn check(
-    field: &'static str,
-    value: f64,
-    ok: impl Fn(f64) -> bool,
-    rule: &'static str,
-) -> Result<(), AscentWindConfigError> {
-    if value.is_finite() && ok(value) {
-        Ok(())
-    } else {
-        Err(AscentWindConfigError::Invalid { field, value, rule })
-    }
-}
+stx_types::invalid_into!(AscentWindConfigError);
 
 impl AscentWindConfig {
     /// Checks every setting; the error names the first one that breaks its rule.
     pub fn validate(&self) -> Result<(), AscentWindConfigError> {
-        let positive = |field, value| check(field, value, |v| v > 0.0, "finite and > 0");
-        let non_negative = |field, value| check(field, value, |v| v >= 0.0, "finite and ≥ 0");
         positive("band_height_m", self.band_height_m)?;
         check(
             "min_samples_per_band",
             f64::from(self.min_samples_per_band),
-            |v| v >= 4.0,
+            self.min_samples_per_band >= 4,
             "≥ 4",
         )?;
         positive("min_ascent_rate_mps", self.min_ascent_rate_mps)?;

@@ -4,6 +4,7 @@
 //! uses on every call, so no unit conversion happens on the hot path.
 
 use serde::{Deserialize, Serialize};
+use stx_types::validate::{check, non_negative, positive};
 use thiserror::Error;
 
 /// Why an estimator configuration was refused.
@@ -192,24 +193,11 @@ impl Default for EstimatorConfig {
     }
 }
 
-fn check(
-    field: &'static str,
-    value: f64,
-    ok: impl Fn(f64) -> bool,
-    rule: &'static str,
-) -> Result<(), EstimatorConfigError> {
-    if value.is_finite() && ok(value) {
-        Ok(())
-    } else {
-        Err(EstimatorConfigError::Invalid { field, value, rule })
-    }
-}
+stx_types::invalid_into!(EstimatorConfigError);
 
 impl EstimatorConfig {
     /// Checks every setting; the error names the first one that breaks its rule.
     pub fn validate(&self) -> Result<(), EstimatorConfigError> {
-        let positive = |field, value| check(field, value, |v| v > 0.0, "finite and > 0");
-        let non_negative = |field, value| check(field, value, |v| v >= 0.0, "finite and ≥ 0");
         positive("max_latency_s", self.max_latency_s)?;
         non_negative("max_clock_skew_s", self.max_clock_skew_s)?;
         positive("gps_timeout_s", self.gps_timeout_s)?;
@@ -218,7 +206,7 @@ impl EstimatorConfig {
         check(
             "ground_altitude_msl_m",
             self.ground_altitude_msl_m,
-            |_| true,
+            true,
             "finite",
         )?;
         non_negative(

@@ -14,7 +14,8 @@
 //! ```
 //!
 //! CSV: one row per line, `alt_msl_m,speed_mps,from_deg[,sigma_mps]`, an optional header line
-//! of those names, blank lines and lines starting with `#` ignored.
+//! of those names, blank lines and lines starting with `#` ignored; cells may be quoted, as
+//! spreadsheets write them.
 //!
 //! Rows must have strictly increasing altitudes, finite values, speeds and sigmas ≥ 0. Between
 //! rows the wind is interpolated by component, above the top and below the bottom row the end
@@ -195,18 +196,31 @@ pub fn merge_measured(
 const CSV_COLUMNS: [&str; 4] = ["alt_msl_m", "speed_mps", "from_deg", "sigma_mps"];
 
 fn parse_csv(text: &str) -> Result<Vec<ForecastRow>, ForecastError> {
+    // The `csv` crate reads what spreadsheets write (quoted cells included); the header is
+    // optional, so it is recognised here rather than by the reader.
+    let mut reader = csv::ReaderBuilder::new()
+        .has_headers(false)
+        .flexible(true)
+        .trim(csv::Trim::All)
+        .comment(Some(b'#'))
+        .from_reader(text.as_bytes());
     let mut rows = Vec::new();
     let mut seen_data = false;
-    for (i, raw) in text.lines().enumerate() {
-        let line = raw.trim();
-        if line.is_empty() || line.starts_with('#') {
+    for record in reader.records() {
+        let record = record.map_err(|e| ForecastError::Csv {
+            line: e.position().map_or(0, |p| p.line() as usize),
+            message: e.to_string(),
+        })?;
+        let cells: Vec<&str> = record.iter().collect();
+        // Blank and indented comment lines, which the reader's own comment rule (a `#` in
+        // the first column) does not catch.
+        if cells == [""] || cells.first().is_some_and(|c| c.starts_with('#')) {
             continue;
         }
         let err = |message: String| ForecastError::Csv {
-            line: i + 1,
+            line: record.position().map_or(0, |p| p.line() as usize),
             message,
         };
-        let cells: Vec<&str> = line.split(',').map(str::trim).collect();
         if !seen_data && cells.first() == Some(&CSV_COLUMNS[0]) {
             if cells.len() < 3
                 || cells.len() > 4
@@ -256,6 +270,10 @@ mod tests {
         let b = Forecast::parse(csv).unwrap();
         assert_eq!(a, b);
         assert_eq!(a.rows()[1].sigma_mps, Some(1.5));
+        // As a spreadsheet saves it: quoted cells, CRLF line ends.
+        let quoted = "\"alt_msl_m\",\"speed_mps\",\"from_deg\"\r\n\"300\",\"2\",\"270\"\r\n";
+        let c = Forecast::parse(quoted).unwrap();
+        assert_eq!(c.rows()[0], a.rows()[0]);
         assert_eq!(a.sigma_rows(245.0, 2.0), vec![(55.0, 2.0), (2755.0, 1.5)]);
         let p = a.profile(245.0).unwrap();
         assert!((p.rows()[0].altitude_m - 55.0).abs() < 1e-12);

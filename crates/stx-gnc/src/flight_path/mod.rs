@@ -37,6 +37,7 @@ use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 use stx_types::atmosphere::Atmosphere;
 use stx_types::controls::Controls;
+use stx_types::validate::check;
 use stx_types::wind::WindField;
 
 use crate::performance::GlidePerformance;
@@ -120,18 +121,7 @@ pub enum FlightPathError {
     },
 }
 
-fn check(
-    field: &'static str,
-    value: f64,
-    ok: bool,
-    rule: &'static str,
-) -> Result<(), FlightPathError> {
-    if value.is_finite() && ok {
-        Ok(())
-    } else {
-        Err(FlightPathError::Invalid { field, value, rule })
-    }
-}
+stx_types::invalid_into!(FlightPathError);
 
 impl StackConfig {
     /// Checks every setting against its rule (see the fields).
@@ -185,7 +175,12 @@ impl StackConfig {
             "≥ 0",
         )?;
         check("step_m", s.step_m, s.step_m > 0.0, "> 0")?;
-        check("glide_step_s", s.glide_step_s, s.glide_step_s > 0.0, "> 0")
+        Ok(check(
+            "glide_step_s",
+            s.glide_step_s,
+            s.glide_step_s > 0.0,
+            "> 0",
+        )?)
     }
 
     /// The round chute's model.

@@ -12,6 +12,7 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 use stx_types::atmosphere::StandardAtmosphere;
+use stx_types::validate::check;
 
 use super::spread::{PlanInputs, PlanSample, PointSpread, monte_carlo};
 use super::{Air, Dispersion, Ellipse, Forecast, ForecastRow, StackConfig, Start};
@@ -200,13 +201,7 @@ pub struct PlanReport {
     pub landing_samples_lat_lon_deg: Vec<[f64; 2]>,
 }
 
-fn check(field: &'static str, value: f64, ok: bool, rule: &'static str) -> Result<(), PlanError> {
-    if value.is_finite() && ok {
-        Ok(())
-    } else {
-        Err(PlanError::Invalid { field, value, rule })
-    }
-}
+stx_types::invalid_into!(PlanError);
 
 /// Makes the plan `request` asks for (see the module doc).
 pub fn plan(request: &PlanRequest) -> Result<PlanReport, PlanError> {

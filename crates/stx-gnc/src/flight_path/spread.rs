@@ -25,9 +25,10 @@ use nalgebra::{Matrix2, Vector2, Vector3};
 use rand::Rng;
 use rand_distr::{Distribution, StandardNormal};
 use serde::{Deserialize, Serialize};
+use stx_types::validate::check;
 use stx_types::wind::WindField;
 
-use super::{Air, FlightPath, FlightPathError, ReachDisc, StackConfig, Start, check, propagate};
+use super::{Air, FlightPath, FlightPathError, ReachDisc, StackConfig, Start, propagate};
 use crate::performance::GlidePerformance;
 
 /// Bearings of the reachable region's outline.

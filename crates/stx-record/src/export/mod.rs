@@ -1,12 +1,15 @@
 //! A recording for tools that do not read MCAP: one CSV per channel ([`csv`]: columns are the
 //! messages' JSON fields, flattened, with units from the channels' JSON Schemas) and the
-//! flight's track as KML (Google Earth) or GPX (phones, GIS) ([`track`]).
+//! flight's track as KML (Google Earth) or GPX (phones, GIS) ([`track`]), KML through the one
+//! KML writer of stx ([`kml`], which the station's live feed uses too).
 //!
 //! CSV and the two XML formats are written by hand: each is a few lines of text whose only
-//! subtleties (quoting a CSV field, escaping XML text) are handled here and tested, where a
-//! library would add a dependency for less than it saves.
+//! subtleties are quoting a CSV field (handled and tested here) and escaping XML text (by
+//! `quick_xml::escape::escape`, everywhere stx writes XML), where a writer library would add
+//! a dependency for less than it saves.
 
 pub mod csv;
+pub mod kml;
 pub mod track;
 
 use thiserror::Error;

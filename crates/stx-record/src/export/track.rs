@@ -5,6 +5,9 @@
 
 use std::io::{Read, Seek};
 
+use quick_xml::escape::escape;
+
+use super::kml::{AltitudeMode, Coordinate, Kml};
 use super::{ExportError, utc};
 use crate::Recording;
 use crate::foxglove::{LOCATION_FIX, LocationFix};
@@ -65,55 +68,27 @@ pub fn track<R: Read + Seek>(
     Ok((topic, points))
 }
 
-/// XML text with `&`, `<`, `>`, `"` and `'` escaped.
-pub fn xml_escape(text: &str) -> String {
-    let mut out = String::with_capacity(text.len());
-    for c in text.chars() {
-        match c {
-            '&' => out.push_str("&amp;"),
-            '<' => out.push_str("&lt;"),
-            '>' => out.push_str("&gt;"),
-            '"' => out.push_str("&quot;"),
-            '\'' => out.push_str("&apos;"),
-            c => out.push(c),
+/// The track as a KML 2.2 document named `name`: a line at its absolute altitude, with
+/// placemarks at the start and the end.
+pub fn kml(name: &str, points: &[TrackPoint]) -> String {
+    let at = |p: &TrackPoint| Coordinate {
+        lat_deg: p.lat_deg,
+        lon_deg: p.lon_deg,
+        alt_m: p.alt_m,
+    };
+    let mut doc = Kml::document(name);
+    doc.line("track", points.iter().map(at), AltitudeMode::Absolute);
+    if let (Some(first), Some(last)) = (points.first(), points.last()) {
+        for (label, p) in [("start", first), ("end", last)] {
+            doc.point(label, Some(&utc(p.time_ns)), at(p), AltitudeMode::Absolute);
         }
     }
-    out
-}
-
-/// The track as a KML 2.2 document named `name`.
-pub fn kml(name: &str, points: &[TrackPoint]) -> String {
-    let name = xml_escape(name);
-    let coordinates: Vec<String> = points
-        .iter()
-        .map(|p| format!("{:.7},{:.7},{:.1}", p.lon_deg, p.lat_deg, p.alt_m))
-        .collect();
-    let placemark = |label: &str, p: &TrackPoint| {
-        format!(
-            "    <Placemark><name>{label}</name><TimeStamp><when>{}</when></TimeStamp><Point><altitudeMode>absolute</altitudeMode><coordinates>{:.7},{:.7},{:.1}</coordinates></Point></Placemark>\n",
-            utc(p.time_ns),
-            p.lon_deg,
-            p.lat_deg,
-            p.alt_m
-        )
-    };
-    let mut out = String::from("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
-    out.push_str("<kml xmlns=\"http://www.opengis.net/kml/2.2\">\n  <Document>\n");
-    out.push_str(&format!("    <name>{name}</name>\n"));
-    out.push_str("    <Placemark><name>track</name><LineString><altitudeMode>absolute</altitudeMode><coordinates>");
-    out.push_str(&coordinates.join(" "));
-    out.push_str("</coordinates></LineString></Placemark>\n");
-    if let (Some(first), Some(last)) = (points.first(), points.last()) {
-        out.push_str(&placemark("start", first));
-        out.push_str(&placemark("end", last));
-    }
-    out.push_str("  </Document>\n</kml>\n");
-    out
+    doc.finish()
 }
 
 /// The track as a GPX 1.1 document named `name`.
 pub fn gpx(name: &str, points: &[TrackPoint]) -> String {
-    let name = xml_escape(name);
+    let name = escape(name);
     let mut out = String::from("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
     out.push_str(
         "<gpx version=\"1.1\" creator=\"stx\" xmlns=\"http://www.topografix.com/GPX/1/1\">\n",

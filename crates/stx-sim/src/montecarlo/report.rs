@@ -2,6 +2,7 @@
 //! worst runs, named so that each can be replayed.
 
 use serde::{Deserialize, Serialize};
+use stx_gnc::stats::percentile;
 
 use super::config::MonteCarloConfig;
 use super::run::{RunConditions, RunResult};
@@ -46,15 +47,13 @@ impl Stats {
         }
         let mut sorted = values.to_vec();
         sorted.sort_by(f64::total_cmp);
-        let rank =
-            |q: f64| sorted[((q * sorted.len() as f64).ceil() as usize).clamp(1, sorted.len()) - 1];
         Self {
             median: if sorted.len() % 2 == 1 {
                 sorted[sorted.len() / 2]
             } else {
                 0.5 * (sorted[sorted.len() / 2 - 1] + sorted[sorted.len() / 2])
             },
-            p95: rank(0.95),
+            p95: percentile(&sorted, 0.95),
             max: sorted[sorted.len() - 1],
             mean: sorted.iter().sum::<f64>() / sorted.len() as f64,
         }

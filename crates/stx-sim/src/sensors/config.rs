@@ -2,6 +2,7 @@
 //! or built in code, and checked by [`SensorConfig::validate`] before a run.
 
 use serde::Deserialize;
+use stx_dynamics::validate::{check, non_negative, positive};
 use thiserror::Error;
 
 /// Why a sensor configuration was refused. `field` is the TOML path, e.g. `gps.rate_hz`.
@@ -229,27 +230,7 @@ impl Default for PitotConfig {
     }
 }
 
-/// Checks of one number.
-fn check(
-    field: &'static str,
-    value: f64,
-    ok: impl Fn(f64) -> bool,
-    rule: &'static str,
-) -> Result<(), SensorConfigError> {
-    if value.is_finite() && ok(value) {
-        Ok(())
-    } else {
-        Err(SensorConfigError::Invalid { field, value, rule })
-    }
-}
-
-fn non_negative(field: &'static str, value: f64) -> Result<(), SensorConfigError> {
-    check(field, value, |v| v >= 0.0, "finite and ≥ 0")
-}
-
-fn positive(field: &'static str, value: f64) -> Result<(), SensorConfigError> {
-    check(field, value, |v| v > 0.0, "finite and > 0")
-}
+stx_dynamics::invalid_into!(SensorConfigError);
 
 /// The timing settings every sensor has, named by their TOML paths.
 struct TimingFields<'a> {
@@ -265,7 +246,7 @@ impl TimingFields<'_> {
         check(
             self.rate_hz.0,
             self.rate_hz.1,
-            |v| v > 0.0 && v <= MAX_RATE_HZ,
+            self.rate_hz.1 > 0.0 && self.rate_hz.1 <= MAX_RATE_HZ,
             "finite, > 0 and ≤ 1000 Hz",
         )?;
         non_negative(self.phase_s.0, self.phase_s.1)?;
@@ -273,7 +254,7 @@ impl TimingFields<'_> {
         check(
             self.dropout_probability.0,
             self.dropout_probability.1,
-            |v| (0.0..=1.0).contains(&v),
+            (0.0..=1.0).contains(&self.dropout_probability.1),
             "in [0, 1]",
         )?;
         for (index, &[from_s, to_s]) in self.dropouts_s.1.iter().enumerate() {
@@ -372,7 +353,7 @@ impl SensorConfig {
         check(
             "pitot.differential_scale_sigma",
             p.differential_scale_sigma,
-            |v| (0.0..=0.3).contains(&v),
+            (0.0..=0.3).contains(&p.differential_scale_sigma),
             "in [0, 0.3]",
         )?;
         non_negative("pitot.static_noise_pa", p.static_noise_pa)?;

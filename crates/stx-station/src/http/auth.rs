@@ -1,12 +1,14 @@
 //! Who is calling: the token from `Authorization: Bearer …` or `?token=` (the WebSocket and
 //! Google Earth cannot set headers), its name and role from the station config (a rehearsal
-//! token only from loopback, `crate::exposure`); and the percent-encoding of tokens in URLs.
+//! token only from loopback, `crate::exposure`); and the percent-encoding of tokens in URLs
+//! (`percent-encoding` and `form_urlencoded`, the URL crates' own).
 
 use std::net::SocketAddr;
 
 use axum::extract::{ConnectInfo, FromRequestParts};
 use axum::http::request::Parts;
 use axum::http::{StatusCode, header};
+use percent_encoding::{AsciiSet, NON_ALPHANUMERIC, utf8_percent_encode};
 
 use super::shared::{AppState, HttpError, error};
 use crate::config::Role;
@@ -45,56 +47,28 @@ fn token_from(parts: &Parts) -> Option<String> {
     {
         return Some(token.trim().to_string());
     }
-    parts.uri.query().and_then(|q| {
-        q.split('&').find_map(|pair| {
-            let (k, v) = pair.split_once('=')?;
-            (k == "token").then(|| percent_decode(v))
-        })
-    })
+    parts.uri.query().and_then(token_from_query)
 }
 
+/// The `token` of a query string, decoded as browsers and `form_urlencoded` encode it: `%2B`
+/// is `+`, a bare `+` a space, a broken `%` sequence kept as written.
+fn token_from_query(query: &str) -> Option<String> {
+    form_urlencoded::parse(query.as_bytes())
+        .find(|(k, _)| k == "token")
+        .map(|(_, v)| v.into_owned())
+}
+
+/// What a token keeps as written in a URL: RFC 3986's unreserved characters; every other
+/// byte is percent-encoded (so `+` is `%2B`, never read back as a space).
+const TOKEN_IN_URL: &AsciiSet = &NON_ALPHANUMERIC
+    .remove(b'-')
+    .remove(b'.')
+    .remove(b'_')
+    .remove(b'~');
+
+/// `s` as a URL query value (see [`TOKEN_IN_URL`]).
 pub(crate) fn percent_encode(s: &str) -> String {
-    let mut out = String::with_capacity(s.len());
-    for b in s.bytes() {
-        if b.is_ascii_alphanumeric() || b"-._~".contains(&b) {
-            out.push(char::from(b));
-        } else {
-            out.push_str(&format!("%{b:02X}"));
-        }
-    }
-    out
-}
-
-fn percent_decode(s: &str) -> String {
-    let bytes = s.as_bytes();
-    let mut out = Vec::with_capacity(bytes.len());
-    let mut i = 0;
-    while i < bytes.len() {
-        match bytes[i] {
-            b'%' if i + 2 < bytes.len() => {
-                let hex = std::str::from_utf8(&bytes[i + 1..i + 3]).ok();
-                match hex.and_then(|h| u8::from_str_radix(h, 16).ok()) {
-                    Some(b) => {
-                        out.push(b);
-                        i += 3;
-                    }
-                    None => {
-                        out.push(b'%');
-                        i += 1;
-                    }
-                }
-            }
-            b'+' => {
-                out.push(b' ');
-                i += 1;
-            }
-            b => {
-                out.push(b);
-                i += 1;
-            }
-        }
-    }
-    String::from_utf8_lossy(&out).into_owned()
+    utf8_percent_encode(s, TOKEN_IN_URL).to_string()
 }
 
 impl FromRequestParts<AppState> for Caller {
@@ -178,4 +152,23 @@ fn wrong_token(
         return HttpError::too_many("too many wrong tokens from this address", retry);
     }
     error(StatusCode::UNAUTHORIZED, "unauthorized", reason)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tokens_in_urls_decode_as_before_and_survive_a_round_trip() {
+        assert_eq!(token_from_query("token=a%2Bb").as_deref(), Some("a+b"));
+        assert_eq!(token_from_query("x=1&token=a+b").as_deref(), Some("a b"));
+        assert_eq!(token_from_query("token=100%").as_deref(), Some("100%"));
+        assert_eq!(token_from_query("token=%zz1").as_deref(), Some("%zz1"));
+        assert_eq!(token_from_query("tokens=a"), None);
+        let token = "a+b/c=d e~f_g.h-ü";
+        let encoded = percent_encode(token);
+        assert_eq!(encoded, "a%2Bb%2Fc%3Dd%20e~f_g.h-%C3%BC");
+        let query = format!("token={encoded}");
+        assert_eq!(token_from_query(&query).as_deref(), Some(token));
+    }
 }
