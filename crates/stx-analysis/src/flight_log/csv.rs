@@ -49,22 +49,24 @@ const WIND_DOWN: &str = "wind_down_mps";
 /// Reads a flight log from CSV text.
 pub fn from_csv(text: &str) -> Result<FlightLog, FlightLogError> {
     // The `csv` crate reads what spreadsheets write: quoted fields, commas inside them.
+    // Blank and comment lines are left out first, so that errors name the editor's line.
+    let (table, numbers) = stx_types::table_text::data_lines(text);
     let mut reader = csv::ReaderBuilder::new()
         .has_headers(false)
         .flexible(true)
         .trim(csv::Trim::All)
-        .comment(Some(b'#'))
-        .from_reader(text.as_bytes());
-    let line_of = |p: Option<&csv::Position>| p.map_or(0, |p| p.line() as usize);
-    let mut records = reader.records().filter_map(|r| match r {
-        Err(e) => Some(Err(FlightLogError::Csv {
+        .from_reader(table.as_bytes());
+    let line_of = |p: Option<&csv::Position>| {
+        p.map_or(0, |p| {
+            stx_types::table_text::original_line(&numbers, p.line())
+        })
+    };
+    let mut records = reader.records().map(|r| match r {
+        Err(e) => Err(FlightLogError::Csv {
             line: line_of(e.position()),
             message: e.to_string(),
-        })),
-        // Blank and indented comment lines, which the reader's own comment rule (a `#` in
-        // the first column) does not catch.
-        Ok(r) if r.len() == 1 && (r[0].is_empty() || r[0].starts_with('#')) => None,
-        Ok(r) => Some(Ok((line_of(r.position()), r))),
+        }),
+        Ok(r) => Ok((line_of(r.position()), r)),
     });
     let Some(header) = records.next().transpose()?.map(|(_, r)| r) else {
         return Err(FlightLogError::TooShort { samples: 0 });
@@ -204,6 +206,11 @@ mod tests {
         assert!(matches!(
             from_csv(&bad),
             Err(FlightLogError::Csv { line: 2, .. })
+        ));
+        // As `stx compare --write-log` writes it, headed by a comment: the editor's line 3.
+        assert!(matches!(
+            from_csv(&format!("# a flight log\n{bad}")),
+            Err(FlightLogError::Csv { line: 3, .. })
         ));
     }
 

@@ -198,27 +198,27 @@ const CSV_COLUMNS: [&str; 4] = ["alt_msl_m", "speed_mps", "from_deg", "sigma_mps
 fn parse_csv(text: &str) -> Result<Vec<ForecastRow>, ForecastError> {
     // The `csv` crate reads what spreadsheets write (quoted cells included); the header is
     // optional, so it is recognised here rather than by the reader.
+    let (table, numbers) = stx_types::table_text::data_lines(text);
+    let line_at = |p: Option<&csv::Position>| {
+        p.map_or(0, |p| {
+            stx_types::table_text::original_line(&numbers, p.line())
+        })
+    };
     let mut reader = csv::ReaderBuilder::new()
         .has_headers(false)
         .flexible(true)
         .trim(csv::Trim::All)
-        .comment(Some(b'#'))
-        .from_reader(text.as_bytes());
+        .from_reader(table.as_bytes());
     let mut rows = Vec::new();
     let mut seen_data = false;
     for record in reader.records() {
         let record = record.map_err(|e| ForecastError::Csv {
-            line: e.position().map_or(0, |p| p.line() as usize),
+            line: line_at(e.position()),
             message: e.to_string(),
         })?;
         let cells: Vec<&str> = record.iter().collect();
-        // Blank and indented comment lines, which the reader's own comment rule (a `#` in
-        // the first column) does not catch.
-        if cells == [""] || cells.first().is_some_and(|c| c.starts_with('#')) {
-            continue;
-        }
         let err = |message: String| ForecastError::Csv {
-            line: record.position().map_or(0, |p| p.line() as usize),
+            line: line_at(record.position()),
             message,
         };
         if !seen_data && cells.first() == Some(&CSV_COLUMNS[0]) {
