@@ -8,15 +8,9 @@ use std::path::Path;
 
 use common::{stx, temp_dir};
 
-/// The shipped vehicle file with `from` replaced by `to` (which must be there).
+/// The shipped vehicle file with `from` replaced by `to`, as a path string.
 fn vehicle_file(dir: &Path, name: &str, from: &str, to: &str) -> String {
-    let shipped = std::fs::read_to_string(
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../config/vehicle/straplex.toml"),
-    )
-    .expect("shipped vehicle file");
-    assert!(shipped.contains(from), "{from} in the shipped vehicle file");
-    let path = dir.join(name);
-    std::fs::write(&path, shipped.replacen(from, to, 1)).expect("write");
+    let path = common::vehicle_file(dir, name, from, to);
     path.to_str().expect("utf-8").to_string()
 }
 

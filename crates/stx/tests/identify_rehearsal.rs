@@ -17,24 +17,19 @@ use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 
-use common::{stx, temp_dir};
+use common::{stx, temp_dir, vehicle_file};
 use serde_json::Value;
 
 const TRUE_CL_ALPHA: f64 = 1.840;
 
 /// Records the rehearsal flown by the shipped vehicle with `cl_alpha = 1.840` to its landing.
 fn record_rehearsal(dir: &Path) -> PathBuf {
-    let shipped = std::fs::read_to_string(
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../config/vehicle/straplex.toml"),
-    )
-    .expect("shipped vehicle file");
-    assert!(shipped.contains("cl_alpha = 2.300"));
-    let vehicle = dir.join("less-lift.toml");
-    std::fs::write(
-        &vehicle,
-        shipped.replacen("cl_alpha = 2.300", "cl_alpha = 1.840", 1),
-    )
-    .expect("write");
+    let vehicle = vehicle_file(
+        dir,
+        "less-lift.toml",
+        "cl_alpha = 2.300",
+        "cl_alpha = 1.840",
+    );
     let recordings = dir.join("recordings");
     let mut serve = Command::new(env!("CARGO_BIN_EXE_stx"))
         .args(["serve", "--sim", "--sim-scenario", "rehearsal"])
