@@ -1,7 +1,7 @@
 //! What guidance and the landing predictor assume about how the parafoil flies: airspeed and
 //! sink rate against brake and density, and how fast it turns for a main-line command. A
 //! point-mass summary of the 14-DOF model, measured from it (the values below are checked
-//! against the model by `crates/stx-sim/tests/performance_matches_model.rs`).
+//! against the model by `crates/stx-sim/tests/sim/performance_matches_model.rs`).
 //!
 //! The steady glide is a table over the brake setting because it is far from linear in it:
 //! the first fifth of brake costs as much airspeed as the last two fifths, and in a headwind

@@ -123,7 +123,7 @@ pub struct Summary {
     /// line) from its length, m, measured between the model's own line ends. The model's
     /// coordinates make these lengths hold by construction, so this is the floating-point
     /// consistency of its kinematic chain (~1e-11 m), not a check of the physics; the chain
-    /// itself is checked against the tabled geometry in `stx-dynamics/tests/physics.rs`.
+    /// itself is checked against the tabled geometry in `stx-dynamics/tests/dynamics/physics.rs`.
     pub max_line_length_error_m: f64,
     /// Largest total speed of the canopy, km/h.
     pub max_total_speed_kmh: f64,

@@ -30,7 +30,7 @@
 //! the configured irreducible error (slow GPS drifts, the balloon's lag), and `A/T` the
 //! payload's swing amplitude over the passage time.
 //!
-//! **Checked** (`tests/ascent_wind.rs`, 40 simulated ascents to 20 km through a sheared,
+//! **Checked** (`tests/gnc/ascent_wind.rs`, 40 simulated ascents to 20 km through a sheared,
 //! veering wind with a jet, 5-s gusts of 0.3 m/s, a 10-s swing of 1.5 m and GPS noise): with
 //! the scatter term alone, 95.5 % of band components lie within 2 σ of the truth from 2-Hz
 //! velocities, 99.4 % from 1-Hz positions (whose σ is about 1.5 times too large: differenced

@@ -23,7 +23,7 @@
 //!   plan assumes for a forecast row that states none. A band less certain than that tells
 //!   less than the forecast it would replace, and the Newey–West scatter behind such a σ means
 //!   the fixes disagreed with one another (a clock or GPS fault), not a gusty sky: the
-//!   checked ascents (`tests/ascent_wind.rs`) give 0.1–0.5 m/s.
+//!   checked ascents (`tests/gnc/ascent_wind.rs`) give 0.1–0.5 m/s.
 
 use serde::{Deserialize, Serialize};
 

@@ -1,5 +1,5 @@
 //! The estimator on small noise-free ascents whose every band is known exactly; the noisy,
-//! many-seed coverage check is `tests/ascent_wind.rs`.
+//! many-seed coverage check is `tests/gnc/ascent_wind.rs`.
 
 use nalgebra::Vector3;
 use stx_types::wind::{ProfileRow, WindError, WindField};

@@ -99,7 +99,7 @@
 //! spirals, spiral-landing legs and slow weaving, give 0.12–0.29 m/s RMS from 30 s on (the
 //! project's goal is 0.3); steady air about 0.1 m/s. In gusts 0.2 m/s stronger and faster
 //! (L = 200 m horizontally, 50 m vertically), 0.28–0.42 m/s: the goal then is not met. The
-//! figures are printed by `crates/stx-sim/tests/sensors_estimator.rs`. The scale `k`
+//! figures are printed by `crates/stx-sim/tests/sim/sensors_estimator.rs`. The scale `k`
 //! separates from the along-x wind once the flight turns.
 //!
 //! During a GPS dropout the same equations dead-reckon: the air velocity keeps turning at ω,
@@ -128,7 +128,7 @@
 //! when its measurement is committed, so replays count nothing twice.
 //!
 //! Cost: fixed-size `nalgebra` matrices, the transition's sparsity exploited, no allocation
-//! after [`Estimator::new`]; `crates/stx-sim/tests/sensors_estimator.rs` prints the measured
+//! after [`Estimator::new`]; `crates/stx-sim/tests/sim/sensors_estimator.rs` prints the measured
 //! time per call.
 
 mod angle;

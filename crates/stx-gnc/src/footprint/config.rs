@@ -20,7 +20,7 @@ pub struct FootprintConfig {
     /// Height kept for the final approach and the flare, m (≥ 0): below it the vehicle flies
     /// into the wind to the point. Guidance's final needs about 156 m, plus a base leg when
     /// the point lies downwind; 250 m is what the full-model test needed
-    /// (`crates/stx-sim/tests/footprint_against_full_model.rs`).
+    /// (`crates/stx-sim/tests/sim/footprint_against_full_model.rs`).
     pub reserve_height_m: f64,
     /// Distance taken off every reach for the turns a flight to the point needs (towards it,
     /// onto the base leg and the final), m (≥ 0); 100 m set by the same test.

@@ -27,7 +27,7 @@
 //! a point downwind costs the final's run twice (out past it and back), a point upwind none.
 //! In calm air (under 0.5 m/s over the final) the final may point anywhere and the disc keeps
 //! its whole still-air reach. The reserve and margin are settings, checked against the 14-DOF
-//! model with guidance in the loop (`crates/stx-sim/tests/footprint_against_full_model.rs`).
+//! model with guidance in the loop (`crates/stx-sim/tests/sim/footprint_against_full_model.rs`).
 //!
 //! # Uncertainty
 //!

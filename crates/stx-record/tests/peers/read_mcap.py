@@ -1,5 +1,5 @@
 """An independent reader of stx recordings: the `mcap` package from PyPI (pinned, see
-tests/python_mcap.rs). Prints what it finds as JSON on stdout; the Rust test compares.
+tests/record/python_mcap.rs). Prints what it finds as JSON on stdout; the Rust test compares.
 
     read_mcap.py summary FILE   whole file: summary, metadata, every message (indexed reader)
     read_mcap.py stream FILE    any file, cut or not: messages per topic (stream reader)

@@ -5,10 +5,10 @@
 //! then the same flight as a station running 20 times slower than the drone's clock (an
 //! accelerated rehearsal) sees it, live and from its recordings.
 //!
-//! `cargo test --release -p stx-station --test ascent_winds -- --nocapture` prints the
+//! `cargo test --release -p stx-station --test station ascent_winds:: -- --nocapture` prints the
 //! comparison band by band.
 
-mod common;
+use crate::common;
 
 use std::io::Cursor;
 use std::time::Duration;

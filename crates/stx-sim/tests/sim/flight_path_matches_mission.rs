@@ -8,7 +8,7 @@
 //! deployment against the true height, the 14-DOF parafoil's inflation and its glide against
 //! the point mass's, and (in the second test) turbulence the plan does not know of.
 //!
-//! Measured (seed 1, `cargo test --release -p stx-sim --test flight_path_matches_mission --
+//! Measured (seed 1, `cargo test --release -p stx-sim --test sim flight_path_matches_mission:: --
 //! --nocapture`): in the mean wind the burst is 1.1 m from the plan's, the deployment 9.7 m
 //! and the landing 32.5 m (1166 s flown, 1167 s planned); in turbulence 58, 54 and 493 m —
 //! gusts turn the unsteered parafoil, which the plan cannot know, so there the landing is

@@ -4,7 +4,7 @@
 //! 3,000 m) over the MAVLink link. Issue 28: the map said "burst in 1 h 45 min at 35.0 km"
 //! while the drone burst at 3,000 m.
 
-mod common;
+use crate::common;
 
 use std::time::Duration;
 

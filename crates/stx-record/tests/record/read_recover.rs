@@ -1,7 +1,7 @@
 //! Reading recordings back (from the summary, or by a scan when it is missing), seeking by
 //! time through the indexes, and recovering files cut at any byte.
 
-mod common;
+use crate::common;
 
 use std::io::{Cursor, Read, Seek, SeekFrom};
 use std::sync::Arc;

@@ -1,7 +1,7 @@
 //! HTTPS on loopback with a certificate made for the test: the API and the WebSocket work over
 //! TLS, plain HTTP is not served on that port, and unusable files are refused before start.
 
-mod common;
+use crate::common;
 
 use std::sync::Arc;
 

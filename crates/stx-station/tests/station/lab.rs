@@ -9,7 +9,7 @@
 //! The work here is a stand-in that reads the file it is handed (the flying is the binary's,
 //! tested in `crates/stx/src/lab_compare.rs` and by `tests/browser/lab.mjs`).
 
-mod common;
+use crate::common;
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;

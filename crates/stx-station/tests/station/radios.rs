@@ -1,7 +1,7 @@
 //! Two radios to one drone: a relay stands for the pair (every datagram the drone sends goes
 //! out on both, each radio's uplink reaches the drone) and can silence either radio.
 
-mod common;
+use crate::common;
 
 use std::net::SocketAddr;
 use std::sync::Arc;

@@ -2,7 +2,7 @@
 //! writes) serves its tiles under `/tiles/`, fills in the dashboard's tile source from it, and
 //! with a missing or corrupt pack still starts and tells the dashboard why there is no map.
 
-mod common;
+use crate::common;
 
 use std::net::SocketAddr;
 use std::path::{Path, PathBuf};

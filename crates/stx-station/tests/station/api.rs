@@ -1,7 +1,7 @@
 //! The station's API end to end on loopback: a real daemon, a scripted drone on the other end
 //! of the real MAVLink link, HTTP and WebSocket clients.
 
-mod common;
+use crate::common;
 
 use std::time::Duration;
 

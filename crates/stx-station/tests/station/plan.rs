@@ -3,7 +3,7 @@
 //! ascent of a recording in place of the forecast, bad requests refused with the field named,
 //! and one plan at a time with the station answering meanwhile.
 
-mod common;
+use crate::common;
 
 use std::path::{Path, PathBuf};
 use std::time::Duration;

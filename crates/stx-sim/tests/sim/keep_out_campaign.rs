@@ -10,7 +10,7 @@ use stx_sim::montecarlo::{MonteCarloConfig, RunResult, run_sensed};
 
 /// Run `index` of the 1000-run campaign of `seed` with the sample zones.
 fn fly(seed: u64, index: usize) -> RunResult {
-    let geojson = include_str!("../../../config/keep-out/montecarlo.geojson");
+    let geojson = include_str!("../../../../config/keep-out/montecarlo.geojson");
     let config = MonteCarloConfig {
         runs: 1000,
         seed,

@@ -2,7 +2,7 @@
 //! zones when it is heard, an operator's edit when it is made; the drone's own guidance flies
 //! them and the station says so.
 
-mod common;
+use crate::common;
 
 use std::time::Duration;
 

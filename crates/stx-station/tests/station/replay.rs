@@ -4,7 +4,7 @@
 //! (mode, stage, position, fresh), the track and the plots' history ending there, every page
 //! told to start over — and a re-run must fly the drone's own plan, exactly as live.
 
-mod common;
+use crate::common;
 
 use std::path::{Path, PathBuf};
 use std::time::Duration;

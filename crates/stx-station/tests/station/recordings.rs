@@ -2,7 +2,7 @@
 //! files), and replays opened from it — each a station of its own, at most
 //! `MAX_SESSIONS` at once, refused with a reason past that or for a file that is no recording.
 
-mod common;
+use crate::common;
 
 use std::path::{Path, PathBuf};
 use std::time::Duration;

@@ -3,7 +3,7 @@
 //! shipped rehearsal tokens refused from any address that is not loopback (127.0.0.2 stands for
 //! the field network, by `StationConfig::not_loopback`, the test switch of `exposure`).
 
-mod common;
+use crate::common;
 
 use std::net::IpAddr;
 

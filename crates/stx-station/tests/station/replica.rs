@@ -1,7 +1,7 @@
 //! The station's guidance replica against the real simulated drone: it must fly the plan the
 //! drone flies, wherever the target is, whoever set it.
 
-mod common;
+use crate::common;
 
 use std::time::Duration;
 

@@ -1,6 +1,6 @@
 //! Ground and vehicle endpoints talking through a simulated lossy channel with a fake clock.
 
-mod common;
+use crate::common;
 
 use std::time::Duration;
 

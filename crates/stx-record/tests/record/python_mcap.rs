@@ -7,7 +7,7 @@
 //! Python: `$STX_PYTHON`, or `.venv/bin/python` at the workspace root. To set it up:
 //! `python3 -m venv .venv && .venv/bin/pip install mcap==1.6.0`.
 
-mod common;
+use crate::common;
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
