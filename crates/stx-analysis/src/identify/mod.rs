@@ -23,7 +23,7 @@
 //!   replay through that wind wants a draggier, lower-lift canopy. Each flight's scale `s` is
 //!   fitted ([`Nuisance::air_scale`](crate::compare::Nuisance)): the wind flown becomes
 //!   `w − s·(v − w)`, the airspeed compared `(1 + s)·a`. On the simulated drone's recording of a
-//!   stack with `cl_alpha` 1.840 (`crates/stx/tests/identify_rehearsal.rs`) it moved the fitted
+//!   stack with `cl_alpha` 1.840 (`crates/stx/tests/cli/identify_rehearsal.rs`) it moved the fitted
 //!   lift slope from 1.943 (interval 1.908 … 1.977) to 1.899 (1.823 … 1.974) and the drag from
 //!   0.200 to 0.189 (truth 0.150). It is off by default: the scale and the drag both set the
 //!   airspeed's level, which then only turns tell apart, so on flights whose air data are right

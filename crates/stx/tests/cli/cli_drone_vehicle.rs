@@ -1,7 +1,7 @@
 //! `stx drone --vehicle FILE` and `stx serve --sim --sim-vehicle FILE` from the outside: a
 //! vehicle file is flown as the truth, and a bad one exits with code 2 naming the field.
 
-mod common;
+use crate::common;
 
 use std::net::UdpSocket;
 use std::path::Path;

@@ -3,7 +3,7 @@
 //! from the shipped vehicle; the fitted drag lands near the truth with an interval around it,
 //! and the written vehicle file flies in `stx sim`. Bad input exits 2.
 
-mod common;
+use crate::common;
 
 use common::stx;
 

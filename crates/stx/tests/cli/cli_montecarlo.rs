@@ -2,7 +2,7 @@
 //! into shards and merged gives the one-machine report; bad parts and bad dispersion files are
 //! refused with a clear message and exit code 2; capsules landed in keep-out zones are counted.
 
-mod common;
+use crate::common;
 
 use common::stx;
 

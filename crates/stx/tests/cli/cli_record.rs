@@ -1,7 +1,7 @@
 //! `stx record recover` from the outside: a cut recording becomes a whole one; bad input
 //! exits 2 without touching anything.
 
-mod common;
+use crate::common;
 
 use common::stx;
 

@@ -3,7 +3,7 @@
 //! clearly worse with one whose drag is doubled; a window of it compares as closely from
 //! the recorded state at its start; bad input (a bad window too) exits 2.
 
-mod common;
+use crate::common;
 
 use common::stx;
 

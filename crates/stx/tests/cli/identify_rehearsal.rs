@@ -11,7 +11,7 @@
 //! flight's air-data scale fitted too (`--fit-air-scale`, +1.85 %), 1.899 (1.823 … 1.974) and
 //! 0.189 (0.162 … 0.215): the lift slope's interval holds the truth, the drag's still does not.
 
-mod common;
+use crate::common;
 
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
