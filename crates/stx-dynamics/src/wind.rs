@@ -328,15 +328,7 @@ impl WindConfig {
                 speed_mps,
                 from_deg,
             } => Box::new(ConstantWind::from_speed_direction(*speed_mps, *from_deg)?),
-            MeanWindConfig::Profile { rows } => Box::new(WindProfile::new(
-                rows.iter()
-                    .map(|&[altitude_m, speed_mps, from_deg]| ProfileRow {
-                        altitude_m,
-                        speed_mps,
-                        from_deg,
-                    })
-                    .collect(),
-            )?),
+            MeanWindConfig::Profile { rows } => Box::new(WindProfile::from_rows(rows)?),
         };
         let turbulence = self.turbulence.clone().map(Turbulence::new).transpose()?;
         Ok(Box::new(WindComposite { mean, turbulence }))

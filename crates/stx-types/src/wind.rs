@@ -185,6 +185,20 @@ pub struct WindProfile {
 }
 
 impl WindProfile {
+    /// A profile from `[altitude m, speed m/s, from °]` rows, as config files and tests write
+    /// them; the rules of [`WindProfile::new`].
+    pub fn from_rows(rows: &[[f64; 3]]) -> Result<Self, WindError> {
+        Self::new(
+            rows.iter()
+                .map(|&[altitude_m, speed_mps, from_deg]| ProfileRow {
+                    altitude_m,
+                    speed_mps,
+                    from_deg,
+                })
+                .collect(),
+        )
+    }
+
     /// A profile from rows whose altitudes strictly increase; every value finite, speeds ≥ 0.
     pub fn new(rows: Vec<ProfileRow>) -> Result<Self, WindError> {
         if rows.is_empty() {

@@ -34,15 +34,7 @@ fn constant_wind_refuses_negative_or_non_finite_values() {
 }
 
 fn profile(rows: &[[f64; 3]]) -> Result<WindProfile, WindError> {
-    WindProfile::new(
-        rows.iter()
-            .map(|&[altitude_m, speed_mps, from_deg]| ProfileRow {
-                altitude_m,
-                speed_mps,
-                from_deg,
-            })
-            .collect(),
-    )
+    WindProfile::from_rows(rows)
 }
 
 #[test]

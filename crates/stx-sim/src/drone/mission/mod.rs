@@ -47,8 +47,12 @@
 //! as on the real capsule.
 //!
 //! Positions are local NED from the launch site (z = 0 is the site's ground, the ground level
-//! of the whole mission); the point mass is the drone itself.
+//! of the whole mission); the point mass is the drone itself. The point-mass models are in
+//! `point_mass`, the parafoil stages in `parafoil`, the round-chute landing forecast in
+//! `forecast`.
 
+mod forecast;
+mod parafoil;
 mod point_mass;
 
 use std::sync::Arc;
@@ -58,16 +62,15 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use stx_dynamics::atmosphere::{Atmosphere, StandardAtmosphere};
 use stx_dynamics::integrate::IntegrateError;
-use stx_dynamics::model::{Body, Environment, Kinematics, ParafoilModel};
+use stx_dynamics::model::{Body, Environment, ParafoilModel};
 use stx_dynamics::rotation::t_from_euler;
 use stx_dynamics::state::{Controls, StateVector, idx};
 use stx_dynamics::vehicle::Vehicle;
 use stx_dynamics::wind::WindField;
 use stx_gnc::mission::FlightStage;
 
-use crate::closed_loop::{Touchdown, fly_period, touchdown};
+use crate::closed_loop::Touchdown;
 use crate::drone::config::MissionConfig;
-use crate::guided::STEP_S;
 use crate::sensors::Truth;
 pub use point_mass::{Balloon, RoundChute, Swing};
 
@@ -470,116 +473,5 @@ impl MissionPhysics {
         }
         self.time_s = end_s;
         false
-    }
-
-    /// Releases the round chute (the onboard software's decision): the parafoil deploys at
-    /// the drone's position, heading along the drift or as configured.
-    pub fn deploy(&mut self) -> Result<StageEvent, DeployRefused> {
-        if self.stage != FlightStage::RoundChute {
-            return Err(DeployRefused { stage: self.stage });
-        }
-        let heading_rad = self.start_parafoil();
-        Ok(StageEvent::Deployed {
-            height_m: -self.position_ned_m.z,
-            heading_rad,
-        })
-    }
-
-    /// Starts the parafoil model at the drone's position. Returns the heading, rad.
-    fn start_parafoil(&mut self) -> f64 {
-        let v = self.velocity_ned_mps;
-        let heading = self.deploy_heading_rad.unwrap_or_else(|| {
-            if v.x.hypot(v.y) > 0.1 {
-                v.y.atan2(v.x)
-            } else {
-                0.0
-            }
-        });
-        let mut x = self.template;
-        x[idx::CANOPY_EULER + 2] = heading;
-        // Place the stack so that its drone is where the point mass was.
-        let k = Kinematics::new(&self.vehicle, &x, 0.0);
-        let offset = self.position_ned_m - k.position_ned_m[Body::Drone as usize];
-        for axis in 0..3 {
-            x[idx::POSITION + axis] += offset[axis];
-        }
-        let model = ParafoilModel::new(self.vehicle.clone(), self.environment.clone());
-        self.parafoil = Some((model, x));
-        self.stage = FlightStage::ParafoilDeploy;
-        self.deployed_at_s = Some(self.time_s);
-        heading
-    }
-
-    /// Where the stack would land under its round chute from `from_ned_m` (the drone's
-    /// estimated position) in the `forecast` wind: rising with the balloon to the burst
-    /// altitude first if still before burst, then falling at the chute's terminal speed,
-    /// drifting with the forecast. `None` once the parafoil is out. Returns the touchdown
-    /// point (north, east), m, and the time to it, s.
-    pub fn forecast_round_chute_landing(
-        &self,
-        from_ned_m: &Vector3<f64>,
-        forecast: &dyn WindField,
-    ) -> Option<([f64; 2], f64)> {
-        let ground = self.environment.ground_altitude_msl_m;
-        let air = |p: &Vector3<f64>| {
-            self.environment
-                .atmosphere
-                .air_at(ground - p.z)
-                .density_kg_per_m3
-        };
-        let mut p = *from_ned_m;
-        let mut t = 0.0;
-        match self.stage {
-            FlightStage::PreLaunch | FlightStage::Ascent => {
-                // Coarse steps: the forecast is smooth and the answer is for a map.
-                while ground - p.z < self.burst_altitude_msl_m && t < 1.0e5 {
-                    let w = forecast.wind_ned_mps(self.time_s, &p);
-                    let dt = 10.0;
-                    p += Vector3::new(w.x, w.y, -self.balloon.ascent_rate_mps(air(&p))) * dt;
-                    t += dt;
-                }
-            }
-            FlightStage::RoundChute => {}
-            _ => return None,
-        }
-        while p.z < 0.0 && t < 2.0e5 {
-            let w = forecast.wind_ned_mps(self.time_s, &p);
-            let sink = self.chute.terminal_speed_mps(air(&p));
-            // About 50 m of fall per step, shorter at the end so the ground is not overshot.
-            let dt = (50.0 / sink).min(-p.z / sink).max(0.05);
-            p += Vector3::new(w.x, w.y, sink) * dt;
-            t += dt;
-        }
-        Some(([p.x, p.y], t))
-    }
-
-    fn fly_parafoil(
-        &mut self,
-        controls: Controls,
-        period_s: f64,
-    ) -> Result<Option<Touchdown>, PhysicsError> {
-        let Some((model, x)) = self.parafoil.as_mut() else {
-            self.time_s += period_s;
-            return Ok(None);
-        };
-        model.set_controls(controls);
-        let (time_s, state, contact_s) = fly_period(model, self.time_s, x, STEP_S, period_s)
-            .map_err(|source| PhysicsError::Integration {
-                time_s: self.time_s,
-                source,
-            })?;
-        *x = state;
-        self.time_s = time_s;
-        let truth = Truth::from_model(model, time_s, x);
-        self.position_ned_m = truth.position_ned_m;
-        self.velocity_ned_mps = truth.velocity_ned_mps;
-        Ok(contact_s.map(|t| {
-            let td = touchdown(model, x, t);
-            // The drone comes to rest on the ground beside the bodies below it.
-            self.position_ned_m.z = 0.0;
-            self.velocity_ned_mps = Vector3::zeros();
-            self.touchdown = Some(td);
-            td
-        }))
     }
 }

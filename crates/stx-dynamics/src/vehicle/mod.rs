@@ -3,16 +3,19 @@
 //! Configuration is staged: [`VehicleConfig`] is the TOML file as written (every field with its
 //! unit in its name and its source in the file), [`VehicleConfig::validate`] checks every rule
 //! and names the field that breaks one, and [`Vehicle`] is the validated, derived form the model
-//! runs on (inertia tensors, apparent-mass coefficients, control geometry).
+//! runs on (inertia tensors, apparent-mass coefficients, control geometry). The file's tables are
+//! in `file`, its rules in `validate`.
 
 use nalgebra::{Matrix3, Vector3};
-use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
-use stx_types::validate::{Invalid, check};
+mod file;
+mod validate;
+
+pub use file::*;
 
 /// The STRAPLEX vehicle file shipped with stx (`config/vehicle/straplex.toml`).
-pub const STRAPLEX_TOML: &str = include_str!("../../../config/vehicle/straplex.toml");
+pub const STRAPLEX_TOML: &str = include_str!("../../../../config/vehicle/straplex.toml");
 
 /// Why a vehicle description was refused.
 #[derive(Debug, Error)]
@@ -30,190 +33,6 @@ pub enum VehicleError {
         rule: &'static str,
     },
 }
-
-/// Canopy description (seed Table 3.1).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct CanopyConfig {
-    /// Mass of canopy, lines and beam, kg.
-    pub mass_kg: f64,
-    /// Span b, m.
-    pub span_m: f64,
-    /// Chord c, m.
-    pub chord_m: f64,
-    /// Maximum thickness d, m.
-    pub thickness_m: f64,
-    /// Height of the lateral arc a at mid-span, m.
-    pub arc_height_m: f64,
-    /// Reference area S, m².
-    pub area_m2: f64,
-    /// Natural main-line length L0 of the control geometry, m.
-    pub main_line_length_m: f64,
-    /// Anti-twist beam length B of the control geometry, m.
-    pub beam_length_m: f64,
-    /// Whether the canopy feels the Munk moment `−V_rel × (M_app·V_rel)` of its apparent mass
-    /// (Kirchhoff). If not given, no: the seed's model (its A.11) leaves it out.
-    #[serde(default)]
-    pub munk_moment: bool,
-    /// Aerodynamic coefficients.
-    pub aero: CanopyAeroConfig,
-    /// Brake coefficients.
-    pub brakes: BrakeConfig,
-}
-
-/// Canopy aerodynamic coefficients (seed Table 4.2); rate-damping terms are magnitudes.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct CanopyAeroConfig {
-    /// Drag coefficient at zero angle of attack.
-    pub cd0: f64,
-    /// Drag growth with α², 1/rad².
-    pub cd_alpha2: f64,
-    /// Side-force slope with sideslip, 1/rad (force opposes sideslip).
-    pub cy_beta: f64,
-    /// Lift coefficient at zero angle of attack.
-    pub cl0: f64,
-    /// Lift slope, 1/rad.
-    pub cl_alpha: f64,
-    /// Roll damping magnitude (per non-dimensional roll rate b·p/2V).
-    pub clp: f64,
-    /// Pitch damping magnitude (per non-dimensional pitch rate c·q/2V).
-    pub cmq: f64,
-    /// Yaw damping magnitude (per non-dimensional yaw rate b·r/2V).
-    pub cnr: f64,
-    /// Yaw moment with sideslip, 1/rad, in the seed's sign (negative weathervanes).
-    pub cn_beta: f64,
-    /// Angles of attack `[lowest, highest]` over which these coefficients describe a gliding
-    /// canopy, degrees. A trim outside them is refused as a glide the model does not describe
-    /// (flights pass through other angles in transients and are flown regardless).
-    #[serde(default = "default_alpha_range_deg")]
-    pub alpha_range_deg: [f64; 2],
-}
-
-/// The angle-of-attack range of a vehicle file that gives none, degrees (see
-/// `config/vehicle/straplex.toml` for the reasoning).
-pub fn default_alpha_range_deg() -> [f64; 2] {
-    [0.0, 45.0]
-}
-
-/// Brake coefficients per unit of normalised deflection (0 released … 1 fully pulled).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct BrakeConfig {
-    /// Lift added by symmetric deflection δs.
-    pub cl_ds: f64,
-    /// Drag added by symmetric deflection δs.
-    pub cd_ds: f64,
-    /// Roll moment of asymmetric deflection δa = right − left.
-    pub cl_da: f64,
-    /// Yaw moment of asymmetric deflection δa = right − left.
-    pub cn_da: f64,
-}
-
-/// Drone description (seed Tables 3.2, 4.2).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct DroneConfig {
-    /// Mass, kg.
-    pub mass_kg: f64,
-    /// Box length c (x), m.
-    pub length_m: f64,
-    /// Box width b (y), m.
-    pub width_m: f64,
-    /// Box height d (z), m.
-    pub height_m: f64,
-    /// Drag reference area, m².
-    pub area_m2: f64,
-    /// Drag coefficient, the same in every direction.
-    pub cd: f64,
-    /// Roll damping magnitude.
-    pub clp: f64,
-    /// Pitch damping magnitude.
-    pub cmq: f64,
-    /// Yaw damping magnitude.
-    pub cnr: f64,
-}
-
-/// A body hanging on a line whose own rotation the model neglects (capsule, transponder).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct PendantConfig {
-    /// Mass, kg.
-    pub mass_kg: f64,
-    /// Width, m.
-    pub width_m: f64,
-    /// Length, m.
-    pub length_m: f64,
-    /// Height, m.
-    pub height_m: f64,
-    /// Drag reference area, m².
-    pub area_m2: f64,
-    /// Drag coefficient.
-    pub cd: f64,
-}
-
-/// Attachment points and lines (seed Table 4.1), metres, each in the frame its doc names.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct GeometryConfig {
-    /// Canopy pressure centre from the canopy CM, frame C.
-    pub canopy_pressure_centre_m: [f64; 3],
-    /// Right main line's canopy end from the canopy CM, frame C.
-    pub right_line_on_canopy_m: [f64; 3],
-    /// Left main line's canopy end from the canopy CM, frame C.
-    pub left_line_on_canopy_m: [f64; 3],
-    /// Right main line from its canopy end to its drone end, frame L.
-    pub right_line_m: [f64; 3],
-    /// Left main line from its canopy end to its drone end, frame L.
-    pub left_line_m: [f64; 3],
-    /// Drone pressure centre from the drone CM, frame D.
-    pub drone_pressure_centre_m: [f64; 3],
-    /// Right main line's drone end from the drone CM, frame D.
-    pub right_line_on_drone_m: [f64; 3],
-    /// Left main line's drone end from the drone CM, frame D.
-    pub left_line_on_drone_m: [f64; 3],
-    /// Capsule line's drone end from the drone CM, frame D.
-    pub capsule_line_on_drone_m: [f64; 3],
-    /// Drone–capsule line, m.
-    pub capsule_line_length_m: f64,
-    /// Capsule–transponder line, m.
-    pub transponder_line_length_m: f64,
-}
-
-/// Servo dynamics and travel (eqs. 4.15–4.17).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct ServoConfig {
-    /// Main-line servo rate constant K_L, 1/s.
-    pub main_line_rate_per_s: f64,
-    /// Right brake servo rate constant K_SR, 1/s.
-    pub brake_right_rate_per_s: f64,
-    /// Left brake servo rate constant K_SL, 1/s.
-    pub brake_left_rate_per_s: f64,
-    /// Largest differential main-line displacement |ΔL|, m.
-    pub main_line_travel_m: f64,
-}
-
-/// The vehicle file as written.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct VehicleConfig {
-    /// Gravitational acceleration, m/s².
-    pub gravity_mps2: f64,
-    /// The canopy.
-    pub canopy: CanopyConfig,
-    /// The control drone.
-    pub drone: DroneConfig,
-    /// The payload capsule.
-    pub capsule: PendantConfig,
-    /// The transponder.
-    pub transponder: PendantConfig,
-    /// Attachment points and lines.
-    pub geometry: GeometryConfig,
-    /// Servos.
-    pub servos: ServoConfig,
-}
-
 /// A body's rigid-body and drag constants.
 #[derive(Debug, Clone, PartialEq)]
 pub struct BodyConstants {
@@ -330,7 +149,6 @@ pub struct Vehicle {
     /// Largest |ΔL|, m.
     pub main_line_travel_m: f64,
 }
-
 fn vec3(a: [f64; 3]) -> Vector3<f64> {
     Vector3::new(a[0], a[1], a[2])
 }
@@ -342,189 +160,6 @@ fn box_inertia(mass_kg: f64, x_m: f64, y_m: f64, z_m: f64) -> Matrix3<f64> {
         x_m * x_m + y_m * y_m,
     )) * (mass_kg / 12.0)
 }
-
-/// Field names of the capsule's and the transponder's rules, in [`PendantConfig`]'s order.
-const PENDANT_FIELDS: [[&str; 6]; 2] = [
-    [
-        "capsule.mass_kg",
-        "capsule.width_m",
-        "capsule.length_m",
-        "capsule.height_m",
-        "capsule.area_m2",
-        "capsule.cd",
-    ],
-    [
-        "transponder.mass_kg",
-        "transponder.width_m",
-        "transponder.length_m",
-        "transponder.height_m",
-        "transponder.area_m2",
-        "transponder.cd",
-    ],
-];
-
-/// Every rule's verdict, in the file's order: the first broken one is the error.
-struct Rules(Vec<Result<(), Invalid>>);
-
-impl Rules {
-    fn check(&mut self, field: &'static str, value: f64, rule: &'static str, ok: bool) {
-        self.0.push(check(field, value, ok, rule));
-    }
-    fn positive(&mut self, field: &'static str, value: f64) {
-        self.check(field, value, "must be a finite number > 0", value > 0.0);
-    }
-    fn non_negative(&mut self, field: &'static str, value: f64) {
-        self.check(field, value, "must be a finite number ≥ 0", value >= 0.0);
-    }
-    fn finite(&mut self, field: &'static str, value: f64) {
-        self.check(field, value, "must be a finite number", true);
-    }
-    fn first_broken(self) -> Result<(), VehicleError> {
-        Ok(self.0.into_iter().collect::<Result<(), Invalid>>()?)
-    }
-}
-
-crate::invalid_into!(VehicleError);
-
-impl VehicleConfig {
-    /// Parses a vehicle file (it is not validated yet).
-    pub fn from_toml_str(text: &str) -> Result<Self, VehicleError> {
-        Ok(toml::from_str(text)?)
-    }
-
-    /// Checks every rule and builds the vehicle; the error names the first field that breaks one.
-    pub fn validate(self) -> Result<Vehicle, VehicleError> {
-        let mut rules = Rules(Vec::new());
-        rules.positive("gravity_mps2", self.gravity_mps2);
-        let c = &self.canopy;
-        rules.positive("canopy.mass_kg", c.mass_kg);
-        rules.positive("canopy.span_m", c.span_m);
-        rules.positive("canopy.chord_m", c.chord_m);
-        rules.positive("canopy.thickness_m", c.thickness_m);
-        rules.check(
-            "canopy.thickness_m",
-            c.thickness_m,
-            "must be less than canopy.chord_m",
-            c.thickness_m < c.chord_m,
-        );
-        rules.non_negative("canopy.arc_height_m", c.arc_height_m);
-        rules.check(
-            "canopy.arc_height_m",
-            c.arc_height_m,
-            "must be less than half of canopy.span_m",
-            c.arc_height_m < 0.5 * c.span_m,
-        );
-        rules.positive("canopy.area_m2", c.area_m2);
-        rules.positive("canopy.main_line_length_m", c.main_line_length_m);
-        rules.positive("canopy.beam_length_m", c.beam_length_m);
-        let a = &c.aero;
-        rules.non_negative("canopy.aero.cd0", a.cd0);
-        rules.non_negative("canopy.aero.cd_alpha2", a.cd_alpha2);
-        rules.finite("canopy.aero.cy_beta", a.cy_beta);
-        rules.finite("canopy.aero.cl0", a.cl0);
-        rules.finite("canopy.aero.cl_alpha", a.cl_alpha);
-        rules.non_negative("canopy.aero.clp", a.clp);
-        rules.non_negative("canopy.aero.cmq", a.cmq);
-        rules.non_negative("canopy.aero.cnr", a.cnr);
-        rules.finite("canopy.aero.cn_beta", a.cn_beta);
-        let [alpha_low, alpha_high] = a.alpha_range_deg;
-        rules.check(
-            "canopy.aero.alpha_range_deg",
-            alpha_low,
-            "the lower end must lie in [-90, 90) degrees",
-            (-90.0..90.0).contains(&alpha_low),
-        );
-        rules.check(
-            "canopy.aero.alpha_range_deg",
-            alpha_high,
-            "the upper end must lie in (lower end, 90] degrees",
-            alpha_high > alpha_low && alpha_high <= 90.0,
-        );
-        let b = &c.brakes;
-        rules.finite("canopy.brakes.cl_ds", b.cl_ds);
-        rules.non_negative("canopy.brakes.cd_ds", b.cd_ds);
-        rules.finite("canopy.brakes.cl_da", b.cl_da);
-        rules.finite("canopy.brakes.cn_da", b.cn_da);
-        let d = &self.drone;
-        rules.positive("drone.mass_kg", d.mass_kg);
-        rules.positive("drone.length_m", d.length_m);
-        rules.positive("drone.width_m", d.width_m);
-        rules.positive("drone.height_m", d.height_m);
-        rules.non_negative("drone.area_m2", d.area_m2);
-        rules.non_negative("drone.cd", d.cd);
-        rules.non_negative("drone.clp", d.clp);
-        rules.non_negative("drone.cmq", d.cmq);
-        rules.non_negative("drone.cnr", d.cnr);
-        for (fields, p) in [
-            (PENDANT_FIELDS[0], &self.capsule),
-            (PENDANT_FIELDS[1], &self.transponder),
-        ] {
-            let [mass, width, length, height, area, cd] = fields;
-            rules.positive(mass, p.mass_kg);
-            rules.positive(width, p.width_m);
-            rules.positive(length, p.length_m);
-            rules.positive(height, p.height_m);
-            rules.non_negative(area, p.area_m2);
-            rules.non_negative(cd, p.cd);
-        }
-        let g = &self.geometry;
-        let vectors: [(&'static str, [f64; 3]); 9] = [
-            (
-                "geometry.canopy_pressure_centre_m",
-                g.canopy_pressure_centre_m,
-            ),
-            ("geometry.right_line_on_canopy_m", g.right_line_on_canopy_m),
-            ("geometry.left_line_on_canopy_m", g.left_line_on_canopy_m),
-            ("geometry.right_line_m", g.right_line_m),
-            ("geometry.left_line_m", g.left_line_m),
-            (
-                "geometry.drone_pressure_centre_m",
-                g.drone_pressure_centre_m,
-            ),
-            ("geometry.right_line_on_drone_m", g.right_line_on_drone_m),
-            ("geometry.left_line_on_drone_m", g.left_line_on_drone_m),
-            (
-                "geometry.capsule_line_on_drone_m",
-                g.capsule_line_on_drone_m,
-            ),
-        ];
-        for (field, v) in vectors {
-            for component in v {
-                rules.finite(field, component);
-            }
-        }
-        for (field, v) in [
-            ("geometry.right_line_m", g.right_line_m),
-            ("geometry.left_line_m", g.left_line_m),
-        ] {
-            rules.check(
-                field,
-                v[2],
-                "the line must hang down (z component > 0 in the line frame)",
-                v[2] > 0.0,
-            );
-        }
-        rules.positive("geometry.capsule_line_length_m", g.capsule_line_length_m);
-        rules.positive(
-            "geometry.transponder_line_length_m",
-            g.transponder_line_length_m,
-        );
-        let s = &self.servos;
-        rules.positive("servos.main_line_rate_per_s", s.main_line_rate_per_s);
-        rules.positive("servos.brake_right_rate_per_s", s.brake_right_rate_per_s);
-        rules.positive("servos.brake_left_rate_per_s", s.brake_left_rate_per_s);
-        rules.positive("servos.main_line_travel_m", s.main_line_travel_m);
-        rules.check(
-            "servos.main_line_travel_m",
-            s.main_line_travel_m,
-            "must be less than half of canopy.beam_length_m (the lines would cross)",
-            s.main_line_travel_m < 0.5 * c.beam_length_m,
-        );
-        rules.first_broken()?;
-        Ok(Vehicle::derive(self))
-    }
-}
-
 impl Vehicle {
     /// Parses and validates a vehicle file.
     pub fn from_toml_str(text: &str) -> Result<Self, VehicleError> {
@@ -595,7 +230,6 @@ impl Vehicle {
         self.canopy_mass_kg + self.drone_mass_kg + self.capsule.mass_kg + self.transponder.mass_kg
     }
 }
-
 #[cfg(test)]
 mod tests {
     use super::*;
