@@ -10,7 +10,7 @@ use std::sync::Arc;
 use stx_analysis::analysis::analyze;
 use stx_analysis::flight_log::window::Window;
 use stx_analysis::gains_file::gains_file;
-use stx_analysis::tune::{Controller, tune};
+use stx_analysis::tune::{Controller, DEFAULT_ALTITUDE_M, tune};
 use stx_dynamics::vehicle::Vehicle;
 use stx_gnc::estimator::EstimatorConfig;
 use stx_gnc::guidance::GuidanceConfig;
@@ -219,7 +219,7 @@ fn tuning(
             .unwrap_or_else(|| "no step flown".into());
         return Err(format!(
             "the tuned gains failed the 14-DOF step at {altitude_m} m: {why} (tune at {} m, where the Monte Carlo releases, or higher)",
-            crate::tune::DEFAULT_ALTITUDE_M
+            DEFAULT_ALTITUDE_M
         ));
     };
     Ok(LabResult::Tune(TuneSummary {
