@@ -93,7 +93,7 @@ impl LabLoad {
     /// [`LabLoad::stop`]; returns once the first batch runs.
     pub async fn start(running: &Running, token: &str, runs: u32) -> anyhow::Result<Self> {
         let dir = std::env::temp_dir().join("stx-bench-lab");
-        let _ = running.shared.lab.set(crate::lab::service(dir));
+        let _ = running.shared.lab.set(stx_lab::service(dir));
         let lab = running.shared.lab.get().context("the Lab")?.clone();
         let mut sender = connect(running.http).await?;
         let mut batches = Batches::default();
