@@ -6,12 +6,6 @@
 
 mod analyze;
 mod bench;
-mod bench_abuse;
-mod bench_agreement;
-mod bench_http;
-mod bench_lab;
-mod bench_memory;
-mod bench_station;
 mod compare;
 mod drone;
 mod export;
