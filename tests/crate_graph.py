@@ -46,10 +46,22 @@ ALLOWED: dict[str, set[str]] = {
     "stx-agreement": {
         "stx-types", "stx-dynamics", "stx-gnc", "stx-link", "stx-sim", "stx-station",
     },
+    # The Lab's jobs: the station's Lab decides, this flies the simulator and the analysis for
+    # it, and reads the recordings it compares and identifies from.
+    "stx-lab": {
+        "stx-types", "stx-dynamics", "stx-gnc", "stx-sim", "stx-analysis", "stx-station",
+        "stx-record",
+    },
+    # The measurements behind `stx bench`: drives the daemon, the simulated drone and the Lab
+    # from outside, and flies the agreement campaign.
+    "stx-bench": {
+        "stx-types", "stx-gnc", "stx-link-tokio", "stx-sim", "stx-station", "stx-agreement",
+        "stx-lab",
+    },
     # The command-line binary at the top: it wires every crate together.
     "stx": {
         "stx-types", "stx-dynamics", "stx-gnc", "stx-link", "stx-link-tokio", "stx-sim",
-        "stx-station", "stx-record", "stx-analysis", "stx-agreement",
+        "stx-station", "stx-record", "stx-analysis", "stx-agreement", "stx-lab", "stx-bench",
     },
 }
 

@@ -17,8 +17,8 @@
 //!   reads (parameter ranges, units and meanings come from the onboard catalogue,
 //!   `stx_gnc::params`, shared with the drone); [`contract`]: all of them as one JSON Schema,
 //!   the contract the dashboard's TypeScript types are generated from; [`kml`]: the Google
-//!   Earth feed; [`keep_out`]: the keep-out zones' messages; [`lab`]: the Lab's jobs, requests and results (the work itself is the
-//!   binary's); [`limits`]: requests per token, wrong tokens per address and pages at once,
+//!   Earth feed; [`keep_out`]: the keep-out zones' messages; [`lab`]: the Lab's jobs, requests and results (the work itself is
+//!   stx-lab's); [`limits`]: requests per token, wrong tokens per address and pages at once,
 //!   as token buckets on the station's clock; [`preflight`]: the Plan page's pre-flight plans
 //!   (`POST /api/plan`); [`recording`]: what a flight's MCAP recording
 //!   holds, under which topics; [`replay`]: a recording played back through the station.

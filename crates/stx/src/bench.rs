@@ -2,11 +2,15 @@
 //!
 //! `stx bench dynamics` is `stx_sim::speed` (derivative evaluations per second, and the
 //! stratospheric descent's real-time factor per integrator); `stx bench memory` and
-//! `stx bench station` measure the station daemon (see their modules); `stx bench agreement`
-//! flies whole missions and holds what the station shows against the truth
-//! (`stx_agreement`).
+//! `stx bench station` measure the station daemon, and `stx bench agreement` flies whole
+//! missions and holds what the station shows against the truth: the measuring is `stx_bench`'s,
+//! the flags, the printing and the exit code are here.
 
+use anyhow::{Context, bail};
 use clap::{Args, Subcommand};
+use stx_bench::{agreement, memory, station};
+
+use crate::BadInput;
 
 #[derive(Args)]
 pub struct BenchArgs {
@@ -33,7 +37,7 @@ enum BenchWhat {
         #[arg(long, value_delimiter = ',')]
         seeds: Option<Vec<u64>>,
         /// Speeds, factors of real time or `max` (comma-separated); default: 20,max.
-        #[arg(long, value_delimiter = ',', value_parser = crate::bench_agreement::parse_speed)]
+        #[arg(long, value_delimiter = ',', value_parser = agreement::parse_speed)]
         speeds: Option<Vec<f64>>,
         /// Dispersion set: `nominal`, `realistic` or a file; default: realistic.
         #[arg(long)]
@@ -138,12 +142,18 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
                 campaign.dispersions = Some(d);
             }
             campaign.bursts &= !no_bursts;
-            crate::bench_agreement::run_bench(crate::bench_agreement::AgreementBenchOptions {
-                campaign,
-                keep_out: Some(keep_out),
-                threads,
-                json,
-            })
+            let specs = agreement::specs(&campaign, Some(&keep_out)).map_err(BadInput)?;
+            let flown = agreement::fly(&specs, threads);
+            if json {
+                println!("{}", serde_json::to_string_pretty(&flown.json())?);
+            } else {
+                print!("{flown}");
+            }
+            let unmet = flown.unmet();
+            if !unmet.is_empty() {
+                bail!("goals not met: {}", unmet.join("; "));
+            }
+            Ok(())
         }
         BenchWhat::Memory {
             json,
@@ -151,7 +161,8 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
             speed,
             clients,
         } => {
-            let report = crate::bench_memory::run(&crate::bench_memory::MemoryBenchOptions {
+            let report = memory::run(&memory::MemoryBenchOptions {
+                stx: std::env::current_exe().context("this program's path")?,
                 mission_s: mission_hours * 3600.0,
                 speed,
                 clients,
@@ -159,35 +170,10 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
             if json {
                 println!("{}", serde_json::to_string_pretty(&report)?);
             } else {
-                println!(
-                    "station daemon alone after {:.0} s of mission ({}, {:.0} s wall at {}x, {} pages): RSS {:.1} MB, peak {:.1} MB (after 1 min: {:.1} MB; the drone's process peaked at {:.1} MB); pages received {} messages, {:.1} MB",
-                    report.mission_time_s,
-                    if report.landed {
-                        "landed"
-                    } else {
-                        "NOT landed"
-                    },
-                    report.wall_time_s,
-                    report.speed,
-                    report.clients,
-                    report.rss_after_mb,
-                    report.rss_peak_mb,
-                    report.rss_early_mb,
-                    report.drone_rss_peak_mb,
-                    report.page_messages,
-                    report.page_bytes as f64 / 1e6
-                );
-                println!(
-                    "{} pages came and went; open file descriptors {} after 1 min, {} at the end; recording {:.1} MB on disk, {} messages lost",
-                    report.pages_come_and_gone,
-                    report.fds_early,
-                    report.fds_after,
-                    report.recording_mb,
-                    report.recording_lost
-                );
+                print!("{report}");
             }
             if !report.landed {
-                anyhow::bail!("the simulated drone did not land in time");
+                bail!("the simulated drone did not land in time");
             }
             Ok(())
         }
@@ -201,7 +187,7 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
             abuse,
             lab_montecarlo,
         } => {
-            let report = crate::bench_station::run(&crate::bench_station::StationBenchOptions {
+            let report = station::run(&station::StationBenchOptions {
                 clients,
                 frames,
                 frame_rate_hz,
@@ -213,61 +199,7 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
             if json {
                 println!("{}", serde_json::to_string_pretty(&report)?);
             } else {
-                let t = &report.telemetry_to_websocket;
-                let c = &report.command_to_mavlink;
-                println!(
-                    "telemetry → WebSocket, {} pages, {} bursts at {} Hz, state {} bytes: p50 {:.2} ms, p99 {:.2} ms, max {:.2} ms ({} samples, {} missed)",
-                    t.clients,
-                    t.frames_sent,
-                    t.frame_rate_hz,
-                    t.state_bytes,
-                    t.latency.p50_ms,
-                    t.latency.p99_ms,
-                    t.latency.max_ms,
-                    t.latency.samples,
-                    t.missed
-                );
-                println!(
-                    "command → MAVLink bytes, {} commands: p50 {:.2} ms, p99 {:.2} ms, max {:.2} ms ({} lost)",
-                    c.commands_sent, c.latency.p50_ms, c.latency.p99_ms, c.latency.max_ms, c.lost
-                );
-                if let Some(a) = &report.abuse {
-                    println!(
-                        "flood during it: {} wrong-token requests ({} answered 429, {} 401, {} other), {} WebSockets tried ({} opened and closed); process RSS {:.1} MB before, {:.1} MB after",
-                        a.bad_token_requests,
-                        a.answered_429,
-                        a.answered_401,
-                        a.other,
-                        a.websockets_tried,
-                        a.websockets_opened,
-                        a.rss_before_mb,
-                        a.rss_after_mb
-                    );
-                }
-                if let Some(l) = &report.lab {
-                    println!(
-                        "Lab Monte Carlo during it: {} batch{} of {} runs started back to back ({} ended on their own), {} runs flown; the Lab busy {:.1} % of the window (longest gap {:.0} ms)",
-                        l.batches,
-                        if l.batches == 1 { "" } else { "es" },
-                        l.runs_per_batch,
-                        l.batches_finished,
-                        l.runs_flown,
-                        l.busy_fraction * 100.0,
-                        l.longest_idle_ms
-                    );
-                }
-                let r = &report.recording;
-                println!(
-                    "recording: {:?}, {} messages ({:.2} MB) written, {} lost{}",
-                    r.state,
-                    r.messages_written,
-                    r.bytes_written as f64 / 1e6,
-                    r.messages_lost,
-                    r.problem
-                        .as_deref()
-                        .map(|p| format!(" (last problem: {p})"))
-                        .unwrap_or_default()
-                );
+                print!("{report}");
             }
             Ok(())
         }

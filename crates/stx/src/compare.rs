@@ -10,10 +10,9 @@ use std::path::{Path, PathBuf};
 use anyhow::Context;
 use clap::Args;
 use stx_analysis::compare::{CompareOptions, CompareReport, compare};
-use stx_analysis::flight_log::recording::LogBuilder;
+use stx_analysis::flight_log::FlightLog;
 use stx_analysis::flight_log::window::{Window, WindowEnd, WindowError};
-use stx_analysis::flight_log::{FlightLog, csv::from_csv};
-use stx_record::Recording;
+use stx_lab::flight_file::read_log;
 
 use crate::BadInput;
 use crate::inputs::load_vehicle;
@@ -74,37 +73,13 @@ fn flag_error(e: WindowError, path: Option<&Path>) -> anyhow::Error {
     BadInput(e).into()
 }
 
-/// The flight log of `path` (as [`read_log`]) cut to `window`; a window holding no flight
-/// of it is bad input naming the flags and the file.
+/// The flight log of `path` (as the Lab reads one, `stx_lab::flight_file`) cut to `window`;
+/// a file that reads as no flight log, or a window holding no flight of it, is bad input.
 pub fn read_window(path: &Path, window: &Window) -> anyhow::Result<FlightLog> {
-    read_log(path)?
+    read_log(path)
+        .map_err(BadInput)?
         .cut(window)
         .map_err(|e| flag_error(e, Some(path)))
-}
-
-/// The flight log of a recording or a CSV file; what cannot be read is bad input.
-pub fn read_log(path: &Path) -> anyhow::Result<FlightLog> {
-    let is_csv = path
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("csv"));
-    if is_csv {
-        let text = std::fs::read_to_string(path)
-            .with_context(|| format!("reading {}", path.display()))
-            .map_err(BadInput)?;
-        return from_csv(&text)
-            .with_context(|| format!("flight log {}", path.display()))
-            .map_err(|e| BadInput(e).into());
-    }
-    let bad = |e: anyhow::Error| BadInput(e.context(format!("recording {}", path.display())));
-    let mut recording = Recording::open(path).map_err(|e| bad(e.into()))?;
-    let mut builder = LogBuilder::default();
-    for message in recording.messages().map_err(|e| bad(e.into()))? {
-        let message = message.map_err(|e| bad(e.into()))?;
-        builder
-            .add(&message.topic, message.log_time, &message.data)
-            .map_err(|e| bad(e.into()))?;
-    }
-    builder.finish().map_err(|e| bad(e.into()).into())
 }
 
 /// The per-channel error table.

@@ -6,22 +6,12 @@
 
 mod analyze;
 mod bench;
-mod bench_abuse;
-mod bench_agreement;
-mod bench_http;
-mod bench_lab;
-mod bench_memory;
-mod bench_station;
 mod compare;
 mod drone;
 mod export;
 mod identify;
 mod import;
 mod inputs;
-mod lab;
-mod lab_compare;
-mod lab_identify;
-mod lab_recording;
 mod logging;
 mod montecarlo;
 mod plan;

@@ -120,7 +120,7 @@ pub fn run(args: ServeArgs) -> anyhow::Result<()> {
             .unwrap_or_default()
             .join("lab")
     });
-    let lab = crate::lab::service(lab_dir);
+    let lab = stx_lab::service(lab_dir);
     let sim = if args.sim {
         let options = sim_options(&config, &args)?;
         // The rehearsal's station knows the balloon it flies with: its burst, ascent rate and

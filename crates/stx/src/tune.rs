@@ -12,7 +12,9 @@ use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use stx_analysis::figures::tune_figure;
 use stx_analysis::gains_file::gains_file;
-use stx_analysis::tune::{Controller, SensedSet, SensedSpec, StepMetrics, TuneReport, tune};
+use stx_analysis::tune::{
+    Controller, DEFAULT_ALTITUDE_M, SensedSet, SensedSpec, StepMetrics, TuneReport, tune,
+};
 use stx_gnc::control::ControlGains;
 use stx_gnc::guidance::GuidanceConfig;
 use stx_sim::dispersions::Dispersions;
@@ -20,10 +22,6 @@ use stx_sim::sensors::SensorConfig;
 
 use crate::BadInput;
 use crate::inputs::{load_gains, load_vehicle};
-
-/// The altitude tuning trims at unless told, m: where the Monte Carlo releases, high enough
-/// for the 14-DOF steps to finish before the ground (at 100 m they do not).
-pub const DEFAULT_ALTITUDE_M: f64 = 600.0;
 
 #[derive(Args)]
 pub struct TuneArgs {

@@ -50,3 +50,7 @@ pub use optimiser::{
     Candidate, MAX_EVALUATIONS, MAX_SENSED_EVALUATIONS, Trial, TuneReport, round_significant, tune,
 };
 pub use sensed::{SETTLE_S, SensedCost, SensedSet, SensedSpec, SensedSummary};
+
+/// The altitude tuning trims at unless told, m: where the Monte Carlo releases, high enough
+/// for the 14-DOF steps to finish before the ground (at 100 m they do not).
+pub const DEFAULT_ALTITUDE_M: f64 = 600.0;

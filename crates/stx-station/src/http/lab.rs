@@ -1,6 +1,6 @@
 //! The Lab's endpoints (`/api/lab/…`): its status and last result for every page; starting and
 //! cancelling a job, saving a vehicle or gains file and sending gains to the drone for
-//! operators. A job's work runs on a thread of its own (`stx-lab`), never on the runtime that
+//! operators. A job's work runs on a thread of its own (named `stx-lab`), never on the runtime that
 //! carries the telemetry, at the lowest priority (the idle scheduling class and
 //! [`LAB_NICE`]), and reports to the pure runner ([`crate::lab::LabJobs`]). A comparison's
 //! recording is checked before its job starts: a plain name of the recordings directory (as

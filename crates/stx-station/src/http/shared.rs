@@ -60,8 +60,8 @@ pub struct Shared {
     /// Held while a pre-flight plan is computed (up to a second of a core): one at a time,
     /// so pages cannot take the cores the link and the telemetry need.
     pub planning: Arc<tokio::sync::Mutex<()>>,
-    /// The Lab, set once by the binary that can run its jobs (`stx serve`); unset, the Lab's
-    /// endpoints answer that there is none.
+    /// The Lab, set once with stx-lab's jobs by the binary (`stx serve`, and `stx bench
+    /// station` for its Lab load); unset, the Lab's endpoints answer that there is none.
     pub lab: std::sync::OnceLock<Arc<crate::lab::LabService>>,
     /// The simulated drone's restarts, set once by a binary that flies one beside the station
     /// (`stx serve --sim`); unset, `POST /api/lab/rehearse` answers that there is none.

@@ -2,7 +2,7 @@
 //! the dashboard): what the page asks ([`super::LabJobBody::Compare`] names a recording of the
 //! station's recordings directory, and may name a window of it), the checks made before a job
 //! starts (a recording holds a flight: [`missing_flight`]; a window is one:
-//! [`check_window`]), and what the page draws ([`CompareSeries`]). The flying is the binary's
+//! [`check_window`]), and what the page draws ([`CompareSeries`]). The flying is stx-lab's
 //! (stx-analysis sits above the station); it hands the series over thinned to at most
 //! [`MAX_COMPARE_POINTS`] instants ([`plotted`]), while the error figures are over every
 //! recorded sample.
@@ -54,8 +54,8 @@ pub fn missing_flight<R: Read + Seek>(recording: &Recording<R>) -> Option<String
 /// finite and ≥ 0, and the end after the start. Whether the recording's flight reaches into
 /// the window is known only once its log is read, so the work answers that
 /// ([`super::LabWorker::check_window`]). The rule is
-/// stx-analysis' `flight_log::window::Window::check` (above the station; a test of the
-/// binary holds the two equal).
+/// stx-analysis' `flight_log::window::Window::check` (above the station; a test of stx-lab
+/// holds the two equal).
 pub fn check_window(from_s: Option<f64>, to_s: Option<f64>) -> Result<(), (String, String)> {
     for (field, value) in [("from_s", from_s), ("to_s", to_s)] {
         if let Some(v) = value.filter(|v| !(v.is_finite() && *v >= 0.0)) {

@@ -1,7 +1,7 @@
 //! The Lab's identification of vehicle parameters from a recorded flight (issue 16 item 3;
 //! `stx identify` in the dashboard): the parameter names a page may ask for, checked before
-//! a job starts, and what the page shows ([`IdentifySummary`]). The fitting is the binary's
-//! (stx-analysis sits above the station, so the names are kept here and a test of the binary
+//! a job starts, and what the page shows ([`IdentifySummary`]). The fitting is stx-lab's
+//! (stx-analysis sits above the station, so the names are kept here and a test of stx-lab
 //! holds them equal to the library's).
 
 use schemars::JsonSchema;

@@ -3,8 +3,8 @@
 //! background, never on the telemetry path.
 //!
 //! The station cannot fly a scenario itself (stx-sim and stx-analysis sit above it in the
-//! crates' order), so the work is a [`LabWorker`] the binary hands over when it starts the
-//! daemon; the station owns what the pages see and send: the requests ([`LabJobBody`]), the
+//! crates' order), so the work is a [`LabWorker`] (stx-lab's) the binary hands over when it
+//! starts the daemon; the station owns what the pages see and send: the requests ([`LabJobBody`]), the
 //! results ([`LabResult`]), the job's life ([`jobs::LabJobs`]: one at a time, a time cap,
 //! progress, cancel, the last outcome kept), the vehicle editor ([`vehicle_fields`]) and
 //! what a comparison needs of a recording ([`compare`]), the parameters an identification
@@ -333,8 +333,8 @@ pub struct JobInputs {
     pub recording: Option<PathBuf>,
 }
 
-/// The work behind the Lab, supplied by the binary (it alone links the simulator and the
-/// analysis). Called on a blocking thread of its own.
+/// The work behind the Lab: stx-lab's, handed over by the binary (the station links neither
+/// the simulator nor the analysis). Called on a blocking thread of its own.
 pub trait LabWorker: Send + Sync {
     /// Runs `job` (already checked) with `inputs`; `Err` is the reason it failed.
     fn run(

@@ -6,8 +6,8 @@
 //! `invalid_job` — and a good one reaches the Lab's
 //! work as the file of the directory, whose result every page then reads.
 //!
-//! The work here is a stand-in that reads the file it is handed (the flying is the binary's,
-//! tested in `crates/stx/src/lab_compare.rs` and by `tests/browser/lab.mjs`).
+//! The work here is a stand-in that reads the file it is handed (the flying is stx-lab's,
+//! tested in `crates/stx-lab/src/compare.rs` and by `tests/browser/lab.mjs`).
 
 use crate::common;
 

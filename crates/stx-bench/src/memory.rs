@@ -2,17 +2,17 @@
 //! faster than real time.
 //!
 //! It runs the real thing as an operator would: the daemon `stx serve` in one child process
-//! (this binary) and the simulated drone `stx drone` in another, on the daemon's UDP link —
-//! the same bytes as `stx serve --sim`, but with the drone's physics and memory outside the
-//! figure. The drone flies the built-in `mission` held on the pad long enough that launch day
-//! lasts three hours of mission time (a station is up well before the balloon goes), and
-//! dashboard pages are connected over WebSocket the whole time, reading everything. Once the
-//! station sees the drone landed, the daemon's resident set (`VmRSS`) and its peak (`VmHWM`)
-//! are read from `/proc` (sampled every second along the way too); the drone's peak is reported
-//! beside it. The daemon records the run (into a directory of its own, removed after: the
-//! recording's size is reported), 20 more pages come and go every five seconds, and the
-//! daemon's open file descriptors are counted a minute in and at the end, so a leak of
-//! either shows.
+//! (the `stx` executable of [`MemoryBenchOptions::stx`]) and the simulated drone `stx drone` in
+//! another, on the daemon's UDP link — the same bytes as `stx serve --sim`, but with the
+//! drone's physics and memory outside the figure. The drone flies the built-in `mission` held
+//! on the pad long enough that launch day lasts three hours of mission time (a station is up
+//! well before the balloon goes), and dashboard pages are connected over WebSocket the whole
+//! time, reading everything. Once the station sees the drone landed, the daemon's resident set
+//! (`VmRSS`) and its peak (`VmHWM`) are read from `/proc` (sampled every second along the way
+//! too); the drone's peak is reported beside it. The daemon records the run (into a directory
+//! of its own, removed after: the recording's size is reported), 20 more pages come and go
+//! every five seconds, and the daemon's open file descriptors are counted a minute in and at
+//! the end, so a leak of either shows.
 
 use std::io::IsTerminal;
 use std::path::PathBuf;
@@ -30,6 +30,9 @@ use tokio::process::Command;
 
 /// What [`run`] measures and how.
 pub struct MemoryBenchOptions {
+    /// The `stx` executable, run as the daemon and as the drone (the command line passes
+    /// itself): the figure is of the program an operator runs.
+    pub stx: PathBuf,
     /// Mission time of the whole launch day, s.
     pub mission_s: f64,
     /// Mission time per real time.
@@ -75,6 +78,36 @@ pub struct MemoryReport {
     pub recording_mb: f64,
     /// Messages the recording could not write.
     pub recording_lost: u64,
+}
+
+/// The report as `stx bench memory` prints it without `--json`.
+impl std::fmt::Display for MemoryReport {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        writeln!(
+            f,
+            "station daemon alone after {:.0} s of mission ({}, {:.0} s wall at {}x, {} pages): RSS {:.1} MB, peak {:.1} MB (after 1 min: {:.1} MB; the drone's process peaked at {:.1} MB); pages received {} messages, {:.1} MB",
+            self.mission_time_s,
+            if self.landed { "landed" } else { "NOT landed" },
+            self.wall_time_s,
+            self.speed,
+            self.clients,
+            self.rss_after_mb,
+            self.rss_peak_mb,
+            self.rss_early_mb,
+            self.drone_rss_peak_mb,
+            self.page_messages,
+            self.page_bytes as f64 / 1e6
+        )?;
+        writeln!(
+            f,
+            "{} pages came and went; open file descriptors {} after 1 min, {} at the end; recording {:.1} MB on disk, {} messages lost",
+            self.pages_come_and_gone,
+            self.fds_early,
+            self.fds_after,
+            self.recording_mb,
+            self.recording_lost
+        )
+    }
 }
 
 /// Open file descriptors of a process (`/proc/PID/fd`).
@@ -234,11 +267,11 @@ pub fn run(options: &MemoryBenchOptions) -> anyhow::Result<MemoryReport> {
 
 async fn measure(options: &MemoryBenchOptions) -> anyhow::Result<MemoryReport> {
     let mission = three_hour_mission(options.mission_s)?;
-    let exe: PathBuf = std::env::current_exe().context("this program's path")?;
+    let exe = &options.stx;
     // The station records, as it does in the field; into a directory of its own.
     let record_dir = std::env::temp_dir().join(format!("stx-bench-memory-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&record_dir);
-    let mut child = Command::new(&exe)
+    let mut child = Command::new(exe)
         .args([
             "serve",
             "--listen",
@@ -267,7 +300,7 @@ async fn measure(options: &MemoryBenchOptions) -> anyhow::Result<MemoryReport> {
     else {
         bail!("stx serve did not print its link: {link_line:?}");
     };
-    let mut drone = Command::new(&exe)
+    let mut drone = Command::new(exe)
         .args(["drone", "--connect", &format!("udpout:{link}")])
         .arg("--scenario")
         .arg(mission.path())

@@ -1,5 +1,5 @@
 //! The station benchmarks' HTTP client side: one POST on a kept-alive HTTP/1.1 connection,
-//! shared by the command timing (`bench_station`) and the Lab load (`bench_lab`).
+//! shared by the command timing ([`crate::station`]) and the Lab load ([`crate::lab_load`]).
 
 use std::net::SocketAddr;
 

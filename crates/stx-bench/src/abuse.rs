@@ -101,7 +101,7 @@ pub struct Flood {
 impl Flood {
     /// Starts the flood on the station at `http`; `viewer_token` opens the churned pages.
     pub fn start(http: SocketAddr, viewer_token: String) -> anyhow::Result<Self> {
-        let (rss_before_mb, _) = crate::bench_memory::memory_mb(std::process::id())?;
+        let (rss_before_mb, _) = crate::memory::memory_mb(std::process::id())?;
         let counters = Arc::new(Counters::default());
         let c = counters.clone();
         let requests = tokio::spawn(async move {
@@ -136,7 +136,7 @@ impl Flood {
             t.abort();
         }
         tokio::time::sleep(Duration::from_secs(2)).await;
-        let (rss_after_mb, _) = crate::bench_memory::memory_mb(std::process::id())?;
+        let (rss_after_mb, _) = crate::memory::memory_mb(std::process::id())?;
         let c = &self.counters;
         Ok(AbuseReport {
             bad_token_requests: c.sent.load(Ordering::Relaxed),

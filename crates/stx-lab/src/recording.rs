@@ -1,13 +1,13 @@
-//! What the Lab's jobs on a recording (`crate::lab_compare`, `crate::lab_identify`) share:
-//! the recording the station checked before the job started, read as a flight log as the
-//! command line reads it; a job's progress and cancel in the form the analysis' loops take;
-//! and the vehicle edits as the results list them.
+//! What the Lab's jobs on a recording ([`crate::compare`], [`crate::identify`]) share: the
+//! recording the station checked before the job started, read as a flight log as the command
+//! line reads it ([`crate::flight_file`]); a job's progress and cancel in the form the
+//! analysis' loops take; and the vehicle edits as the results list them.
 
 use stx_analysis::flight_log::FlightLog;
 use stx_analysis::flight_log::window::{Window, WindowEnd};
 use stx_station::lab::{JobControl, JobInputs, LabJobBody, VehicleEdits};
 
-use crate::compare::read_log;
+use crate::flight_file::read_log;
 
 /// Why a job on a recording cannot run.
 #[derive(Debug, Clone, PartialEq)]
@@ -256,7 +256,7 @@ pub(crate) mod tests {
             "{}",
             cut.duration_s()
         );
-        let LabResult::Compare(s) = crate::lab_compare::run(
+        let LabResult::Compare(s) = crate::compare::run(
             "flight.mcap",
             &inputs,
             &Window::new(Some(30.0), Some(40.0)),

@@ -13,7 +13,7 @@ use stx_station::lab::{
     IdentifiedParam, IdentifySummary, JobControl, JobInputs, LabResult, VehicleEdits,
 };
 
-use crate::lab_recording::{flight_log, vehicle_changes, watcher};
+use crate::recording::{flight_log, vehicle_changes, watcher};
 
 /// Fits `params` to the recording `name`, from the vehicle of `inputs` (edited from the
 /// seed's by `edits`).
@@ -87,7 +87,7 @@ mod tests {
     use stx_dynamics::vehicle::Vehicle;
     use stx_station::lab::identify::IDENTIFY_PARAMS;
 
-    use crate::lab_recording::tests::{control, inputs, recorded_flight, temp};
+    use crate::recording::tests::{control, inputs, recorded_flight, temp};
 
     #[test]
     fn the_station_knows_the_library_s_parameters() {

@@ -52,10 +52,10 @@ pub struct StationBenchOptions {
     pub commands: usize,
     /// Record the run into this directory (the station's recording on), else not.
     pub record_dir: Option<std::path::PathBuf>,
-    /// Flood the station from other addresses while telemetry is timed (`bench_abuse`).
+    /// Flood the station from other addresses while telemetry is timed ([`crate::abuse`]).
     pub abuse: bool,
     /// Keep Lab Monte Carlo batches of this many runs going while telemetry is timed
-    /// (`bench_lab`).
+    /// ([`crate::lab_load`]).
     pub lab_montecarlo: Option<u32>,
 }
 
@@ -110,9 +110,75 @@ pub struct StationReport {
     /// The station's recording at the end (`off` without `--record-dir`).
     pub recording: stx_station::messages::RecordingView,
     /// The flood during the telemetry window, with `--abuse`.
-    pub abuse: Option<crate::bench_abuse::AbuseReport>,
+    pub abuse: Option<crate::abuse::AbuseReport>,
     /// The Lab batches during the telemetry window, with `--lab-montecarlo`.
-    pub lab: Option<crate::bench_lab::LabLoadReport>,
+    pub lab: Option<crate::lab_load::LabLoadReport>,
+}
+
+/// The report as `stx bench station` prints it without `--json`: a line a figure.
+impl std::fmt::Display for StationReport {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let t = &self.telemetry_to_websocket;
+        let c = &self.command_to_mavlink;
+        writeln!(
+            f,
+            "telemetry → WebSocket, {} pages, {} bursts at {} Hz, state {} bytes: p50 {:.2} ms, p99 {:.2} ms, max {:.2} ms ({} samples, {} missed)",
+            t.clients,
+            t.frames_sent,
+            t.frame_rate_hz,
+            t.state_bytes,
+            t.latency.p50_ms,
+            t.latency.p99_ms,
+            t.latency.max_ms,
+            t.latency.samples,
+            t.missed
+        )?;
+        writeln!(
+            f,
+            "command → MAVLink bytes, {} commands: p50 {:.2} ms, p99 {:.2} ms, max {:.2} ms ({} lost)",
+            c.commands_sent, c.latency.p50_ms, c.latency.p99_ms, c.latency.max_ms, c.lost
+        )?;
+        if let Some(a) = &self.abuse {
+            writeln!(
+                f,
+                "flood during it: {} wrong-token requests ({} answered 429, {} 401, {} other), {} WebSockets tried ({} opened and closed); process RSS {:.1} MB before, {:.1} MB after",
+                a.bad_token_requests,
+                a.answered_429,
+                a.answered_401,
+                a.other,
+                a.websockets_tried,
+                a.websockets_opened,
+                a.rss_before_mb,
+                a.rss_after_mb
+            )?;
+        }
+        if let Some(l) = &self.lab {
+            writeln!(
+                f,
+                "Lab Monte Carlo during it: {} batch{} of {} runs started back to back ({} ended on their own), {} runs flown; the Lab busy {:.1} % of the window (longest gap {:.0} ms)",
+                l.batches,
+                if l.batches == 1 { "" } else { "es" },
+                l.runs_per_batch,
+                l.batches_finished,
+                l.runs_flown,
+                l.busy_fraction * 100.0,
+                l.longest_idle_ms
+            )?;
+        }
+        let r = &self.recording;
+        writeln!(
+            f,
+            "recording: {:?}, {} messages ({:.2} MB) written, {} lost{}",
+            r.state,
+            r.messages_written,
+            r.bytes_written as f64 / 1e6,
+            r.messages_lost,
+            r.problem
+                .as_deref()
+                .map(|p| format!(" (last problem: {p})"))
+                .unwrap_or_default()
+        )
+    }
 }
 
 /// Starts the station on its own runtime; returns its addresses and the stop switch.
@@ -341,12 +407,12 @@ pub fn run(options: &StationBenchOptions) -> anyhow::Result<StationReport> {
                 .find(|t| t.role == Role::Viewer)
                 .map(|t| t.token.clone())
                 .context("the station config has no viewer token")?;
-            Some(crate::bench_abuse::Flood::start(running.http, viewer)?)
+            Some(crate::abuse::Flood::start(running.http, viewer)?)
         } else {
             None
         };
         let lab = match options.lab_montecarlo {
-            Some(runs) => Some(crate::bench_lab::LabLoad::start(&running, &token, runs).await?),
+            Some(runs) => Some(crate::lab_load::LabLoad::start(&running, &token, runs).await?),
             None => None,
         };
         let timed_from = Instant::now();
@@ -410,7 +476,7 @@ pub fn run(options: &StationBenchOptions) -> anyhow::Result<StationReport> {
             // A new heading each time, so the drone never takes it for a retry.
             let body = format!(r#"{{"heading_deg":{}}}"#, (k % 3600) as f64 * 0.1);
             let started = Instant::now();
-            let status = crate::bench_http::post(
+            let status = crate::http::post(
                 &mut sender,
                 running.http,
                 "/api/commands/heading",

@@ -11,7 +11,7 @@ use stx_station::lab::{
     CompareChannel, CompareSeries, JobControl, JobInputs, LabResult, VehicleEdits,
 };
 
-use crate::lab_recording::{flight_log, vehicle_changes, watcher};
+use crate::recording::{flight_log, vehicle_changes, watcher};
 
 /// Compares the recording `name` with the vehicle of `inputs` (edited from the seed's by
 /// `edits`).
@@ -83,7 +83,7 @@ mod tests {
     use stx_analysis::flight_log::synthetic::{SyntheticFlight, simulate};
     use stx_dynamics::vehicle::Vehicle;
 
-    use crate::lab_recording::tests::{control, inputs, recorded_flight, temp};
+    use crate::recording::tests::{control, inputs, recorded_flight, temp};
 
     #[test]
     fn a_recorded_flight_is_compared_as_stx_compare_compares_it() {

@@ -1,8 +1,22 @@
-//! The Lab's work for `stx serve`: the station's Lab (`stx_station::lab`) decides what runs
-//! and when; this flies the scenario, the Monte Carlo batch, the stability analysis, the
-//! tuning run, a recording's comparison with the model (`crate::lab_compare`) or its
-//! parameters' identification (`crate::lab_identify`; what the two share is
-//! `crate::lab_recording`) with the simulator and the analysis, which only the binary links.
+//! The Lab's jobs. The station's Lab (`stx_station::lab`) decides what runs and when, and owns
+//! what the pages see; the work itself needs the simulator and the analysis, which sit above
+//! the station in the crates' order, so it lives here as the [`LabWorker`] the binary hands the
+//! daemon ([`service`]).
+//!
+//! How the parts fit: this file flies a built-in scenario, a Monte Carlo batch, the stability
+//! analysis and a tuning run; a recording's comparison with the model is [`compare`] and its
+//! parameters' identification [`identify`], what the two share (the recording read as a flight
+//! log, progress and cancel, the edits listed) is [`recording`], and [`flight_file`] reads a
+//! flight log from a file as `stx compare` and `stx identify` do, so the Lab and the command
+//! line read a flight alike.
+//!
+//! No tokio (the station without its `daemon` feature): the Lab runs each job on a blocking
+//! thread of its own, and the jobs only compute.
+
+pub mod compare;
+pub mod flight_file;
+pub mod identify;
+pub mod recording;
 
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -10,7 +24,7 @@ use std::sync::Arc;
 use stx_analysis::analysis::analyze;
 use stx_analysis::flight_log::window::Window;
 use stx_analysis::gains_file::gains_file;
-use stx_analysis::tune::{Controller, tune};
+use stx_analysis::tune::{Controller, DEFAULT_ALTITUDE_M, tune};
 use stx_dynamics::vehicle::Vehicle;
 use stx_gnc::estimator::EstimatorConfig;
 use stx_gnc::guidance::GuidanceConfig;
@@ -75,7 +89,7 @@ impl LabWorker for Worker {
                 to_s,
             } => {
                 let window = Window::new(*from_s, *to_s);
-                crate::lab_compare::run(recording, inputs, &window, edits, control)
+                compare::run(recording, inputs, &window, edits, control)
             }
             LabJobBody::Identify {
                 recording,
@@ -85,13 +99,13 @@ impl LabWorker for Worker {
                 to_s,
             } => {
                 let window = Window::new(*from_s, *to_s);
-                crate::lab_identify::run(recording, params, inputs, &window, edits, control)
+                identify::run(recording, params, inputs, &window, edits, control)
             }
         }
     }
 
     fn check_window(&self, job: &LabJobBody, inputs: &JobInputs) -> Result<(), (String, String)> {
-        crate::lab_recording::check_window(job, inputs)
+        recording::check_window(job, inputs)
     }
 }
 
@@ -219,7 +233,7 @@ fn tuning(
             .unwrap_or_else(|| "no step flown".into());
         return Err(format!(
             "the tuned gains failed the 14-DOF step at {altitude_m} m: {why} (tune at {} m, where the Monte Carlo releases, or higher)",
-            crate::tune::DEFAULT_ALTITUDE_M
+            DEFAULT_ALTITUDE_M
         ));
     };
     Ok(LabResult::Tune(TuneSummary {

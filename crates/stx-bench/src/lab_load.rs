@@ -93,7 +93,7 @@ impl LabLoad {
     /// [`LabLoad::stop`]; returns once the first batch runs.
     pub async fn start(running: &Running, token: &str, runs: u32) -> anyhow::Result<Self> {
         let dir = std::env::temp_dir().join("stx-bench-lab");
-        let _ = running.shared.lab.set(crate::lab::service(dir));
+        let _ = running.shared.lab.set(stx_lab::service(dir));
         let lab = running.shared.lab.get().context("the Lab")?.clone();
         let mut sender = connect(running.http).await?;
         let mut batches = Batches::default();
@@ -125,7 +125,7 @@ impl LabLoad {
         let _ = self.stop.send(true);
         let mut batches = self.task.await.context("the Lab load's task")??;
         let mut sender = connect(self.http).await?;
-        let cancel = crate::bench_http::post(
+        let cancel = crate::http::post(
             &mut sender,
             self.http,
             "/api/lab/cancel",
@@ -173,7 +173,7 @@ async fn start_batch(
     let body = format!(
         r#"{{"kind":"monte_carlo","runs":{runs},"seed":{n},"wind_max_mps":4,"altitude_m":600}}"#
     );
-    let status = crate::bench_http::post(sender, http, "/api/lab/jobs", token, body)
+    let status = crate::http::post(sender, http, "/api/lab/jobs", token, body)
         .await
         .context("starting a Lab batch")?;
     if status != 202 {
