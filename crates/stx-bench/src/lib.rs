@@ -14,6 +14,9 @@
 //! - [`agreement`]: whole missions flown by `stx_agreement`, held against its goals.
 //!
 //! `stx bench dynamics` is `stx_sim::speed` itself and needs nothing here.
+//!
+//! Errors are `anyhow`, unlike the other libraries': a bench's failure ends the run and is
+//! told to whoever started it, with its context; no caller matches on it.
 
 pub mod abuse;
 pub mod agreement;

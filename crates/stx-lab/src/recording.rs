@@ -7,7 +7,7 @@ use stx_analysis::flight_log::FlightLog;
 use stx_analysis::flight_log::window::{Window, WindowEnd};
 use stx_station::lab::{JobControl, JobInputs, LabJobBody, VehicleEdits};
 
-use crate::flight_file::read_log;
+use crate::flight_file::{chain, read_log};
 
 /// Why a job on a recording cannot run.
 #[derive(Debug, Clone, PartialEq)]
@@ -36,7 +36,7 @@ pub fn flight_log(name: &str, inputs: &JobInputs, window: &Window) -> Result<Fli
             "the station gave the job on {name} no recording (a bug)"
         ))
     })?;
-    let log = read_log(path).map_err(|e| Refused::Recording(format!("{e:#}")))?;
+    let log = read_log(path).map_err(|e| Refused::Recording(chain(&e)))?;
     log.cut(window).map_err(|e| Refused::Window {
         field: match e.end() {
             WindowEnd::From => "from_s",

@@ -77,7 +77,7 @@ fn flag_error(e: WindowError, path: Option<&Path>) -> anyhow::Error {
 /// a file that reads as no flight log, or a window holding no flight of it, is bad input.
 pub fn read_window(path: &Path, window: &Window) -> anyhow::Result<FlightLog> {
     read_log(path)
-        .map_err(BadInput)?
+        .map_err(|e| BadInput(e.into()))?
         .cut(window)
         .map_err(|e| flag_error(e, Some(path)))
 }
