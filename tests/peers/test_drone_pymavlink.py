@@ -206,6 +206,33 @@ def exercise(conn):
     ack = recv(conn, "COMMAND_ACK", cond=lambda m: m.command == mavutil.mavlink.MAV_CMD_DO_SET_MODE)
     assert ack.result != mavutil.mavlink.MAV_RESULT_ACCEPTED, f"unknown mode 42 accepted: {ack}"
     report["refusals"] = "ok"
+
+    # 5. What the drone is, as QGroundControl and MAVProxy ask on connecting: the message by
+    # MAV_CMD_REQUEST_MESSAGE, and by the older MAV_CMD_REQUEST_AUTOPILOT_CAPABILITIES.
+    versions = []
+    for cmd, p1 in ((mavutil.mavlink.MAV_CMD_REQUEST_MESSAGE, 148),
+                    (mavutil.mavlink.MAV_CMD_REQUEST_AUTOPILOT_CAPABILITIES, 1)):
+        conn.mav.command_long_send(1, 1, cmd, 0, p1, 0, 0, 0, 0, 0, 0)
+        ack = recv(conn, "COMMAND_ACK", cond=lambda m, cmd=cmd: m.command == cmd)
+        assert ack.result == mavutil.mavlink.MAV_RESULT_ACCEPTED, ack
+        versions.append(recv(conn, "AUTOPILOT_VERSION"))
+    v = versions[0]
+    caps = v.capabilities
+    names = [n for n, bit in (
+        ("MAVLINK2", mavutil.mavlink.MAV_PROTOCOL_CAPABILITY_MAVLINK2),
+        ("PARAM_ENCODE_C_CAST", mavutil.mavlink.MAV_PROTOCOL_CAPABILITY_PARAM_ENCODE_C_CAST),
+        ("PARAM_ENCODE_BYTEWISE", mavutil.mavlink.MAV_PROTOCOL_CAPABILITY_PARAM_ENCODE_BYTEWISE),
+        ("COMMAND_INT", mavutil.mavlink.MAV_PROTOCOL_CAPABILITY_COMMAND_INT),
+        ("MISSION_INT", mavutil.mavlink.MAV_PROTOCOL_CAPABILITY_MISSION_INT),
+        ("MISSION_FENCE", mavutil.mavlink.MAV_PROTOCOL_CAPABILITY_MISSION_FENCE),
+        ("FLIGHT_TERMINATION", mavutil.mavlink.MAV_PROTOCOL_CAPABILITY_FLIGHT_TERMINATION),
+    ) if caps & bit]
+    sw = v.flight_sw_version
+    report["autopilot_version"] = {
+        "capabilities": names,
+        "flight_sw_version": f"{sw >> 24}.{(sw >> 16) & 0xFF}.{(sw >> 8) & 0xFF} type {sw & 0xFF}",
+        "same_answer_twice": versions[1].capabilities == caps and versions[1].flight_sw_version == sw,
+    }
     return report
 
 

@@ -22,6 +22,11 @@
 //! its retries are identical copies, which the vehicle recognises by content within
 //! [`CommandServer::dedup_window`].
 //!
+//! A request for AUTOPILOT_VERSION (`MAV_CMD_REQUEST_MESSAGE` with p1 = 148, or
+//! `MAV_CMD_REQUEST_AUTOPILOT_CAPABILITIES`) never reaches the command server: the vehicle
+//! endpoint answers it itself (`endpoint/identity.rs`), since what the link implements is the
+//! link's to say.
+//!
 //! ## Files
 //! - `encoding.rs`: [`Command`], [`CommandResult`], [`CommandDecodeError`] and the mapping
 //!   above.

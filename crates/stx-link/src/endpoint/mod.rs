@@ -4,8 +4,8 @@
 //! - [`GroundEndpoint`] (station): sends commands, parameter and plan requests and the
 //!   joystick; receives telemetry; tracks whether the drone is connected.
 //! - [`VehicleEndpoint`] (drone, simulated or not): sends telemetry and its status heartbeat;
-//!   answers commands, parameters and plan transfers; turns MANUAL_CONTROL into sticks that go
-//!   stale.
+//!   answers commands, parameters, plan transfers and requests for AUTOPILOT_VERSION; turns
+//!   MANUAL_CONTROL into sticks that go stale.
 //!
 //! Both send a HEARTBEAT every [`LinkConfig::heartbeat_period`] and declare the peer connected
 //! on its first heartbeat and lost after [`LinkConfig::link_timeout`] without one, with a
@@ -30,18 +30,21 @@
 //! - `core.rs`: [`LinkConfig`], [`LinkEvent`] and the link core both ends own (framing,
 //!   signing, radios, heartbeat timer, liveness, statistics).
 //! - `ground.rs`: [`GroundEndpoint`] with its [`GroundConfig`] and [`GroundEvent`].
-//! - `vehicle.rs`: [`VehicleEndpoint`] with its [`VehicleConfig`] and [`VehicleEvent`].
+//! - `vehicle.rs`: [`VehicleEndpoint`] with its [`VehicleConfig`] and [`VehicleEvent`];
+//!   `identity.rs`: the AUTOPILOT_VERSION it answers with ([`Identity`], [`capabilities`]).
 //! - `stats.rs`: [`LinkStats`]; `senders.rs`: [`SenderStats`] and the loss accounting that
 //!   [`crate::paths`] applies per radio too.
 
 mod core;
 mod ground;
+mod identity;
 pub(crate) mod senders;
 mod stats;
 mod vehicle;
 
 pub use self::core::{LinkConfig, LinkEvent};
 pub use ground::{GroundConfig, GroundEndpoint, GroundEvent};
+pub use identity::{AUTOPILOT_VERSION_ID, Identity, capabilities};
 pub use senders::{MAX_LOSS_GAP, MAX_REORDER_DEPTH, SenderStats};
 pub use stats::LinkStats;
 pub use vehicle::{VehicleConfig, VehicleEndpoint, VehicleEvent};

@@ -1,5 +1,6 @@
 //! The drone's end of the link (simulated or not): sends telemetry and its status heartbeat;
-//! answers commands, parameters and plan transfers; turns MANUAL_CONTROL into sticks that go
+//! answers commands, parameters, plan transfers and requests for its identity
+//! (AUTOPILOT_VERSION, `identity.rs`); turns MANUAL_CONTROL into sticks that go
 //! stale.
 
 use std::collections::VecDeque;
@@ -9,6 +10,7 @@ use mavlink::dialects::common as mc;
 use mavlink::dialects::common::MavMessage;
 
 use super::core::{LinkConfig, LinkCore, LinkEvent};
+use super::identity::{Identity, IdentityServer};
 use super::stats::LinkStats;
 use crate::command::{CommandResult, CommandServer, IncomingCommand, IncomingId};
 use crate::frame::Frame;
@@ -35,6 +37,8 @@ pub struct VehicleConfig {
     pub command_dedup_window: Duration,
     /// Status sent in heartbeats until the application sets one.
     pub initial_status: VehicleStatus,
+    /// How the drone names itself when a ground station asks (AUTOPILOT_VERSION).
+    pub identity: Identity,
 }
 
 impl Default for VehicleConfig {
@@ -52,6 +56,7 @@ impl Default for VehicleConfig {
                 phase: GuidancePhase::Idle,
                 state: SystemState::Standby,
             },
+            identity: Identity::default(),
         }
     }
 }
@@ -84,6 +89,7 @@ pub struct VehicleEndpoint {
     core: LinkCore,
     status: VehicleStatus,
     commands: CommandServer,
+    identity: IdentityServer,
     params: ParamTable,
     plan: PlanServer,
     fence: FenceServer,
@@ -104,6 +110,7 @@ impl VehicleEndpoint {
             fence: FenceServer::new(sys, comp, config.plan),
             manual: ManualReceiver::new(sys, config.manual_timeout),
             commands,
+            identity: IdentityServer::new(sys, comp, config.identity),
             status: config.initial_status,
             core: LinkCore::new(config.link, now),
             next_text_id: 1,
@@ -229,7 +236,8 @@ impl VehicleEndpoint {
                     false
                 }
                 _ => {
-                    self.commands.handle_message(now, from, msg)
+                    self.identity.handle_message(from, msg)
+                        || self.commands.handle_message(now, from, msg)
                         || self.params.handle_message_with(msg, validator)
                         || self.plan.handle_message(now, from, msg)
                         || self.fence.handle_message(now, from, msg)
@@ -336,6 +344,9 @@ impl VehicleEndpoint {
     /// Next frame to send.
     pub fn poll_transmit(&mut self, now: Duration) -> Option<Vec<u8>> {
         while let Some(m) = self.commands.poll_transmit() {
+            self.core.send(now, &m);
+        }
+        while let Some(m) = self.identity.poll_transmit() {
             self.core.send(now, &m);
         }
         while let Some(m) = self.params.poll_transmit() {

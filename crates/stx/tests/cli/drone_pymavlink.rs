@@ -1,7 +1,8 @@
 //! `stx drone` against an independent MAVLink implementation: pymavlink 2.4.50 as the ground
 //! station (`tests/peers/test_drone_pymavlink.py`). It reads the telemetry and measures its
 //! rates, lists the parameters, sets one and reads it back, changes the mode and times the
-//! COMMAND_ACK, and has refusals acknowledged as refusals. The script raises on any failed
+//! COMMAND_ACK, has refusals acknowledged as refusals, and asks for AUTOPILOT_VERSION as
+//! QGroundControl and MAVProxy do on connecting. The script raises on any failed
 //! check; this test runs it and prints what it measured.
 //!
 //! Python: `$STX_PYTHON`, or `.venv/bin/python` at the workspace root (`tests/run-all`
@@ -84,5 +85,30 @@ fn pymavlink_reads_telemetry_lists_and_sets_parameters_and_gets_its_commands_ack
         report["set_mode_ack_ms"].as_f64().unwrap_or(f64::INFINITY) < 250.0,
         "{report}"
     );
+    // Read as a generic MAVLink vehicle: MAVLink 2, whole-number parameters cast into the
+    // float field (not bytewise), the same answer to either request.
+    let version = &report["autopilot_version"];
+    let capabilities: Vec<&str> = version["capabilities"]
+        .as_array()
+        .map(|a| a.iter().filter_map(|c| c.as_str()).collect())
+        .unwrap_or_default();
+    for expected in [
+        "MAVLINK2",
+        "PARAM_ENCODE_C_CAST",
+        "COMMAND_INT",
+        "MISSION_INT",
+    ] {
+        assert!(
+            capabilities.contains(&expected),
+            "{expected} missing: {report}"
+        );
+    }
+    assert!(!capabilities.contains(&"PARAM_ENCODE_BYTEWISE"), "{report}");
+    assert_eq!(
+        version["flight_sw_version"],
+        format!("{} type 0", env!("CARGO_PKG_VERSION")),
+        "{report}"
+    );
+    assert_eq!(version["same_answer_twice"], true, "{report}");
     assert_eq!(report["drone_exit_code"], 0, "{report}");
 }
