@@ -147,17 +147,23 @@ async function rehearsal() {
     };
     window.__pad = pad;
     navigator.getGamepads = () => [pad, null, null, null];
+    // What the page sends, stamped in the page's own clock: the browser reports sent frames
+    // to the test asynchronously, so under load a frame sent before a mark can arrive after it.
+    window.__sent = [];
+    const send = WebSocket.prototype.send;
+    WebSocket.prototype.send = function (data) {
+      let type = "?";
+      try {
+        type = JSON.parse(data).type;
+      } catch {}
+      window.__sent.push({ t: performance.now(), type });
+      return send.call(this, data);
+    };
   });
   const page = await ctx.newPage();
   watchErrors(page, "operator");
-  const sentFrames = [];
-  page.on("websocket", (ws) => ws.on("framesent", (f) => {
-    try {
-      sentFrames.push(JSON.parse(f.payload).type);
-    } catch {
-      sentFrames.push("?");
-    }
-  }));
+  // Frames the page sent since an instant of its clock, pings left out.
+  const sentSince = (t) => page.evaluate((t) => window.__sent.filter((f) => f.t >= t && f.type !== "ping").map((f) => f.type), t);
   await page.goto(`${base}/?token=${OPERATOR}`);
   await page.waitForFunction(() => document.querySelector('[data-testid="conn-status"]')?.textContent === "CONNECTED", null, { timeout: 15000 });
 
@@ -269,25 +275,28 @@ async function rehearsal() {
   const turned = await until(vehicle, (v) => (v?.servos?.main_line ?? 0) > 0.3, 8000);
   await page.screenshot({ path: join(out, "live-joystick.png") });
   check("gamepad right stick → the drone's main-line servo moves", (turned?.servos?.main_line ?? 0) > 0.3, `main_line ${turned?.servos?.main_line}`);
-  const mark = sentFrames.length;
-  await page.evaluate(() => {
+  const mark = await page.evaluate(() => {
     window.__pad.buttons[0] = { pressed: false, touched: false, value: 0 };
     window.__pad.axes[2] = 0;
+    return performance.now();
   });
   const released = await until(vehicle, (v) => Math.abs(v?.servos?.main_line ?? 1) < 0.1, 8000);
   check("dead-man released → the main line returns", Math.abs(released?.servos?.main_line ?? 1) < 0.1, `main_line ${released?.servos?.main_line}`);
-  const afterRelease = sentFrames.slice(mark).filter((t) => t !== "ping");
+  const afterRelease = await sentSince(mark);
   check("dead-man released → exactly one manual_release, after the last sticks", afterRelease.filter((t) => t === "manual_release").length === 1 && afterRelease[afterRelease.length - 1] === "manual_release", afterRelease.join(" ") || "nothing sent");
   // Focus lost while flying: the stream stops and is released once.
   await page.evaluate(() => {
     window.__pad.buttons[0] = { pressed: true, touched: true, value: 1 };
   });
   await sleep(600);
-  const mark2 = sentFrames.length;
-  await page.evaluate(() => window.dispatchEvent(new Event("blur")));
+  const mark2 = await page.evaluate(() => {
+    const t = performance.now();
+    window.dispatchEvent(new Event("blur"));
+    return t;
+  });
   await sleep(800);
-  const afterBlur = sentFrames.slice(mark2).filter((t) => t !== "ping");
-  check("page loses focus → the stream stops with exactly one manual_release", afterBlur.filter((t) => t === "manual_release").length === 1 && afterBlur.filter((t) => t === "manual").length <= 1 && afterBlur[afterBlur.length - 1] === "manual_release", afterBlur.join(" ") || "nothing sent");
+  const afterBlur = await sentSince(mark2);
+  check("page loses focus → the stream stops with exactly one manual_release", afterBlur.filter((t) => t === "manual_release").length === 1 && afterBlur.filter((t) => t === "manual").length === 0 && afterBlur[afterBlur.length - 1] === "manual_release", afterBlur.join(" ") || "nothing sent");
   await page.evaluate(() => {
     window.__pad.buttons[0] = { pressed: false, touched: false, value: 0 };
     window.dispatchEvent(new Event("focus"));
