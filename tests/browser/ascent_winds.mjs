@@ -51,6 +51,9 @@ async function flight() {
   // During the ascent: the first bands appear while the balloon still rises.
   const during = await until(async () => ({ n: await diamonds(), stage: (await api("/api/state")).body?.mission?.stage }), (x) => x.n >= 1 || x.stage === "round_chute", 120000, 500);
   check("during the ascent the wind panel draws measured bands", during.n >= 1 && during.stage === "ascent", `${during.n} band(s) drawn at stage ${during.stage}`);
+  // Its legend names what is drawn, and under the balloon nothing is a descent.
+  const legendItems = await page.locator('[data-testid="wind-chart"] [data-testid="wind-legend-item"]').allTextContents();
+  check("during the ascent the wind legend names the ascent's bands and no descent", legendItems.includes("ascent ±2σ") && !legendItems.includes("descent"), legendItems.join(", "));
 
   // The flight path on the map while the balloon rises, and the last burst it predicted
   // against where the balloon burst (the estimate at the first state under the round chute).

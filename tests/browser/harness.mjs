@@ -273,6 +273,9 @@ export const browser = await chromium.launch({
 });
 export const text = (page, id) => page.locator(`[data-testid="${id}"]`).first().innerText();
 export const attr = (page, id, name) => page.locator(`[data-testid="${id}"]`).first().getAttribute(name);
+/** The readouts on the page whose text is cut short (an ellipsis shown): "testid: text". */
+export const cutShort = (page) => page.locator(".ro-val").evaluateAll((els) =>
+  els.filter((e) => e.offsetParent !== null && e.scrollWidth > e.clientWidth + 1).map((e) => `${e.dataset.testid ?? "?"}: ${e.textContent}`));
 export const rectOf = (page, sel) => page.evaluate((s) => {
   const e = document.querySelector(s);
   if (!e) return null;

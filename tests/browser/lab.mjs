@@ -190,6 +190,21 @@ async function lab() {
   check("compare: a viewer sees the comparison but cannot start one (button disabled, 403); a name outside the recordings directory is 404 unknown_recording",
     viewerPlots === 9 && (await vpage.locator('[data-testid="compare-start"]').isDisabled()) && viewerCompare.status === 403 && outside.status === 404 && outside.body?.error === "unknown_recording",
     `${viewerPlots} plots for the viewer; viewer ${viewerCompare.status}; outside ${outside.status} ${outside.body?.error}`);
+  // The page fits its window at 1440 and 1200 px: no sideways scrolling, the vehicle table's
+  // columns whole, one legend for the nine plots instead of nine wrapped into each other.
+  const fitsWindow = (p) => p.evaluate(() => {
+    const t = document.querySelector(".vehicle-table");
+    return {
+      page: document.documentElement.scrollWidth, window: window.innerWidth,
+      table: t ? t.scrollWidth - t.clientWidth : NaN,
+      legends: document.querySelectorAll('[data-testid="compare-legend"]').length,
+      plotLegends: document.querySelectorAll(".compare-grid .u-legend").length,
+    };
+  });
+  const fits = { operator: await fitsWindow(page), viewer: await fitsWindow(vpage) };
+  check("compare: the Lab fits its window at 1440 and 1200 px (no sideways scroll, the vehicle table whole) with one legend for the plots",
+    Object.values(fits).every((f) => f.page <= f.window && f.table <= 1 && f.legends === 1 && f.plotLegends === 0), JSON.stringify(fits));
+  await vpage.screenshot({ path: join(out, "lab-compare-1200.png"), fullPage: true });
 
   // Identify the lift slope on the same recording, from the seed's vehicle (the drone's own).
   await page.fill('[data-testid="identify-params"]', "cl_alpha, bogus");

@@ -27,7 +27,7 @@ import { readFile, readdir, stat } from "node:fs/promises";
 import { basename, join } from "node:path";
 import {
   OPERATOR, VIEWER, FIELD_HOST, root, out, speed, sleep, check, newContext, distanceM, bearingDeg, fromNorthEast, angleDiff, shownMetres, rad,
-  run, recordDir, startStation, freeUdpPort, apiOf, until, text, attr, watchErrors, hold, lastRequest, stopChildren, runFlights,
+  run, recordDir, startStation, freeUdpPort, apiOf, until, text, attr, watchErrors, hold, lastRequest, stopChildren, runFlights, cutShort,
 } from "./harness.mjs";
 
 /** Values the altitude plot holds (what uPlot draws: null is a gap), with their times. */
@@ -197,6 +197,8 @@ async function rehearsal() {
       guidanceBottom: r("panel-guidance-inputs").bottom, tabBottom: tabBody.bottom, outcomesTop: r("panel-commands").top,
     };
   });
+  const cutFlying = await cutShort(page);
+  check("1440×900, flying: no readout is cut short (recording, wind, air)", cutFlying.length === 0, cutFlying.join(" | ") || "none");
   check("1440×900: the wind chart and the Link panel are in view in the left column", layout.windBottom <= layout.leftBottom && layout.linkBottom <= layout.leftBottom, `wind ${layout.windBottom.toFixed(0)}, link ${layout.linkBottom.toFixed(0)}, column ends ${layout.leftBottom.toFixed(0)}`);
   check("1440×900: Heading/Course/Localizer fully above Command Outcomes", layout.guidanceBottom <= layout.tabBottom && layout.guidanceBottom <= layout.outcomesTop, `panel ends ${layout.guidanceBottom.toFixed(0)}, tab ends ${layout.tabBottom.toFixed(0)}, outcomes start ${layout.outcomesTop.toFixed(0)}`);
   await page.screenshot({ path: join(out, "live-operator.png") });
@@ -252,6 +254,24 @@ async function rehearsal() {
   });
   check("the parameter table fits its column (names not cut off)", table.tableW <= table.boxW && table.scrolled === 0 && table.minName >= table.boxLeft, `table ${table.tableW} px in ${table.boxW} px, scrolled ${table.scrolled}`);
   await page.screenshot({ path: join(out, "live-params.png") });
+  // The Plan tab's table: a waypoint and the land item, every value whole in its cell.
+  await page.click('[data-testid="tab-plan"]');
+  await page.waitForSelector('[data-testid="plan-item-0"]', { timeout: 5000 }).catch(() => {});
+  await page.fill('[data-testid="plan-lat-0"]', "38.5412345").catch(() => {});
+  const planTable = await page.evaluate(() => {
+    const t = document.querySelector('[data-testid="plan-table"]');
+    const panel = t?.closest(".panel");
+    const inputs = [...(t?.querySelectorAll("input") ?? [])];
+    return {
+      rows: t?.querySelectorAll("tbody tr").length ?? 0,
+      tableRight: t?.getBoundingClientRect().right ?? Infinity,
+      panelRight: panel ? panel.getBoundingClientRect().right : 0,
+      cut: inputs.filter((i) => i.scrollWidth > i.clientWidth + 1).map((i) => `${i.dataset.testid}: ${i.value}`),
+    };
+  });
+  check("the Plan tab's table fits its tab, and no value is cut off", planTable.rows >= 1 && planTable.tableRight <= planTable.panelRight && planTable.cut.length === 0,
+    `${planTable.rows} row(s), table ends ${planTable.tableRight.toFixed(0)} px, panel ${planTable.panelRight.toFixed(0)} px; cut: ${planTable.cut.join(", ") || "none"}`);
+  await page.locator('[data-testid="panel-plan"]').screenshot({ path: join(out, "live-plan-tab.png") });
   await page.click('[data-testid="tab-command"]');
 
   // ---------------------------------------------------------------- a mode change reaches the drone
@@ -301,6 +321,12 @@ async function rehearsal() {
     window.__pad.buttons[0] = { pressed: false, touched: false, value: 0 };
     window.dispatchEvent(new Event("focus"));
   });
+
+  // ---------------------------------------------------------------- one-shot answers are not OLD
+  // The parameters were read seconds ago: PARAM_VALUE's age grows, but it is an answer, not a stream.
+  const paramAge = await page.locator('[data-testid="link-age-PARAM_VALUE"]').evaluate((tr) => ({ text: tr.textContent, old: tr.classList.contains("old") })).catch(() => null);
+  check("per-message ages: PARAM_VALUE, an answer seconds old, is not flagged OLD", paramAge !== null && !paramAge.old && !/OLD/.test(paramAge.text) && parseFloat(paramAge.text.replace("PARAM_VALUE", "")) > 2,
+    paramAge?.text ?? "no PARAM_VALUE row");
 
   // ---------------------------------------------------------------- a landing target set in the page is flown to
   // 300 m from the origin (the rehearsal's own target), on the vehicle's side of it, so that it
@@ -499,6 +525,9 @@ async function replay(rehearsalStation) {
   await sleep(1000);
   const enabled = await page.locator('[data-command]').evaluateAll((els) => els.filter((e) => "disabled" in e && !e.disabled).map((e) => e.dataset.testid ?? e.dataset.command ?? e.tagName));
   const modeDisabled = enabled.length === 0;
+  // An operator is told why the controls are off: it is a replay, not the role.
+  const titles = new Set(await page.locator('[data-command]').evaluateAll((els) => els.filter((e) => "disabled" in e && e.disabled).map((e) => e.title)));
+  check("replay: an operator's disabled controls say a replay has no drone, not that the role is missing", !titles.has("operator role required") && titles.has("a replay has no drone to command"), [...titles].join(" | "));
   const refused = await api("/api/commands/mode", OPERATOR, { method: "POST", body: JSON.stringify({ mode: "heading" }) });
   check("replay: the page says REPLAY, its command controls are off and the station refuses commands", badge && modeDisabled && refused.status === 409 && refused.body?.error === "replay", `badge ${badge}, controls still on: [${enabled.join(", ")}], command → ${refused.status} ${refused.body?.error}`);
   // It plays: the re-run station estimates the recorded flight.

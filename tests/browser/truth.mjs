@@ -23,7 +23,7 @@
 import { readdir, writeFile } from "node:fs/promises";
 import { basename, join } from "node:path";
 import {
-  OPERATOR, VIEWER, out, sleep, check, newContext, distanceM, angleDiff, run, recordDir, startStation, freeUdpPort, apiOf, until, text, watchErrors, runFlights,
+  OPERATOR, VIEWER, out, sleep, check, newContext, distanceM, angleDiff, run, recordDir, startStation, freeUdpPort, apiOf, until, text, watchErrors, runFlights, cutShort,
 } from "./harness.mjs";
 
 const SPEED = Number(process.env.TRUTH_SPEED ?? 20);
@@ -193,6 +193,15 @@ async function wholeMission() {
     one.size === 1 && figures.header === `drone ${stationMiss.toFixed(1)}`, `${JSON.stringify(figures)}; station ${stationMiss.toFixed(2)} m; log "${logText[logText.length - 1] ?? ""}"`);
   check("the figure is the drone's real miss, give or take its GPS error (≤ 8 m)", Math.abs(stationMiss - truth.landing.miss_m) <= 8,
     `station ${stationMiss.toFixed(1)} m (the drone's GPS), truth ${truth.landing.miss_m.toFixed(1)} m (its ground contact)`);
+  // On the ground there is no glide, and the height above the origin's ground is not a height.
+  const landedReadouts = { glideAir: await text(page, "ro-glide-air"), glideGround: await text(page, "ro-glide-ground"), height: await text(page, "ro-height") };
+  check("landed: no glide ratio, and the height reads \"landed\"",
+    landedReadouts.glideAir === "—" && landedReadouts.glideGround === "—" && landedReadouts.height === "landed", JSON.stringify(landedReadouts));
+  // The wind chart's height axis stops at the ground: the landing's own altitude, give or take its GPS.
+  const axisMin = Number(await page.locator('[data-testid="wind-axis-min"]').textContent());
+  check("landed: the wind chart's height axis does not run below the ground", ground !== null && axisMin >= ground - 10, `axis from ${axisMin} m MSL, the landing at ${ground?.toFixed(0)} m MSL`);
+  const cut = await cutShort(page);
+  check("landed, link stale: no readout is cut short", cut.length === 0, cut.join(" | ") || "none");
   await page.screenshot({ path: join(out, "truth-landed.png") });
   await viewerCtx.close();
   return { station, page, ctx, base, figure: figures.header, truth };

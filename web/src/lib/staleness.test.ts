@@ -49,6 +49,10 @@ describe("messageAges", () => {
     expect(ages.map((a) => [a.name, a.old])).toEqual([["HEARTBEAT", false], ["GPS_RAW_INT", true], ["ATTITUDE", false]]);
     expect(ages[0]!.age_s).toBeCloseTo(3.1);
   });
+  it("one-shot answers (PARAM_VALUE, MISSION_ACK) are never OLD and come after the streams", () => {
+    const ages = messageAges(link({ ages_s: { PARAM_VALUE: 40, MISSION_ACK: 95, ATTITUDE: 2.5 } }), T, T);
+    expect(ages.map((a) => [a.name, a.old, a.limit_s])).toEqual([["ATTITUDE", true, 2], ["MISSION_ACK", false, null], ["PARAM_VALUE", false, null]]);
+  });
 });
 
 describe("linkStale", () => {

@@ -12,6 +12,14 @@ export const STATE_GAP_STALE_S = 2;
 /** Per-message limits; HEARTBEAT comes at 1 Hz, so it gets more room than the 4 Hz streams. */
 export const MESSAGE_AGE_LIMIT_S: Readonly<Record<string, number>> = { HEARTBEAT: 3.5 };
 export const DEFAULT_MESSAGE_AGE_LIMIT_S = 2;
+/**
+ * Messages the drone sends once, as an answer or on an event, not as a stream: their age says
+ * when the last answer came, so it never makes them OLD.
+ */
+export const ONE_SHOT_MESSAGES: ReadonlySet<string> = new Set([
+  "PARAM_VALUE", "MISSION_ACK", "MISSION_COUNT", "MISSION_ITEM_INT", "MISSION_REQUEST_INT", "MISSION_REQUEST",
+  "COMMAND_ACK", "AUTOPILOT_VERSION", "PROTOCOL_VERSION", "STATUSTEXT", "MESSAGE_INTERVAL",
+]);
 
 export type Freshness = "fresh" | "stale" | "disconnected" | "no_data";
 
@@ -62,18 +70,19 @@ export function linkStale(link: Link): boolean {
 export interface MessageAge {
   name: string;
   age_s: number;
-  limit_s: number;
+  /** Null for a one-shot message, which has no limit. */
+  limit_s: number | null;
   old: boolean;
 }
 
-/** Per-message ages, grown by the time since the state arrived, oldest first. */
+/** Per-message ages, grown by the time since the state arrived: streams oldest first, then one-shot answers. */
 export function messageAges(link: Link, receivedAtMs: number, nowMs: number): MessageAge[] {
   const gap_s = Math.max(0, (nowMs - receivedAtMs) / 1000);
   return Object.entries(link.ages_s)
     .map(([name, a]) => {
-      const limit_s = MESSAGE_AGE_LIMIT_S[name] ?? DEFAULT_MESSAGE_AGE_LIMIT_S;
+      const limit_s = ONE_SHOT_MESSAGES.has(name) ? null : MESSAGE_AGE_LIMIT_S[name] ?? DEFAULT_MESSAGE_AGE_LIMIT_S;
       const age_s = a + gap_s;
-      return { name, age_s, limit_s, old: age_s > limit_s };
+      return { name, age_s, limit_s, old: limit_s !== null && age_s > limit_s };
     })
-    .sort((x, y) => y.age_s - x.age_s);
+    .sort((x, y) => Number(x.limit_s === null) - Number(y.limit_s === null) || y.age_s - x.age_s);
 }

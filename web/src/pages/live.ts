@@ -31,7 +31,7 @@ import { ParamEditor } from "../ui/paramEditor";
 import { PickGroup } from "../ui/pick";
 import { PlanEditor } from "../ui/planEditor";
 import { Plots } from "../ui/plots";
-import { applyRole, OPERATOR_REQUIRED } from "../ui/role";
+import { applyRole, OPERATOR_REQUIRED, REPLAY_HAS_NO_DRONE } from "../ui/role";
 import { tabs } from "../ui/tabs";
 import { View3D } from "../ui/view3d";
 import { WindPanel } from "../ui/windPanel";
@@ -90,7 +90,7 @@ function build(session: Session): void {
   const compass = new Compass();
   const flight = new FlightData();
   const actuators = new Actuators();
-  const wind = new WindPanel();
+  const wind = new WindPanel(station.origin.alt_msl_m);
   const link = new LinkPanel();
   const replayBar = new ReplayBar(async (body) => {
     try {
@@ -256,7 +256,7 @@ function build(session: Session): void {
   function applyRoleEverywhere(): void {
     // A replay has no drone to command: every command control is off, for everyone.
     const operator = role === "operator" && !station.replay;
-    applyRole(document, operator);
+    applyRole(document, operator, station.replay ? REPLAY_HAS_NO_DRONE : OPERATOR_REQUIRED);
     joystick.setRole(operator);
     setText(roleBadge, `${station.replay ? "REPLAY" : operator ? "OPERATOR" : "VIEWER"} ${session.name}`);
     if (station.replay) setText(viewerNote, "Replay of a recording: there is no drone to command; pause, seek and speed are in the bar above.");

@@ -5,6 +5,9 @@ import { vehiclePosition } from "../lib/fix";
 import { fmt, fmtLatLon, label } from "../lib/format";
 import type { N, State } from "../lib/types";
 
+/** "2.04 : 1", or a bare dash when there is no glide (on the ground, under the balloon). */
+const glide = (v: N | undefined): string => (v === null || v === undefined ? "—" : fmt(v, ": 1", 2));
+
 type Row = { value: HTMLElement; get: (s: State) => string };
 
 export class FlightData {
@@ -26,10 +29,12 @@ export class FlightData {
     add("Ground speed", "ro-groundspeed", (s) => fmt(s.estimate?.ground_speed_mps, "m/s"));
     add("Sink rate", "ro-sink", (s) => fmt(s.estimate?.sink_rate_mps, "m/s"), "positive down");
     add("Heading rate", "ro-heading-rate", (s) => fmt(s.estimate?.heading_rate_dps, "°/s"));
-    add("Glide air", "ro-glide-air", (s) => fmt(s.estimate?.glide_ratio_air, ": 1", 2), "horizontal air distance per metre of height");
-    add("Glide gnd", "ro-glide-ground", (s) => fmt(s.estimate?.glide_ratio_ground, ": 1", 2), "horizontal ground distance per metre of height");
+    add("Glide air", "ro-glide-air", (s) => glide(s.estimate?.glide_ratio_air), "horizontal air distance per metre of height");
+    add("Glide gnd", "ro-glide-ground", (s) => glide(s.estimate?.glide_ratio_ground), "horizontal ground distance per metre of height");
     add("Altitude MSL", "ro-alt-msl", (s) => fmt(vehiclePosition(s)?.alt_msl_m, "m", 0));
-    add("Height AGL", "ro-height", (s) => fmt(s.estimate?.height_m, "m", 0), "height above the ground at the station origin");
+    // Once landed, the height above the origin's ground is the field's elevation difference
+    // plus noise ("−4 m"): the stack is on the ground, and that is what to read.
+    add("Height AGL", "ro-height", (s) => (s.vehicle?.stage === "landed" ? "landed" : fmt(s.estimate?.height_m, "m", 0)), "height above the ground at the station origin");
     add("Position σ", "ro-pos-sigma", (s) => fmt(s.estimate?.position_sigma_m, "m"));
     into = list;
     add("Position", "ro-position", (s) => {

@@ -16,7 +16,9 @@ function channelPlot(r: CompareResult, c: CompareResult["channels"][number], wid
     width,
     height: 160,
     scales: { x: { time: false } },
-    legend: { show: true },
+    // One legend for the grid: nine per-plot legends of "t s: -- recorded: -- model: --" wrapped
+    // into each other at narrow widths.
+    legend: { show: false },
     series: [{ label: "t s" }, { label: "recorded", stroke: RECORDED, spanGaps: false }, { label: "model", stroke: MODEL, dash: [6, 3] }],
   };
   new uPlot(opts, [r.time_s, c.recorded, c.model], box);
@@ -30,6 +32,13 @@ export function compareView(r: CompareResult, width: number): HTMLElement[] {
   const header = h("tr", {}, ...["channel", "unit", "RMS", "largest |error|", "bias", "samples"].map((t) => h("th", {}, t)));
   const rows = compareRows(r).map((cells) => h("tr", {}, ...cells.map((t) => h("td", {}, t))));
   const table = h("table", { "data-testid": "compare-errors" }, h("caption", {}, "model − recorded, over every recorded sample"), header, ...rows);
+  const swatch = (colour: string, dashed: boolean): Node => {
+    const line = h("span", { class: "swatch" });
+    line.style.borderTop = `2px ${dashed ? "dashed" : "solid"} ${colour}`;
+    return line;
+  };
+  const legend = h("div", { class: "compare-legend", "data-testid": "compare-legend" },
+    h("span", {}, swatch(RECORDED, false), " recorded"), h("span", {}, swatch(MODEL, true), " model"), h("span", { class: "note" }, "against t, s from the compared part's start"));
   const grid = h("div", { class: "compare-grid" }, ...r.channels.map((c) => channelPlot(r, c, width)));
-  return [h("div", { "data-testid": "compare-result" }, head, table), grid];
+  return [h("div", { "data-testid": "compare-result" }, head, table), legend, grid];
 }

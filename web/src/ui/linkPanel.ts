@@ -32,6 +32,7 @@ export class LinkPanel {
     const b = readout("Bad msgs", "link-bad-messages", "messages from the station this page could not read");
     const st = readout("Link", "link-state");
     const rec = readout("Recording", "recording-state", "the station's MCAP recording of this run");
+    rec.root.classList.add("wide");
     [this.rate, this.loss, this.age, this.errors, this.bad, this.state, this.rec] = [r.value, l.value, a.value, e.value, b.value, st.value, rec.value];
     this.recDetail = h("div", { class: "rec-detail", "data-testid": "recording-problem", hidden: true });
     this.agesBody = h("tbody");
@@ -60,7 +61,8 @@ export class LinkPanel {
       return;
     }
     const rows = messageAges(link, receivedAtMs, nowMs).map((m) =>
-      h("tr", { class: m.old ? "old" : "", "data-testid": `link-age-${m.name}` }, h("td", {}, m.name), h("td", {}, `${m.age_s.toFixed(1)} s${m.old ? " OLD" : ""}`)));
+      h("tr", { class: m.old ? "old" : "", "data-testid": `link-age-${m.name}`, title: m.limit_s === null ? "sent once, as an answer: its age is when the last one came" : `streamed: OLD after ${m.limit_s} s` },
+        h("td", {}, m.name), h("td", {}, `${m.age_s.toFixed(1)} s${m.old ? " OLD" : m.limit_s === null ? " · answer" : ""}`)));
     this.agesBody.replaceChildren(...rows);
   }
 

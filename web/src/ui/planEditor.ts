@@ -43,7 +43,9 @@ export class PlanEditor {
       this.err.textContent = "";
       send("set_plan", `plan → ${this.waypoints.length} waypoint(s) + land`, "/api/commands/plan", b.body);
     });
-    const table = h("table", { class: "plan" }, h("thead", {}, h("tr", {}, ...["#", "kind", "lat °", "lon °", "alt MSL m", "approach °", ""].map((t) => h("th", {}, t)))), this.rows);
+    // Fixed column widths: the inputs fill their cells instead of pushing the table out of the tab.
+    const cols = h("colgroup", {}, ...["5%", "11%", "26%", "26%", "11%", "14%", "7%"].map((w) => h("col", { style: `width:${w}` })));
+    const table = h("table", { class: "plan", "data-testid": "plan-table" }, cols, h("thead", {}, h("tr", {}, ...[["#", "item"], ["kind", "waypoint or land"], ["lat °", "latitude, degrees"], ["lon °", "longitude, degrees"], ["alt m", "altitude MSL, m"], ["appr °", "the final approach's course, degrees; empty: into the wind"], ["", ""]].map(([t, title]) => h("th", { title: title || null }, t)))), this.rows);
     this.root = panel("Plan", "panel-plan", h("div", { class: "form-row" }, addWp, setLand, clear), table, h("div", { class: "form-row" }, sendBtn), this.err);
     this.render();
   }
@@ -107,7 +109,10 @@ export class PlanEditor {
           return null;
         })
       : h("span", {}, "");
-    if (it.kind === "land") approach.setAttribute("placeholder", "into wind");
+    if (it.kind === "land") {
+      approach.setAttribute("placeholder", "wind");
+      approach.setAttribute("title", "the final approach's course, degrees; empty: into the wind");
+    }
     return h("tr", { "data-testid": `plan-item-${i}`, "data-kind": it.kind },
       h("td", {}, String(i + 1)), h("td", {}, it.kind),
       h("td", {}, num(it.lat_deg.toFixed(6), `plan-lat-${i}`, set("lat_deg", (t) => parseLat(t)))),

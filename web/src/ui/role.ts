@@ -1,10 +1,13 @@
 // Who may command: every control marked `data-command` is disabled for viewers (and until the
-// session says otherwise), with the tooltip "operator role required". The station enforces this
-// too (403); the page only avoids offering what would be refused.
+// session says otherwise), with a tooltip saying why: "operator role required", or for a replay,
+// which has no drone, that reason instead. The station enforces this too (403, 409); the page only
+// avoids offering what would be refused.
 
 export const OPERATOR_REQUIRED = "operator role required";
+export const REPLAY_HAS_NO_DRONE = "a replay has no drone to command";
 
-export function applyRole(root: ParentNode, operator: boolean): void {
+/** Enables the command controls under `root`, or disables them with `why` as their tooltip. */
+export function applyRole(root: ParentNode, operator: boolean, why: string = OPERATOR_REQUIRED): void {
   for (const el of Array.from(root.querySelectorAll<HTMLElement>("[data-command]"))) {
     if (el instanceof HTMLButtonElement || el instanceof HTMLInputElement || el instanceof HTMLSelectElement) el.disabled = !operator;
     if (operator) {
@@ -13,7 +16,7 @@ export function applyRole(root: ParentNode, operator: boolean): void {
         delete el.dataset.roleTitle;
       }
     } else if (!el.title || el.dataset.roleTitle === "1") {
-      el.title = OPERATOR_REQUIRED;
+      el.title = why;
       el.dataset.roleTitle = "1";
     }
   }

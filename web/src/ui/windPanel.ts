@@ -9,7 +9,7 @@ import { h, panel, readout, s, setText } from "./dom";
 import { fmt, fmtDir } from "../lib/format";
 import { linkStale } from "../lib/staleness";
 import { ascentBandAt, ascentPoint, directionPieces, directionSpans, forecastAt, MeasuredProfile, type AscentPoint } from "../lib/wind";
-import type { AscentWindMsg, ForecastWind, State } from "../lib/types";
+import type { AscentWindMsg, ForecastWind, N, State } from "../lib/types";
 
 const W = 280;
 const H = 134;
@@ -36,6 +36,14 @@ function forecastIn(p: readonly ForecastWind[], lo: number, hi: number): Forecas
   return [...end(lo), ...p.filter((x) => x.alt_msl_m > lo && x.alt_msl_m < hi), ...end(hi)];
 }
 
+/** "2.0 ±0.2 m/s": the unit once, so that speed, spread and direction fit the sidebar's line. */
+function speedWithin(speed: N | undefined, spread: N | undefined): string {
+  return `${fmt(speed, "")} ±${fmt(spread, "m/s")}`;
+}
+
+/** Stages whose wind the estimate measures on the way down. */
+const DESCENT_STAGES: ReadonlySet<string> = new Set(["round_chute", "parafoil_deploy", "parafoil"]);
+
 export class WindPanel {
   readonly root: HTMLElement;
   private readonly est: HTMLElement;
@@ -49,7 +57,8 @@ export class WindPanel {
   private lastKey = "";
   private lastTime = -Infinity;
 
-  constructor() {
+  /** @param groundMslM the ground at the station's origin, m MSL: the chart's axis stops there. */
+  constructor(private readonly groundMslM: N = null) {
     const a = readout("Estimate", "ro-wind");
     const b = readout("Forecast", "ro-wind-forecast", "the forecast profile at the current altitude");
     const c = readout("Ascent", "ro-wind-ascent", "the wind measured from the balloon's drift during the ascent: the band at the current altitude (±2σ of the speed), or the bands measured");
@@ -73,7 +82,7 @@ export class WindPanel {
     const here = alt === null ? null : ascentBandAt(this.ascent, alt);
     let text = "—";
     if (here) {
-      text = `${fmt(here.speed_mps, "m/s")} from ${here.dir_half_deg === null ? "—" : fmtDir(here.from_deg)} ±${fmt((here.speed_hi_mps - here.speed_lo_mps) / 2, "m/s", 2)}`;
+      text = `${speedWithin(here.speed_mps, (here.speed_hi_mps - here.speed_lo_mps) / 2)} from ${here.dir_half_deg === null ? "—" : fmtDir(here.from_deg)}`;
     } else if (this.ascent.length > 0) {
       const lo = Math.min(...this.ascent.map((p) => p.alt_min_msl_m));
       const hi = Math.max(...this.ascent.map((p) => p.alt_max_msl_m));
@@ -84,14 +93,17 @@ export class WindPanel {
 
   update(st: State): void {
     const e = st.estimate;
-    setText(this.est, e ? `${fmt(e.wind_speed_mps, "m/s")} from ${fmtDir(e.wind_from_deg)} ±${fmt(e.wind_sigma_mps, "m/s", 2)}` : "—");
+    setText(this.est, e ? `${speedWithin(e.wind_speed_mps, e.wind_sigma_mps)} from ${fmtDir(e.wind_from_deg)}` : "—");
     const alt = e?.alt_msl_m ?? null;
     const f = alt === null ? null : forecastAt(st.forecast_wind, alt);
     setText(this.fc, f ? `${fmt(f.speed_mps, "m/s")} from ${fmtDir(f.from_deg)}` : "—");
     // A new mission clock (station restart) is a new descent: the old profile does not belong.
     if (st.time_s < this.lastTime) this.measured.clear();
     this.lastTime = st.time_s;
-    if (!linkStale(st.link) && alt !== null && e?.wind_speed_mps != null && e.wind_from_deg != null) this.measured.add(alt, e.wind_speed_mps, e.wind_from_deg);
+    // The solid profile is the descent's: under the balloon the estimator's wind is not one (the
+    // ascent's own measurement is the diamonds).
+    const descending = st.vehicle?.stage != null && DESCENT_STAGES.has(st.vehicle.stage);
+    if (descending && !linkStale(st.link) && alt !== null && e?.wind_speed_mps != null && e.wind_from_deg != null) this.measured.add(alt, e.wind_speed_mps, e.wind_from_deg);
     this.last = { profile: st.forecast_wind, alt, speed: e?.wind_speed_mps ?? null, sigma: e?.wind_sigma_mps ?? null, from: e?.wind_from_deg ?? null };
     this.showAscentReadout();
     this.draw();
@@ -120,8 +132,9 @@ export class WindPanel {
       const lo = Math.min(...flown);
       const hi = Math.max(...flown);
       const pad = Math.max(50, (hi - lo) * 0.1, (MIN_BAND_M - (hi - lo)) / 2);
-      aMin = lo - pad;
-      aMax = hi + pad;
+      // Not below the ground: only data measured below it (a lower field) may take the axis there.
+      aMin = this.groundMslM === null ? lo - pad : Math.max(lo - pad, Math.min(this.groundMslM, lo));
+      aMax = Math.max(hi + pad, aMin + MIN_BAND_M);
     } else {
       aMin = Math.min(...p.map((x) => x.alt_msl_m));
       aMax = Math.max(...p.map((x) => x.alt_msl_m), aMin + 1);
@@ -140,14 +153,14 @@ export class WindPanel {
     const grid = s("g", { stroke: "#ccc", "stroke-width": 1 }, ...[90, 180, 270].map((d) => s("line", { x1: XD(d), x2: XD(d), y1: T, y2: H - B })));
     const labels = s("g", { "font-size": 9, fill: "#000" },
       s("text", { x: SP.l - 2, y: T + 8, "text-anchor": "end" }, `${aMax.toFixed(0)}`),
-      s("text", { x: SP.l - 2, y: H - B, "text-anchor": "end" }, `${aMin.toFixed(0)}`),
+      s("text", { x: SP.l - 2, y: H - B, "text-anchor": "end", "data-testid": "wind-axis-min" }, `${aMin.toFixed(0)}`),
       s("text", { x: 1, y: (H - B) / 2 + 2 }, "m MSL"),
       s("text", { x: SP.l, y: H - B + 10, "text-anchor": "start" }, "0"),
       s("text", { x: SP.r, y: H - B + 10, "text-anchor": "end" }, `${(vTop / 1.1).toFixed(1)}`),
       s("text", { x: (SP.l + SP.r) / 2, y: H - 3, "text-anchor": "middle", "font-weight": 700 }, "speed m/s"),
       ...[0, 90, 180, 270, 360].map((d) => s("text", { x: XD(d), y: H - B + 10, "text-anchor": d === 0 ? "start" : d === 360 ? "end" : "middle" }, d === 0 ? "N" : d === 90 ? "E" : d === 180 ? "S" : d === 270 ? "W" : "N")),
       s("text", { x: (DR.l + DR.r) / 2, y: H - 3, "text-anchor": "middle", "font-weight": 700 }, "from °"));
-    this.svg.append(grid, frame, labels, this.legend());
+    this.svg.append(grid, frame, labels, this.legend({ forecast: p.length > 0, ascent: asc.length > 0, descent: m.length > 1, estimate: alt !== null && speed !== null }));
 
     // Speed profiles.
     if (p.length > 0) this.svg.append(line(p.map((x) => at(XS(x.speed_mps), Y(x.alt_msl_m))), FORECAST, "wind-forecast-speed"));
@@ -190,14 +203,22 @@ export class WindPanel {
     }
   }
 
-  /** What each mark is, in a row above the charts. */
-  private legend(): SVGElement {
+  /** What each mark drawn is, in a row above the charts: nothing that is not on them. */
+  private legend(shown: { forecast: boolean; ascent: boolean; descent: boolean; estimate: boolean }): SVGElement {
     const y = 9;
-    const item = (x: number, mark: SVGElement, label: string): SVGElement[] => [mark, s("text", { x: x + 14, y: y + 3, "font-size": 8 }, label)];
-    return s("g", { "data-testid": "wind-legend" },
-      ...item(4, s("line", { x1: 4, x2: 16, y1: y, y2: y, ...FORECAST }), "forecast"),
-      ...item(60, s("path", { d: `M66,${y - 4} l4,4 l-4,4 l-4,-4 z`, fill: ASCENT }), "ascent ±2σ"),
-      ...item(128, s("line", { x1: 128, x2: 140, y1: y, y2: y, ...MEASURED }), "descent"),
-      ...item(180, s("circle", { cx: 186, cy: y, r: 3.5, fill: "#006b8f", stroke: "#000" }), "estimate"));
+    const items: [boolean, number, (x: number) => SVGElement, string][] = [
+      [shown.forecast, 56, (x) => s("line", { x1: x, x2: x + 12, y1: y, y2: y, ...FORECAST }), "forecast"],
+      [shown.ascent, 68, (x) => s("path", { d: `M${x + 6},${y - 4} l4,4 l-4,4 l-4,-4 z`, fill: ASCENT }), "ascent ±2σ"],
+      [shown.descent, 52, (x) => s("line", { x1: x, x2: x + 12, y1: y, y2: y, ...MEASURED }), "descent"],
+      [shown.estimate, 50, (x) => s("circle", { cx: x + 6, cy: y, r: 3.5, fill: "#006b8f", stroke: "#000" }), "estimate"],
+    ];
+    const g = s("g", { "data-testid": "wind-legend" });
+    let x = 4;
+    for (const [on, width, mark, label] of items) {
+      if (!on) continue;
+      g.append(mark(x), s("text", { x: x + 14, y: y + 3, "font-size": 8, "data-testid": "wind-legend-item" }, label));
+      x += width;
+    }
+    return g;
   }
 }

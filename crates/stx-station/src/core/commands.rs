@@ -34,6 +34,9 @@ pub const ANSWER_WITHIN_S: f64 = 30.0;
 /// For a plan upload, this much more per item: the link re-sends each item up to 5 times
 /// 1.5 s apart before it gives up, and progress starts its count again.
 pub const ANSWER_PER_PLAN_ITEM_S: f64 = 8.0;
+/// A refusal's reason comes as a STATUSTEXT just before the COMMAND_ACK (which has no room for
+/// text); a warning older than this belongs to something else.
+pub const REASON_WITHIN_S: f64 = 2.0;
 
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum Stage {
@@ -79,6 +82,8 @@ pub(crate) struct Commands {
     param_sets: HashMap<String, u64>,
     /// The plan upload the link took.
     plan_upload: Option<u64>,
+    /// The drone's last warning (or worse) and when it came: the reason of the next refusal.
+    last_warning: Option<(f64, String)>,
 }
 
 impl Commands {
@@ -223,6 +228,11 @@ impl Commands {
         settled
     }
 
+    /// A warning the drone said (STATUSTEXT): kept to explain a refusal that follows it.
+    pub fn on_vehicle_warning(&mut self, now_s: f64, text: &str) {
+        self.last_warning = Some((now_s, text.to_string()));
+    }
+
     /// COMMAND_ACKs as the link reports them.
     pub fn on_command_event(&mut self, now_s: f64, e: &CommandEvent) -> Option<CommandResultMsg> {
         let r = self.records.get_mut(&e.request_id.0)?;
@@ -246,7 +256,16 @@ impl Commands {
                     CommandResult::Failed => Outcome::Failed,
                     _ => Outcome::Denied,
                 };
-                (outcome, format!("the drone answered {result:?}"))
+                // Taken once: two refusals in a row must not share one reason.
+                let reason = self
+                    .last_warning
+                    .take()
+                    .filter(|(at_s, _)| now_s - at_s <= REASON_WITHIN_S);
+                let detail = match reason {
+                    Some((_, why)) => format!("the drone answered {result:?}: {why}"),
+                    None => format!("the drone answered {result:?}"),
+                };
+                (outcome, detail)
             }
         };
         r.result.outcome = outcome;

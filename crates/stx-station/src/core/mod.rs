@@ -361,6 +361,9 @@ impl StationCore {
                     Severity::Warning => Level::Warning,
                     _ => Level::Info,
                 };
+                if level != Level::Info {
+                    self.commands.on_vehicle_warning(now_s, &text);
+                }
                 self.log(now_s, level, "vehicle", text);
             }
             GroundEvent::Command(e) => {

@@ -244,6 +244,7 @@ mod tests {
     use stx_link::manual::Sticks;
     use stx_link::param::ParamEvent;
     use stx_link::plan::{PlanEvent, PlanItem};
+    use stx_link::telemetry::Severity;
 
     use super::super::actions::{APPLY_WITHIN_S, LinkOp, OUTCOME_GRACE_S};
     use super::super::commands::{
@@ -354,6 +355,55 @@ mod tests {
         let r = only(results(&mut core));
         assert_eq!((r.request_id, r.outcome), (id, Outcome::Denied));
         assert_eq!(core.replica_plan().heading_rad, before);
+    }
+
+    #[test]
+    fn a_refusal_carries_the_reason_the_drone_said_just_before_it_once() {
+        let mut core = core();
+        let said = |core: &mut StationCore, now_s: f64, text: &str| {
+            core.on_link_event(
+                now_s,
+                GroundEvent::StatusText {
+                    from: (1, 1),
+                    severity: Severity::Warning,
+                    text: text.into(),
+                },
+            );
+        };
+        let denied = CommandOutcome::Rejected {
+            result: CommandResult::TemporarilyRejected,
+        };
+        heading(&mut core, 0.0, 45.0);
+        sent_ops(&mut core, 0.0);
+        said(
+            &mut core,
+            0.4,
+            "manual refused: no stick input (hold the dead-man first)",
+        );
+        answer(&mut core, 0.5, 1, denied);
+        let r = only(results(&mut core));
+        assert_eq!(r.outcome, Outcome::Denied);
+        assert_eq!(
+            r.detail,
+            "the drone answered TemporarilyRejected: manual refused: no stick input (hold the dead-man first)"
+        );
+        // The next refusal has no reason of its own: it does not borrow the last one.
+        heading(&mut core, 1.0, 50.0);
+        sent_ops(&mut core, 1.0);
+        answer(&mut core, 1.5, 2, denied);
+        assert_eq!(
+            only(results(&mut core)).detail,
+            "the drone answered TemporarilyRejected"
+        );
+        // Nor one said long before.
+        said(&mut core, 2.0, "GPS glitch");
+        heading(&mut core, 9.0, 55.0);
+        sent_ops(&mut core, 9.0);
+        answer(&mut core, 9.5, 3, denied);
+        assert_eq!(
+            only(results(&mut core)).detail,
+            "the drone answered TemporarilyRejected"
+        );
     }
 
     #[test]

@@ -412,3 +412,30 @@ fn waiting_for_the_drone_is_said_once() {
     }
     assert_eq!(core.events.len(), 1);
 }
+
+#[test]
+fn glide_ratios_are_shown_under_the_canopy_and_not_once_landed() {
+    let mut core = core();
+    glide(&mut core, 0.0, 20.0);
+    let gliding = core.state_msg_now(20.0).estimate.expect("an estimate");
+    // 6 m/s forward for 3 m/s down.
+    let air = gliding.glide_ratio_air.expect("a glide ratio in flight");
+    assert!((air - 2.0).abs() < 0.2, "{air}");
+    core.on_link_event(
+        20.1,
+        GroundEvent::Telemetry {
+            from: (1, 1),
+            telemetry: Telemetry::Status(VehicleStatus {
+                mode: FlightMode::Heading,
+                stage: stx_gnc::mission::FlightStage::Landed,
+                phase: stx_gnc::mission::GuidancePhase::Landed,
+                state: SystemState::Standby,
+            }),
+        },
+    );
+    let landed = core.state_msg_now(20.2).estimate.expect("an estimate");
+    assert_eq!(
+        (landed.glide_ratio_air, landed.glide_ratio_ground),
+        (None, None)
+    );
+}

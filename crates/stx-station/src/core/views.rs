@@ -1,6 +1,7 @@
 //! The dashboard's view of the station's state: the `state` and `params` messages.
 
 use stx_dynamics::rotation::wrap_pi;
+use stx_gnc::mission::FlightStage;
 use stx_gnc::mission::GuidancePhase;
 use stx_gnc::params::ParamKind;
 use stx_gnc::predict::PredictedTouchdown;
@@ -134,6 +135,19 @@ impl StationCore {
             }),
         });
         let estimate_age_s = self.estimate.and(age(self.latest.sensors_s));
+        // A glide ratio is a canopy's: on the pad, under the balloon, under the round chute
+        // and on the ground the estimator's quotient of noise reads as "24.67 : 1".
+        let stage = self.latest.status.map(|(s, _)| s.stage);
+        let gliding = !matches!(
+            stage,
+            Some(
+                FlightStage::PreLaunch
+                    | FlightStage::Ascent
+                    | FlightStage::RoundChute
+                    | FlightStage::Landed
+            )
+        );
+        let glide = |v: f64| finite(v).filter(|_| gliding);
         let estimate = self.estimate.map(|e| {
             let (lat, lon, alt) = self.frame.to_geodetic(&e.position_ned_m);
             let w = e.wind_ned_mps;
@@ -153,8 +167,8 @@ impl StationCore {
                 heading_rate_dps: e.heading_rate_rad_s.to_degrees(),
                 airspeed_mps: e.airspeed_mps,
                 sink_rate_mps: e.sink_rate_mps,
-                glide_ratio_air: finite(e.glide_ratio_air),
-                glide_ratio_ground: finite(e.glide_ratio_ground),
+                glide_ratio_air: glide(e.glide_ratio_air),
+                glide_ratio_ground: glide(e.glide_ratio_ground),
                 wind_ned_mps: [w.x, w.y, w.z],
                 wind_speed_mps: e.wind_speed_mps(),
                 wind_from_deg: (-w.y).atan2(-w.x).to_degrees().rem_euclid(360.0),
