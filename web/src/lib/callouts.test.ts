@@ -59,6 +59,12 @@ describe("stage", () => {
     const said = run(seq).said.filter((c) => c.class === "stage");
     expect(texts(said)).toEqual(["Launched, ascending", "Under the round chute", "Parafoil deploying", "Parafoil flying"]);
   });
+  it("the first stage heard (the drone joins a page already open) is not a change", () => {
+    const noDrone = decodeMessage(JSON.stringify({ type: "state", time_s: 1, link: { connected: false, stale: true, age_s: null, ages_s: {} }, mission: { stage: null, landing: null } }));
+    if (!noDrone.ok || noDrone.msg.type !== "state") throw new Error("bad fixture");
+    const said = run([noDrone.msg, noDrone.msg, state({ stage: "pre_launch" }), state({ stage: "pre_launch" }), state({ stage: "ascent" })]).said.filter((c) => c.class === "stage");
+    expect(texts(said)).toEqual(["Launched, ascending"]);
+  });
   it("landed is the landing's call-out, not a stage change", () => {
     const said = run([state({ stage: "parafoil" }), state({ stage: "landed" }), state({ stage: "landed", miss_m: 6.4 })]).said;
     expect(said.map((c) => [c.class, c.text])).toEqual([["landing", "Landed, 6 metres from the target"]]);
@@ -172,10 +178,7 @@ describe("command refused", () => {
   const wired = () => {
     const said: Callout[] = [];
     const calls = new CommandCallouts();
-    const t = new CommandTracker((e: CommandEntry) => {
-      const c = calls.take(e, true);
-      if (c) said.push(c);
-    });
+    const t: CommandTracker = new CommandTracker((e: CommandEntry) => said.push(...calls.take(e, t.entries, true)));
     return { t, said };
   };
   it("denied by the drone: said once, with the command in words", () => {
@@ -194,12 +197,30 @@ describe("command refused", () => {
     t.result(result({ outcome: "accepted" }), 2);
     expect(said).toEqual([]);
   });
-  it("a refusal that overtook the 202 is said once, not again when merged into the page's entry", () => {
+  it("a refusal that overtook the 202 is said once, with what the page asked, when the 202 merges it", () => {
     const { t, said } = wired();
     const id = t.begin("set_mode", "mode → manual", 0);
     t.result(result({ request_id: "r7", outcome: "denied" }), 1);
+    expect(said).toEqual([]);
     t.accepted(id, "r7", 2);
-    expect(said).toHaveLength(1);
+    expect(texts(said)).toEqual(["Command denied: mode to manual"]);
+  });
+  it("held for a request of this page that turns out to be another, it is said by its name", () => {
+    const { t, said } = wired();
+    const id = t.begin("set_mode", "mode → manual", 0);
+    t.result(result({ request_id: "theirs", command: "set_target", outcome: "denied" }), 1);
+    t.accepted(id, "mine", 2);
+    expect(texts(said)).toEqual(["Command denied: set target"]);
+  });
+  it("held while the page's request hangs, released on demand (the page's timer)", () => {
+    const calls = new CommandCallouts();
+    const t = new CommandTracker();
+    t.begin("set_mode", "mode → manual", 0);
+    const theirs = t.result(result({ request_id: "x", outcome: "denied" }), 1);
+    expect(calls.take(theirs, t.entries, true)).toEqual([]);
+    expect(calls.holding).toBe(true);
+    expect(texts(calls.release(true))).toEqual(["Command denied: set mode"]);
+    expect(calls.release(true)).toEqual([]);
   });
   it("failed, timed out, not supported, refused by the station; another operator's by its name", () => {
     const { t, said } = wired();

@@ -157,7 +157,8 @@ export function stateCallouts(memory: CalloutMemory | null, s: State, nowMs: num
 
   // ---- stage
   if (stage !== m.stage && stage !== null) {
-    if (stage !== "landed") say("stage", STAGE_WORDS[stage]);
+    // The first stage heard (a drone joining the link) is where it is, not a change.
+    if (stage !== "landed" && m.stage !== null) say("stage", STAGE_WORDS[stage]);
     if (!isFlying(stage) && stage !== "landed") {
       // Back on the pad (a new mission): its landing and approach are ahead again.
       m.landingSaid = false;
@@ -250,18 +251,46 @@ export function spokenCommand(label: string): string {
 
 /**
  * Remembers which commands were said, so that a refusal is said once however often its entry
- * changes (a result may overtake the station's 202 and be merged into the page's own entry).
+ * changes. A refusal often overtakes the station's 202 to this page's own request: it first shows
+ * as another operator's, named by the command alone ("set mode"). While one of this page's
+ * requests is still unanswered such a refusal is held, so that the page's entry, with what was
+ * asked ("mode to manual"), says it once the 202 merges them.
  */
 export class CommandCallouts {
   private readonly said = new Set<string>();
+  private held: CommandEntry[] = [];
 
-  /** The call-out for an entry's change, if it just became a refusal. */
-  take(e: CommandEntry, inFlight: boolean): Callout | null {
+  /** The call-outs after entry `e` changed; `entries` are all the page's (the tracker's). */
+  take(e: CommandEntry, entries: readonly CommandEntry[], inFlight: boolean): Callout[] {
+    const out: Callout[] = [];
+    const awaiting = entries.some((x) => !x.foreign && x.status === "sending");
+    if (e.foreign && awaiting && REFUSALS[e.status] !== undefined) {
+      if (!this.held.includes(e)) this.held.push(e);
+    } else {
+      this.sayOnce(out, e, inFlight);
+    }
+    if (!awaiting) out.push(...this.release(inFlight));
+    return out;
+  }
+
+  /** Refusals still held: to be said anyway when the page's request never comes back. */
+  get holding(): boolean {
+    return this.held.length > 0;
+  }
+
+  /** The held refusals not said since, said now. */
+  release(inFlight: boolean): Callout[] {
+    const out: Callout[] = [];
+    for (const e of this.held.splice(0)) this.sayOnce(out, e, inFlight);
+    return out;
+  }
+
+  private sayOnce(out: Callout[], e: CommandEntry, inFlight: boolean): void {
     const word = REFUSALS[e.status];
-    if (word === undefined) return null;
+    if (word === undefined) return;
     const key = e.requestId ?? `page:${e.id}`;
-    if (this.said.has(key)) return null;
+    if (this.said.has(key)) return;
     this.said.add(key);
-    return { class: "command", text: `Command ${word}: ${spokenCommand(e.label)}`, inFlight, alarm: false };
+    out.push({ class: "command", text: `Command ${word}: ${spokenCommand(e.label)}`, inFlight, alarm: false });
   }
 }
