@@ -32,7 +32,8 @@ registerRest("PUT", /^\/api\/keep-out$/, "KeepOutBody", "KeepOutMsg");
 const SPEED = Number(process.env.VOICE_SPEED ?? 10);
 /** Link down during the ascent, in mission seconds (launch at 60 s, burst at about 200 s). */
 const DROP = [80, 140];
-const ZONE = "Road N114 corridor";
+/** The zone put under the landing: not a name of the shipped sample's (it has a "Road N114 corridor"). */
+const ZONE = "Voice test field";
 /** How the test expects each stage change to be said (landed is the landing's call-out). */
 const STAGE_WORDS = { pre_launch: "On the pad", ascent: "Launched, ascending", round_chute: "Under the round chute", parafoil_deploy: "Parafoil deploying", parafoil: "Parafoil flying" };
 const ALARM = /^(Link lost|Keep-out alarm|Station and drone disagree)/;
