@@ -34,6 +34,7 @@ import { Plots } from "../ui/plots";
 import { applyRole, OPERATOR_REQUIRED, REPLAY_HAS_NO_DRONE } from "../ui/role";
 import { tabs } from "../ui/tabs";
 import { View3D } from "../ui/view3d";
+import { VoicePanel } from "../ui/voicePanel";
 import { WindPanel } from "../ui/windPanel";
 
 const app = document.getElementById("app")!;
@@ -103,6 +104,7 @@ function build(session: Session): void {
   const view3d = new View3D(station.origin);
   const events = new EventLog();
   const recordings = new RecordingsPanel(api, token);
+  const voice = new VoicePanel();
   const commandList = new CommandList();
   const tracker = new CommandTracker((e) => onCommand(e));
 
@@ -215,7 +217,7 @@ function build(session: Session): void {
   const header = h("header", { class: "top" },
     h("strong", { class: "station" }, station.name), clock, conn, roleBadge,
     h("span", { class: "hdr-group" }, h("small", {}, "mode "), hdrMode, h("small", {}, " stage "), hdrStage, h("small", {}, " phase "), hdrPhase),
-    hdrLink, hdrLanding, hdrReplica, h("span", { class: "spacer" }), kml, recovery, planLink, lab);
+    hdrLink, hdrLanding, hdrReplica, h("span", { class: "spacer" }), voice.quick, kml, recovery, planLink, lab);
   const banner = h("div", { class: "banner", role: "alert", "data-testid": "banner", hidden: true });
   const viewerNote = h("div", { class: "viewer-note", "data-testid": "viewer-note" }, `Viewer: you can watch everything; commanding needs the operator role (${OPERATOR_REQUIRED}).`);
 
@@ -226,6 +228,7 @@ function build(session: Session): void {
     { id: "3d", label: "3-D view", content: view3d.root, onShow: () => view3d.layout() },
     { id: "events", label: "Event log", content: events.root },
     { id: "recordings", label: "Recordings", content: recordings.root, onShow: () => void recordings.load() },
+    { id: "voice", label: "Voice", content: voice.root },
   ]);
   const centre = h("section", { class: "col centre" }, h("div", { class: "map-wrap vd" }, map.root), bottom.root);
   // Modes and the joystick first: in manual flight both must be in view without scrolling.
@@ -266,6 +269,7 @@ function build(session: Session): void {
   function onCommand(e: CommandEntry): void {
     commandList.update(e, tracker.entries);
     params.onCommand(e);
+    voice.onCommand(e, tracker.entries);
   }
 
   function onState(s: State): void {
@@ -274,6 +278,7 @@ function build(session: Session): void {
     if (seek === "restart") startOver();
     latest = s;
     replayBar.update(s.replay);
+    voice.onState(s, Date.now());
     receivedAtMs = Date.now();
     plots.push(s);
     const e = s.estimate;
@@ -307,6 +312,7 @@ function build(session: Session): void {
     view3d.setTrack(track);
     events.reset([]);
     plots.reset([], null);
+    voice.restart();
   }
 
   function render(): void {
