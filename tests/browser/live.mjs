@@ -322,6 +322,46 @@ async function rehearsal() {
     window.dispatchEvent(new Event("focus"));
   });
 
+  // ---------------------------------------------------------------- manual without a gamepad
+  await page.evaluate(() => {
+    window.__pad.connected = false;
+  });
+  await until(vehicle, (v) => v?.mode !== "manual", 8000);
+  // Asked for manual with nothing held, the drone refuses, and Command outcomes says why.
+  await page.click('[data-testid="mode-manual"]');
+  const refusal = await until(() => page.locator('[data-testid="command-item"][data-command="set_mode"]').first().evaluate((li) => ({
+    status: li.dataset.status, detail: li.querySelector('[data-testid="command-detail"]')?.textContent ?? "",
+  })).catch(() => null), (r) => r !== null && r.status !== "in_progress" && r.status !== "sending", 10000);
+  check("manual refused: the drone's reason is in Command outcomes", refusal?.status === "denied" && /no stick input/.test(refusal?.detail ?? ""), JSON.stringify(refusal));
+  // The keyboard: Space held on the focused on-screen stick is the dead-man, → moves the main line.
+  await page.focus('[data-testid="joystick-stick"]');
+  await page.keyboard.down(" ");
+  for (let i = 0; i < 7; i++) await page.keyboard.press("ArrowRight");
+  const keyMark = await page.evaluate(() => performance.now());
+  await api("/api/commands/mode", OPERATOR, { method: "POST", body: JSON.stringify({ mode: "manual" }) });
+  const keyTurned = await until(vehicle, (v) => v?.mode === "manual" && (v?.servos?.main_line ?? 0) > 0.3, 10000);
+  check("keyboard: Space held + → ×7 flies manual, the main line follows", keyTurned?.mode === "manual" && (keyTurned?.servos?.main_line ?? 0) > 0.3,
+    `mode ${keyTurned?.mode}, main_line ${keyTurned?.servos?.main_line}; page: ${await text(page, "joystick-values")}`);
+  await page.keyboard.up(" ");
+  const keyReleased = await until(vehicle, (v) => Math.abs(v?.servos?.main_line ?? 1) < 0.1, 8000);
+  await sleep(300);
+  const sentAfterKeys = await sentSince(keyMark);
+  check("keyboard: Space let go → one manual_release, the stream stops and the main line returns",
+    Math.abs(keyReleased?.servos?.main_line ?? 1) < 0.1 && sentAfterKeys.filter((t) => t === "manual_release").length === 1 && sentAfterKeys[sentAfterKeys.length - 1] === "manual_release",
+    `main_line ${keyReleased?.servos?.main_line}; sent ${sentAfterKeys.filter((t) => t === "manual").length} manual then ${sentAfterKeys.filter((t) => t === "manual_release").length} release`);
+  // The pointer: pressed on the stick's left part, it holds and steers left; let go, it stops.
+  const box = await page.locator('[data-testid="joystick-stick"]').boundingBox();
+  await page.mouse.move(box.x + box.width * 0.15, box.y + box.height * 0.3);
+  await page.mouse.down();
+  await sleep(400);
+  const dragged = { sending: await attr(page, "joystick-sending", "data-sending"), values: await text(page, "joystick-values") };
+  await page.screenshot({ path: join(out, "live-screen-stick.png") });
+  await page.mouse.up();
+  await sleep(300);
+  const letGo = await attr(page, "joystick-sending", "data-sending");
+  check("on-screen stick: pressed left of centre it sends a left main line; let go, it stops", dragged.sending === "true" && /main line -0\.[6-9]/.test(dragged.values) && letGo === "false",
+    `${JSON.stringify(dragged)}; let go: sending ${letGo}`);
+
   // ---------------------------------------------------------------- one-shot answers are not OLD
   // The parameters were read seconds ago: PARAM_VALUE's age grows, but it is an answer, not a stream.
   const paramAge = await page.locator('[data-testid="link-age-PARAM_VALUE"]').evaluate((tr) => ({ text: tr.textContent, old: tr.classList.contains("old") })).catch(() => null);

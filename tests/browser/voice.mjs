@@ -199,7 +199,8 @@ async function flight() {
     if (zonePut === null && p.stage === "parafoil" && u) {
       const zones = (await api("/api/keep-out")).body.zones;
       const ring = [[-250, -250], [-250, 250], [250, 250], [250, -250], [-250, -250]].map(([n, e]) => fromNorthEast(u, n, e)).map((q) => [q.lon_deg, q.lat_deg]);
-      const put = await api("/api/keep-out", OPERATOR, { method: "PUT", body: JSON.stringify({ ...zones, features: [...zones.features, { type: "Feature", properties: { name: ZONE }, geometry: { type: "Polygon", coordinates: [ring] } }] }) });
+      // Ours alone: a landing inside a shipped zone too is reported under that zone's name only.
+      const put = await api("/api/keep-out", OPERATOR, { method: "PUT", body: JSON.stringify({ ...zones, features: [{ type: "Feature", properties: { name: ZONE }, geometry: { type: "Polygon", coordinates: [ring] } }] }) });
       zonePut = { at: Date.now(), status: put.status };
     }
     // The link back after its cut: the operator asks for manual without sticks, which the drone denies.

@@ -2,7 +2,7 @@ import { afterEach, beforeEach, describe, expect, it, vi } from "vitest";
 import { blockedBy, ManualSender, type ManualGate } from "./manualSender";
 import type { ManualMsg, ManualReleaseMsg } from "./types";
 
-const OPEN: ManualGate = { operator: true, socketOpen: true, focused: true, visible: true, padConnected: true, deadman: true };
+const OPEN: ManualGate = { operator: true, socketOpen: true, focused: true, visible: true, sticksConnected: true, deadman: true };
 const MSG: ManualMsg = { type: "manual", x: 0, y: 0.3, z: 0.1, r: 0, buttons: 1 };
 
 describe("blockedBy", () => {
@@ -12,7 +12,7 @@ describe("blockedBy", () => {
     expect(blockedBy({ ...OPEN, deadman: false })).toBe("dead-man released");
     expect(blockedBy({ ...OPEN, focused: false })).toBe("page not focused");
     expect(blockedBy({ ...OPEN, visible: false })).toBe("page hidden");
-    expect(blockedBy({ ...OPEN, padConnected: false })).toBe("no gamepad");
+    expect(blockedBy({ ...OPEN, sticksConnected: false })).toBe("no sticks");
     expect(blockedBy({ ...OPEN, socketOpen: false })).toBe("disconnected");
   });
 });
@@ -60,7 +60,7 @@ describe("ManualSender", () => {
     ["dead-man released", { ...OPEN, deadman: false }],
     ["window blur", { ...OPEN, focused: false }],
     ["page hidden (visibilitychange)", { ...OPEN, visible: false }],
-    ["gamepad disconnected", { ...OPEN, padConnected: false }],
+    ["gamepad disconnected", { ...OPEN, sticksConnected: false }],
     ["socket closed", { ...OPEN, socketOpen: false }],
   ] as const) {
     it(`stops immediately on ${name}`, () => {
@@ -80,7 +80,7 @@ describe("ManualSender", () => {
     sample = null;
     vi.advanceTimersByTime(500);
     expect(sticks()).toHaveLength(1);
-    expect(sender.blocked).toBe("no gamepad");
+    expect(sender.blocked).toBe("no sticks");
   });
 
   it("stops when a send fails", () => {
@@ -106,7 +106,7 @@ describe("ManualSender", () => {
     ["dead-man released", { ...OPEN, deadman: false }],
     ["window blur", { ...OPEN, focused: false }],
     ["page hidden", { ...OPEN, visible: false }],
-    ["gamepad disconnected", { ...OPEN, padConnected: false }],
+    ["gamepad disconnected", { ...OPEN, sticksConnected: false }],
   ] as const) {
     it(`sends exactly one manual_release, right after the last sticks, on ${name}`, () => {
       sender.update(OPEN);

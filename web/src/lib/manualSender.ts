@@ -1,5 +1,5 @@
 // When may the page send joystick commands? Only while every condition holds: operator role,
-// socket open, page focused and visible, a gamepad connected, and the dead-man held. The moment
+// socket open, page focused and visible, sticks to read (a gamepad or the on-screen stick), and the dead-man held. The moment
 // one fails the stream stops — the station then stops uplinking within 0.5 s (API.md). While it
 // holds, messages go out at a steady 10 Hz from a timer, not from input events, so the rate is
 // what the station expects whatever the gamepad or the display does. When a stream ends for any
@@ -17,7 +17,8 @@ export interface ManualGate {
   socketOpen: boolean;
   focused: boolean;
   visible: boolean;
-  padConnected: boolean;
+  /** A gamepad, or the on-screen stick (lib/screenStick.ts), to read. */
+  sticksConnected: boolean;
   deadman: boolean;
 }
 
@@ -25,7 +26,7 @@ export interface ManualGate {
 export function blockedBy(g: ManualGate): string | null {
   if (!g.operator) return "operator role required";
   if (!g.socketOpen) return "disconnected";
-  if (!g.padConnected) return "no gamepad";
+  if (!g.sticksConnected) return "no sticks";
   if (!g.visible) return "page hidden";
   if (!g.focused) return "page not focused";
   if (!g.deadman) return "dead-man released";
@@ -35,7 +36,7 @@ export function blockedBy(g: ManualGate): string | null {
 export interface ManualSenderDeps {
   /** Sends one message; false if it could not be sent (socket gone), which stops the stream. */
   send: (m: ManualMsg | ManualReleaseMsg) => boolean;
-  /** The current stick message, or null if the gamepad vanished. */
+  /** The current stick message, or null if the sticks vanished (a gamepad unplugged). */
   sample: () => ManualMsg | null;
   now?: () => number;
   rateHz?: number;
@@ -96,7 +97,7 @@ export class ManualSender {
   private tick(): void {
     const msg = this.deps.sample();
     if (msg === null) {
-      this.stop("no gamepad");
+      this.stop("no sticks");
       return;
     }
     if (!this.deps.send(msg)) {

@@ -104,7 +104,10 @@ function vehicleTable(): void {
     ...fields.map((f) => {
       const input = h("input", { type: "text", "data-testid": `vehicle-${f.name}`, value: String(f.seed), "data-role": "operator" });
       input.addEventListener("input", () => typed.set(f.name, input.value));
-      return h("tr", { "data-field": f.name }, h("td", {}, f.name), h("td", {}, input), h("td", {}, f.unit), h("td", { class: "note" }, String(f.seed)), h("td", { class: "field-error", "data-testid": `vehicle-error-${f.name}` }));
+      // The rule a value breaks goes under its name: a fifth column widened the table out of its panel.
+      return h("tr", { "data-field": f.name },
+        h("td", { class: "vehicle-name" }, f.name, h("div", { class: "field-error", "data-testid": `vehicle-error-${f.name}` })),
+        h("td", {}, input), h("td", {}, f.unit), h("td", { class: "note" }, String(f.seed)));
     }),
   );
 }
@@ -431,7 +434,7 @@ async function main(): Promise<void> {
     h("main", {},
       h("div", {},
         h("section", {}, h("h2", {}, "Vehicle (seed: STRAPLEX, config/vehicle/straplex.toml)"),
-          h("table", { class: "vehicle-table" }, h("thead", {}, h("tr", {}, h("th", {}, "parameter"), h("th", {}, "value"), h("th", {}, "unit"), h("th", {}, "seed"), h("th", {}, ""))), el.vehicleRows),
+          h("table", { class: "vehicle-table" }, h("thead", {}, h("tr", {}, h("th", {}, "parameter"), h("th", {}, "value"), h("th", {}, "unit"), h("th", {}, "seed"))), el.vehicleRows),
           h("div", { class: "row" }, check, el.vehicleName, save, el.rehearse), el.vehicleMsg, el.rehearsal),
         h("section", {}, h("h2", {}, "Run"),
           h("div", { class: "row" }, h("label", {}, "job ", el.kind)),

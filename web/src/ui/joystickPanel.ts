@@ -1,11 +1,14 @@
-// Manual mode with the browser Gamepad API. The page polls `navigator.getGamepads()` (a test can
-// replace it), shows the sticks live, and streams `manual` messages at 10 Hz only while the
-// dead-man is held — gamepad button 0 or the on-screen hold button — and the page is focused and
-// visible (lib/manualSender.ts decides; this module only gathers the facts and shows them).
+// Manual mode with the browser Gamepad API, or without a gamepad the on-screen stick (pointer or
+// keyboard, lib/screenStick.ts). The page polls `navigator.getGamepads()` (a test can replace
+// it), shows the sticks live, and streams `manual` messages at 10 Hz only while the dead-man is
+// held — gamepad button 0, the on-screen hold button, Space, or the pointer on the stick — and the
+// page is focused and visible (lib/manualSender.ts decides; this module gathers the facts and
+// shows them). A gamepad, when there is one, is the only source of sticks.
 
 import { h, panel, s, setAttr, setText } from "./dom";
 import { firstPad, manualMessage, readSticks, type PadLike, type Sticks } from "../lib/joystick";
 import { ManualSender, MANUAL_RATE_HZ, type ManualGate } from "../lib/manualSender";
+import { ScreenStick } from "../lib/screenStick";
 import type { ManualMsg, ManualReleaseMsg } from "../lib/types";
 
 const POLL_MS = 20;
@@ -22,6 +25,7 @@ export class JoystickPanel {
   private readonly dot: SVGCircleElement;
   private readonly hold: HTMLButtonElement;
   private screenHold = false;
+  private readonly screen = new ScreenStick();
   private operator = false;
   private socketOpen = false;
   /** False between a window blur and the next focus. */
@@ -40,7 +44,8 @@ export class JoystickPanel {
     this.valuesEl = h("span", { "data-testid": "joystick-values" });
     this.modeWarn = h("div", { class: "form-error", "data-testid": "joystick-mode-warning" });
     this.dot = s("circle", { cx: 50, cy: 50, r: 7, fill: "#ffd400", stroke: "#000", "stroke-width": 2 });
-    const stick = s("svg", { viewBox: "0 0 100 100", class: "stick", role: "img", "aria-label": "stick position: x main line, y brake", "data-testid": "joystick-stick" },
+    const stick = s("svg", { viewBox: "0 0 100 100", class: "stick", role: "application", tabindex: 0, "data-command": "",
+      "aria-label": "on-screen stick: press and drag, or Space held with the arrow keys (C centres); x main line, y brake", "data-testid": "joystick-stick" },
       s("rect", { x: 1, y: 1, width: 98, height: 98, fill: "#fff", stroke: "#000", "stroke-width": 2 }),
       s("line", { x1: 50, y1: 0, x2: 50, y2: 100, stroke: "#999" }),
       s("text", { x: 3, y: 10, "font-size": 9 }, "brake 0"),
@@ -66,11 +71,13 @@ export class JoystickPanel {
     this.hold.addEventListener("keyup", release);
     this.hold.addEventListener("blur", release);
     this.hold.addEventListener("contextmenu", (e) => e.preventDefault());
+    this.bindScreenStick(stick);
 
     // Stop at once when the page loses focus or visibility, or the gamepad goes.
     window.addEventListener("blur", () => {
       this.focused = false;
       this.screenHold = false;
+      this.screen.release();
       this.evaluate();
     });
     window.addEventListener("focus", () => {
@@ -79,7 +86,10 @@ export class JoystickPanel {
     });
     document.addEventListener("visibilitychange", () => {
       this.visible = document.visibilityState === "visible";
-      if (!this.visible) this.screenHold = false;
+      if (!this.visible) {
+        this.screenHold = false;
+        this.screen.release();
+      }
       this.evaluate();
     });
     window.addEventListener("gamepaddisconnected", () => this.evaluate());
@@ -113,6 +123,46 @@ export class JoystickPanel {
     setText(this.modeWarn, this.sender.sending && mode !== "manual" ? `vehicle is in ${mode ?? "unknown"} mode: the drone ignores the sticks until mode is manual` : "");
   }
 
+  /** The on-screen stick: the pointer on it, or the keys while it or the HOLD button has focus. */
+  private bindScreenStick(stick: SVGSVGElement): void {
+    const at = (e: PointerEvent): void => {
+      const r = stick.getBoundingClientRect();
+      this.screen.point(((e.clientX - r.left) / r.width) * 100, ((e.clientY - r.top) / r.height) * 100);
+      this.evaluate();
+    };
+    stick.addEventListener("pointerdown", (e) => {
+      if (!this.operator) return;
+      e.preventDefault();
+      stick.setPointerCapture?.(e.pointerId);
+      stick.focus();
+      at(e);
+    });
+    stick.addEventListener("pointermove", (e) => {
+      if (stick.hasPointerCapture?.(e.pointerId)) at(e);
+    });
+    const letGo = (): void => {
+      this.screen.release();
+      this.evaluate();
+    };
+    for (const ev of ["pointerup", "pointercancel", "lostpointercapture", "blur"]) stick.addEventListener(ev, letGo);
+    const keys = (down: boolean) => (e: KeyboardEvent): void => {
+      if (!this.operator || (down && e.repeat && e.key === " ")) return;
+      if (this.screen.key(e.key, down)) {
+        e.preventDefault();
+        this.evaluate();
+      }
+    };
+    stick.addEventListener("keydown", keys(true));
+    stick.addEventListener("keyup", keys(false));
+    // On the HOLD button Space is its own dead-man; the arrows still move the stick.
+    this.hold.addEventListener("keydown", (e) => {
+      if (e.key !== " " && e.key !== "Enter" && this.operator && this.screen.key(e.key, true)) {
+        e.preventDefault();
+        this.evaluate();
+      }
+    });
+  }
+
   private readPad(): PadLike | null {
     let pads: readonly (Gamepad | null)[] | null = null;
     try {
@@ -127,20 +177,20 @@ export class JoystickPanel {
 
   private sample(): ManualMsg | null {
     const p = this.readPad();
-    if (p === null) return null;
-    return manualMessage(readSticks(p));
+    return manualMessage(p === null ? this.screen.sticks() : readSticks(p));
   }
 
   private evaluate(): void {
     const pad = this.readPad();
-    this.sticks = pad ? readSticks(pad) : null;
+    this.sticks = pad ? readSticks(pad) : this.screen.sticks();
     const gate: ManualGate = {
       operator: this.operator,
       socketOpen: this.socketOpen,
       // The blur/focus events react at once; hasFocus() covers the initial state.
       focused: this.focused && document.hasFocus(),
       visible: this.visible,
-      padConnected: pad !== null,
+      // Without a gamepad the on-screen stick is always there to read.
+      sticksConnected: true,
       deadman: (this.sticks?.deadman ?? false) || this.screenHold,
     };
     this.sender.update(gate);
@@ -152,7 +202,7 @@ export class JoystickPanel {
     if (!force && now - this.lastPaint < 100) return;
     this.lastPaint = now;
     const st = this.sticks;
-    setText(this.status, st ? this.padId || "connected" : "none (connect, press a button)");
+    setText(this.status, this.padId || "none: the on-screen stick (drag it, or Space + arrows)");
     setAttr(this.dot, "cx", String(50 + 46 * (st?.mainLine ?? 0)));
     setAttr(this.dot, "cy", String(4 + 92 * (st?.brake ?? 0)));
     setText(this.valuesEl, st ? `main line ${st.mainLine >= 0 ? "+" : ""}${st.mainLine.toFixed(2)} · brake ${st.brake.toFixed(2)}` : "main line — · brake —");
