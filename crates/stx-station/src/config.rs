@@ -220,6 +220,11 @@ pub struct StationConfig {
     /// Flight recordings (`[recording]`): on by default, in the state directory.
     #[serde(default)]
     pub recording: RecordingSettings,
+    /// The go/no-go board (`[readiness]`: the checklist file, the saved parameter set, the
+    /// battery's least voltage V and the plan's least reach share; see
+    /// [`crate::checklist::ReadinessConfig`]).
+    #[serde(default)]
+    pub readiness: crate::checklist::ReadinessConfig,
     /// What one caller may ask (`[limits]`: requests per token, wrong tokens per address,
     /// pages at once); the defaults suit a field laptop.
     #[serde(default)]
@@ -336,6 +341,9 @@ impl StationConfig {
         };
         if self.tokens.is_empty() {
             return invalid("tokens", "at least one token is needed");
+        }
+        if let Some((field, rule)) = self.readiness.invalid() {
+            return invalid(field, rule);
         }
         let mut seen: HashMap<&str, usize> = HashMap::new();
         for (i, t) in self.tokens.iter().enumerate() {

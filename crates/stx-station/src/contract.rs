@@ -24,7 +24,8 @@ use crate::lab::bodies::{
 use crate::lab::jobs::LabStatusBody;
 use crate::lab::vehicle_fields::VehicleFieldsBody;
 use crate::messages::{
-    AscentWindMsg, CommandResultMsg, ErrorBody, EventMsg, ParamsMsg, ReplayView, Session, StateMsg,
+    AscentWindMsg, CommandResultMsg, ErrorBody, EventMsg, ParamsMsg, ReadinessView, ReplayView,
+    Session, StateMsg, TickBody,
 };
 use crate::preflight::{PreflightBody, PreflightDefaults, PreflightReport};
 use crate::replies::{
@@ -159,6 +160,7 @@ pub fn schema() -> Result<Value, ContractError> {
         sent.subschema_for::<LabGainsListBody>(),
         sent.subschema_for::<LabSavedBody>(),
         sent.subschema_for::<LabRehearsalBody>(),
+        sent.subschema_for::<ReadinessView>(),
     ];
     let read_messages = vec![
         read.subschema_for::<ClientMessage>(),
@@ -176,6 +178,7 @@ pub fn schema() -> Result<Value, ContractError> {
         read.subschema_for::<LabJobBody>(),
         read.subschema_for::<LabVehicleBody>(),
         read.subschema_for::<LabGainsBody>(),
+        read.subschema_for::<TickBody>(),
     ];
     let mut definitions: Map<String, Value> = sent.take_definitions(true);
     let read_definitions = read.take_definitions(true);
@@ -216,7 +219,7 @@ pub fn schema() -> Result<Value, ContractError> {
     Ok(json!({
         "$schema": "http://json-schema.org/draft-07/schema#",
         "title": "stx station API",
-        "description": "Every message of the stx station's HTTP and WebSocket API (crates/stx-station/API.md), generated from the daemon's Rust types by `cargo run -p stx-station --example api_schema`: do not edit. The root is any one of them: on the WebSocket ServerMessage (station to page) and ClientMessage (page to station); over REST the bodies the station answers (Session, StateMsg, ParamsMsg, AscentWindMsg, EventsBody, TrackBody, ClientsBody, CommandResultMsg, CommandAccepted, CutdownArm, ErrorBody, ReplayView, RecordingsBody, ReplayOpened, KeepOutMsg, PreflightReport, PreflightDefaults, the Lab's Lab*Body and VehicleFieldsBody) and the bodies of the commands (*Body).",
+        "description": "Every message of the stx station's HTTP and WebSocket API (crates/stx-station/API.md), generated from the daemon's Rust types by `cargo run -p stx-station --example api_schema`: do not edit. The root is any one of them: on the WebSocket ServerMessage (station to page) and ClientMessage (page to station); over REST the bodies the station answers (Session, StateMsg, ParamsMsg, AscentWindMsg, EventsBody, TrackBody, ClientsBody, CommandResultMsg, CommandAccepted, CutdownArm, ErrorBody, ReplayView, RecordingsBody, ReplayOpened, KeepOutMsg, PreflightReport, PreflightDefaults, ReadinessView, the Lab's Lab*Body and VehicleFieldsBody) and the bodies of the commands (*Body).",
         "anyOf": messages,
         "definitions": definitions,
     }))

@@ -5,7 +5,7 @@
 //! The pure station (no tokio, no sockets; `--no-default-features` builds only this):
 //! - [`config`]: the station's TOML, validated before anything starts; [`exposure`]: what it
 //!   lets through beyond this machine (rehearsal tokens on loopback only, plain HTTP only when
-//!   asked for);
+//!   asked for); [`checklist`]: the go/no-go board's settings and files;
 //! - [`core`]: the station's state and logic: telemetry, link events and operators' requests
 //!   in, with the mission clock; messages for the dashboards and link actions (with ids and
 //!   deadlines) out; the link's outcome of each action back in; retries and time-outs are its
@@ -32,6 +32,7 @@
 //!   for `/tiles/`.
 
 pub mod ascent_wind_msg;
+pub mod checklist;
 pub mod config;
 pub mod contract;
 pub mod core;

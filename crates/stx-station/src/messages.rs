@@ -15,10 +15,12 @@ pub use crate::ascent_wind_msg::{AscentBandView, AscentWindMsg};
 mod flight_path;
 mod footprint;
 mod mission;
+mod readiness;
 mod vehicle;
 pub use flight_path::{FlightPathView, PathPointView};
 pub use footprint::{FootprintContourView, FootprintView, FootprintZoneHit};
 pub use mission::{DisagreementView, LandingView};
+pub use readiness::{CheckStatus, CheckView, ReadinessView, TickBody};
 pub use vehicle::{
     AirView, AttitudeView, GpsView, OnboardLandingView, PowerView, ServosView, VehicleView,
 };
@@ -316,6 +318,8 @@ pub struct StateMsg {
     /// The station's recording of this run; `null` where no daemon records (tests of the
     /// core, replays).
     pub recording: Option<RecordingView>,
+    /// The go/no-go board.
+    pub readiness: ReadinessView,
     /// The replay this station is showing (`stx replay`); `null` when live.
     pub replay: Option<ReplayView>,
 }
@@ -420,8 +424,9 @@ pub struct EventMsg {
     /// Level.
     pub level: Level,
     /// Where it comes from: guidance, link, command, station, vehicle, keep_out (the keep-out
-    /// zones: loaded, edited, a landing predicted in one).
-    #[schemars(extend("enum" = ["guidance", "link", "command", "station", "vehicle", "keep_out"]))]
+    /// zones: loaded, edited, a landing predicted in one), readiness (the go/no-go board: its
+    /// checklist read, an item ticked, a launch with checks open).
+    #[schemars(extend("enum" = ["guidance", "link", "command", "station", "vehicle", "keep_out", "readiness"]))]
     pub source: &'static str,
     /// Text.
     pub text: String,
@@ -524,7 +529,7 @@ pub struct ErrorBody {
     /// Machine-readable kind; every kind the station answers is listed (a new one must be).
     #[schemars(extend("enum" = ["unauthorized", "forbidden", "bad_request", "not_found", "not_armed", "too_many_requests", "replay", "replay_failed", "unreadable", "unavailable", "busy", "internal", "io",
         "tile_pack", "not_saved", "lab_unavailable", "invalid_job", "invalid_vehicle", "invalid_gains", "no_job", "no_thread", "bad_name", "exists", "write_failed", "confirmation_required",
-        "unknown_recording", "no_flight"]))]
+        "unknown_recording", "no_flight", "unknown_item"]))]
     pub error: &'static str,
     /// For people: what is wrong.
     pub reason: String,

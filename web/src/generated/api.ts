@@ -2,7 +2,7 @@
 // the daemon's Rust types by `cargo run -p stx-station --example api_schema`): do not edit.
 
 /**
- * Every message of the stx station's HTTP and WebSocket API (crates/stx-station/API.md), generated from the daemon's Rust types by `cargo run -p stx-station --example api_schema`: do not edit. The root is any one of them: on the WebSocket ServerMessage (station to page) and ClientMessage (page to station); over REST the bodies the station answers (Session, StateMsg, ParamsMsg, AscentWindMsg, EventsBody, TrackBody, ClientsBody, CommandResultMsg, CommandAccepted, CutdownArm, ErrorBody, ReplayView, RecordingsBody, ReplayOpened, KeepOutMsg, PreflightReport, PreflightDefaults, the Lab's Lab*Body and VehicleFieldsBody) and the bodies of the commands (*Body).
+ * Every message of the stx station's HTTP and WebSocket API (crates/stx-station/API.md), generated from the daemon's Rust types by `cargo run -p stx-station --example api_schema`: do not edit. The root is any one of them: on the WebSocket ServerMessage (station to page) and ClientMessage (page to station); over REST the bodies the station answers (Session, StateMsg, ParamsMsg, AscentWindMsg, EventsBody, TrackBody, ClientsBody, CommandResultMsg, CommandAccepted, CutdownArm, ErrorBody, ReplayView, RecordingsBody, ReplayOpened, KeepOutMsg, PreflightReport, PreflightDefaults, ReadinessView, the Lab's Lab*Body and VehicleFieldsBody) and the bodies of the commands (*Body).
  */
 export type StxStationAPI =
   | ServerMessage
@@ -27,6 +27,7 @@ export type StxStationAPI =
   | LabGainsListBody
   | LabSavedBody
   | LabRehearsalBody
+  | ReadinessView
   | ClientMessage
   | ModeBody
   | HeadingBody
@@ -41,7 +42,8 @@ export type StxStationAPI =
   | PreflightBody
   | LabJobBody
   | LabVehicleBody
-  | LabGainsBody;
+  | LabGainsBody
+  | TickBody;
 /**
  * Every message the station sends on the WebSocket, told apart by `type`.
  */
@@ -86,6 +88,10 @@ export type PredictionKind = "planned" | "uncontrolled";
  * stages").
  */
 export type FlightStage = "pre_launch" | "ascent" | "round_chute" | "parafoil_deploy" | "parafoil" | "landed";
+/**
+ * Where one check stands.
+ */
+export type CheckStatus = "go" | "no_go" | "unknown";
 /**
  * Whether the station is recording.
  */
@@ -713,6 +719,10 @@ export interface StateMsg {
    * Prediction.
    */
   prediction: PredictionView | null;
+  /**
+   * The go/no-go board.
+   */
+  readiness: ReadinessView;
   /**
    * The station's recording of this run; `null` where no daemon records (tests of the
    * core, replays).
@@ -1342,6 +1352,62 @@ export interface TouchdownView {
   time_to_land_s: number;
 }
 /**
+ * The whole board.
+ */
+export interface ReadinessView {
+  /**
+   * Why the checklist file could not be read; `null` when it was (or none is configured).
+   */
+  checklist_error: string | null;
+  /**
+   * The station's checks first, then the checklist's items in the file's order.
+   */
+  checks: CheckView[];
+  /**
+   * The labels of the checks still open when the drone reported its launch (empty if it
+   * launched with every check go, or has not launched): every page announces them.
+   */
+  launched_with_open: string[];
+  /**
+   * How many are not `go`.
+   */
+  open: number;
+}
+/**
+ * One line of the board.
+ */
+export interface CheckView {
+  /**
+   * Why, with the figures (e.g. "12.5 V, at least 11.5 V").
+   */
+  detail: string;
+  /**
+   * Stable name: `link`, `gps`, `plan`, `fence`, `params`, `battery`, `recording`,
+   * `forecast`, `reach` for the station's own; the checklist file's `id` for a manual item.
+   */
+  id: string;
+  /**
+   * What is checked, as the board says it.
+   */
+  label: string;
+  /**
+   * Ticked by an operator (a checklist item), not worked out by the station.
+   */
+  manual: boolean;
+  /**
+   * Where it stands.
+   */
+  status: CheckStatus;
+  /**
+   * The operator who ticked a manual item; `null` while it is not ticked.
+   */
+  ticked_by: string | null;
+  /**
+   * When it was ticked, Unix ms; `null` while it is not ticked.
+   */
+  ticked_wall_ms: number | null;
+}
+/**
  * The station's recording, for the dashboard.
  */
 export interface RecordingView {
@@ -1651,9 +1717,10 @@ export interface EventMsg {
   mission_time_s: number | null;
   /**
    * Where it comes from: guidance, link, command, station, vehicle, keep_out (the keep-out
-   * zones: loaded, edited, a landing predicted in one).
+   * zones: loaded, edited, a landing predicted in one), readiness (the go/no-go board: its
+   * checklist read, an item ticked, a launch with checks open).
    */
-  source: "guidance" | "link" | "command" | "station" | "vehicle" | "keep_out";
+  source: "guidance" | "link" | "command" | "station" | "vehicle" | "keep_out" | "readiness";
   /**
    * Text.
    */
@@ -2133,7 +2200,8 @@ export interface ErrorBody {
     | "write_failed"
     | "confirmation_required"
     | "unknown_recording"
-    | "no_flight";
+    | "no_flight"
+    | "unknown_item";
   /**
    * For people: what is wrong.
    */
@@ -3001,4 +3069,13 @@ export interface LabGainsBody {
    * Replace a file of that name.
    */
   overwrite?: boolean;
+}
+/**
+ * `POST /api/readiness/{id}`: an operator ticks (or unticks) a checklist item.
+ */
+export interface TickBody {
+  /**
+   * `true` to tick, `false` to take the tick back.
+   */
+  ticked: boolean;
 }

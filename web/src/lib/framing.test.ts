@@ -1,4 +1,5 @@
 import { describe, expect, it } from "vitest";
+import { NO_READINESS } from "./readiness";
 import { boxAround, keyPoints, MIN_SPAN_M, needsFraming, type Box } from "./framing";
 import { distanceM } from "./geo";
 import type { FlightStage, State } from "./types";
@@ -27,6 +28,7 @@ function state(stage: FlightStage, extra: Partial<State> = {}): State {
     forecast_wind: [],
     mission: { stage, cutdown_armed_until_s: null, landing: null },
     recording: null,
+    readiness: NO_READINESS,
     replay: null,
     ...extra,
   };

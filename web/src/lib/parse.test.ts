@@ -37,6 +37,13 @@ const STATE = {
   flight_path: null,
   keep_out_alarms: [{ prediction: "uncontrolled", zone: "Pond", since_s: 790.5 }],
   recording: { state: "on", file: "/var/lib/stx/recordings/stx-20261124T100000Z-001.mcap", bytes_written: 1200000, messages_written: 9000, messages_lost: 0, problem: null, failing_since_ms: null, next_try_in_s: null, failed_tries: 0, resumed_ms: null, resumed_after_s: null },
+  readiness: {
+    checks: [
+      { id: "link", label: "Link up and signed", manual: false, status: "go", detail: "up and signed, 18 Hz", ticked_by: null, ticked_wall_ms: null },
+      { id: "canopy", label: "Parafoil and lines inspected, folded and stowed", manual: true, status: "go", detail: "ticked by ops", ticked_by: "ops", ticked_wall_ms: 1764410000000 },
+    ],
+    open: 0, launched_with_open: [], checklist_error: null,
+  },
   replay: null,
 };
 const SESSION = {

@@ -1,6 +1,7 @@
 // Parses the station's `state` message (and the station, session and footprint it carries, and
 // the keep-out zones) into the shapes of types.ts; see parse.ts for the rules.
 
+import { parseReadiness } from "./readiness";
 import { parseFlightPath } from "./flightPath";
 import { zonesOf } from "./zones";
 import type {
@@ -346,6 +347,7 @@ export function parseState(v: Obj): Parsed<State> {
     forecast_wind: parseForecast(v.forecast_wind),
     mission: m,
     recording: sub(v, "recording", parseRecording),
+    readiness: parseReadiness(v.readiness),
     replay: sub(v, "replay", parseReplay),
   });
 }

@@ -116,11 +116,16 @@ export type Recording = Lenient<Wire.RecordingView, "state">;
 /** The replay this station shows (`stx replay`). */
 export type Replay = Lenient<Wire.ReplayView, "file" | "mode">;
 
+/** A line of the go/no-go board (`state.readiness`, lib/readiness.ts reads it). */
+export type Check = Pick<Wire.CheckView, "id" | "label" | "manual" | "status" | "detail"> & { ticked_by: string | null; ticked_wall_ms: number | null };
+export type Readiness = Omit<Wire.ReadinessView, "checks" | "checklist_error"> & { checks: Check[]; checklist_error: string | null };
+
 export type State = Omit<
   Lenient<Wire.StateMsg, "type" | "time_s" | "link" | "forecast_wind" | "mission">,
-  "link" | "vehicle" | "guidance" | "prediction" | "forecast_wind" | "recording" | "replay" | "footprint" | "keep_out_alarms" | "flight_path" | "mission"
+  "link" | "vehicle" | "guidance" | "prediction" | "forecast_wind" | "recording" | "replay" | "footprint" | "keep_out_alarms" | "flight_path" | "mission" | "readiness"
 > & {
   mission: Mission;
+  readiness: Readiness;
   recording: Recording | null;
   replay: Replay | null;
   link: Link;

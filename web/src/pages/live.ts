@@ -36,6 +36,7 @@ import { tabs } from "../ui/tabs";
 import { View3D } from "../ui/view3d";
 import { VoicePanel } from "../ui/voicePanel";
 import { WindPanel } from "../ui/windPanel";
+import { ReadinessPanel } from "../ui/readinessPanel";
 
 const app = document.getElementById("app")!;
 const token = resolveToken(location.search, sessionStorage);
@@ -92,6 +93,9 @@ function build(session: Session): void {
   const flight = new FlightData();
   const actuators = new Actuators();
   const wind = new WindPanel(station.origin.alt_msl_m);
+  const readiness = new ReadinessPanel(async (id, ticked) => {
+    await api.post(`/api/readiness/${encodeURIComponent(id)}`, { ticked });
+  });
   const link = new LinkPanel();
   const replayBar = new ReplayBar(async (body) => {
     try {
@@ -217,7 +221,7 @@ function build(session: Session): void {
   const header = h("header", { class: "top" },
     h("strong", { class: "station" }, station.name), clock, conn, roleBadge,
     h("span", { class: "hdr-group" }, h("small", {}, "mode "), hdrMode, h("small", {}, " stage "), hdrStage, h("small", {}, " phase "), hdrPhase),
-    hdrLink, hdrLanding, hdrReplica, h("span", { class: "spacer" }), voice.quick, kml, recovery, planLink, lab);
+    hdrLink, hdrLanding, hdrReplica, readiness.badge, h("span", { class: "spacer" }), voice.quick, kml, recovery, planLink, lab);
   const banner = h("div", { class: "banner", role: "alert", "data-testid": "banner", hidden: true });
   const viewerNote = h("div", { class: "viewer-note", "data-testid": "viewer-note" }, `Viewer: you can watch everything; commanding needs the operator role (${OPERATOR_REQUIRED}).`);
 
@@ -237,6 +241,7 @@ function build(session: Session): void {
     { id: "command", label: "Command", content: commandTab },
     { id: "plan", label: "Plan", content: plan.root },
     { id: "params", label: "Parameters", content: params.root },
+    { id: "readiness", label: "Go/no-go", content: readiness.root },
   ]);
   const rightCol = h("aside", { class: "col right" }, viewerNote, right.root, commandList.root, cutdown.root);
   app.replaceChildren(header, replayBar.root, banner, h("main", { class: "grid" }, left, centre, rightCol));
@@ -325,6 +330,7 @@ function build(session: Session): void {
     flight.update(s);
     actuators.update(s);
     wind.update(s);
+    readiness.update(s.readiness);
     map.update(s, verdict.stale);
     view3d.update(s);
     modes.update(s);

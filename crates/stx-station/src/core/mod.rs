@@ -18,7 +18,9 @@
 //!   balloon rises and the round chute falls;
 //! - `params`: the drone's parameter table; `views`: the `state` and `params` messages;
 //! - `keep_out`: the keep-out zones, the targets they refuse and the alarms they raise;
-//!   `fence`: the zones sent to the drone as its fence, until it acknowledges them.
+//!   `fence`: the zones sent to the drone as its fence, until it acknowledges them;
+//! - `readiness`: the go/no-go board (the station's checks, the checklist's ticks, a launch
+//!   with checks open announced).
 
 mod actions;
 mod ascent;
@@ -35,6 +37,7 @@ mod navigation;
 mod operator;
 mod params;
 mod phase_sync;
+mod readiness;
 mod replica;
 mod requests;
 mod sync;
@@ -65,6 +68,7 @@ pub use keep_out::{CLEAR_AFTER_S, CheckedZones};
 pub use manual::MANUAL_SILENCE_S;
 pub(crate) use navigation::{MAX_TRACK_POINTS, thin_track};
 pub use navigation::{PREDICTION_EVERY_S, Predicted, PredictionJob};
+pub use readiness::TickError;
 pub use requests::{ApiError, CommandRequest};
 pub use sync::TargetSource;
 
@@ -171,6 +175,8 @@ pub struct StationCore {
     pub(crate) keep_out: keep_out::KeepOut,
     /// The drone's copy of the zones.
     fence: fence::FenceSync,
+    /// The go/no-go board's checklist, ticks and what the daemon tells it.
+    readiness: readiness::Readiness,
     /// The unsteered flight path from the balloon or the round chute.
     live_path: flight_path::LivePath,
 }
@@ -217,6 +223,7 @@ impl StationCore {
             main_line_travel_m: stx_dynamics::vehicle::Vehicle::straplex().main_line_travel_m,
             keep_out: keep_out::KeepOut::default(),
             fence: fence::FenceSync::default(),
+            readiness: readiness::Readiness::default(),
             live_path: flight_path::LivePath::default(),
             config,
         }

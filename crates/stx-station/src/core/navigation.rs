@@ -212,6 +212,7 @@ impl StationCore {
                         "vehicle",
                         format!("stage: {:?} → {:?}", p.stage, s.stage),
                     );
+                    self.readiness_on_stage(now_s, p.stage, s.stage);
                 }
             }
             Telemetry::GpsRaw(g) => {

@@ -10,7 +10,7 @@ use super::StationCore;
 use crate::messages::{
     AirView, AttitudeView, CommandsView, EstimateView, GpsView, GuidanceView, LatLonAlt, LinkView,
     LocalizerView, MissionView, OnboardLandingView, ParamView, ParamsMsg, PatternView, PowerView,
-    PredictionView, RadioView, ServosView, StateMsg, TouchdownView, VehicleView,
+    PredictionView, RadioView, ReadinessView, ServosView, StateMsg, TouchdownView, VehicleView,
 };
 
 pub(crate) fn snake<T: serde::Serialize + std::fmt::Debug>(v: T) -> String {
@@ -265,7 +265,7 @@ impl StationCore {
             age_s: prediction_age_s,
             stale: stale(prediction_age_s),
         });
-        StateMsg {
+        let mut msg = StateMsg {
             kind: "state",
             time_s: now_s,
             mission_time_s: self.mission_clock.at(now_s),
@@ -285,8 +285,11 @@ impl StationCore {
             },
             keep_out_alarms: self.keep_out_alarms(),
             recording: None,
+            readiness: ReadinessView::default(),
             replay: None,
-        }
+        };
+        msg.readiness = self.readiness_view(&msg);
+        msg
     }
 
     /// The parameter table as the dashboard shows it.

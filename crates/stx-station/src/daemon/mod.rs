@@ -231,6 +231,22 @@ async fn run_with(
             .map_err(|e| e.to_string());
         core.load_keep_out(0.0, &path.display().to_string(), text);
     }
+    // The go/no-go board's files: like the zones, a missing one leaves its checks open with
+    // the reason rather than stopping the station.
+    let read = |path: &std::path::Path| {
+        let path = path.to_path_buf();
+        async move {
+            tokio::fs::read_to_string(&path)
+                .await
+                .map_err(|e| e.to_string())
+        }
+    };
+    if let Some(path) = &config.readiness.checklist {
+        core.load_checklist(0.0, &path.display().to_string(), read(path).await);
+    }
+    if let Some(path) = &config.readiness.params_file {
+        core.load_saved_params(0.0, &path.display().to_string(), read(path).await);
+    }
     let shared = Arc::new(Shared {
         core: Mutex::new(core),
         config: config.clone(),

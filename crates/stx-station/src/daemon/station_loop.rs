@@ -30,6 +30,7 @@ use super::pages::{send_outbound, show_state};
 use crate::core::LinkAction;
 use crate::http::Shared;
 use crate::link::{LinkReport, StationLink};
+use crate::messages::RecordingState;
 
 /// The state message period: 4 Hz, the drone's rate.
 pub const STATE_PERIOD: Duration = Duration::from_millis(250);
@@ -226,13 +227,15 @@ fn publish_state(shared: &Shared) {
         return;
     }
     let now = shared.now_s();
+    let recording = shared.recording.view();
     let (mut state, outbound) = {
         let mut core = shared.core();
+        core.set_recording_on(recording.state == RecordingState::On);
         let state = core.tick(now);
         (state, core.drain_outbound())
     };
     send_outbound(shared, outbound);
-    state.recording = Some(shared.recording.view());
+    state.recording = Some(recording);
     shared.recording.state(&state);
     if let Ok(text) = serde_json::to_string(&state) {
         show_state(shared, text);

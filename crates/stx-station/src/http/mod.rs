@@ -24,6 +24,7 @@ mod keep_out;
 mod kml;
 mod lab;
 mod plan;
+mod readiness;
 mod recordings;
 mod rehearse;
 mod replay;
@@ -73,6 +74,8 @@ pub fn router(state: std::sync::Arc<Shared>) -> Router {
         )
         .route("/api/plan", post(plan::make_plan))
         .route("/api/plan/defaults", get(plan::plan_defaults))
+        .route("/api/readiness", get(readiness::board))
+        .route("/api/readiness/{id}", post(readiness::tick))
         .route("/api/cutdown/arm", post(arm_cutdown))
         .route("/api/cutdown/confirm", post(confirm_cutdown))
         .route("/api/clients", get(clients))

@@ -66,6 +66,9 @@ pub(crate) async fn make_plan(
     .await
     .map_err(|e| error(StatusCode::INTERNAL_SERVER_ERROR, "internal", e.to_string()))?
     .map_err(|e| error(StatusCode::BAD_REQUEST, "bad_request", e.to_string()))?;
+    // The go/no-go board's reach check reads the last plan made.
+    let share = report.plan.target.as_ref().map(|t| t.reachable_probability);
+    state.core().note_plan_reach(share);
     tracing::info!(
         by = caller.name,
         runs,

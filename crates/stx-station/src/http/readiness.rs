@@ -1,0 +1,36 @@
+//! `GET /api/readiness`: the go/no-go board (any role); `POST /api/readiness/{id}`: an
+//! operator ticks or unticks a checklist item. The board also rides in every `state` message.
+
+use axum::Json;
+use axum::extract::rejection::JsonRejection;
+use axum::extract::{Path, State};
+use axum::http::StatusCode;
+use axum::response::{IntoResponse, Response};
+
+use super::auth::Caller;
+use super::shared::{AppState, HttpError, error, json_body};
+use crate::core::TickError;
+use crate::messages::TickBody;
+
+pub(crate) async fn board(State(state): State<AppState>, _caller: Caller) -> Response {
+    let now = state.now_s();
+    Json(state.core().state_msg_now(now).readiness).into_response()
+}
+
+pub(crate) async fn tick(
+    State(state): State<AppState>,
+    caller: Caller,
+    Path(id): Path<String>,
+    body: Result<Json<TickBody>, JsonRejection>,
+) -> Result<Response, HttpError> {
+    caller.operator()?;
+    let b = json_body(body)?;
+    let now = state.now_s();
+    let mut core = state.core();
+    match core.tick_checklist(now, &caller.name, &id, b.ticked) {
+        Ok(()) => Ok(Json(core.state_msg_now(now).readiness).into_response()),
+        Err(e @ TickError::UnknownItem(_)) => {
+            Err(error(StatusCode::NOT_FOUND, "unknown_item", e.to_string()))
+        }
+    }
+}
