@@ -50,16 +50,7 @@ pub(crate) fn steered_region(discs: &[ReachDisc], share_of_best: f64) -> Steered
             radius_m: d.radius_m,
         })
         .collect();
-    let (lo, hi) = discs.iter().fold(
-        (
-            Vector2::repeat(f64::INFINITY),
-            Vector2::repeat(f64::NEG_INFINITY),
-        ),
-        |(lo, hi), d| {
-            let r = Vector2::repeat(d.radius_m);
-            (lo.inf(&(d.centre_ne_m - r)), hi.sup(&(d.centre_ne_m + r)))
-        },
-    );
+    let (lo, hi) = ProbabilityGrid::bounds(&discs);
     let span = (hi - lo).max();
     if !(span.is_finite() && span > 0.0) {
         return empty;
