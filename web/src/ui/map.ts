@@ -128,6 +128,9 @@ export class MapView {
     L.DomEvent.disableScrollPropagation(overlay);
     el.append(overlay, this.zones.root);
     this.overlay = overlay;
+    // The legend under the map grows and shrinks as symbols come and go, and the map with it:
+    // Leaflet must measure its box again, or it frames and clips to the old one.
+    new ResizeObserver(() => this.invalidate()).observe(el);
 
     this.map.on("moveend zoomend", () => this.noteView());
     this.map.on("click", (e: L.LeafletMouseEvent) => {
