@@ -5,14 +5,15 @@
 // bands must agree with the scenario's mean wind (config/scenarios/mission-short.toml, gusts of
 // 0.2 m/s on top), and the panel must show as many bands as the station measured. During the
 // ascent the map draws the predicted burst, deploy point and unsteered landing flown in those
-// bands; the last burst predicted before the burst must lie where the balloon burst.
+// bands, and its legend names them; the last burst predicted before the burst must lie where the
+// balloon burst.
 //
 // Usage: node tests/browser/ascent_winds.mjs [path/to/stx]   (default target/release/stx)
 // Env: ASCENT_SIM_SPEED (default 20).
 
 import { readFile } from "node:fs/promises";
 import { join } from "node:path";
-import { VIEWER, root, out, check, newContext, startStation, apiOf, until, text, watchErrors, runFlights, distanceM } from "./harness.mjs";
+import { VIEWER, root, out, check, newContext, startStation, apiOf, until, text, watchErrors, runFlights, distanceM, legendAgainstMap, checkLegend, LIVE_SYMBOLS, zoomOut } from "./harness.mjs";
 
 const SPEED = Number(process.env.ASCENT_SIM_SPEED ?? 20);
 
@@ -67,6 +68,12 @@ async function flight() {
       if (marks === null && (await page.locator('[data-testid="map-burst"]').count()) === 1) {
         const alt = async (id) => Number(await page.locator(`[data-testid="${id}"]`).getAttribute("data-alt"));
         marks = { burst: await alt("map-burst"), deploy: await alt("map-deploy"), landing: await page.locator('[data-testid="map-unsteered-landing"]').count(), badge: await text(page, "map-flight-path") };
+        // The legend names the ascent's symbols (✷ ◆ ✕ ○, the path and its reach), zoomed out
+        // so that none of them lies outside the view; and not the descent's, not drawn yet.
+        await zoomOut(page, 2);
+        checkLegend("legend: during the ascent every symbol on the map is listed in its own colour and glyph, and nothing else",
+          await legendAgainstMap(page, "map-legend", LIVE_SYMBOLS), ["vehicle", "burst", "deploy", "unsteered", "chute", "path", "path-reach", "grid"]);
+        await page.screenshot({ path: join(out, "legend-ascent.png") });
       }
     } else if (s?.mission?.stage === "round_chute" && s.estimate) {
       burstAt = { lat_deg: s.estimate.lat_deg, lon_deg: s.estimate.lon_deg, alt_msl_m: s.estimate.alt_msl_m };

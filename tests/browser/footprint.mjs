@@ -4,13 +4,14 @@
 // map draws the reachable footprint (50 % and 95 % regions), which holds the predicted landing and
 // is refreshed; the sample zones are drawn; a target inside a zone is refused naming it; a viewer
 // may not change the zones; an operator's zone around the uncontrolled landing raises the alarm
-// on the map and in the log, and the zones it set are what GET returns.
+// on the map and in the log, and the zones it set are what GET returns. The map's legend lists
+// each symbol drawn, in the map's own colours, and nothing that is not.
 //
 // Usage: node tests/browser/footprint.mjs [path/to/stx]   (default target/release/stx)
 
 import { readFile } from "node:fs/promises";
 import { join } from "node:path";
-import { OPERATOR, VIEWER, root, out, speed, check, newContext, startStation, apiOf, until, attr, text, watchErrors, runFlights, registerRest, fromNorthEast, configWithZoneCopy } from "./harness.mjs";
+import { OPERATOR, VIEWER, root, out, speed, check, newContext, startStation, apiOf, until, attr, text, watchErrors, runFlights, registerRest, fromNorthEast, configWithZoneCopy, legendAgainstMap, checkLegend, LIVE_SYMBOLS, zoomOut } from "./harness.mjs";
 
 registerRest("PUT", /^\/api\/keep-out$/, "KeepOutBody", "KeepOutMsg");
 
@@ -95,6 +96,15 @@ async function flight() {
     onDisk.features?.some((z) => z.properties?.name === "Test field") && sampleAfter === sampleBefore,
     `${onDisk.features?.length} zones in the file; the repository's sample ${sampleAfter === sampleBefore ? "untouched" : "CHANGED"}`);
   await page.screenshot({ path: join(out, "footprint.png") });
+
+  // The legend names what the map draws under the parafoil: the reach contours, the predicted
+  // landings with their ellipses, the zones; not the ascent's flight path, which is not drawn.
+  // Zoomed out, so no symbol drawn lies outside the view (Leaflet leaves those paths empty).
+  await zoomOut(page, 2);
+  const legend = await legendAgainstMap(page, "map-legend", LIVE_SYMBOLS);
+  checkLegend("legend: every symbol on the live map is listed in its own colour, and nothing else", legend,
+    ["vehicle", "track", "target", "planned", "uncontrolled", "reach-50", "reach-95", "keep-out", "grid"]);
+  await page.screenshot({ path: join(out, "legend-live.png") });
   await ctx.close();
 }
 

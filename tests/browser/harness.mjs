@@ -289,6 +289,76 @@ export function watchErrors(page, label) {
     if (m.type() === "error" && !/Failed to load resource/.test(m.text())) pageErrors.push(`${label}: ${m.text()}`);
   });
 }
+/**
+ * A map's legend (ui/mapLegend.ts) against its map. `symbols` maps each legend key to the map
+ * element that draws it (a CSS selector) and the style property carrying its colour. For each:
+ * whether the map shows it (a path of two points or more, another element with a size: Leaflet
+ * leaves an emptied layer's path in the page with nothing in it), whether the legend lists it, and the colour and text of
+ * both, the legend's read from its swatch's marked shape (`data-sw`).
+ */
+export const legendAgainstMap = (page, legend, symbols) => page.evaluate(([legend, symbols]) => {
+  // A path is drawn from two points on, however close (a 1-σ ellipse of a few metres, which
+  // Leaflet rounds to one pixel); its empty path is "M0 0", and a line of one point draws
+  // nothing. Anything else is drawn when it has a size (a grid line has no width).
+  const seen = (e) => {
+    if (e instanceof SVGPathElement) return ((e.getAttribute("d") ?? "").match(/-?[\d.]+/g) ?? []).length >= 4;
+    const r = e?.getBoundingClientRect();
+    return !!r && (r.width > 0 || r.height > 0);
+  };
+  const rows = {};
+  for (const [key, [sel, prop]] of Object.entries(symbols)) {
+    const onMap = [...document.querySelectorAll(sel)].find(seen) ?? null;
+    const row = document.querySelector(`[data-testid="${legend}-${key}"]`);
+    const sw = row?.querySelector("[data-sw]") ?? null;
+    const look = (e) => (e ? `${getComputedStyle(e)[prop]}${e instanceof HTMLElement ? ` ${e.textContent}` : ""}` : null);
+    rows[key] = { drawn: onMap !== null, listed: row !== null && seen(row), map: look(onMap), legend: look(sw), label: row?.textContent ?? null };
+  }
+  return rows;
+}, [legend, symbols]);
+/**
+ * Checks a legend against its map: each symbol drawn is listed with its own colour (and glyph),
+ * none is listed that is not drawn, and each of `expected` is drawn (so the check cannot pass
+ * on an empty map).
+ */
+export function checkLegend(name, rows, expected) {
+  const wrong = Object.entries(rows).filter(([, r]) => r.drawn !== r.listed || (r.drawn && r.map !== r.legend));
+  const missing = expected.filter((k) => !rows[k]?.drawn);
+  check(name, wrong.length === 0 && missing.length === 0,
+    `${wrong.map(([k, r]) => `${k}: ${r.drawn ? "drawn" : "not drawn"} (${r.map}), ${r.listed ? "listed" : "not listed"} (${r.legend})`).join("; ") || "legend agrees"}${missing.length ? `; expected on the map: ${missing.join(", ")}` : ""}; listed: ${Object.entries(rows).filter(([, r]) => r.listed).map(([k]) => k).join(", ")}`);
+}
+/** What the live map draws (ui/mapSymbols.ts), as the page's elements show it. */
+export const LIVE_SYMBOLS = {
+  vehicle: ['[data-testid="map-vehicle"] path', "fill"],
+  track: ["path.map-track", "stroke"],
+  target: ['[data-testid="map-target"] circle:nth-of-type(2)', "stroke"],
+  pattern: ["path.map-pattern", "stroke"],
+  final: ["path.map-final-line", "stroke"],
+  planned: ['[data-testid="map-pred-planned"] circle', "fill"],
+  "ellipse-planned": ["path.map-ellipse-planned", "stroke"],
+  uncontrolled: ['[data-testid="map-pred-uncontrolled"] circle', "fill"],
+  "ellipse-uncontrolled": ["path.map-ellipse-uncontrolled", "stroke"],
+  "reach-50": ["path.map-footprint-50", "fill"],
+  "reach-95": ["path.map-footprint-95", "stroke"],
+  path: ["path.map-flight-path", "stroke"],
+  burst: ['[data-testid="map-burst"]', "color"],
+  deploy: ['[data-testid="map-deploy"]', "color"],
+  unsteered: ['[data-testid="map-unsteered-landing"]', "color"],
+  chute: ['[data-testid="map-chute-landing"]', "color"],
+  "path-reach": ["path.map-path-reach", "stroke"],
+  "keep-out": ["path.map-keep-out", "fill"],
+  "draft-target": ['[data-testid="map-draft-target"] circle:nth-of-type(2)', "stroke"],
+  "draft-plan": ["path.map-draft-plan", "stroke"],
+  "draft-localizer": ["path.map-draft-localizer", "stroke"],
+  grid: ['[data-testid="map"] path.map-grid', "stroke"],
+};
+/** Zooms the live map out by `steps` (following stops), so that nothing drawn lies outside the view. */
+export async function zoomOut(page, steps) {
+  for (let i = 0; i < steps; i++) {
+    await page.click('[data-testid="map"] .leaflet-control-zoom-out');
+    await sleep(350);
+  }
+}
+
 /** Presses the pointer on an element for `ms`, as a person holding a button. */
 export async function hold(page, id, ms) {
   const b = await page.locator(`[data-testid="${id}"]`).boundingBox();

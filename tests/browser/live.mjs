@@ -15,7 +15,8 @@
 //  2. `rehearsal` (`stx serve --sim`, under the parafoil): telemetry, viewer refusal, parameter
 //     read-back, modes, gamepad with dead-man and `manual_release`, layout at 1440×900 and on a
 //     phone, map framing, a target set in the page flown to, the landed state, and the recovery
-//     page with and without the phone's position.
+//     page with and without the phone's position (its grid, its dots named, the location-denied
+//     box gone once a position is typed).
 // Then the rehearsal's recording replayed (`stx replay`: pause, seek, speed from the page), and a
 // new live station listing the recordings (size, run, landing and miss, download, open in replay).
 //
@@ -27,8 +28,26 @@ import { readFile, readdir, stat } from "node:fs/promises";
 import { basename, join } from "node:path";
 import {
   OPERATOR, VIEWER, FIELD_HOST, root, out, speed, sleep, check, newContext, distanceM, bearingDeg, fromNorthEast, angleDiff, shownMetres, rad,
-  run, recordDir, startStation, freeUdpPort, apiOf, until, text, attr, watchErrors, hold, lastRequest, stopChildren, runFlights, cutShort,
+  run, recordDir, startStation, freeUdpPort, apiOf, until, text, attr, watchErrors, hold, lastRequest, stopChildren, runFlights, cutShort, legendAgainstMap, checkLegend,
 } from "./harness.mjs";
+
+/** What the recovery map draws (ui/recoveryMap.ts), as the page's elements show it. */
+const RECOVERY_SYMBOLS = {
+  point: ['[data-testid="rec-map-point"]', "backgroundColor"], phone: ['[data-testid="rec-map-phone"]', "backgroundColor"],
+  line: ['[data-testid="rec-map"] path.rec-line', "stroke"], grid: ['[data-testid="rec-map"] path.map-grid', "stroke"],
+};
+/**
+ * The recovery map's grid: the spacing its legend gives, and the spacing of its north-south lines
+ * measured against the map's scale bar (Leaflet's, which knows nothing of the grid).
+ */
+const recoveryGrid = (page) => page.evaluate(() => {
+  const map = document.querySelector('[data-testid="rec-map"]');
+  const xs = [...map.querySelectorAll("path.map-grid")].map((p) => p.getBoundingClientRect()).filter((r) => r.width < 3 && r.height > 50).map((r) => r.left + r.width / 2).sort((a, b) => a - b);
+  const bar = map.querySelector(".leaflet-control-scale-line");
+  const barM = (/km/.test(bar.textContent) ? 1000 : 1) * parseFloat(bar.textContent);
+  const label = document.querySelector('[data-testid="rec-legend-grid"]')?.textContent ?? "";
+  return { lines: xs.length, label, labelled: Number(/(\d+) m/.exec(label)?.[1] ?? NaN), measured: xs.length > 1 ? ((xs[xs.length - 1] - xs[0]) / (xs.length - 1)) * (barM / bar.getBoundingClientRect().width) : NaN };
+});
 
 /** Values the altitude plot holds (what uPlot draws: null is a gap), with their times. */
 const altitudePlot = (page) => page.evaluate(() => {
@@ -484,6 +503,11 @@ async function rehearsal() {
   check("recovery page: the landing point is where the drone landed", distanceM(recPoint, point) < 5, `${distanceM(recPoint, point).toFixed(1)} m from the station's position`);
   check("recovery page: distance and bearing from the phone's position", Math.abs(shownD - wantD) <= 1 && angleDiff(shownB, wantB) <= 1, `shown ${shownD} m / ${shownB}°, computed ${wantD.toFixed(1)} m / ${wantB.toFixed(1)}°`);
   await rec.screenshot({ path: join(out, "recovery-phone.png"), fullPage: true });
+  const grid = await recoveryGrid(rec);
+  check("recovery map: a metric grid whose spacing the legend gives, as the scale bar measures it", grid.lines >= 2 && Math.abs(grid.measured - grid.labelled) <= 0.05 * grid.labelled,
+    `${grid.lines} north-south lines ${grid.measured.toFixed(0)} m apart by the scale bar; legend "${grid.label}"`);
+  checkLegend("recovery map: its dots and line are named in the legend, in their colours", await legendAgainstMap(rec, "rec-legend", RECOVERY_SYMBOLS), ["point", "phone", "line", "grid"]);
+  await rec.locator(".rec-map-box").screenshot({ path: join(out, "recovery-map.png") });
   await rec.close();
 
   // ---------------------------------------------------------------- the REST bodies the pages do not read, against the contract
@@ -506,6 +530,7 @@ async function rehearsal() {
   await npage.waitForFunction(() => document.querySelector('[data-testid="rec-kind"]')?.dataset.kind === "actual", null, { timeout: 10000 }).catch(() => {});
   await npage.waitForFunction(() => !document.querySelector('[data-testid="rec-phone-why"]')?.hidden, null, { timeout: 10000 }).catch(() => {});
   const why = await text(npage, "rec-phone-why").catch(() => "");
+  const legendBefore = await legendAgainstMap(npage, "rec-legend", RECOVERY_SYMBOLS);
   const decimal = await text(npage, "rec-point-decimal");
   const geo = await attr(npage, "rec-geo-link", "href");
   const osm = await attr(npage, "rec-osm-link", "href");
@@ -523,6 +548,11 @@ async function rehearsal() {
   const typedD = shownMetres(await text(npage, "rec-distance"));
   const typedB = Number(/(\d{3})°/.exec(await text(npage, "rec-bearing"))?.[1]);
   check("no position: a typed position gives distance and bearing; nonsense is refused", /two coordinates|not understood/.test(bad) && Math.abs(typedD - wantD) <= 1.5 && angleDiff(typedB, wantB) <= 1, `"${bad}"; shown ${typedD} m / ${typedB}°, computed ${wantD.toFixed(1)} m / ${wantB.toFixed(1)}°`);
+  const whyAfter = await npage.locator('[data-testid="rec-phone-why"]').isVisible();
+  const legendAfter = await legendAgainstMap(npage, "rec-legend", RECOVERY_SYMBOLS);
+  check("no position: once a position is typed the location-denied box is gone, and the map names the typed position", why !== "" && !whyAfter && !legendBefore.phone.listed && legendAfter.phone.listed,
+    `box ${why ? "shown" : "missing"} before, ${whyAfter ? "still shown" : "gone"} after; "you" ${legendBefore.phone.listed ? "listed" : "not listed"} before, ${legendAfter.phone.listed ? "listed" : "not listed"} after`);
+  checkLegend("no position: the legend agrees with the map once a position is typed", legendAfter, ["point", "phone", "line", "grid"]);
   await npage.screenshot({ path: join(out, "recovery-no-position.png"), fullPage: true });
   // The same page over plain HTTP from another machine's point of view: no secure context. (The
   // estimate of a landed drone still wanders by decimetres between polls.)

@@ -6,11 +6,15 @@
 // checked, with the points, ellipses, samples and region drawn on the map; the target's
 // reachability is shown (none at the launch site, far upwind; all at the centre of the reach
 // disc); a malformed box is named by the page, and a request the station refuses shows its reason.
+// First the station's own defaults are planned as they come (a 35-km ascent whose wind spread
+// carries the samples tens of kilometres apart): the region steering reaches is drawn in green
+// with an area, the whole sample cloud is in view, every number has its unit, and the legend
+// names each symbol in its colour.
 //
 // Usage: node tests/browser/plan.mjs [path/to/stx]   (default target/release/stx)
 
 import { join } from "node:path";
-import { OPERATOR, VIEWER, out, check, newContext, startStation, apiOf, until, text, attr, watchErrors, runFlights, registerRest } from "./harness.mjs";
+import { OPERATOR, VIEWER, out, check, newContext, startStation, apiOf, until, text, attr, watchErrors, runFlights, registerRest, legendAgainstMap, checkLegend, rad } from "./harness.mjs";
 
 registerRest("GET", /^\/api\/plan\/defaults$/, null, "PreflightDefaults");
 registerRest("POST", /^\/api\/plan$/, "PreflightBody", "PreflightReport");
@@ -20,6 +24,29 @@ const RATE = 5;
 const BURST = 20000;
 /** Reads "E 39510 m" and the like from a shown line. */
 const shown = (line, key) => Number(new RegExp(`${key} (-?\\d+) m`).exec(line)?.[1] ?? NaN);
+/** A position as the page writes it: "38.53330° N, 7.88890° W". */
+const latLonText = (lat, lon) => `${Math.abs(lat).toFixed(5)}° ${lat >= 0 ? "N" : "S"}, ${Math.abs(lon).toFixed(5)}° ${lon >= 0 ? "E" : "W"}`;
+/** The unit each box must show beside its label (the seed is a bare number). */
+const UNITS = {
+  launch_lat_deg: "°", launch_lon_deg: "°", launch_alt_msl_m: "m", ascent_rate_mps: "m/s", ascent_rate_sigma_mps: "m/s", burst_altitude_msl_m: "m",
+  burst_altitude_sigma_m: "m", deploy_height_m: "m", default_wind_sigma_mps: "m/s", runs: "samples", target_lat_deg: "°", target_lon_deg: "°",
+};
+/** What the Plan map draws (ui/preflightMap.ts), as the page's elements show it. */
+const PLAN_SYMBOLS = {
+  launch: ['[data-testid="plan-mk-launch"]', "backgroundColor"], burst: ['[data-testid="plan-mk-burst"]', "backgroundColor"],
+  deploy: ['[data-testid="plan-mk-deploy"]', "backgroundColor"], landing: ['[data-testid="plan-mk-landing"]', "backgroundColor"],
+  sample: ["path.plan-sample", "stroke"], region: ["path.plan-region", "fill"], target: ['[data-testid="plan-mk-target"]', "backgroundColor"],
+};
+/** Distinct vertices and enclosed area of a ring of [x, y]. */
+function ringShape(ring) {
+  const distinct = new Set(ring.map(([x, y]) => `${x.toFixed(3)},${y.toFixed(3)}`)).size;
+  let twice = 0;
+  for (let i = 0; i < ring.length; i++) {
+    const [a, b] = [ring[i], ring[(i + 1) % ring.length]];
+    twice += a[0] * b[1] - b[0] * a[1];
+  }
+  return { distinct, area: Math.abs(twice) / 2 };
+}
 
 async function flight() {
   const { base } = await startStation(["--link", "udpin:127.0.0.1:0"]);
@@ -45,6 +72,53 @@ async function flight() {
     `${lat}, forecast:\n${forecast}`);
   const site = defaults.request;
   const fill = async (values) => { for (const [f, v] of Object.entries(values)) await box(f).fill(String(v)); };
+  // The page says "computing…" from the click until it has drawn the answer (or shown why not).
+  const submit = async () => {
+    await page.locator('[data-testid="plan-submit"]').click();
+    await until(() => text(page, "plan-status"), (t) => !/computing/.test(t), 30000);
+  };
+
+  // ---- the station's defaults as they come: the spread is wider than the glide reaches
+  const answer = page.waitForResponse((r) => r.url().endsWith("/api/plan"), { timeout: 30000 });
+  await submit();
+  const spread = await (await answer).json();
+  // The answer's outline in metres about the launch (small-angle: tens of km).
+  const regionM = spread.steered_region_lat_lon_deg.map(([la, lo]) => [(la - site.launch_lat_deg) * rad * 6371000, (lo - site.launch_lon_deg) * rad * 6371000 * Math.cos(site.launch_lat_deg * rad)]);
+  const inAnswer = ringShape(regionM);
+  const drawnRegion = await page.evaluate(() => {
+    const p = document.querySelector("path.plan-region");
+    if (!p) return null;
+    const xy = (p.getAttribute("d") ?? "").match(/-?[\d.]+/g)?.map(Number) ?? [];
+    const ring = [];
+    for (let i = 0; i + 1 < xy.length; i += 2) ring.push([xy[i], xy[i + 1]]);
+    const st = getComputedStyle(p);
+    return { ring, stroke: st.stroke, fill: st.fill, fillOpacity: Number(st.fillOpacity) };
+  });
+  const onPage = drawnRegion ? ringShape(drawnRegion.ring) : { distinct: 0, area: 0 };
+  const green = (c) => {
+    const [r, g, b] = (c ?? "").match(/\d+/g)?.map(Number) ?? [0, 0, 0];
+    return g >= 100 && g > r + 60 && g > b + 60;
+  };
+  check("plan, station defaults: the region steering reaches is a polygon with an area, drawn in green",
+    inAnswer.distinct >= 3 && inAnswer.area > 1e6 && onPage.distinct >= 3 && onPage.area > 100 && green(drawnRegion?.stroke) && green(drawnRegion?.fill) && drawnRegion.fillOpacity > 0,
+    `answer: ${inAnswer.distinct} distinct vertices, ${(inAnswer.area / 1e6).toFixed(0)} km², reached in ≥ ${(100 * spread.steered_region_probability).toFixed(1)} % (best ${(100 * spread.steered_region_best_probability).toFixed(1)} %); page: ${onPage.distinct} vertices, ${onPage.area.toFixed(0)} px², stroke ${drawnRegion?.stroke}, fill ${drawnRegion?.fill} at ${drawnRegion?.fillOpacity}`);
+  const cloud = await page.evaluate(() => {
+    const map = document.querySelector('[data-testid="plan-map"]').getBoundingClientRect();
+    const dots = [...document.querySelectorAll("path.plan-sample")].map((e) => e.getBoundingClientRect());
+    const out = dots.filter((r) => r.left < map.left || r.right > map.right || r.top < map.top || r.bottom > map.bottom).length;
+    return { dots: dots.length, out, spanX: Math.max(...dots.map((r) => r.right)) - Math.min(...dots.map((r) => r.left)), mapW: map.width };
+  });
+  check("plan, station defaults: the map frames the whole sample cloud", cloud.dots === spread.landing_samples_lat_lon_deg.length && cloud.dots > 100 && cloud.out === 0 && cloud.spanX > 0.2 * cloud.mapW,
+    `${cloud.out} of ${cloud.dots} samples outside the map; the cloud spans ${cloud.spanX.toFixed(0)} of ${cloud.mapW.toFixed(0)} px`);
+  const labels = await page.evaluate((fields) => Object.fromEntries(fields.map((f) => [f, document.querySelector(`label[for="plan-${f}"]`)?.textContent ?? ""])), Object.keys(UNITS));
+  const unitless = Object.entries(UNITS).filter(([f, u]) => !(/\(([^)]*)\)$/.exec(labels[f])?.[1].split(/[ ,]+/) ?? []).includes(u)).map(([f]) => `${f}: "${labels[f]}"`);
+  const lines = { burst: await text(page, "plan-burst"), reach: await text(page, "plan-reach") };
+  const pointLine = /^Burst: \d+\.\d{5}° [NS], \d+\.\d{5}° [EW], \d+ m MSL · N -?\d+ m, E -?\d+ m of launch · T\+\d+:\d\d:\d\d ±\d+ s · 1σ \d+ × \d+ m at \d+°$/;
+  const reachLine = /^Steering reaches \d+ m around .* reached in \d+ % of the samples or more, no point in more than \d+ % \(\d+ landings drawn\)$/;
+  check("plan: every box and every number shown has its unit", unitless.length === 0 && pointLine.test(lines.burst) && reachLine.test(lines.reach),
+    `${unitless.join("; ") || "every label has its unit"} | ${lines.burst} | ${lines.reach}`);
+  checkLegend("plan: the legend names each symbol on the map in its colour, and nothing else", await legendAgainstMap(page, "plan-legend", PLAN_SYMBOLS), ["launch", "burst", "deploy", "landing", "sample", "region"]);
+  await page.locator(".plan-result").screenshot({ path: join(out, "plan-region.png") });
   await fill({
     forecast: `alt_msl_m,speed_mps,from_deg,sigma_mps\n0,${WIND},270,0`,
     ascent_rate_mps: RATE, ascent_rate_sigma_mps: 0, burst_altitude_msl_m: BURST, burst_altitude_sigma_m: 0,
@@ -52,8 +126,8 @@ async function flight() {
     // The launch site: 40 km upwind of the landing, out of any glide.
     target_lat_deg: site.launch_lat_deg, target_lon_deg: site.launch_lon_deg,
   });
-  await page.locator('[data-testid="plan-submit"]').click();
-  const burst = await until(() => text(page, "plan-burst").catch(() => ""), (t) => /^Burst/.test(t), 30000);
+  await submit();
+  const burst = await text(page, "plan-burst");
   const climb = (BURST - site.launch_alt_msl_m) / RATE;
   const east = shown(burst, "E");
   check("plan: the burst is east of the launch by wind × climb time (within 0.5 %), on the launch's latitude",
@@ -76,10 +150,10 @@ async function flight() {
   const radius = plan.steered_reach_radius_m;
   const centreLon = l.lon_deg - (radius / (6378137 * Math.cos((l.lat_deg * Math.PI) / 180))) * (180 / Math.PI);
   await fill({ target_lat_deg: l.lat_deg, target_lon_deg: centreLon });
-  await page.locator('[data-testid="plan-submit"]').click();
-  const reached = await until(() => text(page, "plan-target"), (t) => /reachable in 100 %/.test(t), 30000);
+  await submit();
+  const reached = await text(page, "plan-target");
   check("plan: a target at the centre of the glide disc is reachable in every sample", /reachable in 100 %/.test(reached), reached);
-  check("plan: the page shows the station's plan (the same landing as POST /api/plan)", (await text(page, "plan-landing")).includes(`${l.lat_deg.toFixed(5)}, ${l.lon_deg.toFixed(5)}`), `${await text(page, "plan-landing")} vs ${l.lat_deg}, ${l.lon_deg}`);
+  check("plan: the page shows the station's plan (the same landing as POST /api/plan)", (await text(page, "plan-landing")).includes(latLonText(l.lat_deg, l.lon_deg)), `${await text(page, "plan-landing")} vs ${l.lat_deg}, ${l.lon_deg}`);
   await page.screenshot({ path: join(out, "plan.png") });
 
   // A box that is no number is named by the page; a rule the station enforces comes back as its reason.

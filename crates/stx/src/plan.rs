@@ -162,6 +162,11 @@ pub fn run(args: PlanArgs) -> anyhow::Result<()> {
         "steering reaches {:.0} m around the drifted air mass on average ({})",
         report.steered_reach_radius_m, report.reach_method
     );
+    println!(
+        "no point is reached in more than {:.0} % of the samples; the steered region is reached in {:.0} % or more",
+        100.0 * report.steered_region_best_probability,
+        100.0 * report.steered_region_probability
+    );
     if let Some(t) = &report.target {
         println!(
             "target {:.5}, {:.5}: reachable in {:.0} % of the samples, {:.0} m from the unsteered landing",

@@ -2372,11 +2372,18 @@ export interface PreflightReport {
    */
   steered_reach_radius_m: number;
   /**
-   * Outline of the region steering reaches with that probability, `[lat, lon]` degrees.
+   * Fraction of the samples that reach the best-reached point, 0…1: the most a target can
+   * hope for.
+   */
+  steered_region_best_probability: number;
+  /**
+   * Outline of the region steering reaches with that probability, `[lat, lon]` degrees, its
+   * first point repeated at the end; empty if steering reaches nowhere.
    */
   steered_region_lat_lon_deg: [number, number][];
   /**
-   * Probability the steered region stands for.
+   * Fraction of the samples that reach each point of the steered region, at least: half the
+   * best-reached point's (`flight_path::region` says why), 0…1.
    */
   steered_region_probability: number;
   /**

@@ -234,7 +234,7 @@ function build(session: Session): void {
     { id: "recordings", label: "Recordings", content: recordings.root, onShow: () => void recordings.load() },
     { id: "voice", label: "Voice", content: voice.root },
   ]);
-  const centre = h("section", { class: "col centre" }, h("div", { class: "map-wrap vd" }, map.root), bottom.root);
+  const centre = h("section", { class: "col centre" }, h("div", { class: "map-wrap vd" }, map.root), map.legend.root, bottom.root);
   // Modes and the joystick first: in manual flight both must be in view without scrolling.
   const commandTab = h("div", {}, modes.root, joystick.root, target.root, guidanceInputs.root);
   const right = tabs("control", [

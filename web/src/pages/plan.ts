@@ -11,6 +11,7 @@ import "../styles/common.css";
 import "../styles/plan.css";
 import type * as Wire from "../generated/api";
 import { Api, ApiError } from "../lib/api";
+import { fmtLatLon } from "../lib/format";
 import { parseSession } from "../lib/parse";
 import { type PlanForm, buildRequest, formOf, measuredLines } from "../lib/preflight";
 import { resolveToken, searchWithoutToken } from "../lib/token";
@@ -21,25 +22,25 @@ const token = resolveToken(location.search, sessionStorage);
 if (new URLSearchParams(location.search).has("token")) history.replaceState(null, "", `${location.pathname}${searchWithoutToken(location.search)}`);
 const api = new Api(token);
 
-/** Each box: its field, label and what it takes. */
-const BOXES: [Exclude<keyof PlanForm, "forecast" | "from_recording">, string, string][] = [
-  ["launch_lat_deg", "Launch latitude", "degrees north"],
-  ["launch_lon_deg", "Launch longitude", "degrees east"],
-  ["launch_alt_msl_m", "Launch altitude", "m above sea level"],
-  ["ascent_rate_mps", "Ascent rate", "m/s, mean to burst"],
-  ["ascent_rate_sigma_mps", "± ascent rate", "1-σ, m/s"],
-  ["burst_altitude_msl_m", "Burst altitude", "m above sea level"],
-  ["burst_altitude_sigma_m", "± burst altitude", "1-σ, m"],
-  ["deploy_height_m", "Deploy height", "m above the launch site"],
-  ["default_wind_sigma_mps", "Wind σ", "m/s, for rows without a sigma"],
-  ["runs", "Runs", "Monte Carlo samples"],
-  ["seed", "Seed", "same seed, same plan"],
-  ["target_lat_deg", "Target latitude", "degrees north; empty: none"],
-  ["target_lon_deg", "Target longitude", "degrees east"],
+/** Each box: its field, label, unit (shown beside the label; the seed is a bare number) and what it takes. */
+const BOXES: [Exclude<keyof PlanForm, "forecast" | "from_recording">, string, string | null, string][] = [
+  ["launch_lat_deg", "Launch latitude", "° N", "degrees north"],
+  ["launch_lon_deg", "Launch longitude", "° E", "degrees east"],
+  ["launch_alt_msl_m", "Launch altitude", "m MSL", "m above sea level"],
+  ["ascent_rate_mps", "Ascent rate", "m/s", "m/s, mean to burst"],
+  ["ascent_rate_sigma_mps", "± ascent rate", "m/s, 1 σ", "1-σ, m/s"],
+  ["burst_altitude_msl_m", "Burst altitude", "m MSL", "m above sea level"],
+  ["burst_altitude_sigma_m", "± burst altitude", "m, 1 σ", "1-σ, m"],
+  ["deploy_height_m", "Deploy height", "m above launch", "m above the launch site"],
+  ["default_wind_sigma_mps", "Wind σ", "m/s", "m/s, for rows without a sigma"],
+  ["runs", "Runs", "samples", "Monte Carlo samples"],
+  ["seed", "Seed", null, "same seed, same plan"],
+  ["target_lat_deg", "Target latitude", "° N", "degrees north; empty: none"],
+  ["target_lon_deg", "Target longitude", "° E", "degrees east"],
 ];
 
 const inputs = new Map<keyof PlanForm, HTMLInputElement | HTMLTextAreaElement | HTMLSelectElement>();
-for (const [field, , title] of BOXES) inputs.set(field, h("input", { type: "text", inputmode: "decimal", id: `plan-${field}`, "data-testid": `plan-in-${field}`, title }));
+for (const [field, , , title] of BOXES) inputs.set(field, h("input", { type: "text", inputmode: "decimal", id: `plan-${field}`, "data-testid": `plan-in-${field}`, title }));
 const forecastBox = h("textarea", { id: "plan-forecast", "data-testid": "plan-in-forecast", spellcheck: "false", title: "one row a line: alt_msl_m,speed_mps,from_deg[,sigma_mps]" });
 inputs.set("forecast", forecastBox);
 const recordingBox = h("select", { id: "plan-from_recording", "data-testid": "plan-in-from_recording" }, h("option", { value: "" }, "none: the forecast alone"));
@@ -49,7 +50,7 @@ const error = h("div", { class: "plan-error", role: "alert", "data-testid": "pla
 const status = h("div", { class: "small muted wide", role: "status", "data-testid": "plan-status" });
 
 const form = h("form", { class: "plan-form", "data-testid": "plan-form", novalidate: true });
-for (const [field, label] of BOXES) form.append(h("label", { for: `plan-${field}` }, label), inputs.get(field)!);
+for (const [field, label, unit] of BOXES) form.append(h("label", { for: `plan-${field}`, "data-unit": unit ?? "" }, label, unit === null ? "" : h("span", { class: "unit" }, ` (${unit})`)), inputs.get(field)!);
 form.append(
   h("label", { for: "plan-forecast", class: "wide" }, "Forecast (alt_msl_m,speed_mps,from_deg[,sigma_mps]; from: where the wind blows from)"),
   forecastBox,
@@ -87,7 +88,7 @@ const clock = (s: number): string => {
 function pointLine(name: string, p: Wire.PlannedPoint): string {
   const e = p.ellipse;
   const axis = (((e.major_axis_rad * 180) / Math.PI) % 180 + 180) % 180;
-  return `${name}: ${p.lat_deg.toFixed(5)}, ${p.lon_deg.toFixed(5)}, ${p.alt_msl_m.toFixed(0)} m MSL · N ${p.north_m.toFixed(0)} m, E ${p.east_m.toFixed(0)} m of launch · T+${clock(p.time_s)} ±${p.time_sigma_s.toFixed(0)} s · 1σ ${e.semi_major_m.toFixed(0)} × ${e.semi_minor_m.toFixed(0)} m at ${axis.toFixed(0)}°`;
+  return `${name}: ${fmtLatLon(p.lat_deg, p.lon_deg)}, ${p.alt_msl_m.toFixed(0)} m MSL · N ${p.north_m.toFixed(0)} m, E ${p.east_m.toFixed(0)} m of launch · T+${clock(p.time_s)} ±${p.time_sigma_s.toFixed(0)} s · 1σ ${e.semi_major_m.toFixed(0)} × ${e.semi_minor_m.toFixed(0)} m at ${axis.toFixed(0)}°`;
 }
 
 function showPlan(plan: Wire.PreflightReport): void {
@@ -95,9 +96,10 @@ function showPlan(plan: Wire.PreflightReport): void {
   setText(out.deploy, pointLine("Parafoil deploy", plan.deploy));
   setText(out.landing, pointLine("Landing, unsteered", plan.landing_unsteered));
   setText(out.round, pointLine("Landing, round chute only", plan.round_chute_landing));
-  setText(out.reach, `Steering reaches ${plan.steered_reach_radius_m.toFixed(0)} m around the drifted air mass on average; the green region is reached in ${(100 * plan.steered_region_probability).toFixed(0)} % of the samples (${plan.landing_samples_lat_lon_deg.length} landings drawn)`);
+  const pct = (p: number): string => `${(100 * p).toFixed(0)} %`;
+  setText(out.reach, `Steering reaches ${plan.steered_reach_radius_m.toFixed(0)} m around the drifted air mass on average; the green region is reached in ${pct(plan.steered_region_probability)} of the samples or more, no point in more than ${pct(plan.steered_region_best_probability)} (${plan.landing_samples_lat_lon_deg.length} landings drawn)`);
   const t = plan.target;
-  setText(out.target, t ? `Target ${t.lat_deg.toFixed(5)}, ${t.lon_deg.toFixed(5)}: reachable in ${(100 * t.reachable_probability).toFixed(0)} % of the samples, ${t.from_unsteered_landing_m.toFixed(0)} m from the unsteered landing` : "No target given");
+  setText(out.target, t ? `Target ${fmtLatLon(t.lat_deg, t.lon_deg)}: reachable in ${(100 * t.reachable_probability).toFixed(0)} % of the samples, ${t.from_unsteered_landing_m.toFixed(0)} m from the unsteered landing` : "No target given");
   const m = plan.measured_ascent;
   measured.hidden = m === null;
   measured.replaceChildren(

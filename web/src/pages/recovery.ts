@@ -293,8 +293,10 @@ function render(): void {
         ? "phone position unavailable"
         : "locating the phone…";
   setText(el.phone, phoneText);
-  setText(el.why, phone ? "" : (noPos ?? ""));
-  el.why.hidden = phone !== null || noPos === null;
+  // Once a position is typed the page has what it needed: why the phone gave none is no news.
+  const known = phone !== null || manual !== null;
+  setText(el.why, known ? "" : (noPos ?? ""));
+  el.why.hidden = known || noPos === null;
   el.phone.dataset.source = manual ? "manual" : phone ? "gps" : noPos ? "unavailable" : "locating";
   el.phoneClear.hidden = manual === null;
   // Without the phone's own position, typing one is the way to get distance and bearing.

@@ -6,29 +6,25 @@
  */
 import L from "leaflet";
 import { h, setText } from "./dom";
+import { PATH_LINE, PATH_REACH, pathGlyph, type PathMark } from "./mapSymbols";
 import { flightPathSummary, type FlightPath } from "../lib/flightPath";
 import type { LatLon } from "../lib/types";
 
 const ll = (p: LatLon): L.LatLngExpression => [p.lat_deg, p.lon_deg];
 
-const MARK = (testid: string, glyph: string, title: string, colour: string): L.DivIcon =>
-  L.divIcon({
-    className: "mk mk-path",
-    // An element, not HTML text: its style goes through the CSSOM, which the CSP allows.
-    html: h("div", { "data-testid": testid, title, style: `color:${colour};font:bold 18px/20px sans-serif;text-align:center` }, glyph),
-    iconSize: [20, 20],
-    iconAnchor: [10, 10],
-  });
+const MARK = (mark: PathMark, testid: string): L.DivIcon => L.divIcon({ className: "mk mk-path", html: pathGlyph(mark, testid), iconSize: [20, 20], iconAnchor: [10, 10] });
 
 export class FlightPathLayer {
   readonly badge: HTMLElement;
   private readonly group = L.layerGroup();
-  private readonly line = L.polyline([], { color: "#7a4a00", weight: 2, dashArray: "3 6", interactive: false, className: "map-flight-path" });
-  private readonly reach = L.circle([0, 0], { radius: 1, color: "#7a4a00", weight: 1, fillOpacity: 0.05, interactive: false, className: "map-path-reach" });
-  private readonly burst = L.marker([0, 0], { icon: MARK("map-burst", "✷", "predicted burst", "#b00000"), interactive: false });
-  private readonly deploy = L.marker([0, 0], { icon: MARK("map-deploy", "◆", "predicted parafoil deployment", "#7a4a00"), interactive: false });
-  private readonly landing = L.marker([0, 0], { icon: MARK("map-unsteered-landing", "✕", "unsteered parafoil landing", "#7a4a00"), interactive: false });
-  private readonly chute = L.marker([0, 0], { icon: MARK("map-chute-landing", "○", "landing under the round chute alone", "#555"), interactive: false });
+  /** The legend's keys of what is drawn now (mapSymbols.ts). */
+  readonly drawn = new Set<string>();
+  private readonly line = L.polyline([], PATH_LINE);
+  private readonly reach = L.circle([0, 0], { ...PATH_REACH, radius: 1 });
+  private readonly burst = L.marker([0, 0], { icon: MARK("burst", "map-burst"), interactive: false });
+  private readonly deploy = L.marker([0, 0], { icon: MARK("deploy", "map-deploy"), interactive: false });
+  private readonly landing = L.marker([0, 0], { icon: MARK("landing", "map-unsteered-landing"), interactive: false });
+  private readonly chute = L.marker([0, 0], { icon: MARK("chute", "map-chute-landing"), interactive: false });
 
   constructor(map: L.Map) {
     this.badge = h("div", { class: "map-badge path", "data-testid": "map-flight-path", hidden: true });
@@ -38,8 +34,10 @@ export class FlightPathLayer {
   /** Draws `p` from the vehicle at `from`; null clears it (under the parafoil, on the ground). */
   update(p: FlightPath | null, from: LatLon | null, stale: boolean, mission_time_s: number | null = null): void {
     this.group.clearLayers();
+    this.drawn.clear();
     this.badge.hidden = p === null;
     if (p === null) return;
+    for (const key of ["path", "path-reach", "deploy", "unsteered", "chute", ...(p.burst ? ["burst"] : [])]) this.drawn.add(key);
     const points = [from, p.burst, p.deploy, p.landing].filter((x): x is LatLon => x !== null);
     this.line.setLatLngs(points.map(ll));
     this.reach.setLatLng(ll(p.reach_centre)).setRadius(p.reach_radius_m);

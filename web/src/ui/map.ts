@@ -4,15 +4,19 @@
 // are always drawn, so positions stay readable when no tile loads (offline field, no cache).
 // While "follow" is on, the view frames the vehicle, target, pattern and predictions
 // (lib/framing.ts); a drag or zoom by the operator turns it off. Text about the geometry lives in
-// the badge strip along the top, never on the map, so no label hides the target or the pattern.
+// the badge strip along the top, never on the map, so no label hides the target or the pattern;
+// what each symbol means is in the legend under the map, which lists those drawn now.
 
 import L from "leaflet";
 import "leaflet/dist/leaflet.css";
 import { h, setText } from "./dom";
 import { stationTileLayer } from "./tileLayer";
 import { FlightPathLayer } from "./flightPathLayer";
-import { distanceM, ellipsePoints, fromLocal, gridValues, niceStep, toLocal } from "../lib/geo";
-import { fmt, fmtDir, fmtDistance } from "../lib/format";
+import { MapLegend } from "./mapLegend";
+import { DRAFT_LOCALIZER, DRAFT_PLAN, ELLIPSE_PLANNED, ELLIPSE_UNCONTROLLED, FINAL, LIVE_LEGEND, PATTERN, REACH_50, REACH_95, STALE_COLOR, TRACK, dotIcon, targetIcon, vehicleIcon } from "./mapSymbols";
+import { MetricGrid } from "./metricGrid";
+import { ellipsePoints, fromLocal, toLocal } from "../lib/geo";
+import { fmt, fmtDir } from "../lib/format";
 import { boxAround, keyPoints, needsFraming, type Box } from "../lib/framing";
 import { isLanded, landedText } from "../lib/recovery";
 import { trackPositions, vehiclePosition } from "../lib/fix";
@@ -21,6 +25,12 @@ import { ZoneEditor } from "./zoneEditor";
 import type { Footprint, KeepOutAlarm, KeepOutMsg, LandingPrediction, LatLon, Ring, State, Station, TrackPoint } from "../lib/types";
 
 const ll = (p: LatLon): L.LatLngExpression => [p.lat_deg, p.lon_deg];
+/** Whether a layer's points (flat, rings, or polygons of rings) are two or more, without copying a long track. */
+const twoPoints = (latlngs: unknown[]): boolean => {
+  let n = 0;
+  for (const x of latlngs) if ((n += Array.isArray(x) ? (twoPoints(x) ? 2 : x.length) : 1) >= 2) return true;
+  return false;
+};
 const MAX_TRACK = 20_000;
 /** Failed tiles (and none loaded) after which the tile layer is dropped for the grid alone. */
 const GIVE_UP_AFTER_FAILED_TILES = 6;
@@ -29,29 +39,30 @@ export type Picker = ((p: LatLon) => void) | null;
 
 export class MapView {
   readonly root: HTMLElement;
+  /** What each symbol drawn now means: under the map, never over it. */
+  readonly legend = new MapLegend(LIVE_LEGEND, "map-legend");
   private readonly map: L.Map;
   private origin: LatLon;
-  private readonly grid = L.layerGroup();
-  private readonly track = L.polyline([], { color: "#0b2f8a", weight: 3 });
-  private readonly pattern = L.polygon([], { color: "#c000c0", weight: 2, dashArray: "6 5", fill: false, className: "map-pattern" });
-  private readonly final = L.polyline([], { color: "#c000c0", weight: 4, className: "map-final-line" });
-  /** The reachable footprint: at least 95 % (light) and 50 % (darker) of the draws reach it. */
-  private readonly reach95 = L.polygon([], { color: "#2a7ab0", weight: 1, fillColor: "#2a7ab0", fillOpacity: 0.1, interactive: false, className: "map-footprint-95" });
-  private readonly reach50 = L.polygon([], { color: "#2a7ab0", weight: 2, fillColor: "#2a7ab0", fillOpacity: 0.22, interactive: false, className: "map-footprint-50" });
+  private readonly grid: MetricGrid;
+  private readonly track = L.polyline([], TRACK);
+  private readonly pattern = L.polygon([], PATTERN);
+  private readonly final = L.polyline([], FINAL);
+  private readonly reach95 = L.polygon([], REACH_95);
+  private readonly reach50 = L.polygon([], REACH_50);
   private readonly reachText: HTMLElement;
   /** Keep-out zones, drawn under everything else, each named on hover; edited by operators. */
   private readonly zones: ZoneEditor;
   private readonly alarmText: HTMLElement;
   private readonly flightPath: FlightPathLayer;
-  private readonly ellPlanned = L.polygon([], { color: "#006400", weight: 2, fillOpacity: 0.12 });
-  private readonly ellUncontrolled = L.polygon([], { color: "#c05800", weight: 2, fillOpacity: 0.08, dashArray: "4 4" });
+  private readonly ellPlanned = L.polygon([], ELLIPSE_PLANNED);
+  private readonly ellUncontrolled = L.polygon([], ELLIPSE_UNCONTROLLED);
   private readonly planned: L.Marker;
   private readonly uncontrolled: L.Marker;
   private readonly target: L.Marker;
   private readonly vehicle: L.Marker;
   private readonly draftTarget: L.Marker;
-  private readonly draftPlan = L.polyline([], { color: "#000", weight: 2, dashArray: "2 6" });
-  private readonly draftLocalizer = L.polyline([], { color: "#006b8f", weight: 3, dashArray: "10 6" });
+  private readonly draftPlan = L.polyline([], DRAFT_PLAN);
+  private readonly draftLocalizer = L.polyline([], DRAFT_LOCALIZER);
   private readonly tilesStatus: HTMLElement;
   private readonly windText: HTMLElement;
   private readonly windArrow: HTMLElement;
@@ -86,14 +97,14 @@ export class MapView {
       this.tiles.addTo(this.map);
     }
     L.control.scale({ metric: true, imperial: false, maxWidth: 160 }).addTo(this.map);
-    this.grid.addTo(this.map);
-    const icon = (cls: string, html: string, size: number, testid: string): L.DivIcon =>
-      L.divIcon({ className: `mk ${cls}`, html: `<div data-testid="${testid}">${html}</div>`, iconSize: [size, size], iconAnchor: [size / 2, size / 2] });
-    this.target = L.marker(ll(this.origin), { icon: icon("mk-target", TARGET_SVG, 34, "map-target"), keyboard: false, interactive: false });
-    this.planned = L.marker(ll(this.origin), { icon: icon("mk-planned", DOT_SVG("#006400"), 18, "map-pred-planned"), interactive: false });
-    this.uncontrolled = L.marker(ll(this.origin), { icon: icon("mk-uncontrolled", DOT_SVG("#c05800"), 18, "map-pred-uncontrolled"), interactive: false });
-    this.vehicle = L.marker(ll(this.origin), { icon: icon("mk-vehicle", VEHICLE_SVG, 40, "map-vehicle"), zIndexOffset: 1000, interactive: false });
-    this.draftTarget = L.marker(ll(this.origin), { icon: icon("mk-draft", TARGET_SVG, 34, "map-draft-target"), interactive: false, opacity: 0.6 });
+    this.grid = new MetricGrid(this.map, this.origin, { labelLines: true, onStep: (step) => this.legend.setLabel("grid", `grid ${step} m`) });
+    const icon = (cls: string, svg: SVGSVGElement, size: number, testid: string): L.DivIcon =>
+      L.divIcon({ className: `mk ${cls}`, html: h("div", { "data-testid": testid }, svg), iconSize: [size, size], iconAnchor: [size / 2, size / 2] });
+    this.target = L.marker(ll(this.origin), { icon: icon("mk-target", targetIcon(), 34, "map-target"), keyboard: false, interactive: false });
+    this.planned = L.marker(ll(this.origin), { icon: icon("mk-planned", dotIcon(ELLIPSE_PLANNED.color!), 18, "map-pred-planned"), interactive: false });
+    this.uncontrolled = L.marker(ll(this.origin), { icon: icon("mk-uncontrolled", dotIcon(ELLIPSE_UNCONTROLLED.color!), 18, "map-pred-uncontrolled"), interactive: false });
+    this.vehicle = L.marker(ll(this.origin), { icon: icon("mk-vehicle", vehicleIcon(), 40, "map-vehicle"), zIndexOffset: 1000, interactive: false });
+    this.draftTarget = L.marker(ll(this.origin), { icon: icon("mk-draft", targetIcon(), 34, "map-draft-target"), interactive: false, opacity: 0.6 });
     this.zones = new ZoneEditor(this.map, { save: saveZones, onEditing: (on) => on && this.setFollow(false) });
     this.flightPath = new FlightPathLayer(this.map);
     for (const layer of [this.reach95, this.reach50, this.pattern, this.final, this.ellUncontrolled, this.ellPlanned, this.track, this.draftPlan, this.draftLocalizer]) layer.addTo(this.map);
@@ -117,8 +128,11 @@ export class MapView {
     L.DomEvent.disableScrollPropagation(overlay);
     el.append(overlay, this.zones.root);
     this.overlay = overlay;
+    // The legend under the map grows and shrinks as symbols come and go, and the map with it:
+    // Leaflet must measure its box again, or it frames and clips to the old one.
+    new ResizeObserver(() => this.invalidate()).observe(el);
 
-    this.map.on("moveend zoomend", () => this.drawGrid());
+    this.map.on("moveend zoomend", () => this.noteView());
     this.map.on("click", (e: L.LeafletMouseEvent) => {
       if (this.picker) this.picker({ lat_deg: e.latlng.lat, lon_deg: e.latlng.lng });
     });
@@ -165,7 +179,8 @@ export class MapView {
     } finally {
       this.framing = false;
     }
-    this.drawGrid();
+    this.grid.draw();
+    this.noteView();
   }
 
   setPicker(p: Picker): void {
@@ -182,12 +197,30 @@ export class MapView {
     this.root.dataset.trackPoints = String(points.length);
     this.root.dataset.trackLastS = last === undefined ? "" : String(last.time_s);
     this.track.setLatLngs(trackPositions(points.slice(-MAX_TRACK)).map((p) => [p.lat_deg, p.lon_deg] as L.LatLngTuple));
+    this.showLegend();
   }
 
   /** The keep-out zones in force (drawn at once unless an operator is editing them). */
   setZones(k: KeepOutMsg): void {
     this.zones.show(k);
     this.root.dataset.keepOutAreas = String(k.areas.length);
+    this.showLegend();
+  }
+
+  /** Lists in the legend the symbols drawn now. */
+  private showLegend(): void {
+    const on = new Set<string>(["grid", ...this.flightPath.drawn]);
+    const markers = { vehicle: this.vehicle, target: this.target, planned: this.planned, uncontrolled: this.uncontrolled, "draft-target": this.draftTarget };
+    const paths = {
+      track: this.track, pattern: this.pattern, final: this.final, "ellipse-planned": this.ellPlanned, "ellipse-uncontrolled": this.ellUncontrolled,
+      "reach-50": this.reach50, "reach-95": this.reach95, "draft-plan": this.draftPlan, "draft-localizer": this.draftLocalizer,
+    };
+    for (const [key, m] of Object.entries(markers)) if (this.map.hasLayer(m)) on.add(key);
+    // An emptied layer stays on the map with no points, and a line of one point (a plan of its
+    // land item alone) shows nothing: a path is drawn from two points on, however close.
+    for (const [key, p] of Object.entries(paths)) if (twoPoints(p.getLatLngs())) on.add(key);
+    if (this.zones.drawn > 0) on.add("keep-out");
+    this.legend.show(on);
   }
 
   private showAlarms(alarms: KeepOutAlarm[]): void {
@@ -200,7 +233,7 @@ export class MapView {
     this.reach95.setLatLngs(level(0.95));
     this.reach50.setLatLngs(level(0.5));
     const old = stale || (f?.stale ?? false);
-    for (const layer of [this.reach95, this.reach50]) layer.setStyle({ color: old ? "#888" : "#2a7ab0", fillColor: old ? "#888" : "#2a7ab0" });
+    for (const [layer, style] of [[this.reach95, REACH_95], [this.reach50, REACH_50]] as const) layer.setStyle({ color: old ? STALE_COLOR : style.color, fillColor: old ? STALE_COLOR : style.fillColor });
     this.reachText.hidden = f === null;
     if (f !== null) {
       this.reachText.dataset.computed = f.computed_s.toFixed(1);
@@ -253,7 +286,7 @@ export class MapView {
     this.showAlarms(landed ? [] : s.keep_out_alarms);
     this.showPrediction(this.planned, this.ellPlanned, pred?.planned ?? null, "planned", stale);
     this.showPrediction(this.uncontrolled, this.ellUncontrolled, pred?.uncontrolled ?? null, "uncontrolled", stale);
-    for (const [layer, color] of [[this.pattern, "#c000c0"], [this.final, "#c000c0"]] as const) layer.setStyle({ color: stale ? "#888" : color });
+    for (const [layer, style] of [[this.pattern, PATTERN], [this.final, FINAL]] as const) layer.setStyle({ color: stale ? STALE_COLOR : style.color });
     this.landedText.hidden = !landed;
     // The station's figure, measured once: the same in the header, the log and the recordings.
     if (landed) setText(this.landedText, landedText(s));
@@ -263,26 +296,31 @@ export class MapView {
     } else setText(this.windText, "wind —");
     this.lastWant = boxAround(keyPoints(s));
     if (this.follow && this.lastWant && needsFraming(this.viewBox(), this.lastWant)) this.frame(this.lastWant);
+    this.showLegend();
   }
 
   showDraftTarget(p: LatLon | null): void {
     this.show(this.draftTarget, p);
+    this.showLegend();
   }
 
   showDraftPlan(points: readonly LatLon[]): void {
     this.draftPlan.setLatLngs(points.map(ll));
+    this.showLegend();
   }
 
   /** The localizer line: a point and a course, drawn 2 km each way. */
   showDraftLocalizer(p: LatLon | null, course_deg: number | null): void {
     if (p === null || course_deg === null) {
       this.draftLocalizer.setLatLngs([]);
+      this.showLegend();
       return;
     }
     const o = toLocal(this.origin, p);
     const c = (course_deg * Math.PI) / 180;
     const at = (d: number): L.LatLngExpression => ll(fromLocal(this.origin, { east_m: o.east_m + d * Math.sin(c), north_m: o.north_m + d * Math.cos(c) }));
     this.draftLocalizer.setLatLngs([at(-2000), at(2000)]);
+    this.showLegend();
   }
 
   private show(m: L.Marker, p: LatLon | null): void {
@@ -307,7 +345,7 @@ export class MapView {
       ell.setLatLngs([]);
       return;
     }
-    ell.setStyle({ color: stale ? "#888" : name === "planned" ? "#006400" : "#c05800" });
+    ell.setStyle({ color: stale ? STALE_COLOR : (name === "planned" ? ELLIPSE_PLANNED : ELLIPSE_UNCONTROLLED).color });
     ell.setLatLngs(ellipsePoints(p, p.semi_major_m, p.semi_minor_m, p.major_axis_deg ?? 0).map(ll));
     const tip = `predicted landing (${name}) · 1σ ${fmt(p.semi_major_m, "m", 0)} × ${fmt(p.semi_minor_m, "m", 0)} · in ${fmt(p.time_to_land_s, "s", 0)}`;
     if (!ell.getTooltip()) ell.bindTooltip(tip, { sticky: true });
@@ -330,35 +368,13 @@ export class MapView {
     this.tilesStatus.dataset.state = b.state;
   }
 
-  /** Grid lines every 1/2/5×10^k m east and north of the origin, labelled in metres. */
-  private drawGrid(): void {
-    this.grid.clearLayers();
-    // The view, for tests and for people reading the DOM: with the container's size it gives
-    // every pixel's position (Web Mercator), as where a zone's corner was clicked.
+  /**
+   * The view, for tests and for people reading the DOM: with the container's size it gives every
+   * pixel's position (Web Mercator), as where a zone's corner was clicked.
+   */
+  private noteView(): void {
     const c = this.map.getCenter();
     this.root.dataset.center = `${c.lat.toFixed(7)},${c.lng.toFixed(7)}`;
     this.root.dataset.zoom = String(this.map.getZoom());
-    const b = this.map.getBounds();
-    const sw = toLocal(this.origin, { lat_deg: b.getSouth(), lon_deg: b.getWest() });
-    const ne = toLocal(this.origin, { lat_deg: b.getNorth(), lon_deg: b.getEast() });
-    const step = niceStep(Math.max(ne.east_m - sw.east_m, ne.north_m - sw.north_m), 8);
-    const style: L.PolylineOptions = { color: "#000", weight: 1, opacity: 0.35, interactive: false };
-    const pt = (east_m: number, north_m: number): L.LatLngExpression => ll(fromLocal(this.origin, { east_m, north_m }));
-    // Leaflet positions the icon element with its own transform: offsets go on the inner span.
-    const label = (text: string, at: L.LatLngExpression, cls: string): L.Marker =>
-      L.marker(at, { icon: L.divIcon({ className: "grid-label", html: `<span class="${cls}">${text}</span>`, iconSize: [0, 0] }), interactive: false, keyboard: false });
-    for (const x of gridValues(sw.east_m, ne.east_m, step)) {
-      this.grid.addLayer(L.polyline([pt(x, sw.north_m), pt(x, ne.north_m)], { ...style, weight: x === 0 ? 2 : 1 }));
-      this.grid.addLayer(label(`${x >= 0 ? "E" : "W"} ${Math.abs(x)} m`, pt(x, sw.north_m), "bottom"));
-    }
-    for (const y of gridValues(sw.north_m, ne.north_m, step)) {
-      this.grid.addLayer(L.polyline([pt(sw.east_m, y), pt(ne.east_m, y)], { ...style, weight: y === 0 ? 2 : 1 }));
-      this.grid.addLayer(label(`${y >= 0 ? "N" : "S"} ${Math.abs(y)} m`, pt(sw.east_m, y), "left"));
-    }
   }
 }
-
-const TARGET_SVG = `<svg viewBox="-17 -17 34 34" width="34" height="34"><circle r="13" fill="none" stroke="#fff" stroke-width="6"/><circle r="13" fill="none" stroke="#d00000" stroke-width="3"/><circle r="5" fill="#d00000" stroke="#fff" stroke-width="1.5"/></svg>`;
-const DOT_SVG = (c: string): string => `<svg viewBox="-9 -9 18 18" width="18" height="18"><circle r="7" fill="${c}" stroke="#fff" stroke-width="2.5"/></svg>`;
-// Points up (north) at rotation 0; rotated by the heading.
-const VEHICLE_SVG = `<svg viewBox="-20 -20 40 40" width="40" height="40"><path d="M0 -18 L11 14 L0 7 L-11 14 Z" fill="#ffd400" stroke="#000" stroke-width="2.5" stroke-linejoin="round"/></svg>`;

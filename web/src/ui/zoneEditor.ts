@@ -18,6 +18,7 @@ import L from "leaflet";
 import "@geoman-io/leaflet-geoman-free";
 import "@geoman-io/leaflet-geoman-free/dist/leaflet-geoman.css";
 import { h, setText } from "./dom";
+import { KEEP_OUT } from "./mapSymbols";
 import { parseKeepOut, isObj } from "../lib/parse";
 import { collectionOf, newZoneName, polygonsOfLatLngs, withZoneNames, ZONE_KINDS, zonesProblem } from "../lib/zones";
 import type { KeepOutMsg, Zone } from "../lib/types";
@@ -38,7 +39,7 @@ interface Entry {
   extra: Record<string, unknown>;
 }
 
-const STYLE: L.PathOptions = { color: "#b00020", weight: 2, fillColor: "#b00020", fillOpacity: 0.18, dashArray: "4 3", className: "map-keep-out" };
+const STYLE = KEEP_OUT;
 const EDIT_OPTIONS = { allowSelfIntersection: false, removeLayerBelowMinVertexCount: false, snappable: false, draggable: false } as const;
 
 export class ZoneEditor {
@@ -59,6 +60,11 @@ export class ZoneEditor {
   private readonly saveBtn: HTMLButtonElement;
   private readonly errorText: HTMLElement;
   private readonly noteText: HTMLElement;
+
+  /** Zones on the map now (in force, or being edited). */
+  get drawn(): number {
+    return this.entries.length;
+  }
 
   constructor(
     private readonly map: L.Map,
@@ -170,7 +176,7 @@ export class ZoneEditor {
   private draw(): void {
     this.select(null);
     this.drawBtn.classList.add("on");
-    this.map.pm.enableDraw("Polygon", { allowSelfIntersection: false, finishOnEnter: true, snappable: false, pathOptions: STYLE, templineStyle: { color: "#b00020" }, hintlineStyle: { color: "#b00020", dashArray: [5, 5] } });
+    this.map.pm.enableDraw("Polygon", { allowSelfIntersection: false, finishOnEnter: true, snappable: false, pathOptions: STYLE, templineStyle: { color: STYLE.color }, hintlineStyle: { color: STYLE.color, dashArray: [5, 5] } });
   }
 
   private select(entry: Entry | null): void {

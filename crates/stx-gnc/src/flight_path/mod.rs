@@ -31,6 +31,7 @@ pub mod forecast;
 mod models;
 pub mod plan;
 pub mod reach;
+pub mod region;
 pub mod spread;
 
 use nalgebra::Vector3;
@@ -46,6 +47,7 @@ pub use forecast::{Forecast, ForecastError, ForecastRow, merge_measured};
 pub use models::{Balloon, RoundChute};
 pub use plan::{PlanError, PlanReport, PlanRequest, plan};
 pub use reach::ReachDisc;
+pub use region::SteeredRegion;
 pub use spread::{Dispersion, Ellipse, PlanInputs, PlanSpread, PointSpread, monte_carlo};
 
 /// Mass of the STRAPLEX stack under its round chute (the four bodies, 9.1 kg, plus the chute

@@ -187,9 +187,14 @@ pub struct PlanReport {
     pub landing_unsteered: PlannedPoint,
     /// Where the stack would land had the round chute never been released.
     pub round_chute_landing: PlannedPoint,
-    /// Probability the steered region stands for.
+    /// Fraction of the samples that reach each point of the steered region, at least: half the
+    /// best-reached point's (`flight_path::region` says why), 0…1.
     pub steered_region_probability: f64,
-    /// Outline of the region steering reaches with that probability, `[lat, lon]` degrees.
+    /// Fraction of the samples that reach the best-reached point, 0…1: the most a target can
+    /// hope for.
+    pub steered_region_best_probability: f64,
+    /// Outline of the region steering reaches with that probability, `[lat, lon]` degrees, its
+    /// first point repeated at the end; empty if steering reaches nowhere.
     pub steered_region_lat_lon_deg: Vec<[f64; 2]>,
     /// Mean radius of the glide disc steering reaches from the deploy point, m.
     pub steered_reach_radius_m: f64,
@@ -322,7 +327,7 @@ pub fn plan(request: &PlanRequest) -> Result<PlanReport, PlanError> {
         },
         runs: r.runs as usize,
         target_ne_m,
-        region_probability: 0.5,
+        region_share_of_best: 0.5,
     };
     let air = Air {
         wind: &wind,
@@ -365,8 +370,14 @@ pub fn plan(request: &PlanRequest) -> Result<PlanReport, PlanError> {
         deploy: point(&spread.deploy),
         landing_unsteered: landing,
         round_chute_landing: point(&spread.round_chute_landing),
-        steered_region_probability: spread.steered_region_probability,
-        steered_region_lat_lon_deg: spread.steered_region_ne_m.iter().map(|&p| geo(p)).collect(),
+        steered_region_probability: spread.steered_region.probability,
+        steered_region_best_probability: spread.steered_region.best_probability,
+        steered_region_lat_lon_deg: spread
+            .steered_region
+            .outline_ne_m
+            .iter()
+            .map(|&p| geo(p))
+            .collect(),
         steered_reach_radius_m: samples.iter().map(|s| s.reach_radius_m).sum::<f64>()
             / samples.len().max(1) as f64,
         reach_method: "still-air glide disc around the drifted air mass (flight_path::reach)"

@@ -15,11 +15,8 @@
 //!   independent errors per level would average out over the long ascent and understate the
 //!   spread.
 //!
-//! The region steering can reach with probability `p` is drawn around the mean of the samples'
-//! reach centres: along each of [`REGION_BEARINGS`] bearings its edge is the distance that a
-//! fraction `p` of the samples' discs still cover. This takes the mean centre to lie inside
-//! the discs, which it does while the centres spread less than the glide reaches (a few
-//! hundred metres against kilometres).
+//! The region steering reaches is the ground enough of the samples' reach discs cover
+//! ([`super::region`]).
 
 use nalgebra::{Matrix2, Vector2, Vector3};
 use rand::Rng;
@@ -28,11 +25,9 @@ use serde::{Deserialize, Serialize};
 use stx_types::validate::check;
 use stx_types::wind::WindField;
 
+use super::region::{SteeredRegion, steered_region};
 use super::{Air, FlightPath, FlightPathError, ReachDisc, StackConfig, Start, propagate};
 use crate::performance::GlidePerformance;
-
-/// Bearings of the reachable region's outline.
-pub const REGION_BEARINGS: usize = 72;
 
 /// Most samples returned one by one (for a scatter on the map).
 pub const MAX_SAMPLES_RETURNED: usize = 300;
@@ -207,11 +202,8 @@ pub struct PlanSpread {
     pub landing: PointSpread,
     /// Landings under the round chute had it never been released.
     pub round_chute_landing: PointSpread,
-    /// Probability the region below stands for (fraction of samples that reach each of its
-    /// points).
-    pub steered_region_probability: f64,
-    /// Outline of the region steering reaches with that probability (north, east), m.
-    pub steered_region_ne_m: Vec<[f64; 2]>,
+    /// The region steering reaches in enough of the samples.
+    pub steered_region: SteeredRegion,
     /// Fraction of samples from whose deploy point steering can reach the target.
     pub target_reachable_probability: Option<f64>,
     /// Up to [`MAX_SAMPLES_RETURNED`] samples, in the order flown.
@@ -235,8 +227,8 @@ pub struct PlanInputs {
     pub runs: usize,
     /// The landing target (north, east), m, whose reachability is counted.
     pub target_ne_m: Option<[f64; 2]>,
-    /// The probability the steered region stands for, (0, 1].
-    pub region_probability: f64,
+    /// The steered region's level as a share of the best-reached point's, (0, 1].
+    pub region_share_of_best: f64,
 }
 
 /// Flies `inputs.runs` samples of the path (see the module doc) through `air`, drawing from
@@ -253,12 +245,12 @@ pub fn monte_carlo<R: Rng + ?Sized>(
         ref dispersion,
         runs,
         target_ne_m,
-        region_probability,
+        region_share_of_best,
     } = *inputs;
     dispersion.validate()?;
     check("runs", runs as f64, runs >= 1, "≥ 1")?;
-    let p = region_probability;
-    check("region_probability", p, p > 0.0 && p <= 1.0, "in (0, 1]")?;
+    let p = region_share_of_best;
+    check("region_share_of_best", p, p > 0.0 && p <= 1.0, "in (0, 1]")?;
     if let Some(t) = target_ne_m {
         check("target north", t[0], true, "finite")?;
         check("target east", t[1], true, "finite")?;
@@ -301,8 +293,7 @@ pub fn monte_carlo<R: Rng + ?Sized>(
         deploy: spread_of(&|p: &FlightPath| p.deploy),
         landing: spread_of(&|p: &FlightPath| p.landing),
         round_chute_landing: spread_of(&|p: &FlightPath| p.round_chute_landing),
-        steered_region_probability: p,
-        steered_region_ne_m: region(&discs, p),
+        steered_region: steered_region(&discs, p),
         target_reachable_probability,
         samples: paths
             .iter()
@@ -316,38 +307,4 @@ pub fn monte_carlo<R: Rng + ?Sized>(
             })
             .collect(),
     })
-}
-
-/// The outline of the region a fraction `p` of `discs` covers, around their mean centre.
-fn region(discs: &[ReachDisc], p: f64) -> Vec<[f64; 2]> {
-    let n = discs.len() as f64;
-    let centre = discs.iter().fold([0.0, 0.0], |c, d| {
-        [c[0] + d.centre_ne_m[0] / n, c[1] + d.centre_ne_m[1] / n]
-    });
-    // The k-th largest far edge along a bearing is where k discs still cover it.
-    let k = ((p * n).ceil() as usize).clamp(1, discs.len());
-    (0..REGION_BEARINGS)
-        .map(|i| {
-            let bearing = i as f64 * std::f64::consts::TAU / REGION_BEARINGS as f64;
-            let u = [bearing.cos(), bearing.sin()];
-            let mut far: Vec<f64> = discs
-                .iter()
-                .map(|d| {
-                    // Ray from the centre: |c + r·u − d.c|² = R², the larger root.
-                    let o = [centre[0] - d.centre_ne_m[0], centre[1] - d.centre_ne_m[1]];
-                    let b = o[0] * u[0] + o[1] * u[1];
-                    let c = o[0] * o[0] + o[1] * o[1] - d.radius_m * d.radius_m;
-                    let disc = b * b - c;
-                    if disc < 0.0 {
-                        0.0
-                    } else {
-                        (-b + disc.sqrt()).max(0.0)
-                    }
-                })
-                .collect();
-            far.sort_by(|a, b| b.total_cmp(a));
-            let r = far[k - 1];
-            [centre[0] + r * u[0], centre[1] + r * u[1]]
-        })
-        .collect()
 }

@@ -25,8 +25,9 @@ pub struct ProbabilityGrid {
 }
 
 impl ProbabilityGrid {
-    /// Rows and columns a grid needs to hold every disc with a cell of empty margin around.
-    pub(crate) fn extent(discs: &[Disc], cell_size_m: f64) -> ([f64; 2], usize, usize) {
+    /// The south-west and north-east corners of the box holding every disc (north, east), m;
+    /// infinite with no disc.
+    pub(crate) fn bounds(discs: &[Disc]) -> (Vector2<f64>, Vector2<f64>) {
         let (mut lo, mut hi) = (
             Vector2::repeat(f64::INFINITY),
             Vector2::repeat(f64::NEG_INFINITY),
@@ -36,6 +37,12 @@ impl ProbabilityGrid {
             lo = lo.inf(&(d.centre_ne_m - r));
             hi = hi.sup(&(d.centre_ne_m + r));
         }
+        (lo, hi)
+    }
+
+    /// Rows and columns a grid needs to hold every disc with a cell of empty margin around.
+    pub(crate) fn extent(discs: &[Disc], cell_size_m: f64) -> ([f64; 2], usize, usize) {
+        let (lo, hi) = Self::bounds(discs);
         let origin = [lo.x - cell_size_m, lo.y - cell_size_m];
         let cells = |span: f64| (span / cell_size_m).ceil() as usize + 3;
         (origin, cells(hi.x - lo.x), cells(hi.y - lo.y))

@@ -56,6 +56,9 @@ use thiserror::Error;
 pub use config::{FootprintConfig, FootprintConfigError, ValidFootprintConfig};
 pub use grid::ProbabilityGrid;
 pub use outline::{FootprintContour, FootprintPolygon, ZoneHit};
+// The pre-flight plan outlines its steered region with the same counter and contours.
+pub(crate) use outline::contours;
+pub(crate) use reach::Disc;
 
 use crate::estimate::Estimate;
 use crate::keep_out::KeepOutZones;

@@ -39,7 +39,10 @@ fn a_uniform_forecast_without_spread_bursts_downwind_by_wind_times_climb_over_ra
     assert!((p.y - b.east_m).abs() < 1e-3 && p.x.abs() < 1e-3);
     assert!(b.ellipse.semi_major_m < 1e-6);
     assert_eq!(report.landing_samples_lat_lon_deg.len(), 10);
-    assert_eq!(report.steered_region_lat_lon_deg.len(), 72);
+    // No spread: every sample's disc is the same, and the region is that disc.
+    assert_eq!(report.steered_region_best_probability, 1.0);
+    assert_eq!(report.steered_region_probability, 0.5);
+    assert!(report.steered_region_lat_lon_deg.len() > 100);
     assert!(report.target.is_none());
 }
 

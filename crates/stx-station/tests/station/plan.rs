@@ -104,10 +104,9 @@ async fn a_uniform_wind_bursts_and_deploys_downwind_by_wind_times_time() {
             .len(),
         20
     );
-    assert_eq!(
-        plan["steered_region_lat_lon_deg"].as_array().unwrap().len(),
-        72
-    );
+    // Every sample alike: the region is their glide disc, traced cell by cell.
+    assert!(plan["steered_region_lat_lon_deg"].as_array().unwrap().len() > 100);
+    assert_eq!(plan["steered_region_best_probability"], json!(1.0));
     let p = num(&plan["target"]["reachable_probability"]);
     assert!((0.0..=1.0).contains(&p), "{plan}");
     // Defaults filled in and answered with the plan.
