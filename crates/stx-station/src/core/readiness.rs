@@ -359,31 +359,10 @@ impl StationCore {
 
 #[cfg(test)]
 mod tests {
-    use stx_gnc::mission::{FlightMode, GuidancePhase};
-    use stx_link::endpoint::GroundEvent;
-    use stx_link::telemetry::{SystemState, Telemetry, VehicleStatus};
-
-    use super::super::tests::core;
+    use super::super::tests::{core, hear_stage as stage};
     use super::*;
 
     const CHECKLIST: &str = "[[item]]\nid = \"chute\"\ntext = \"Round chute packed\"\n";
-
-    fn stage(core: &mut StationCore, now_s: f64, stage: FlightStage) {
-        let status = VehicleStatus {
-            mode: FlightMode::Heading,
-            stage,
-            phase: GuidancePhase::Idle,
-            state: SystemState::Active,
-        };
-        let telemetry = Telemetry::Status(status);
-        core.on_link_event(
-            now_s,
-            GroundEvent::Telemetry {
-                from: (1, 1),
-                telemetry,
-            },
-        );
-    }
 
     fn status_of(board: &ReadinessView, id: &str) -> CheckStatus {
         board.checks.iter().find(|c| c.id == id).expect(id).status

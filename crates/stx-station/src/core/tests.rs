@@ -58,6 +58,42 @@ pub(super) fn gps_raw(ms: u32, [lat, lon, alt]: [f64; 3], [north, east]: [f64; 2
     }
 }
 
+/// The drone reports `stage` (heading mode, guidance idle) at `now_s`.
+pub(super) fn hear_stage(core: &mut StationCore, now_s: f64, stage: stx_gnc::mission::FlightStage) {
+    let status = VehicleStatus {
+        mode: FlightMode::Heading,
+        stage,
+        phase: stx_gnc::mission::GuidancePhase::Idle,
+        state: SystemState::Active,
+    };
+    let telemetry = Telemetry::Status(status);
+    core.on_link_event(
+        now_s,
+        GroundEvent::Telemetry {
+            from: (1, 1),
+            telemetry,
+        },
+    );
+}
+
+/// The drone reports it has landed (its guidance landed, standing by) at `now_s`.
+fn hear_landed(core: &mut StationCore, now_s: f64) {
+    let status = VehicleStatus {
+        mode: FlightMode::Heading,
+        stage: stx_gnc::mission::FlightStage::Landed,
+        phase: stx_gnc::mission::GuidancePhase::Landed,
+        state: SystemState::Standby,
+    };
+    let telemetry = Telemetry::Status(status);
+    core.on_link_event(
+        now_s,
+        GroundEvent::Telemetry {
+            from: (1, 1),
+            telemetry,
+        },
+    );
+}
+
 /// Telemetry of a parafoil gliding north in still air at 6 m/s, sinking 3 m/s, from 800 m
 /// above the origin, as the drone sends it at 4 Hz.
 fn glide(core: &mut StationCore, from_s: f64, to_s: f64) -> Vector3<f64> {
@@ -218,18 +254,7 @@ fn silence_turns_the_vehicle_stale_and_the_stage_change_is_logged() {
     assert!(!core.state_msg_now(5.0).link.stale);
     let stale_after = core.config.link.stale_after_s;
     assert!(core.state_msg_now(5.0 + stale_after + 0.5).link.stale);
-    core.on_link_event(
-        6.0,
-        GroundEvent::Telemetry {
-            from: (1, 1),
-            telemetry: Telemetry::Status(VehicleStatus {
-                mode: FlightMode::Heading,
-                stage: stx_gnc::mission::FlightStage::Landed,
-                phase: stx_gnc::mission::GuidancePhase::Landed,
-                state: SystemState::Standby,
-            }),
-        },
-    );
+    hear_landed(&mut core, 6.0);
     assert!(core.events.iter().any(|e| e.text.contains("Landed")));
 }
 
@@ -421,18 +446,7 @@ fn glide_ratios_are_shown_under_the_canopy_and_not_once_landed() {
     // 6 m/s forward for 3 m/s down.
     let air = gliding.glide_ratio_air.expect("a glide ratio in flight");
     assert!((air - 2.0).abs() < 0.2, "{air}");
-    core.on_link_event(
-        20.1,
-        GroundEvent::Telemetry {
-            from: (1, 1),
-            telemetry: Telemetry::Status(VehicleStatus {
-                mode: FlightMode::Heading,
-                stage: stx_gnc::mission::FlightStage::Landed,
-                phase: stx_gnc::mission::GuidancePhase::Landed,
-                state: SystemState::Standby,
-            }),
-        },
-    );
+    hear_landed(&mut core, 20.1);
     let landed = core.state_msg_now(20.2).estimate.expect("an estimate");
     assert_eq!(
         (landed.glide_ratio_air, landed.glide_ratio_ground),
