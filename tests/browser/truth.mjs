@@ -66,6 +66,10 @@ const shown = (page) => page.evaluate(() => {
     path: vis("map-flight-path"),
     landed: vis("map-landed"),
     planned: dot?.isConnected && dot.dataset.lat ? { lat_deg: Number(dot.dataset.lat), lon_deg: Number(dot.dataset.lon) } : null,
+    // The planned landings of the last state messages the page received, read in the same task
+    // as the dot: the dot is checked against what the page was told, not against a later poll
+    // of the API (under load the two are seconds of mission apart).
+    told: [...(window.__told ?? [])],
   };
 });
 
@@ -75,6 +79,22 @@ async function wholeMission() {
   const { io: station, base } = await startStation(["--link", `udpin:127.0.0.1:${port}`]);
   const api = apiOf(base);
   const ctx = await newContext("truth", { viewport: { width: 1440, height: 900 } });
+  await ctx.addInitScript(() => {
+    window.__told = [];
+    const Native = window.WebSocket;
+    window.WebSocket = class extends Native {
+      constructor(...args) {
+        super(...args);
+        this.addEventListener("message", (e) => {
+          try {
+            const m = JSON.parse(e.data);
+            const p = m.type === "state" ? m.prediction?.planned : null;
+            if (p) window.__told = [...window.__told.slice(-9), { lat_deg: p.lat_deg, lon_deg: p.lon_deg }];
+          } catch {}
+        });
+      }
+    };
+  });
   const page = await ctx.newPage();
   watchErrors(page, "truth");
   await page.goto(`${base}/?token=${OPERATOR}`);
@@ -168,10 +188,12 @@ async function wholeMission() {
   const median = (xs) => (xs.length ? [...xs].sort((x, y) => x - y)[Math.floor(xs.length / 2)] : NaN);
   const offs = band.map((s) => distanceM(s.planned, touchdown));
   const onboardOffs = band.filter((s) => s.onboard).map((s) => distanceM(s.onboard, touchdown));
-  const drawn = median(band.filter((s) => s.apiPlanned).map((s) => distanceM(s.planned, s.apiPlanned)));
+  // The dot against the nearest of the last ten predictions the page was sent (the map may draw
+  // a message or two after it arrives); the drone's own prediction is metres away from these.
+  const drawn = median(band.filter((s) => s.told.length).map((s) => Math.min(...s.told.map((p) => distanceM(s.planned, p)))));
   check("the planned dot from 200 to 50 m above the ground is the station's prediction, within 20 m of the drone's touchdown and within 5 m of the drone's own prediction's figure (medians)",
     offs.length >= 5 && median(offs) <= 20 && median(offs) <= median(onboardOffs) + 5 && drawn < 1,
-    `${offs.length} samples: the dot ${offs.map((o) => o.toFixed(1)).join(", ")} m from the touchdown (median ${median(offs).toFixed(1)} m; the drone's own prediction at the same instants: median ${median(onboardOffs).toFixed(1)} m); the dot from the station's prediction: median ${drawn.toFixed(2)} m`);
+    `${offs.length} samples: the dot ${offs.map((o) => o.toFixed(1)).join(", ")} m from the touchdown (median ${median(offs).toFixed(1)} m; the drone's own prediction at the same instants: median ${median(onboardOffs).toFixed(1)} m); the dot from the station's prediction the page was last sent: median ${drawn.toFixed(2)} m`);
 
   // ---------------------------------------------------------------- one landing figure, live
   await page.waitForFunction(() => document.querySelector('[data-testid="hdr-landing"]')?.dataset.state === "landed" && !/measuring/.test(document.querySelector('[data-testid="hdr-landing"]').textContent), null, { timeout: 10000 }).catch(() => {});
