@@ -42,6 +42,8 @@
 //! - [`endpoint`]: the two ends composing all of the above (`ground.rs`, `vehicle.rs`) over a
 //!   shared link core (`core.rs`), with [`endpoint::LinkStats`] and the per-sender loss
 //!   accounting (`senders.rs`).
+//! - [`forward`]: read-only forwarding to watching ground stations: mavlink-router's
+//!   per-direction filters, nothing from a watcher to the drone unless allowed.
 //! - [`paths`]: one link over several radios: copies dropped, sends on the radio that works,
 //!   each radio's loss counted with the endpoint's per-sender accounting.
 //! - [`sansio`]: the [`sansio::SansIo`] trait both endpoints implement for an I/O adapter
@@ -66,6 +68,7 @@ pub mod address;
 pub mod command;
 pub mod endpoint;
 pub mod fixtures;
+pub mod forward;
 pub mod frame;
 pub mod manual;
 pub mod param;

@@ -229,6 +229,10 @@ pub struct StationConfig {
     /// pages at once); the defaults suit a field laptop.
     #[serde(default)]
     pub limits: LimitSettings,
+    /// Read-only MAVLink outputs for watching ground stations (`[[forward]]`, see
+    /// [`crate::forward`]); none by default.
+    #[serde(default)]
+    pub forward: Vec<crate::forward::ForwardConfig>,
     /// Test-only: loopback addresses treated as not loopback, from the environment's
     /// [`NOT_LOOPBACK_ENV`] (see [`crate::exposure`]); empty in the field.
     #[serde(skip)]
@@ -344,6 +348,9 @@ impl StationConfig {
         }
         if let Some((field, rule)) = self.readiness.invalid() {
             return invalid(field, rule);
+        }
+        if let Some((field, rule)) = crate::forward::ForwardConfig::invalid(&self.forward) {
+            return invalid(&field, &rule);
         }
         let mut seen: HashMap<&str, usize> = HashMap::new();
         for (i, t) in self.tokens.iter().enumerate() {

@@ -5,7 +5,8 @@
 //! The pure station (no tokio, no sockets; `--no-default-features` builds only this):
 //! - [`config`]: the station's TOML, validated before anything starts; [`exposure`]: what it
 //!   lets through beyond this machine (rehearsal tokens on loopback only, plain HTTP only when
-//!   asked for); [`checklist`]: the go/no-go board's settings and files;
+//!   asked for); [`checklist`]: the go/no-go board's settings and files; [`forward`]: the
+//!   read-only MAVLink outputs for watching ground stations (their sockets are the daemon's);
 //! - [`core`]: the station's state and logic: telemetry, link events and operators' requests
 //!   in, with the mission clock; messages for the dashboards and link actions (with ids and
 //!   deadlines) out; the link's outcome of each action back in; retries and time-outs are its
@@ -39,6 +40,7 @@ pub mod core;
 #[cfg(feature = "daemon")]
 pub mod daemon;
 pub mod exposure;
+pub mod forward;
 #[cfg(feature = "daemon")]
 pub mod http;
 pub mod keep_out;

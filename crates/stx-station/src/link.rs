@@ -36,11 +36,20 @@ pub trait FrameTap: Send {
     fn frame(&mut self, path: usize, sent: bool, bytes: &[u8]);
 }
 
+/// Takes each frame the link accepted, as received, for the read-only forwards
+/// (`crate::forward`). Called on the driver's thread, so it must not block: a forward that
+/// falls behind loses frames, the link never waits for it.
+pub trait ForwardSink: Send {
+    /// `frame` was accepted: checked, its signature verified when signing is on, not a copy.
+    fn accepted(&mut self, frame: Vec<u8>);
+}
+
 /// The ground endpoint with the reports of what was done to it.
 pub struct StationLink {
     endpoint: GroundEndpoint,
     reports: VecDeque<LinkReport>,
     tap: Option<Box<dyn FrameTap>>,
+    forward: Option<Box<dyn ForwardSink>>,
 }
 
 impl std::fmt::Debug for StationLink {
@@ -49,6 +58,7 @@ impl std::fmt::Debug for StationLink {
             .field("endpoint", &self.endpoint)
             .field("reports", &self.reports)
             .field("tap", &self.tap.is_some())
+            .field("forward", &self.forward.is_some())
             .finish()
     }
 }
@@ -60,6 +70,27 @@ impl StationLink {
             endpoint,
             reports: VecDeque::new(),
             tap: None,
+            forward: None,
+        }
+    }
+
+    /// Hands every frame accepted from now on to `sink`.
+    pub fn with_forward(mut self, sink: Box<dyn ForwardSink>) -> Self {
+        self.endpoint.keep_accepted_frames(true);
+        self.forward = Some(sink);
+        self
+    }
+
+    /// Sends `frame` as it is: a watcher's frame its forward's filter let through.
+    pub fn send_raw_frame(&mut self, frame: Vec<u8>) {
+        self.endpoint.send_raw_frame(frame);
+    }
+
+    fn pass_accepted(&mut self) {
+        if let Some(sink) = &mut self.forward {
+            while let Some(frame) = self.endpoint.poll_accepted_frame() {
+                sink.accepted(frame);
+            }
         }
     }
 
@@ -148,13 +179,16 @@ impl SansIo for StationLink {
             tap.frame(path, false, bytes);
         }
         self.endpoint.handle_bytes_on(path, now, bytes);
+        self.pass_accepted();
     }
 
     fn handle_datagram_on(&mut self, path: usize, now: Duration, datagram: &[u8]) -> bool {
         if let Some(tap) = &mut self.tap {
             tap.frame(path, false, datagram);
         }
-        self.endpoint.handle_datagram_on(path, now, datagram)
+        let from_peer = self.endpoint.handle_datagram_on(path, now, datagram);
+        self.pass_accepted();
+        from_peer
     }
 
     fn handle_timeout(&mut self, now: Duration) {
@@ -183,6 +217,7 @@ impl SansIo for StationLink {
 
     fn handle_stream_end_on(&mut self, path: usize, now: Duration) {
         self.endpoint.handle_stream_end_on(path, now);
+        self.pass_accepted();
     }
 
     fn transmit_path(&self, now: Duration) -> usize {
@@ -314,6 +349,42 @@ mod tests {
         let tapped: Vec<Vec<u8>> = seen[2..].iter().map(|(_, _, b)| b.clone()).collect();
         assert_eq!(tapped, sent);
         assert!(seen[2..].iter().all(|(p, s, _)| *p == 0 && *s));
+    }
+
+    #[derive(Clone, Default)]
+    struct Forwarded(std::sync::Arc<std::sync::Mutex<Vec<Vec<u8>>>>);
+
+    impl ForwardSink for Forwarded {
+        fn accepted(&mut self, frame: Vec<u8>) {
+            self.0.lock().unwrap().push(frame);
+        }
+    }
+
+    #[test]
+    fn the_forward_gets_each_accepted_frame_unchanged_and_sends_a_watchers_frame_as_is() {
+        use stx_link::MavMessage;
+        use stx_link::frame::FrameEncoder;
+        let got = Forwarded::default();
+        let mut link = link().with_forward(Box::new(got.clone()));
+        let mut drone = FrameEncoder::new(1, 1);
+        let hb = MavMessage::HEARTBEAT(Default::default());
+        let first = drone.encode(Duration::ZERO, &hb);
+        let second = drone.encode(Duration::ZERO, &hb);
+        let mut datagram = b"noise".to_vec();
+        datagram.extend_from_slice(&first);
+        datagram.extend_from_slice(&second[..4]);
+        link.handle_datagram_on(0, Duration::ZERO, &datagram);
+        // A stream may cut a frame anywhere: it is passed on once whole.
+        link.handle_bytes_on(0, Duration::ZERO, &second[..7]);
+        assert_eq!(got.0.lock().unwrap().len(), 1);
+        link.handle_bytes_on(0, Duration::ZERO, &second[7..]);
+        assert_eq!(*got.0.lock().unwrap(), vec![first, second]);
+
+        let watcher = FrameEncoder::new(255, 190).encode(Duration::ZERO, &hb);
+        link.send_raw_frame(watcher.clone());
+        let sent: Vec<Vec<u8>> =
+            std::iter::from_fn(|| link.poll_transmit(Duration::ZERO)).collect();
+        assert!(sent.contains(&watcher), "{sent:?}");
     }
 
     #[test]

@@ -2,7 +2,7 @@
 // the daemon's Rust types by `cargo run -p stx-station --example api_schema`): do not edit.
 
 /**
- * Every message of the stx station's HTTP and WebSocket API (crates/stx-station/API.md), generated from the daemon's Rust types by `cargo run -p stx-station --example api_schema`: do not edit. The root is any one of them: on the WebSocket ServerMessage (station to page) and ClientMessage (page to station); over REST the bodies the station answers (Session, StateMsg, ParamsMsg, AscentWindMsg, EventsBody, TrackBody, ClientsBody, CommandResultMsg, CommandAccepted, CutdownArm, ErrorBody, ReplayView, RecordingsBody, ReplayOpened, KeepOutMsg, PreflightReport, PreflightDefaults, ReadinessView, the Lab's Lab*Body and VehicleFieldsBody) and the bodies of the commands (*Body).
+ * Every message of the stx station's HTTP and WebSocket API (crates/stx-station/API.md), generated from the daemon's Rust types by `cargo run -p stx-station --example api_schema`: do not edit. The root is any one of them: on the WebSocket ServerMessage (station to page) and ClientMessage (page to station); over REST the bodies the station answers (Session, StateMsg, ParamsMsg, AscentWindMsg, EventsBody, TrackBody, ClientsBody, CommandResultMsg, CommandAccepted, CutdownArm, ErrorBody, ReplayView, RecordingsBody, ReplayOpened, KeepOutMsg, PreflightReport, PreflightDefaults, ReadinessView, ForwardsBody, the Lab's Lab*Body and VehicleFieldsBody) and the bodies of the commands (*Body).
  */
 export type StxStationAPI =
   | ServerMessage
@@ -28,6 +28,7 @@ export type StxStationAPI =
   | LabSavedBody
   | LabRehearsalBody
   | ReadinessView
+  | ForwardsBody
   | ClientMessage
   | ModeBody
   | HeadingBody
@@ -2835,6 +2836,52 @@ export interface LabSavedBody {
    * The parameter requests sent (`send`), one id each as `GET /api/commands/{id}` knows it.
    */
   request_ids: string[];
+}
+/**
+ * `GET /api/forwards`: every forward, in the order of the configuration.
+ */
+export interface ForwardsBody {
+  /**
+   * The forwards; empty when the configuration has none.
+   */
+  forwards: ForwardView[];
+}
+/**
+ * A forward as the pages show it: where it goes, what it may send the drone, and its counts.
+ */
+export interface ForwardView {
+  /**
+   * Its address.
+   */
+  address: string;
+  /**
+   * Frames of the watcher passed on to the drone.
+   */
+  in_passed: number;
+  /**
+   * Frames of the watcher kept from the drone.
+   */
+  in_refused: number;
+  /**
+   * Message ids of the watcher's that may reach the drone; empty: none (read-only).
+   */
+  may_send_to_drone: number[];
+  /**
+   * The forward's name.
+   */
+  name: string;
+  /**
+   * Frames lost because the forward fell behind the link (never the link's loss).
+   */
+  out_dropped: number;
+  /**
+   * Frames its out filter kept from the watcher.
+   */
+  out_filtered: number;
+  /**
+   * Frames sent to the watcher.
+   */
+  out_passed: number;
 }
 /**
  * `POST /api/commands/mode`.

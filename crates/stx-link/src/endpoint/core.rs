@@ -111,7 +111,13 @@ pub(super) struct LinkCore {
     last_by_kind: HashMap<u32, (&'static str, Duration)>,
     frames_out: u64,
     bytes_out: u64,
+    /// The wire bytes of each frame accepted (checked, signature verified, not a copy from
+    /// another radio), kept only while someone forwards them (`None`: nobody does).
+    accepted: Option<VecDeque<Vec<u8>>>,
 }
+
+/// Accepted frames kept for forwarding between two polls; beyond, the oldest go.
+const MAX_ACCEPTED_KEPT: usize = 4096;
 
 impl LinkCore {
     pub(super) fn new(config: LinkConfig, now: Duration) -> Self {
@@ -146,9 +152,27 @@ impl LinkCore {
             last_by_kind: HashMap::new(),
             frames_out: 0,
             bytes_out: 0,
+            accepted: None,
         };
         core.check_persist();
         core
+    }
+
+    /// Starts (or stops) keeping the wire bytes of accepted frames for [`Self::poll_accepted`].
+    pub(super) fn keep_accepted(&mut self, on: bool) {
+        self.accepted = on.then(VecDeque::new);
+    }
+
+    /// The wire bytes of the next accepted frame kept.
+    pub(super) fn poll_accepted(&mut self) -> Option<Vec<u8>> {
+        self.accepted.as_mut()?.pop_front()
+    }
+
+    /// Queues a frame to send as it is (not encoded by us: a watcher's, passed on).
+    pub(super) fn send_raw(&mut self, frame: Vec<u8>) {
+        self.frames_out += 1;
+        self.bytes_out += frame.len() as u64;
+        self.out.push_back(frame);
     }
 
     /// Switches signing on (`Some`) or off (`None`) at `now`.
@@ -273,7 +297,17 @@ impl LinkCore {
                             continue;
                         }
                     }
+                    let raw = self
+                        .accepted
+                        .is_some()
+                        .then(|| p.decoder.last_frame_bytes().to_vec());
                     self.account(now, &frame.header, &frame.message);
+                    if let (Some(kept), Some(raw)) = (&mut self.accepted, raw) {
+                        if kept.len() >= MAX_ACCEPTED_KEPT {
+                            kept.pop_front();
+                        }
+                        kept.push_back(raw);
+                    }
                     frames.push(frame);
                 }
                 Err(e) => {

@@ -283,6 +283,24 @@ impl GroundEndpoint {
         self.manual.release();
     }
 
+    /// Keeps (or stops keeping) the wire bytes of every frame accepted, for
+    /// [`poll_accepted_frame`](Self::poll_accepted_frame): what a read-only forward passes on.
+    pub fn keep_accepted_frames(&mut self, on: bool) {
+        self.core.keep_accepted(on);
+    }
+
+    /// The wire bytes of the next frame accepted since [`keep_accepted_frames`]
+    /// (Self::keep_accepted_frames) was switched on: checked, its signature verified when
+    /// signing is on, and not a second copy heard over another radio.
+    pub fn poll_accepted_frame(&mut self) -> Option<Vec<u8>> {
+        self.core.poll_accepted()
+    }
+
+    /// Sends a frame as it is: one a forward's watcher sent and its filter lets through.
+    pub fn send_raw_frame(&mut self, frame: Vec<u8>) {
+        self.core.send_raw(frame);
+    }
+
     /// Sends any other message now (e.g. for tools).
     pub fn send_message(&mut self, now: Duration, msg: &MavMessage) {
         self.core.send(now, msg);

@@ -138,6 +138,8 @@ pub struct FrameDecoder {
     policy: DecoderPolicy,
     verifier: Option<Verifier>,
     stats: DecoderStats,
+    /// Length of the frame the last [`FrameDecoder::poll`] returned, ending at `pos`.
+    last_len: usize,
 }
 
 impl Default for FrameDecoder {
@@ -166,6 +168,7 @@ impl FrameDecoder {
             policy,
             verifier: None,
             stats: Default::default(),
+            last_len: 0,
         }
     }
 
@@ -190,8 +193,20 @@ impl FrameDecoder {
         self.buf.len() - self.pos
     }
 
+    /// The wire bytes of the frame the last [`poll`](FrameDecoder::poll) returned, as
+    /// received (signature block included), until the next [`push`](FrameDecoder::push) or
+    /// `poll`; empty if that poll returned no frame. For passing a checked frame on unchanged
+    /// (a forward to a watching ground station) without encoding it again.
+    pub fn last_frame_bytes(&self) -> &[u8] {
+        self.pos
+            .checked_sub(self.last_len)
+            .and_then(|start| self.buf.get(start..self.pos))
+            .unwrap_or(&[])
+    }
+
     /// Appends received bytes.
     pub fn push(&mut self, bytes: &[u8]) {
+        self.last_len = 0;
         if self.pos > 0 && self.pos >= self.buf.len() / 2 {
             self.buf.drain(..self.pos);
             self.pos = 0;
@@ -213,6 +228,7 @@ impl FrameDecoder {
     ///
     /// `now` (monotonic) is only used for the signing window of new streams.
     pub fn poll(&mut self, now: Duration) -> Option<Result<Frame, FrameError>> {
+        self.last_len = 0;
         loop {
             let rest = self.buf.get(self.pos..).unwrap_or(&[]);
             if rest.is_empty() {
@@ -232,6 +248,7 @@ impl FrameDecoder {
                 Step::Skip(n) => self.discard(n),
                 Step::Frame(frame, len) => {
                     self.pos += len;
+                    self.last_len = len;
                     self.stats.frames_ok += 1;
                     return Some(Ok(frame));
                 }

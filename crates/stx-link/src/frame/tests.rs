@@ -241,3 +241,23 @@ fn signing_refuses_unsigned_bad_and_replayed_frames() {
     assert_eq!(ok.len(), 1);
     assert_eq!(ok[0].header.signature.map(|s| s.link_id), Some(3));
 }
+
+#[test]
+fn last_frame_bytes_are_the_frame_as_received_between_noise() {
+    let mut enc = FrameEncoder::new(3, 7);
+    let first = enc.encode(Duration::ZERO, &attitude(0.1));
+    let second = enc.encode(Duration::ZERO, &attitude(0.2));
+    let mut stream = b"noise".to_vec();
+    stream.extend_from_slice(&first);
+    stream.extend_from_slice(b"\x00\x01");
+    stream.extend_from_slice(&second);
+    let mut dec = FrameDecoder::default();
+    dec.push(&stream);
+    assert!(dec.last_frame_bytes().is_empty());
+    assert!(matches!(dec.poll(Duration::ZERO), Some(Ok(_))));
+    assert_eq!(dec.last_frame_bytes(), first.as_slice());
+    assert!(matches!(dec.poll(Duration::ZERO), Some(Ok(_))));
+    assert_eq!(dec.last_frame_bytes(), second.as_slice());
+    assert!(dec.poll(Duration::ZERO).is_none());
+    assert!(dec.last_frame_bytes().is_empty());
+}

@@ -6,6 +6,7 @@
 //! the link (`replay_feed`); the live station opens them (`replay_sessions`). Nothing here
 //! decides anything: the core does.
 
+mod forward;
 mod pages;
 mod replay_feed;
 mod replay_sessions;
@@ -204,6 +205,12 @@ async fn run_with(
         link = link.with_tap(tap);
     }
     let (actions_tx, actions_rx) = mpsc::channel::<Action<StationLink>>(1024);
+    let (stop_tx, stop_rx) = watch::channel(false);
+    let (forward_sink, forwards) =
+        forward::start(&config.forward, actions_tx.clone(), stop_rx.clone());
+    if let Some(sink) = forward_sink {
+        link = link.with_forward(sink);
+    }
     let (events_tx, events_rx) = mpsc::channel(4096);
     let options = DriveOptions {
         signing_timestamp_file: config.link.signing_timestamp_file.clone(),
@@ -267,8 +274,8 @@ async fn run_with(
         planning: Default::default(),
         lab: Default::default(),
         rehearsal: Default::default(),
+        forwards,
     });
-    let (stop_tx, stop_rx) = watch::channel(false);
     let sessions_task = replay_requests_rx.map(|rx| {
         tokio::spawn(replay_sessions::replay_sessions(
             config.clone(),

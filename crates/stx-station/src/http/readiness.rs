@@ -1,5 +1,7 @@
 //! `GET /api/readiness`: the go/no-go board (any role); `POST /api/readiness/{id}`: an
 //! operator ticks or unticks a checklist item. The board also rides in every `state` message.
+//! `GET /api/forwards`: what the station shares with watching ground stations (the board's
+//! neighbour on the Go/no-go page).
 
 use axum::Json;
 use axum::extract::rejection::JsonRejection;
@@ -15,6 +17,12 @@ use crate::messages::TickBody;
 pub(crate) async fn board(State(state): State<AppState>, _caller: Caller) -> Response {
     let now = state.now_s();
     Json(state.core().state_msg_now(now).readiness).into_response()
+}
+
+/// `GET /api/forwards` (any role): the read-only MAVLink outputs and their counts.
+pub(crate) async fn forwards(State(state): State<AppState>, _caller: Caller) -> Response {
+    let forwards = state.forwards.lock().map(|f| f.clone()).unwrap_or_default();
+    Json(crate::forward::ForwardsBody { forwards }).into_response()
 }
 
 pub(crate) async fn tick(

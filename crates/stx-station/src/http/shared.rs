@@ -23,6 +23,8 @@ use crate::replies::ClientView;
 pub struct Shared {
     /// The station.
     pub core: Mutex<StationCore>,
+    /// The `[[forward]]` outputs and their counts, kept by their tasks.
+    pub forwards: Arc<Mutex<Vec<crate::forward::ForwardView>>>,
     /// Configuration (immutable).
     pub config: StationConfig,
     /// Mission clock origin.

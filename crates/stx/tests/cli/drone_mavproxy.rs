@@ -10,76 +10,10 @@
 //! Python: `$STX_PYTHON` or `.venv/bin/python` at the workspace root, with MAVProxy installed
 //! (`tests/run-all` does both).
 
-use std::io::{BufRead, BufReader, Write};
 use std::net::UdpSocket;
-use std::path::{Path, PathBuf};
-use std::process::{Child, ChildStdin, Command, Stdio};
-use std::sync::mpsc::{self, Receiver};
-use std::time::{Duration, Instant};
+use std::process::{Command, Stdio};
 
-fn python() -> PathBuf {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
-    let p = std::env::var_os("STX_PYTHON")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| root.join(".venv/bin/python"));
-    assert!(
-        p.exists(),
-        "MAVProxy peer: no Python at {} (set STX_PYTHON or run tests/run-all once)",
-        p.display()
-    );
-    p
-}
-
-/// Kills the process when the test ends, passed or not.
-struct Killed(Child);
-
-impl Drop for Killed {
-    fn drop(&mut self) {
-        let _ = self.0.kill();
-        let _ = self.0.wait();
-    }
-}
-
-/// MAVProxy's console: lines in, everything it printed kept.
-struct Console {
-    stdin: ChildStdin,
-    lines: Receiver<String>,
-    seen: Vec<String>,
-}
-
-impl Console {
-    fn send(&mut self, command: &str) {
-        writeln!(self.stdin, "{command}").expect("MAVProxy reads its console");
-        self.stdin.flush().expect("flush");
-    }
-
-    /// Waits up to `secs` for a line that `pred` accepts; returns it.
-    fn wait_for(&mut self, secs: u64, what: &str, pred: impl Fn(&str) -> bool) -> String {
-        let deadline = Instant::now() + Duration::from_secs(secs);
-        while Instant::now() < deadline {
-            if let Ok(line) = self.lines.recv_timeout(Duration::from_millis(100)) {
-                self.seen.push(line.clone());
-                if pred(&line) {
-                    return line;
-                }
-            }
-        }
-        panic!(
-            "MAVProxy did not show {what} in {secs} s; it printed:\n{}",
-            self.seen.join("\n")
-        );
-    }
-
-    /// Reads what it prints for `secs` seconds.
-    fn drain(&mut self, secs: u64) {
-        let deadline = Instant::now() + Duration::from_secs(secs);
-        while Instant::now() < deadline {
-            if let Ok(line) = self.lines.recv_timeout(Duration::from_millis(100)) {
-                self.seen.push(line);
-            }
-        }
-    }
-}
+use crate::common::mavproxy::{Console, Killed};
 
 #[test]
 fn mavproxy_fetches_sets_parameters_changes_mode_and_raises_no_false_alarm() {
@@ -89,28 +23,7 @@ fn mavproxy_fetches_sets_parameters_changes_mode_and_raises_no_false_alarm() {
         .port();
     let work = std::env::temp_dir().join(format!("stx-mavproxy-{}", std::process::id()));
     std::fs::create_dir_all(&work).expect("work dir");
-    let mut mavproxy = Command::new(python())
-        .args(["-m", "MAVProxy.mavproxy"])
-        .arg(format!("--master=udpin:127.0.0.1:{port}"))
-        .args(["--nowait", "--show-errors"])
-        .current_dir(&work)
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::null())
-        .spawn()
-        .expect("MAVProxy starts (is it installed in the venv?)");
-    let stdin = mavproxy.stdin.take().expect("stdin");
-    let stdout = mavproxy.stdout.take().expect("stdout");
-    let _mavproxy = Killed(mavproxy);
-    let (tx, lines) = mpsc::channel();
-    std::thread::spawn(move || {
-        for line in BufReader::new(stdout).lines() {
-            let Ok(line) = line else { break };
-            if tx.send(line).is_err() {
-                break;
-            }
-        }
-    });
+    let mut c = Console::start(&format!("udpin:127.0.0.1:{port}"), &work);
     let _drone = Killed(
         Command::new(env!("CARGO_BIN_EXE_stx"))
             .args(["drone", "--scenario", "rehearsal", "--speed", "1"])
@@ -121,12 +34,6 @@ fn mavproxy_fetches_sets_parameters_changes_mode_and_raises_no_false_alarm() {
             .spawn()
             .expect("stx drone starts"),
     );
-    let mut c = Console {
-        stdin,
-        lines,
-        seen: Vec::new(),
-    };
-
     c.wait_for(30, "the vehicle online", |l| l.contains("online system 1"));
     c.send("param fetch");
     let received = c.wait_for(60, "the parameters received", |l| {

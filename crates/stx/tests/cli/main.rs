@@ -22,6 +22,7 @@ mod cli_token;
 mod drone_link;
 mod drone_mavproxy;
 mod drone_pymavlink;
+mod forward_mavproxy;
 mod hostile_link;
 mod http_abuse;
 mod identify_rehearsal;

@@ -1,6 +1,8 @@
 //! Helpers the `stx` command-line tests share: run the real binary, and a fresh scratch
 //! directory per test.
 
+pub mod mavproxy;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -32,4 +34,37 @@ pub fn vehicle_file(dir: &Path, name: &str, from: &str, to: &str) -> PathBuf {
     let path = dir.join(name);
     std::fs::write(&path, shipped.replacen(from, to, 1)).expect("write");
     path
+}
+
+/// `GET path` of the station at `http` (host:port) with `token`; the body as JSON, `None` if
+/// there is none yet (not answering, not JSON).
+#[allow(dead_code)]
+pub fn get_json(http: &str, token: &str, path: &str) -> Option<serde_json::Value> {
+    request_json(http, token, "GET", path, "")
+}
+
+/// `method path` with the JSON `body` (may be empty) to the station at `http` with `token`;
+/// the answer's body as JSON. Plain HTTP/1.1 over a socket: the tests need no client library.
+#[allow(dead_code)]
+pub fn request_json(
+    http: &str,
+    token: &str,
+    method: &str,
+    path: &str,
+    body: &str,
+) -> Option<serde_json::Value> {
+    use std::io::{Read, Write};
+    let mut s = std::net::TcpStream::connect(http).ok()?;
+    s.set_read_timeout(Some(std::time::Duration::from_secs(5)))
+        .ok()?;
+    let req = format!(
+        "{method} {path} HTTP/1.1\r\nHost: {http}\r\nAuthorization: Bearer {token}\r\n\
+         Content-Type: application/json\r\nContent-Length: {}\r\nConnection: close\r\n\r\n{body}",
+        body.len()
+    );
+    s.write_all(req.as_bytes()).ok()?;
+    let mut answer = Vec::new();
+    s.read_to_end(&mut answer).ok()?;
+    let text = String::from_utf8_lossy(&answer);
+    serde_json::from_str(text.split_once("\r\n\r\n")?.1).ok()
 }

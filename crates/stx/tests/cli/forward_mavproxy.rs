@@ -1,0 +1,155 @@
+//! Read-only forwarding (`[[forward]]`) against MAVProxy 1.8.75, a ground station nobody here
+//! wrote: `stx serve --sim` forwards its link to MAVProxy, which sees the drone's telemetry and
+//! its parameters (the value the drone answers when the station's operator sets one; MAVProxy
+//! keeps no value from the station's fetch at connection, heard before it knew the vehicle);
+//! MAVProxy's `param set` and mode change never reach the
+//! drone (the drone would answer a set with the new value, and report a new mode in its
+//! heartbeat: the station hears both), and the station counts what it kept back.
+
+use std::io::{BufRead, BufReader};
+use std::net::UdpSocket;
+use std::path::Path;
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+use serde_json::Value;
+
+use crate::common::mavproxy::{Console, Killed};
+use crate::common::{get_json, request_json, temp_dir};
+
+fn param(params: &Value, name: &str) -> Option<f64> {
+    params["params"]
+        .as_array()?
+        .iter()
+        .find(|p| p["name"] == name)?["value"]
+        .as_f64()
+}
+
+#[test]
+fn mavproxy_on_a_forward_sees_the_drone_and_cannot_command_it() {
+    let port = UdpSocket::bind("127.0.0.1:0")
+        .and_then(|s| s.local_addr())
+        .expect("a free port")
+        .port();
+    let dir = temp_dir("forward", "mavproxy");
+    let shipped = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../config/station.toml"),
+    )
+    .expect("shipped station config");
+    let config = dir.join("station.toml");
+    std::fs::write(
+        &config,
+        format!(
+            "{shipped}\n[[forward]]\nname = \"mavproxy\"\naddress = \"udpout:127.0.0.1:{port}\"\n"
+        ),
+    )
+    .expect("write config");
+    // The watcher first, so it hears the station's parameter fetch when the drone connects.
+    let mut c = Console::start(&format!("udpin:127.0.0.1:{port}"), &dir);
+    let mut station = Command::new(env!("CARGO_BIN_EXE_stx"))
+        .arg("serve")
+        .arg("--config")
+        .arg(&config)
+        .args([
+            "--sim",
+            "--sim-scenario",
+            "rehearsal",
+            "--sim-speed",
+            "1",
+            "--no-record",
+        ])
+        .args(["--listen", "127.0.0.1:0", "--link", "udpin:127.0.0.1:0"])
+        .current_dir(Path::new(env!("CARGO_MANIFEST_DIR")).join("../.."))
+        .stdout(Stdio::piped())
+        .stderr(Stdio::null())
+        .spawn()
+        .expect("stx serve starts");
+    let mut line = String::new();
+    BufReader::new(station.stdout.take().expect("stdout"))
+        .read_line(&mut line)
+        .expect("the station says where it listens");
+    let _station = Killed(station);
+    let url = line.trim().rsplit(' ').next().expect("a URL").to_string();
+    let rest = url.strip_prefix("http://").expect("http URL");
+    let (http, token) = rest.split_once("/?token=").expect("address and token");
+    let get = |path: &str| get_json(http, token, path);
+
+    // It watches: the drone comes online, its attitude streams, and the parameters the
+    // station fetched reach MAVProxy's table.
+    c.wait_for(30, "the vehicle online", |l| l.contains("online system 1"));
+    let until = Instant::now() + Duration::from_secs(60);
+    let params = loop {
+        if let Some(p) = get("/api/params")
+            && p["complete"] == true
+        {
+            break p;
+        }
+        assert!(
+            Instant::now() < until,
+            "the station never had the parameters"
+        );
+        std::thread::sleep(Duration::from_millis(300));
+    };
+    let shipped_flare = param(&params, "SP_FLARE_H").expect("SP_FLARE_H on the station");
+    // The station's operator sets it; the drone's answer reaches MAVProxy's table.
+    let flare = shipped_flare + 1.0;
+    let set = request_json(
+        http,
+        token,
+        "POST",
+        "/api/params/SP_FLARE_H",
+        &format!("{{\"value\":{flare}}}"),
+    );
+    assert!(set.is_some(), "the station takes the set");
+    let until = Instant::now() + Duration::from_secs(15);
+    while get("/api/params").and_then(|p| param(&p, "SP_FLARE_H")) != Some(flare) {
+        assert!(
+            Instant::now() < until,
+            "the drone never answered the station's set"
+        );
+        std::thread::sleep(Duration::from_millis(200));
+    }
+    c.send("param show SP_FLARE_H");
+    // Its table's line, not the drone's STATUSTEXT ("AP: parameter SP_FLARE_H = 7").
+    c.wait_for(10, "SP_FLARE_H in MAVProxy's table", |l| {
+        l.contains("SP_FLARE_H") && !l.contains('=')
+    });
+    assert_eq!(
+        c.shown_param("SP_FLARE_H"),
+        Some(flare),
+        "{}",
+        c.seen.join("\n")
+    );
+    c.send("status ATTITUDE");
+    c.wait_for(10, "the drone's attitude", |l| l.contains("ATTITUDE"));
+
+    // It cannot command: a parameter set and a mode change go nowhere.
+    let mode_before = get("/api/state").expect("state")["vehicle"]["mode"].clone();
+    assert!(
+        mode_before.is_string(),
+        "the drone's mode is known: {mode_before}"
+    );
+    c.send(&format!("param set SP_FLARE_H {}", flare + 3.0));
+    c.send("long DO_SET_MODE 1 1");
+    c.send("mode 1");
+    c.drain(4);
+    let after = get("/api/params").expect("params");
+    assert_eq!(
+        param(&after, "SP_FLARE_H"),
+        Some(flare),
+        "the drone's value is unchanged"
+    );
+    let mode_after = get("/api/state").expect("state")["vehicle"]["mode"].clone();
+    assert_eq!(mode_after, mode_before, "the drone's mode is unchanged");
+    let forwards = get("/api/forwards").expect("forwards");
+    let f = &forwards["forwards"][0];
+    assert_eq!(f["name"], "mavproxy");
+    assert_eq!(f["may_send_to_drone"], serde_json::json!([]));
+    assert_eq!(f["in_passed"], 0, "{forwards}");
+    assert!(
+        f["in_refused"].as_u64() >= Some(3),
+        "the set, the command and heartbeats kept back: {forwards}"
+    );
+    assert!(f["out_passed"].as_u64() >= Some(100), "{forwards}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
