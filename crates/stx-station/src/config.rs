@@ -233,6 +233,9 @@ pub struct StationConfig {
     /// [`crate::forward`]); none by default.
     #[serde(default)]
     pub forward: Vec<crate::forward::ForwardConfig>,
+    /// The broadcast for chase cars' maps (`[chase]`, see [`crate::chase`]); off without it.
+    #[serde(default)]
+    pub chase: Option<crate::chase::settings::ChaseConfig>,
     /// Test-only: loopback addresses treated as not loopback, from the environment's
     /// [`NOT_LOOPBACK_ENV`] (see [`crate::exposure`]); empty in the field.
     #[serde(skip)]
@@ -351,6 +354,9 @@ impl StationConfig {
         }
         if let Some((field, rule)) = crate::forward::ForwardConfig::invalid(&self.forward) {
             return invalid(&field, &rule);
+        }
+        if let Some((field, rule)) = self.chase.as_ref().and_then(|c| c.invalid()) {
+            return invalid(field, rule);
         }
         let mut seen: HashMap<&str, usize> = HashMap::new();
         for (i, t) in self.tokens.iter().enumerate() {

@@ -7,6 +7,7 @@
 //!   lets through beyond this machine (rehearsal tokens on loopback only, plain HTTP only when
 //!   asked for); [`checklist`]: the go/no-go board's settings and files; [`forward`]: the
 //!   read-only MAVLink outputs for watching ground stations (their sockets are the daemon's);
+//!   [`chase`]: the Horus UDP summaries for chase cars' maps;
 //! - [`core`]: the station's state and logic: telemetry, link events and operators' requests
 //!   in, with the mission clock; messages for the dashboards and link actions (with ids and
 //!   deadlines) out; the link's outcome of each action back in; retries and time-outs are its
@@ -33,6 +34,7 @@
 //!   for `/tiles/`.
 
 pub mod ascent_wind_msg;
+pub mod chase;
 pub mod checklist;
 pub mod config;
 pub mod contract;

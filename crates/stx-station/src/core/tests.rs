@@ -453,3 +453,84 @@ fn glide_ratios_are_shown_under_the_canopy_and_not_once_landed() {
         (None, None)
     );
 }
+
+/// The chase cars' summaries (`crate::chase`) from a live state: the payload where its GPS
+/// says, its speed in km/h and course, Horus's fields and nothing else; then the landing.
+#[test]
+fn chase_summaries_carry_the_gps_fix_and_the_predicted_landing_in_horus_fields() {
+    use crate::chase::{ChaseConfig, summaries};
+    let config: ChaseConfig = toml::from_str("callsign = \"STRAPLEX1\"").expect("config");
+    let mut core = core();
+    assert!(
+        summaries(&config, 240.0, &core.state_msg_now(0.0)).is_empty(),
+        "no fix, nothing"
+    );
+    glide(&mut core, 0.0, 40.0);
+    let job = core.prediction_job().expect("a prediction can run");
+    core.set_prediction(job.run());
+    let state = core.state_msg_now(40.0);
+    let sent = summaries(&config, 240.0, &state);
+    let gps = state
+        .vehicle
+        .as_ref()
+        .and_then(|v| v.gps.clone())
+        .expect("a fix");
+    let payload = &sent[0];
+    assert_eq!(payload.callsign, "STRAPLEX1");
+    assert_eq!(
+        (payload.latitude, payload.longitude),
+        (gps.lat_deg, gps.lon_deg)
+    );
+    assert!(
+        (payload.speed - 6.0 * 3.6).abs() < 1e-6,
+        "{}",
+        payload.speed
+    );
+    assert!(payload.heading.abs() < 1e-6, "north: {}", payload.heading);
+    assert_eq!(
+        (payload.sats, payload.comment.as_str()),
+        (10, "stx: parafoil")
+    );
+    let json = serde_json::to_value(payload).expect("json");
+    let mut keys: Vec<&str> = json
+        .as_object()
+        .expect("object")
+        .keys()
+        .map(String::as_str)
+        .collect();
+    keys.sort_unstable();
+    // What horusdemodlib's send_payload_summary sends (without its optional snr/frequency).
+    assert_eq!(
+        keys,
+        [
+            "altitude",
+            "batt_voltage",
+            "callsign",
+            "comment",
+            "heading",
+            "latitude",
+            "longitude",
+            "sats",
+            "speed",
+            "temp",
+            "time",
+            "type"
+        ]
+    );
+    let landing = &sent[1];
+    let predicted = state.prediction.as_ref().expect("a prediction");
+    let touchdown = predicted
+        .planned
+        .as_ref()
+        .unwrap_or(&predicted.uncontrolled);
+    assert_eq!(landing.callsign, "STRAPLEX1_LANDING");
+    assert_eq!(
+        (landing.latitude, landing.longitude),
+        (touchdown.lat_deg, touchdown.lon_deg)
+    );
+    assert!(
+        landing.comment.starts_with("stx predicted landing"),
+        "{}",
+        landing.comment
+    );
+}

@@ -6,6 +6,7 @@
 //! the link (`replay_feed`); the live station opens them (`replay_sessions`). Nothing here
 //! decides anything: the core does.
 
+mod chase;
 mod forward;
 mod pages;
 mod replay_feed;
@@ -175,6 +176,9 @@ pub async fn run_replay(
     started: impl FnOnce(Running) + Send,
 ) -> Result<(), DaemonError> {
     config.recording.enabled = false;
+    // A replay is not the flight: chase cars and watchers must not take it for the drone.
+    config.chase = None;
+    config.forward.clear();
     run_with(config, Some(replay), shutdown, started).await
 }
 
@@ -284,6 +288,9 @@ async fn run_with(
             stop_rx.clone(),
         ))
     });
+    if let Some(chase_config) = config.chase.clone() {
+        tokio::spawn(chase::run(chase_config, shared.clone(), stop_rx.clone()));
+    }
     let station_task = tokio::spawn(station_loop::station_loop(station_loop::StationLoop {
         shared: shared.clone(),
         actions: actions_tx,

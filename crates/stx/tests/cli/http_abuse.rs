@@ -6,19 +6,11 @@
 //! Regression (issue 17 item 6): wrong tokens were answered 401 as fast as they came, with no
 //! limit, and any number of pages could connect.
 
-use std::io::{BufRead, BufReader, Read, Write};
+use std::io::{Read, Write};
 use std::net::{SocketAddr, TcpStream};
-use std::process::{Child, Command, Stdio};
+use std::process::{Command, Stdio};
 
-/// Kills the daemon when the test ends, passed or not.
-struct Killed(Child);
-
-impl Drop for Killed {
-    fn drop(&mut self) {
-        let _ = self.0.kill();
-        let _ = self.0.wait();
-    }
-}
+use crate::common::Killed;
 
 fn serve() -> (Killed, SocketAddr, String) {
     let mut child = Command::new(env!("CARGO_BIN_EXE_stx"))
@@ -34,18 +26,8 @@ fn serve() -> (Killed, SocketAddr, String) {
         .stderr(Stdio::null())
         .spawn()
         .expect("stx serve starts");
-    let mut line = String::new();
-    BufReader::new(child.stdout.take().expect("stdout"))
-        .read_line(&mut line)
-        .expect("a line");
-    let url = line.trim().rsplit(' ').next().expect("a URL").to_string();
-    let rest = url.strip_prefix("http://").expect("http URL");
-    let (address, token) = rest.split_once("/?token=").expect("address and token");
-    (
-        Killed(child),
-        address.parse().expect("address"),
-        token.to_string(),
-    )
+    let (address, token) = crate::common::read_started(&mut child);
+    (Killed(child), address.parse().expect("address"), token)
 }
 
 /// GET `path` from the local address `from` (any of 127.0.0.0/8), `extra` headers added;

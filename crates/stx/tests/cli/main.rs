@@ -5,6 +5,7 @@
 
 mod common;
 
+mod chase_horus;
 mod cli_analysis;
 mod cli_bench;
 mod cli_compare;

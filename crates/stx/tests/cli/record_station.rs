@@ -6,7 +6,6 @@
 //! and resumes when space returns; `stx replay` refuses what it cannot play. (Replay itself
 //! is driven from a browser: tests/browser/live.mjs.)
 
-use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
@@ -58,18 +57,8 @@ fn serve(record_dir: &Path) -> Daemon {
         .stderr(Stdio::null())
         .spawn()
         .expect("stx serve starts");
-    let mut line = String::new();
-    BufReader::new(child.stdout.take().expect("stdout"))
-        .read_line(&mut line)
-        .expect("a line");
-    let url = line.trim().rsplit(' ').next().expect("a URL").to_string();
-    let rest = url.strip_prefix("http://").expect("http URL").to_string();
-    let (http, token) = rest.split_once("/?token=").expect("address and token");
-    Daemon {
-        http: http.to_string(),
-        token: token.to_string(),
-        child,
-    }
+    let (http, token) = crate::common::read_started(&mut child);
+    Daemon { http, token, child }
 }
 
 fn state(d: &Daemon) -> Option<Value> {

@@ -2,9 +2,35 @@
 //! directory per test.
 
 pub mod mavproxy;
+pub mod station;
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::{Child, Command, Output};
+
+/// Kills the process when the test ends, passed or not.
+pub struct Killed(pub Child);
+
+impl Drop for Killed {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
+/// The HTTP address (host:port) and operator token a starting `stx serve` prints on its first
+/// line of stdout (`… http://HOST:PORT/?token=TOKEN`).
+#[allow(dead_code)]
+pub fn read_started(child: &mut Child) -> (String, String) {
+    use std::io::{BufRead, BufReader};
+    let mut line = String::new();
+    BufReader::new(child.stdout.take().expect("stdout piped"))
+        .read_line(&mut line)
+        .expect("the station says where it listens");
+    let url = line.trim().rsplit(' ').next().expect("a URL");
+    let rest = url.strip_prefix("http://").expect("an http URL");
+    let (http, token) = rest.split_once("/?token=").expect("address and token");
+    (http.to_string(), token.to_string())
+}
 
 /// Runs the `stx` binary under test with `args`.
 pub fn stx(args: &[&str]) -> Output {
