@@ -5,10 +5,12 @@
 // the station itself reports (link, GPS, plan, recording, forecast, battery) and against changes
 // made on purpose (a parameter changed away from the saved set, a plan made); an operator ticks
 // an item in the page and every page shows who; a viewer cannot; the launch comes with items open
-// and every page says which.
+// and every page says which. Beside the board, what the station shares: a chase broadcast and a
+// MAVLink forward, each to a UDP socket of the test's own, shown as the station counts them.
 //
 // Usage: node tests/browser/gonogo.mjs [path/to/stx]   (default target/release/stx)
 
+import { createSocket } from "node:dgram";
 import { mkdtemp, readFile, writeFile } from "node:fs/promises";
 import { tmpdir } from "node:os";
 import { join } from "node:path";
@@ -19,6 +21,7 @@ import {
 registerRest("GET", /^\/api\/readiness$/, null, "ReadinessView");
 registerRest("POST", /^\/api\/readiness\/[^/]+$/, "TickBody", "ReadinessView");
 registerRest("GET", /^\/api\/plan\/defaults$/, null, "PreflightDefaults");
+registerRest("GET", /^\/api\/sharing$/, null, "SharingBody");
 registerRest("POST", /^\/api\/plan$/, "PreflightBody", "PreflightReport");
 
 const SPEED = 4;
@@ -27,13 +30,24 @@ const ON_PAD_S = 140;
 /** The drone's own GN_HK1, saved as the flight's set. */
 const HK1 = 0.00661;
 
-async function setup() {
+/** A loopback UDP socket of the test's own, keeping what it hears. */
+async function listener() {
+  const sock = createSocket("udp4");
+  const heard = [];
+  sock.on("message", (m) => heard.push(m));
+  await new Promise((r) => sock.bind(0, "127.0.0.1", r));
+  return { port: sock.address().port, heard, close: () => sock.close() };
+}
+
+async function setup(chasePort, forwardPort) {
   const dir = await mkdtemp(join(tmpdir(), "stx-browser-gonogo-"));
   const params = join(dir, "flight-params.toml");
   await writeFile(params, `GN_HK1 = ${HK1}\n`);
   const toml = await readFile(join(root, "config/station.toml"), "utf8");
-  const station = toml.replace(/^checklist = .*$/m, (line) => `${line}\nparams_file = ${JSON.stringify(params)}`);
-  if (station === toml) throw new Error("config/station.toml has no [readiness] checklist line");
+  const withParams = toml.replace(/^checklist = .*$/m, (line) => `${line}\nparams_file = ${JSON.stringify(params)}`);
+  if (withParams === toml) throw new Error("config/station.toml has no [readiness] checklist line");
+  const station = `${withParams}\n[chase]\ncallsign = "GONOGO1"\naddress = "127.0.0.1"\nport = ${chasePort}\nperiod_s = 1.0\n`
+    + `\n[[forward]]\nname = "watcher"\naddress = "udpout:127.0.0.1:${forwardPort}"\n`;
   const stationFile = join(dir, "station.toml");
   await writeFile(stationFile, station);
   const scenario = (await readFile(join(root, "config/scenarios/mission-short.toml"), "utf8")).replace(/^launch_delay_s = .*$/m, `launch_delay_s = ${ON_PAD_S}.0`);
@@ -43,7 +57,9 @@ async function setup() {
 }
 
 async function flight() {
-  const { stationFile, scenarioFile } = await setup();
+  const chaseEar = await listener();
+  const forwardEar = await listener();
+  const { stationFile, scenarioFile } = await setup(chaseEar.port, forwardEar.port);
   const port = await freeUdpPort();
   const { base } = await startStation(["--config", stationFile, "--link", `udpin:127.0.0.1:${port}`]);
   const api = apiOf(base);
@@ -114,6 +130,27 @@ async function flight() {
     `${JSON.stringify(byId(ticked).canopy)}; viewer shows "${who.trim()}"`);
   await page.locator('[data-testid="panel-readiness"]').screenshot({ path: join(out, "gonogo-board.png") });
 
+  // ---------------------------------------------------------------- what is shared, beside the board
+  await page.waitForFunction(() => /datagrams sent/.test(document.querySelector('[data-testid="sharing-chase"]')?.textContent ?? ""), null, { timeout: 10000 }).catch(() => {});
+  const chaseText = await text(page, "sharing-chase");
+  const forwardText = await text(page, "sharing-forward-watcher");
+  const sharing = (await api("/api/sharing", VIEWER)).body;
+  const shownSent = Number(/: (\d+) datagrams sent/.exec(chaseText)?.[1] ?? NaN);
+  const callsigns = new Set(chaseEar.heard.map((m) => JSON.parse(m.toString()).callsign));
+  check("shared: the chase broadcast is shown with its callsigns, where it goes and what it sent, as the test's own socket heard it",
+    sharing.chase?.to === `127.0.0.1:${chaseEar.port}` && chaseText.includes(`GONOGO1 and GONOGO1_LANDING to 127.0.0.1:${chaseEar.port} every 1 s`)
+      && shownSent > 0 && shownSent <= sharing.chase.sent && callsigns.has("GONOGO1") && chaseEar.heard.length >= shownSent,
+    `page "${chaseText}"; station sent ${sharing.chase?.sent}; heard ${chaseEar.heard.length} (${[...callsigns].join(", ")})`);
+  const shownFrames = Number(/(\d+) frames sent/.exec(forwardText)?.[1] ?? NaN);
+  const f = sharing.forwards?.[0];
+  check("shared: the MAVLink forward is shown read-only with the frames it sent, which reached the test's socket",
+    /watcher → udpout:127\.0\.0\.1:\d+ · read-only · /.test(forwardText) && f?.name === "watcher" && f.may_send_to_drone.length === 0
+      && shownFrames > 0 && shownFrames <= f.out_passed && forwardEar.heard.length >= shownFrames,
+    `page "${forwardText}"; station ${JSON.stringify(f)}; heard ${forwardEar.heard.length} datagrams`);
+  await page.locator('[data-testid="panel-sharing"]').screenshot({ path: join(out, "gonogo-sharing.png") });
+  chaseEar.close();
+  forwardEar.close();
+
   // ---------------------------------------------------------------- the launch, with items open
   const atLaunch = await until(async () => (await api("/api/state")).body, (s) => s?.mission?.stage === "ascent", (ON_PAD_S / SPEED) * 1000 + 30000, 300);
   const launched = atLaunch?.readiness;
@@ -130,4 +167,4 @@ async function flight() {
   await vctx.close();
 }
 
-await runFlights(flight, ["ReadinessView", "TickBody", "ServerMessage:state", "StateMsg", "ErrorBody"]);
+await runFlights(flight, ["ReadinessView", "TickBody", "ServerMessage:state", "StateMsg", "ErrorBody", "SharingBody"]);

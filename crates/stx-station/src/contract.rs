@@ -161,7 +161,7 @@ pub fn schema() -> Result<Value, ContractError> {
         sent.subschema_for::<LabSavedBody>(),
         sent.subschema_for::<LabRehearsalBody>(),
         sent.subschema_for::<ReadinessView>(),
-        sent.subschema_for::<crate::forward::ForwardsBody>(),
+        sent.subschema_for::<crate::forward::SharingBody>(),
     ];
     let read_messages = vec![
         read.subschema_for::<ClientMessage>(),
@@ -220,7 +220,7 @@ pub fn schema() -> Result<Value, ContractError> {
     Ok(json!({
         "$schema": "http://json-schema.org/draft-07/schema#",
         "title": "stx station API",
-        "description": "Every message of the stx station's HTTP and WebSocket API (crates/stx-station/API.md), generated from the daemon's Rust types by `cargo run -p stx-station --example api_schema`: do not edit. The root is any one of them: on the WebSocket ServerMessage (station to page) and ClientMessage (page to station); over REST the bodies the station answers (Session, StateMsg, ParamsMsg, AscentWindMsg, EventsBody, TrackBody, ClientsBody, CommandResultMsg, CommandAccepted, CutdownArm, ErrorBody, ReplayView, RecordingsBody, ReplayOpened, KeepOutMsg, PreflightReport, PreflightDefaults, ReadinessView, ForwardsBody, the Lab's Lab*Body and VehicleFieldsBody) and the bodies of the commands (*Body).",
+        "description": "Every message of the stx station's HTTP and WebSocket API (crates/stx-station/API.md), generated from the daemon's Rust types by `cargo run -p stx-station --example api_schema`: do not edit. The root is any one of them: on the WebSocket ServerMessage (station to page) and ClientMessage (page to station); over REST the bodies the station answers (Session, StateMsg, ParamsMsg, AscentWindMsg, EventsBody, TrackBody, ClientsBody, CommandResultMsg, CommandAccepted, CutdownArm, ErrorBody, ReplayView, RecordingsBody, ReplayOpened, KeepOutMsg, PreflightReport, PreflightDefaults, ReadinessView, SharingBody, the Lab's Lab*Body and VehicleFieldsBody) and the bodies of the commands (*Body).",
         "anyOf": messages,
         "definitions": definitions,
     }))

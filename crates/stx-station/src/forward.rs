@@ -6,7 +6,8 @@
 //! reaches the drone.
 //!
 //! The sockets live in the daemon (`daemon::forward`); here are the settings, their checks and
-//! what the pages are shown.
+//! what the pages are shown (with the chase cars' broadcast, [`crate::chase`]: `GET
+//! /api/sharing`).
 
 use serde::{Deserialize, Serialize};
 use stx_link::forward::{ForwardCounts, MessageFilter};
@@ -96,11 +97,33 @@ impl ForwardView {
     }
 }
 
-/// `GET /api/forwards`: every forward, in the order of the configuration.
+/// The chase cars' broadcast as the pages show it.
 #[derive(Debug, Clone, PartialEq, Serialize, schemars::JsonSchema)]
-pub struct ForwardsBody {
+pub struct ChaseView {
+    /// The payload's callsign.
+    pub callsign: String,
+    /// The predicted landing's callsign.
+    pub landing_callsign: String,
+    /// Where the datagrams go, address:port.
+    pub to: String,
+    /// Time between two summaries, s.
+    pub period_s: f64,
+    /// Datagrams sent so far.
+    pub sent: u64,
+    /// When the last one was sent, Unix ms; `null` before the first (no GPS fix yet).
+    pub last_sent_wall_ms: Option<u64>,
+    /// Why the last send failed, while sends fail.
+    pub error: Option<String>,
+}
+
+/// `GET /api/sharing`: what the station shares beyond its pages: the forwards, in the order
+/// of the configuration, and the chase cars' broadcast.
+#[derive(Debug, Clone, PartialEq, Serialize, schemars::JsonSchema)]
+pub struct SharingBody {
     /// The forwards; empty when the configuration has none.
     pub forwards: Vec<ForwardView>,
+    /// The chase broadcast; `null` when it is off.
+    pub chase: Option<ChaseView>,
 }
 
 #[cfg(test)]

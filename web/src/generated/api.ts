@@ -2,7 +2,7 @@
 // the daemon's Rust types by `cargo run -p stx-station --example api_schema`): do not edit.
 
 /**
- * Every message of the stx station's HTTP and WebSocket API (crates/stx-station/API.md), generated from the daemon's Rust types by `cargo run -p stx-station --example api_schema`: do not edit. The root is any one of them: on the WebSocket ServerMessage (station to page) and ClientMessage (page to station); over REST the bodies the station answers (Session, StateMsg, ParamsMsg, AscentWindMsg, EventsBody, TrackBody, ClientsBody, CommandResultMsg, CommandAccepted, CutdownArm, ErrorBody, ReplayView, RecordingsBody, ReplayOpened, KeepOutMsg, PreflightReport, PreflightDefaults, ReadinessView, ForwardsBody, the Lab's Lab*Body and VehicleFieldsBody) and the bodies of the commands (*Body).
+ * Every message of the stx station's HTTP and WebSocket API (crates/stx-station/API.md), generated from the daemon's Rust types by `cargo run -p stx-station --example api_schema`: do not edit. The root is any one of them: on the WebSocket ServerMessage (station to page) and ClientMessage (page to station); over REST the bodies the station answers (Session, StateMsg, ParamsMsg, AscentWindMsg, EventsBody, TrackBody, ClientsBody, CommandResultMsg, CommandAccepted, CutdownArm, ErrorBody, ReplayView, RecordingsBody, ReplayOpened, KeepOutMsg, PreflightReport, PreflightDefaults, ReadinessView, SharingBody, the Lab's Lab*Body and VehicleFieldsBody) and the bodies of the commands (*Body).
  */
 export type StxStationAPI =
   | ServerMessage
@@ -28,7 +28,7 @@ export type StxStationAPI =
   | LabSavedBody
   | LabRehearsalBody
   | ReadinessView
-  | ForwardsBody
+  | SharingBody
   | ClientMessage
   | ModeBody
   | HeadingBody
@@ -2838,13 +2838,51 @@ export interface LabSavedBody {
   request_ids: string[];
 }
 /**
- * `GET /api/forwards`: every forward, in the order of the configuration.
+ * `GET /api/sharing`: what the station shares beyond its pages: the forwards, in the order
+ * of the configuration, and the chase cars' broadcast.
  */
-export interface ForwardsBody {
+export interface SharingBody {
+  /**
+   * The chase broadcast; `null` when it is off.
+   */
+  chase: ChaseView | null;
   /**
    * The forwards; empty when the configuration has none.
    */
   forwards: ForwardView[];
+}
+/**
+ * The chase cars' broadcast as the pages show it.
+ */
+export interface ChaseView {
+  /**
+   * The payload's callsign.
+   */
+  callsign: string;
+  /**
+   * Why the last send failed, while sends fail.
+   */
+  error: string | null;
+  /**
+   * The predicted landing's callsign.
+   */
+  landing_callsign: string;
+  /**
+   * When the last one was sent, Unix ms; `null` before the first (no GPS fix yet).
+   */
+  last_sent_wall_ms: number | null;
+  /**
+   * Time between two summaries, s.
+   */
+  period_s: number;
+  /**
+   * Datagrams sent so far.
+   */
+  sent: number;
+  /**
+   * Where the datagrams go, address:port.
+   */
+  to: string;
 }
 /**
  * A forward as the pages show it: where it goes, what it may send the drone, and its counts.

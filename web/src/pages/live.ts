@@ -37,6 +37,8 @@ import { View3D } from "../ui/view3d";
 import { VoicePanel } from "../ui/voicePanel";
 import { WindPanel } from "../ui/windPanel";
 import { ReadinessPanel } from "../ui/readinessPanel";
+import { SharingPanel } from "../ui/sharingPanel";
+import { parseSharing } from "../lib/sharing";
 
 const app = document.getElementById("app")!;
 const token = resolveToken(location.search, sessionStorage);
@@ -96,6 +98,7 @@ function build(session: Session): void {
   const readiness = new ReadinessPanel(async (id, ticked) => {
     await api.post(`/api/readiness/${encodeURIComponent(id)}`, { ticked });
   });
+  const sharing = new SharingPanel();
   const link = new LinkPanel();
   const replayBar = new ReplayBar(async (body) => {
     try {
@@ -241,7 +244,7 @@ function build(session: Session): void {
     { id: "command", label: "Command", content: commandTab },
     { id: "plan", label: "Plan", content: plan.root },
     { id: "params", label: "Parameters", content: params.root },
-    { id: "readiness", label: "Go/no-go", content: readiness.root },
+    { id: "readiness", label: "Go/no-go", content: h("div", {}, readiness.root, sharing.root) },
   ]);
   const rightCol = h("aside", { class: "col right" }, viewerNote, right.root, commandList.root, cutdown.root);
   app.replaceChildren(header, replayBar.root, banner, h("main", { class: "grid" }, left, centre, rightCol));
@@ -410,8 +413,18 @@ function build(session: Session): void {
     );
   }
 
+  // What is shared changes slowly (counts, the chase broadcast's last datagram): every 3 s.
+  function loadSharing(): void {
+    api.get("/api/sharing").then(
+      (r) => sharing.update(parseSharing(r), Date.now()),
+      (e: unknown) => sharing.failed(e instanceof Error ? e.message : String(e)),
+    );
+  }
+
   applyRoleEverywhere();
   setInterval(refresh, 250);
+  loadSharing();
+  setInterval(loadSharing, 3000);
   socket.start();
   api.get("/api/params").then(
     (r) => {

@@ -11,7 +11,21 @@ use tokio::net::UdpSocket;
 use tokio::sync::watch;
 
 use crate::chase::{ChaseConfig, summaries};
+use crate::forward::ChaseView;
 use crate::http::Shared;
+
+/// What the pages show of `config` before anything was sent.
+pub(super) fn view(config: &ChaseConfig) -> ChaseView {
+    ChaseView {
+        callsign: config.callsign.clone(),
+        landing_callsign: config.landing_callsign(),
+        to: SocketAddr::new(config.address, config.port).to_string(),
+        period_s: config.period_s,
+        sent: 0,
+        last_sent_wall_ms: None,
+        error: None,
+    }
+}
 
 /// Sends the summaries until `stop`.
 pub(super) async fn run(config: ChaseConfig, shared: Arc<Shared>, mut stop: watch::Receiver<bool>) {

@@ -279,6 +279,7 @@ async fn run_with(
         lab: Default::default(),
         rehearsal: Default::default(),
         forwards,
+        chase: Mutex::new(config.chase.as_ref().map(chase::view)),
     });
     let sessions_task = replay_requests_rx.map(|rx| {
         tokio::spawn(replay_sessions::replay_sessions(

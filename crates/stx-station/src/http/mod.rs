@@ -76,7 +76,7 @@ pub fn router(state: std::sync::Arc<Shared>) -> Router {
         .route("/api/plan/defaults", get(plan::plan_defaults))
         .route("/api/readiness", get(readiness::board))
         .route("/api/readiness/{id}", post(readiness::tick))
-        .route("/api/forwards", get(readiness::forwards))
+        .route("/api/sharing", get(readiness::sharing))
         .route("/api/cutdown/arm", post(arm_cutdown))
         .route("/api/cutdown/confirm", post(confirm_cutdown))
         .route("/api/clients", get(clients))

@@ -1,7 +1,7 @@
 //! `GET /api/readiness`: the go/no-go board (any role); `POST /api/readiness/{id}`: an
 //! operator ticks or unticks a checklist item. The board also rides in every `state` message.
-//! `GET /api/forwards`: what the station shares with watching ground stations (the board's
-//! neighbour on the Go/no-go page).
+//! `GET /api/sharing`: what the station shares with watching ground stations and chase cars
+//! (the board's neighbour on the Go/no-go tab).
 
 use axum::Json;
 use axum::extract::rejection::JsonRejection;
@@ -19,10 +19,11 @@ pub(crate) async fn board(State(state): State<AppState>, _caller: Caller) -> Res
     Json(state.core().state_msg_now(now).readiness).into_response()
 }
 
-/// `GET /api/forwards` (any role): the read-only MAVLink outputs and their counts.
-pub(crate) async fn forwards(State(state): State<AppState>, _caller: Caller) -> Response {
+/// `GET /api/sharing` (any role): the read-only MAVLink outputs and the chase broadcast.
+pub(crate) async fn sharing(State(state): State<AppState>, _caller: Caller) -> Response {
     let forwards = state.forwards.lock().map(|f| f.clone()).unwrap_or_default();
-    Json(crate::forward::ForwardsBody { forwards }).into_response()
+    let chase = state.chase.lock().ok().and_then(|c| c.clone());
+    Json(crate::forward::SharingBody { forwards, chase }).into_response()
 }
 
 pub(crate) async fn tick(

@@ -25,6 +25,8 @@ pub struct Shared {
     pub core: Mutex<StationCore>,
     /// The `[[forward]]` outputs and their counts, kept by their tasks.
     pub forwards: Arc<Mutex<Vec<crate::forward::ForwardView>>>,
+    /// The chase broadcast as its task last reported it; `None` when it is off.
+    pub chase: Mutex<Option<crate::forward::ChaseView>>,
     /// Configuration (immutable).
     pub config: StationConfig,
     /// Mission clock origin.

@@ -140,5 +140,15 @@ fn chase_cars_hear_the_payload_and_its_landing_as_horusdemodlib_sends_them() {
         off < 50.0,
         "{off} m from the station's prediction: {landing} / {touchdown}"
     );
+    // The pages are told what was sent.
+    let chase = &station.get("/api/sharing").expect("sharing")["chase"];
+    assert_eq!(
+        (chase["callsign"].as_str(), chase["to"].as_str()),
+        (
+            Some("STRAPLEX1"),
+            Some(format!("127.0.0.1:{port}").as_str())
+        )
+    );
+    assert!(chase["sent"].as_u64() >= Some(stx.len() as u64), "{chase}");
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -107,7 +107,7 @@ fn mavproxy_on_a_forward_sees_the_drone_and_cannot_command_it() {
     );
     let mode_after = get("/api/state").expect("state")["vehicle"]["mode"].clone();
     assert_eq!(mode_after, mode_before, "the drone's mode is unchanged");
-    let forwards = get("/api/forwards").expect("forwards");
+    let forwards = get("/api/sharing").expect("forwards");
     let f = &forwards["forwards"][0];
     assert_eq!(f["name"], "mavproxy");
     assert_eq!(f["may_send_to_drone"], serde_json::json!([]));
