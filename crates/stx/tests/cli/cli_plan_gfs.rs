@@ -1,0 +1,155 @@
+//! `stx plan --gfs` and `--sounding`: the plan's forecast rows are ecCodes' reading of the GFS
+//! file at the launch site (a grid point, a forecast hour), and bad files exit 2 naming what
+//! is missing.
+
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+fn testdata(name: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../stx-weather/testdata")
+        .join(name)
+}
+
+fn stx_plan(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_stx"))
+        .arg("plan")
+        .args(["--runs", "20"])
+        .args(args)
+        .output()
+        .expect("stx runs")
+}
+
+fn path(name: &str) -> String {
+    testdata(name).display().to_string()
+}
+
+/// ecCodes' values of `short_name` at the file's first point, forecast hour 0, per level
+/// (as committed beside the file by make_fixtures.py).
+fn eccodes_first_point(file: &str, short_name: &str) -> Vec<f64> {
+    let text = std::fs::read_to_string(testdata("eccodes_reads.json")).unwrap();
+    let v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    v["files"][file]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|m| m["short_name"] == short_name && m["step_hours"] == 0)
+        .map(|m| {
+            let p = &m["points"][0];
+            assert_eq!((p[0].as_f64(), p[1].as_f64()), (Some(36.0), Some(350.0)));
+            p[2].as_f64().unwrap()
+        })
+        .collect()
+}
+
+#[test]
+fn gfs_rows_at_a_grid_point_are_eccodes_winds_and_geometric_heights() {
+    let file = "gfs_0p50_simple.grib2";
+    let out = stx_plan(&[
+        "--launch",
+        "36.0,-10.0,0",
+        "--gfs",
+        &path(file),
+        "--launch-time",
+        "2026-11-30T06:00:00Z",
+        "--json",
+    ]);
+    assert!(out.status.success(), "{out:?}");
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON");
+    let rows = report["request"]["forecast"].as_array().unwrap();
+    let (u, v, gh) = (
+        eccodes_first_point(file, "u"),
+        eccodes_first_point(file, "v"),
+        eccodes_first_point(file, "gh"),
+    );
+    assert_eq!(rows.len(), 4);
+    for (k, row) in rows.iter().enumerate() {
+        let speed = row["speed_mps"].as_f64().unwrap();
+        let from = row["from_deg"].as_f64().unwrap().to_radians();
+        // Back to components: where the air goes is opposite to where it comes from.
+        let (east, north) = (-speed * from.sin(), -speed * from.cos());
+        assert!(
+            (east - u[k]).abs() < 0.01,
+            "level {k}: {east} vs ecCodes {}",
+            u[k]
+        );
+        assert!(
+            (north - v[k]).abs() < 0.01,
+            "level {k}: {north} vs ecCodes {}",
+            v[k]
+        );
+        let h = 6_371_008.8 * gh[k] / (6_371_008.8 - gh[k]);
+        assert!(
+            (row["alt_msl_m"].as_f64().unwrap() - h).abs() < 0.01,
+            "level {k}"
+        );
+    }
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("GFS run 2026-11-30T06:00:00Z"), "{stderr}");
+}
+
+#[test]
+fn a_sounding_gives_the_plan_its_winds() {
+    let out = stx_plan(&[
+        "--launch",
+        "40.53,-80.22,360",
+        "--sounding",
+        &path("72520_sounding.txt"),
+        "--json",
+    ]);
+    assert!(out.status.success(), "{out:?}");
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON");
+    let rows = report["request"]["forecast"].as_array().unwrap();
+    assert_eq!(rows.len(), 16);
+    assert_eq!(rows[0]["from_deg"].as_f64().unwrap().round(), 250.0);
+    // The jet at 250 hPa, 101 knots from 285°, carries the burst east.
+    assert!(report["burst"]["east_m"].as_f64().unwrap() > 50_000.0);
+}
+
+#[test]
+fn bad_gfs_files_and_times_exit_2_naming_what_is_missing() {
+    let subset = path("gfs_0p25_subset.grib2");
+    let (no_hgt, sounding) = (path("no_hgt.grib2"), path("72520_sounding.txt"));
+    let cases: [(Vec<&str>, &str); 5] = [
+        (
+            vec!["--launch", "38,-8", "--gfs", &no_hgt],
+            "no HGT on isobaric levels",
+        ),
+        (
+            vec!["--launch", "45,-8", "--gfs", &subset],
+            "45° N -8° E is outside the file's box (latitudes 36…40°, longitudes -10…-5°)",
+        ),
+        (
+            vec![
+                "--launch",
+                "38,-8",
+                "--gfs",
+                &subset,
+                "--launch-time",
+                "2026-11-30T13:00:00Z",
+            ],
+            "outside the forecast: its hours cover 2026-11-30T06:00:00Z to 2026-11-30T12:00:00Z",
+        ),
+        (
+            vec!["--launch", "38,-8", "--gfs", &sounding],
+            "not a readable GRIB2 file",
+        ),
+        (
+            vec![
+                "--launch",
+                "38,-8",
+                "--gfs",
+                &subset,
+                "--launch-time",
+                "tomorrow",
+            ],
+            "not an RFC 3339 time",
+        ),
+    ];
+    for (args, expected) in cases {
+        let out = stx_plan(&args);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
+        assert!(stderr.contains(expected), "{args:?}: {stderr}");
+    }
+}
