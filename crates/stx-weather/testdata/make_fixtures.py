@@ -109,36 +109,32 @@ def axis(first: float, step: float, count: int) -> list:
 
 def fixtures() -> None:
     hpa = [1000, 850, 700, 500, 300, 200, 100, 50, 10, 1, 0.4]
-    write(
-        os.path.join(HERE, "gfs_0p25_subset.grib2"),
-        lats=axis(40.0, -0.25, 17),
-        lons=axis(350.0, 0.25, 21),
-        levels_pa=[p * 100 for p in hpa],
-        steps=[0, 3, 6],
-        names=["u", "v", "gh"],
-        packing="grid_complex_spatial_differencing",
-        seed=1,
-    )
-    write(
-        os.path.join(HERE, "gfs_0p50_simple.grib2"),
-        lats=axis(36.0, 0.5, 9),
-        lons=axis(-10.0, 0.5, 11),
-        levels_pa=[100000, 50000, 10000, 1000],
-        steps=[0, 6],
-        names=["u", "v", "gh"],
-        packing="grid_simple",
-        seed=2,
-    )
-    write(
-        os.path.join(HERE, "no_hgt.grib2"),
-        lats=axis(36.0, 0.5, 3),
-        lons=axis(-10.0, 0.5, 3),
-        levels_pa=[100000, 50000],
-        steps=[0],
-        names=["u", "v"],
-        packing="grid_simple",
-        seed=3,
-    )
+    # name: latitudes, longitudes, levels (Pa), hours, variables, packing
+    files = {
+        "gfs_0p25_subset.grib2": (
+            axis(40.0, -0.25, 17), axis(350.0, 0.25, 21), [p * 100 for p in hpa], [0, 3, 6],
+            ["u", "v", "gh"], "grid_complex_spatial_differencing",
+        ),
+        "gfs_0p50_simple.grib2": (
+            axis(36.0, 0.5, 9), axis(-10.0, 0.5, 11), [100000, 50000, 10000, 1000], [0, 6],
+            ["u", "v", "gh"], "grid_simple",
+        ),
+        "no_hgt.grib2": (
+            axis(36.0, 0.5, 3), axis(-10.0, 0.5, 3), [100000, 50000], [0], ["u", "v"],
+            "grid_simple",
+        ),
+    }
+    for seed, (name, (lats, lons, levels_pa, steps, names, packing)) in enumerate(files.items()):
+        write(
+            os.path.join(HERE, name),
+            lats=lats,
+            lons=lons,
+            levels_pa=levels_pa,
+            steps=steps,
+            names=names,
+            packing=packing,
+            seed=seed + 1,
+        )
     reads = {}
     # A dozen points of each made-up message; a thousand of the real GFS one (a 0.25° global
     # field from NOMADS: see README.md here).

@@ -110,43 +110,29 @@ fn a_sounding_gives_the_plan_its_winds() {
 fn bad_gfs_files_and_times_exit_2_naming_what_is_missing() {
     let subset = path("gfs_0p25_subset.grib2");
     let (no_hgt, sounding) = (path("no_hgt.grib2"), path("72520_sounding.txt"));
-    let cases: [(Vec<&str>, &str); 5] = [
+    // (launch site, file, launch time, what stderr says)
+    let cases = [
+        ("38,-8", &no_hgt, None, "no HGT on isobaric levels"),
         (
-            vec!["--launch", "38,-8", "--gfs", &no_hgt],
-            "no HGT on isobaric levels",
-        ),
-        (
-            vec!["--launch", "45,-8", "--gfs", &subset],
+            "45,-8",
+            &subset,
+            None,
             "45° N -8° E is outside the file's box (latitudes 36…40°, longitudes -10…-5°)",
         ),
         (
-            vec![
-                "--launch",
-                "38,-8",
-                "--gfs",
-                &subset,
-                "--launch-time",
-                "2026-11-30T13:00:00Z",
-            ],
+            "38,-8",
+            &subset,
+            Some("2026-11-30T13:00:00Z"),
             "outside the forecast: its hours cover 2026-11-30T06:00:00Z to 2026-11-30T12:00:00Z",
         ),
-        (
-            vec!["--launch", "38,-8", "--gfs", &sounding],
-            "not a readable GRIB2 file",
-        ),
-        (
-            vec![
-                "--launch",
-                "38,-8",
-                "--gfs",
-                &subset,
-                "--launch-time",
-                "tomorrow",
-            ],
-            "not an RFC 3339 time",
-        ),
+        ("38,-8", &sounding, None, "not a readable GRIB2 file"),
+        ("38,-8", &subset, Some("tomorrow"), "not an RFC 3339 time"),
     ];
-    for (args, expected) in cases {
+    for (launch, file, time, expected) in cases {
+        let mut args = vec!["--launch", launch, "--gfs", file];
+        if let Some(t) = time {
+            args.extend(["--launch-time", t]);
+        }
         let out = stx_plan(&args);
         let stderr = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
