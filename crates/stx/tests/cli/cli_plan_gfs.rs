@@ -1,9 +1,11 @@
 //! `stx plan --gfs` and `--sounding`: the plan's forecast rows are ecCodes' reading of the GFS
 //! file at the launch site (a grid point, a forecast hour), and bad files exit 2 naming what
-//! is missing.
+//! is missing; `stx serve` with a `[forecast_file]` starts the Plan page from its rows.
 
 use std::path::PathBuf;
 use std::process::{Command, Output};
+
+use crate::common::{get_json, serve, sigterm, stx, temp_dir};
 
 fn testdata(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -138,4 +140,77 @@ fn bad_gfs_files_and_times_exit_2_naming_what_is_missing() {
         assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
         assert!(stderr.contains(expected), "{args:?}: {stderr}");
     }
+}
+
+/// The shipped station config with its `[[forecast_wind]]` rows replaced by `table`.
+fn station_config(dir: &std::path::Path, table: &str) -> PathBuf {
+    let shipped = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../config/station.toml"
+    ))
+    .expect("shipped config");
+    let mut in_rows = false;
+    let mut text = String::new();
+    for line in shipped.lines() {
+        in_rows = line.starts_with("[[forecast_wind]]") || (in_rows && !line.is_empty());
+        if !in_rows {
+            text.push_str(line);
+            text.push('\n');
+        }
+    }
+    let path = dir.join("station.toml");
+    std::fs::write(&path, format!("{text}\n{table}")).expect("write");
+    path
+}
+
+#[test]
+fn the_station_plans_from_its_configured_gfs_file_and_refuses_a_bad_one() {
+    let dir = temp_dir("plan-gfs", "station");
+    // The shipped origin, Évora (38.53° N, 7.89° W), lies in the subset's box.
+    let good = station_config(
+        &dir,
+        &format!(
+            "[forecast_file]\ngfs = [\"{}\"]\nvalid_time = \"2026-11-30T09:00:00Z\"\n",
+            path("gfs_0p25_subset.grib2")
+        ),
+    );
+    let (child, address, token) = serve(&[
+        "--config",
+        good.to_str().unwrap(),
+        "--listen",
+        "127.0.0.1:0",
+        "--link",
+        "udpin:127.0.0.1:0",
+    ]);
+    let defaults = get_json(&address, "/api/plan/defaults", &token);
+    sigterm(&child);
+    let rows = defaults["request"]["forecast"].as_array().expect("rows");
+    assert_eq!(rows.len(), 11, "{defaults}");
+    let out = stx_plan(&[
+        "--launch",
+        "38.5333,-7.8889,245",
+        "--gfs",
+        &path("gfs_0p25_subset.grib2"),
+        "--launch-time",
+        "2026-11-30T09:00:00Z",
+        "--json",
+    ]);
+    let plan: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON");
+    assert_eq!(
+        &plan["request"]["forecast"],
+        &defaults["request"]["forecast"]
+    );
+
+    let bad = station_config(
+        &dir,
+        &format!("[forecast_file]\ngfs = [\"{}\"]\n", path("no_hgt.grib2")),
+    );
+    let out = stx(&["serve", "--config", bad.to_str().unwrap()]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("forecast_file") && stderr.contains("no HGT"),
+        "{stderr}"
+    );
+    let _ = std::fs::remove_dir_all(dir);
 }
