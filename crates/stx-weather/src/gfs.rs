@@ -84,6 +84,21 @@ pub enum GfsError {
         /// The forecast hour after the model run.
         hour: f64,
     },
+    /// Two messages hold the same variable, level and hour.
+    #[error(
+        "{file}: a second {variable} at {level_hpa} hPa for forecast hour {hour} (a file given \
+         twice, or several ensemble members?)"
+    )]
+    Duplicate {
+        /// The file of the second message.
+        file: String,
+        /// `UGRD`, `VGRD` or `HGT`.
+        variable: &'static str,
+        /// The level, hPa.
+        level_hpa: f64,
+        /// The forecast hour.
+        hour: f64,
+    },
     /// A message has missing points (a bitmap) where the field needs every one.
     #[error(
         "{variable} at {level_hpa} hPa, forecast hour {hour}: {missing} grid points have no value"
@@ -211,7 +226,16 @@ impl GfsField {
                     GfsError::Run(format!("{file}: a forecast time in an unknown unit"))
                 })?;
                 let key = (forecast_s, (m.surface_value * 1000.0).round() as i64);
-                slices[v].insert(key, g.reorder(&m));
+                // A second message for the same slot (a file given twice, or two ensemble
+                // members) would silently replace the first.
+                if slices[v].insert(key, g.reorder(&m)).is_some() {
+                    return Err(GfsError::Duplicate {
+                        file: file.to_string(),
+                        variable: VARIABLES[v].name,
+                        level_hpa: m.surface_value / 100.0,
+                        hour: forecast_s as f64 / 3600.0,
+                    });
+                }
             }
         }
         for (v, s) in slices.iter().enumerate() {

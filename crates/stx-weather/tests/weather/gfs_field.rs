@@ -119,6 +119,14 @@ fn a_file_without_hgt_or_missing_one_message_is_refused_naming_what_is_missing()
         "no VGRD at 500 hPa for forecast hour 0: every level needs UGRD, VGRD and HGT at every hour"
     );
 
+    // The same file twice: its messages would replace one another.
+    let e = GfsField::from_files([("a", whole.as_slice()), ("b", whole.as_slice())]).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "b: a second UGRD at 1000 hPa for forecast hour 0 (a file given twice, or several \
+         ensemble members?)"
+    );
+
     // Cut inside a message (its 24 are of one size: half the file is a whole 12): the
     // reason, with the file's name.
     let e = GfsField::from_files([("half.grib2", &whole[..whole.len() / 2 + 100])]).unwrap_err();
