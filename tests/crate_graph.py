@@ -24,6 +24,9 @@ ALLOWED: dict[str, set[str]] = {
     "stx-types": set(),
     # The MCAP recorder writes JSON it is handed: it needs no stx type to do so.
     "stx-record": set(),
+    # Forecast files (GFS GRIB2, soundings) to wind levels: plain numbers out, so no stx type;
+    # its callers make their forecast rows of them.
+    "stx-weather": set(),
     # The 14-DOF flight model: physics over the shared types, nothing onboard or on the link.
     "stx-dynamics": {"stx-types"},
     # Onboard guidance, navigation and control: runs on the drone, so no simulator physics.
@@ -41,6 +44,7 @@ ALLOWED: dict[str, set[str]] = {
     # the flight model's vehicle file (the Lab edits it); the simulated drone only in its tests.
     "stx-station": {
         "stx-types", "stx-dynamics", "stx-gnc", "stx-link", "stx-link-tokio", "stx-record",
+        "stx-weather",
     },
     # Station beside simulated drone, checked against truth: needs both sides.
     "stx-agreement": {
@@ -62,6 +66,7 @@ ALLOWED: dict[str, set[str]] = {
     "stx": {
         "stx-types", "stx-dynamics", "stx-gnc", "stx-link", "stx-link-tokio", "stx-sim",
         "stx-station", "stx-record", "stx-analysis", "stx-agreement", "stx-lab", "stx-bench",
+        "stx-weather",
     },
 }
 

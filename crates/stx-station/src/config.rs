@@ -195,6 +195,12 @@ pub struct StationConfig {
     /// `sigma_mps` is used by plans only).
     #[serde(default)]
     pub forecast_wind: Vec<ForecastRow>,
+    /// A forecast file in place of `forecast_wind` (`[forecast_file]`: GFS GRIB2 files and the
+    /// instant to take them at, or a sounding; see
+    /// [`crate::forecast_file::ForecastFileConfig`]), read into `forecast_wind` at the launch
+    /// site (`origin`) before the station starts ([`Self::load_forecast_file`]).
+    #[serde(default)]
+    pub forecast_file: Option<crate::forecast_file::ForecastFileConfig>,
     /// How the wind is measured from the balloon's drift during the ascent (`[ascent_wind]`:
     /// band height, fixes per band, what counts as rising; see
     /// [`AscentWindConfig`]); the defaults suit a sounding balloon with a 1–10 Hz GPS.
@@ -240,6 +246,9 @@ pub struct StationConfig {
     /// [`NOT_LOOPBACK_ENV`] (see [`crate::exposure`]); empty in the field.
     #[serde(skip)]
     pub not_loopback: Vec<IpAddr>,
+    /// Whether `forecast_wind` holds the rows read from `forecast_file`.
+    #[serde(skip)]
+    pub forecast_file_loaded: bool,
 }
 
 fn default_web_dir() -> PathBuf {
@@ -335,6 +344,22 @@ impl StationConfig {
             self.recording.dir = stx_link::signing::persist::default_state_dir(&env)
                 .map(|dir| stx_record::file::recordings_dir(&dir));
         }
+        Ok(())
+    }
+
+    /// Reads `forecast_file`, if any, into `forecast_wind` at the launch site (reads files:
+    /// the caller runs it once, after parsing and before the station starts).
+    pub fn load_forecast_file(&mut self) -> Result<(), ConfigError> {
+        let Some(file) = &self.forecast_file else {
+            return Ok(());
+        };
+        self.forecast_wind = file
+            .rows(self.origin.lat_deg, self.origin.lon_deg)
+            .map_err(|rule| ConfigError::Invalid {
+                field: "forecast_file".into(),
+                rule,
+            })?;
+        self.forecast_file_loaded = true;
         Ok(())
     }
 
@@ -457,6 +482,17 @@ impl StationConfig {
             self.ascent_wind.validate()
         {
             return invalid(&format!("ascent_wind.{field}"), rule);
+        }
+        if let Some(file) = &self.forecast_file {
+            if let Some((field, rule)) = file.invalid() {
+                return invalid(&format!("forecast_file.{field}"), &rule);
+            }
+            if !self.forecast_wind.is_empty() && !self.forecast_file_loaded {
+                return invalid(
+                    "forecast_file",
+                    "give forecast_wind rows or a forecast_file, not both",
+                );
+            }
         }
         for (i, r) in self.forecast_wind.iter().enumerate() {
             let sigma_ok = r.sigma_mps.is_none_or(|s| s.is_finite() && s >= 0.0);

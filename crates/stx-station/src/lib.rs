@@ -18,7 +18,8 @@
 //!   sends, [`requests`]: what it
 //!   reads (parameter ranges, units and meanings come from the onboard catalogue,
 //!   `stx_gnc::params`, shared with the drone); [`contract`]: all of them as one JSON Schema,
-//!   the contract the dashboard's TypeScript types are generated from; [`kml`]: the Google
+//!   the contract the dashboard's TypeScript types are generated from; [`forecast_file`]: a
+//!   GFS GRIB2 file or a sounding as forecast rows (`[forecast_file]`); [`kml`]: the Google
 //!   Earth feed; [`keep_out`]: the keep-out zones' messages; [`lab`]: the Lab's jobs, requests and results (the work itself is
 //!   stx-lab's); [`limits`]: requests per token, wrong tokens per address and pages at once,
 //!   as token buckets on the station's clock; [`preflight`]: the Plan page's pre-flight plans
@@ -42,6 +43,7 @@ pub mod core;
 #[cfg(feature = "daemon")]
 pub mod daemon;
 pub mod exposure;
+pub mod forecast_file;
 pub mod forward;
 #[cfg(feature = "daemon")]
 pub mod http;

@@ -1,8 +1,9 @@
 //! `stx plan --launch LAT,LON[,ALT] --forecast FILE …`: the pre-flight plan (burst, deploy
-//! and landing regions, the target's reachability) from a forecast file and, if given, the
-//! wind an earlier recording measured on its ascent. Argument parsing and files only; the plan
-//! and the recording's wind are `stx_station::preflight::preflight_plan`, as the station's
-//! `POST /api/plan`.
+//! and landing regions, the target's reachability) from a forecast file (rows, GFS GRIB2 files
+//! with `--gfs`, or a sounding with `--sounding`) and, if given, the wind an earlier recording
+//! measured on its ascent. Argument parsing only; the files become rows in
+//! `stx_station::forecast_file`, and the plan and the recording's wind are
+//! `stx_station::preflight::preflight_plan`, as the station's `POST /api/plan`.
 
 use std::path::PathBuf;
 
@@ -11,6 +12,7 @@ use clap::Args;
 use stx_gnc::flight_path::plan::{MAX_RUNS, PlannedPoint};
 use stx_gnc::flight_path::{Forecast, PlanRequest};
 use stx_gnc::geo::LocalFrame;
+use stx_station::forecast_file;
 use stx_station::preflight::{MeasuredAscentView, preflight_plan};
 
 use crate::BadInput;
@@ -22,8 +24,25 @@ pub struct PlanArgs {
     #[arg(long, value_name = "LAT,LON[,ALT]", value_parser = parse_launch)]
     launch: LocalFrame,
     /// Forecast wind file, TOML or CSV (format: README, "Pre-flight planning").
-    #[arg(long, value_name = "FILE", required_unless_present = "from_recording")]
+    #[arg(
+        long,
+        value_name = "FILE",
+        required_unless_present_any = ["from_recording", "gfs", "sounding"],
+        conflicts_with_all = ["gfs", "sounding"]
+    )]
     forecast: Option<PathBuf>,
+    /// GFS GRIB2 files of one run (pgrb2 0.25° or 0.5°, or a NOMADS filter subset with UGRD,
+    /// VGRD and HGT on isobaric levels around the launch site): the wind over the launch site
+    /// at --launch-time.
+    #[arg(long, value_name = "FILE", num_args = 1.., conflicts_with = "sounding")]
+    gfs: Vec<PathBuf>,
+    /// When the wind is taken from the GFS files, RFC 3339 (2026-11-30T12:00:00Z); default:
+    /// their first forecast time.
+    #[arg(long, value_name = "RFC3339", requires = "gfs", value_parser = parse_time)]
+    launch_time: Option<stx_weather::OffsetDateTime>,
+    /// A radiosonde sounding as the University of Wyoming prints it (TEXT:LIST).
+    #[arg(long, value_name = "FILE")]
+    sounding: Option<PathBuf>,
     /// An earlier recording (MCAP) whose measured ascent wind replaces the forecast where it
     /// reaches.
     #[arg(long, value_name = "FILE.mcap")]
@@ -79,6 +98,10 @@ fn parse_launch(text: &str) -> Result<LocalFrame, String> {
     })
 }
 
+fn parse_time(text: &str) -> Result<stx_weather::OffsetDateTime, String> {
+    stx_weather::parse_time(text).map_err(|e| format!("not an RFC 3339 time ({e}): `{text}`"))
+}
+
 fn parse_target(text: &str) -> Result<[f64; 2], String> {
     let v = numbers(text, &[2])?;
     Ok([v[0], v[1]])
@@ -86,6 +109,24 @@ fn parse_target(text: &str) -> Result<[f64; 2], String> {
 
 pub fn run(args: PlanArgs) -> anyhow::Result<()> {
     let forecast = match &args.forecast {
+        None if !args.gfs.is_empty() => {
+            let field = forecast_file::read_gfs(&args.gfs).map_err(bad_input)?;
+            let at = args.launch_time.unwrap_or_else(|| field.valid_times()[0]);
+            let rows =
+                forecast_file::gfs_rows(&field, args.launch.lat_deg, args.launch.lon_deg, Some(at))
+                    .map_err(bad_input)?;
+            eprintln!(
+                "GFS run {}: the wind at {} over the launch site, {} levels",
+                stx_weather::format_time(field.reference_time()),
+                stx_weather::format_time(at),
+                rows.len()
+            );
+            rows
+        }
+        None if args.sounding.is_some() => {
+            let path = args.sounding.as_deref().expect("matched");
+            forecast_file::read_sounding(path).map_err(bad_input)?
+        }
         Some(path) => {
             let text = std::fs::read_to_string(path)
                 .with_context(|| format!("cannot read the forecast {}", path.display()))
@@ -202,6 +243,10 @@ fn print_measured(measured: &MeasuredAscentView) {
             b.alt_min_msl_m, b.alt_max_msl_m, b.speed_mps, b.from_deg, sigma
         );
     }
+}
+
+fn bad_input(message: String) -> BadInput {
+    BadInput(anyhow::anyhow!(message))
 }
 
 /// `h:mm:ss`.

@@ -78,14 +78,22 @@ pub fn load_config(path: Option<&std::path::Path>) -> anyhow::Result<StationConf
             .with_context(|| format!("cannot read station config {}", p.display()))
             .map_err(BadInput)?,
     };
-    StationConfig::from_toml_str_with_env(&text, |k| std::env::var_os(k))
-        .with_context(|| {
-            format!(
-                "station config {}",
-                path.map_or("(shipped)".into(), |p| p.display().to_string())
-            )
-        })
-        .map_err(|e| BadInput(e).into())
+    let name = || {
+        format!(
+            "station config {}",
+            path.map_or("(shipped)".into(), |p| p.display().to_string())
+        )
+    };
+    let mut config = StationConfig::from_toml_str_with_env(&text, |k| std::env::var_os(k))
+        .with_context(name)
+        .map_err(BadInput)?;
+    // `[forecast_file]`: its rows become the forecast wind before anything starts.
+    config
+        .load_forecast_file()
+        .and_then(|()| config.validate())
+        .with_context(name)
+        .map_err(BadInput)?;
+    Ok(config)
 }
 
 pub fn run(args: ServeArgs) -> anyhow::Result<()> {

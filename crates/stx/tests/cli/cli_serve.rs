@@ -1,22 +1,10 @@
 //! `stx serve` from the outside: it starts, prints where to look, answers, and stops cleanly on
 //! SIGTERM; a bad configuration is refused with exit code 2.
 
-use std::io::{BufRead, BufReader, Read, Write};
-use std::net::TcpStream;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-fn get(address: &str, path: &str, token: &str) -> String {
-    let mut stream = TcpStream::connect(address).expect("connect");
-    write!(
-        stream,
-        "GET {path} HTTP/1.1\r\nHost: {address}\r\nAuthorization: Bearer {token}\r\nConnection: close\r\n\r\n"
-    )
-    .expect("write");
-    let mut response = String::new();
-    stream.read_to_string(&mut response).expect("read");
-    response
-}
+use crate::common::{banner, get, get_json, serve, sigterm, spawn_serve};
 
 #[test]
 fn serve_prints_its_url_answers_and_stops_on_sigterm() {
@@ -140,53 +128,6 @@ fn beyond_loopback_the_rehearsal_tokens_and_plain_http_are_refused_with_exit_2()
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(stderr.contains("cross the network in clear"), "{stderr}");
     let _ = std::fs::remove_dir_all(&dir);
-}
-
-/// The first line `child` prints: the start banner with the dashboard's URL.
-fn banner(child: &mut std::process::Child) -> String {
-    let mut line = String::new();
-    BufReader::new(child.stdout.take().expect("stdout"))
-        .read_line(&mut line)
-        .expect("a line");
-    line
-}
-
-/// Asks `child` to stop as systemd does.
-fn sigterm(child: &std::process::Child) {
-    let killed = Command::new("kill")
-        .args(["-TERM", &child.id().to_string()])
-        .status()
-        .expect("kill");
-    assert!(killed.success());
-}
-
-/// Starts `stx serve` with `args`, its stdout piped.
-fn spawn_serve(args: &[&str]) -> std::process::Child {
-    Command::new(env!("CARGO_BIN_EXE_stx"))
-        .arg("serve")
-        .arg("--no-record")
-        .args(args)
-        .stdout(Stdio::piped())
-        .stderr(Stdio::null())
-        .spawn()
-        .expect("stx serve starts")
-}
-
-/// Starts `stx serve` with `args` and returns the child and the address and token it printed.
-fn serve(args: &[&str]) -> (std::process::Child, String, String) {
-    let mut child = spawn_serve(args);
-    let line = banner(&mut child);
-    let url = line.trim().rsplit(' ').next().expect("a URL").to_string();
-    let rest = url.strip_prefix("http://").expect("http URL");
-    let (address, token) = rest.split_once("/?token=").expect("address and token");
-    (child, address.to_string(), token.to_string())
-}
-
-fn get_json(address: &str, path: &str, token: &str) -> serde_json::Value {
-    let response = get(address, path, token);
-    let body = response.split_once("\r\n\r\n").map_or("", |(_, b)| b);
-    // The station answers with a content length, so the body is the JSON itself.
-    serde_json::from_str(body).unwrap_or(serde_json::Value::Null)
 }
 
 #[test]

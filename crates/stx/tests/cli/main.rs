@@ -16,6 +16,7 @@ mod cli_logs;
 mod cli_montecarlo;
 mod cli_pipe;
 mod cli_plan;
+mod cli_plan_gfs;
 mod cli_record;
 mod cli_serve;
 mod cli_sim;

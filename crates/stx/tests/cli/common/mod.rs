@@ -1,11 +1,13 @@
-//! Helpers the `stx` command-line tests share: run the real binary, and a fresh scratch
-//! directory per test.
+//! Helpers the `stx` command-line tests share: run the real binary, a fresh scratch
+//! directory per test, and a running `stx serve` to ask over HTTP.
 
 pub mod mavproxy;
 pub mod station;
 
+use std::io::{BufRead, BufReader, Read, Write};
+use std::net::TcpStream;
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Output};
+use std::process::{Child, Command, Output, Stdio};
 
 /// Kills the process when the test ends, passed or not.
 pub struct Killed(pub Child);
@@ -79,8 +81,7 @@ pub fn request_json(
     path: &str,
     body: &str,
 ) -> Option<serde_json::Value> {
-    use std::io::{Read, Write};
-    let mut s = std::net::TcpStream::connect(http).ok()?;
+    let mut s = TcpStream::connect(http).ok()?;
     s.set_read_timeout(Some(std::time::Duration::from_secs(5)))
         .ok()?;
     let req = format!(
@@ -93,4 +94,64 @@ pub fn request_json(
     s.read_to_end(&mut answer).ok()?;
     let text = String::from_utf8_lossy(&answer);
     serde_json::from_str(text.split_once("\r\n\r\n")?.1).ok()
+}
+
+/// `GET path` from the station at `address` with `token`: the whole HTTP response.
+pub fn get(address: &str, path: &str, token: &str) -> String {
+    let mut stream = TcpStream::connect(address).expect("connect");
+    write!(
+        stream,
+        "GET {path} HTTP/1.1\r\nHost: {address}\r\nAuthorization: Bearer {token}\r\nConnection: close\r\n\r\n"
+    )
+    .expect("write");
+    let mut response = String::new();
+    stream.read_to_string(&mut response).expect("read");
+    response
+}
+
+/// The first line `child` prints: the start banner with the dashboard's URL.
+pub fn banner(child: &mut std::process::Child) -> String {
+    let mut line = String::new();
+    BufReader::new(child.stdout.take().expect("stdout"))
+        .read_line(&mut line)
+        .expect("a line");
+    line
+}
+
+/// Asks `child` to stop as systemd does.
+pub fn sigterm(child: &std::process::Child) {
+    let killed = Command::new("kill")
+        .args(["-TERM", &child.id().to_string()])
+        .status()
+        .expect("kill");
+    assert!(killed.success());
+}
+
+/// Starts `stx serve` with `args`, its stdout piped.
+pub fn spawn_serve(args: &[&str]) -> std::process::Child {
+    Command::new(env!("CARGO_BIN_EXE_stx"))
+        .arg("serve")
+        .arg("--no-record")
+        .args(args)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::null())
+        .spawn()
+        .expect("stx serve starts")
+}
+
+/// Starts `stx serve` with `args` and returns the child and the address and token it printed.
+pub fn serve(args: &[&str]) -> (std::process::Child, String, String) {
+    let mut child = spawn_serve(args);
+    let line = banner(&mut child);
+    let url = line.trim().rsplit(' ').next().expect("a URL").to_string();
+    let rest = url.strip_prefix("http://").expect("http URL");
+    let (address, token) = rest.split_once("/?token=").expect("address and token");
+    (child, address.to_string(), token.to_string())
+}
+
+pub fn get_json(address: &str, path: &str, token: &str) -> serde_json::Value {
+    let response = get(address, path, token);
+    let body = response.split_once("\r\n\r\n").map_or("", |(_, b)| b);
+    // The station answers with a content length, so the body is the JSON itself.
+    serde_json::from_str(body).unwrap_or(serde_json::Value::Null)
 }
