@@ -12,6 +12,7 @@ use super::senders::{SenderStats, SenderTable, account_sender, loss_pct};
 use super::stats::LinkStats;
 use crate::frame::{
     DecoderPolicy, DecoderStats, Frame, FrameDecoder, FrameEncoder, FrameError, FrameHeader,
+    FrameIds, encode_frame_into,
 };
 use crate::paths::{Deduplicator, PathStats, RadioPath, signature_failures, transmit_path};
 use crate::signing::SigningConfig;
@@ -100,6 +101,9 @@ pub(super) struct LinkCore {
     paths: Vec<RadioPath>,
     copies: Deduplicator,
     encoder: FrameEncoder,
+    /// Sequence of each other component of our system that speaks through this link (a
+    /// body's IMU): MAVLink counts sequences per component, and a receiver counts gaps so.
+    other_sequences: HashMap<u8, u8>,
     pub(super) out: VecDeque<Vec<u8>>,
     pub(super) events: VecDeque<LinkEvent>,
     next_heartbeat: Duration,
@@ -135,6 +139,7 @@ impl LinkCore {
             paths,
             copies: Deduplicator::default(),
             encoder,
+            other_sequences: HashMap::new(),
             out: VecDeque::new(),
             events: VecDeque::new(),
             next_heartbeat: now,
@@ -189,6 +194,26 @@ impl LinkCore {
 
     pub(super) fn send(&mut self, now: Duration, msg: &MavMessage) {
         let bytes = self.encoder.encode(now, msg);
+        self.frames_out += 1;
+        self.bytes_out += bytes.len() as u64;
+        self.out.push_back(bytes);
+        self.check_persist();
+    }
+
+    /// Sends `msg` as component `component_id` of our system (signed as our own frames are).
+    pub(super) fn send_from(&mut self, now: Duration, component_id: u8, msg: &MavMessage) {
+        if component_id == self.config.component_id {
+            return self.send(now, msg);
+        }
+        let sequence = self.other_sequences.entry(component_id).or_insert(0);
+        let ids = FrameIds {
+            system_id: self.config.system_id,
+            component_id,
+            sequence: *sequence,
+        };
+        *sequence = sequence.wrapping_add(1);
+        let mut bytes = Vec::with_capacity(64);
+        encode_frame_into(now, msg, ids, self.encoder.signer_mut(), &mut bytes);
         self.frames_out += 1;
         self.bytes_out += bytes.len() as u64;
         self.out.push_back(bytes);

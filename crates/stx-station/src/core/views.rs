@@ -273,6 +273,16 @@ impl StationCore {
             link,
             vehicle,
             estimate,
+            stack: self.latest.attitude.map(|(a, at)| {
+                let euler = nalgebra::Vector3::new(a.roll_rad, a.pitch_rad, a.yaw_rad);
+                super::stack::stack_view(
+                    &self.rigging,
+                    euler,
+                    (now_s - at).max(0.0),
+                    &self.body_attitudes,
+                    now_s,
+                )
+            }),
             guidance,
             prediction,
             footprint: self.footprint_view(now_s),
