@@ -2,7 +2,7 @@
 //! heartbeat timer, the peer's liveness and the statistics ([`LinkStats`]). The ground and
 //! vehicle endpoints each own one and add their protocols on top.
 
-use std::collections::{HashMap, VecDeque};
+use std::collections::{BTreeMap, HashMap, VecDeque};
 use std::time::Duration;
 
 use mavlink::Message;
@@ -112,7 +112,9 @@ pub(super) struct LinkCore {
     pub(super) connected: bool,
     arrivals: VecDeque<Duration>,
     senders: SenderTable,
-    last_by_kind: HashMap<u32, (&'static str, Duration)>,
+    /// Last arrival of each message kind from each component: a body IMU's ATTITUDE must not
+    /// keep the autopilot's fresh in the ages the operators watch.
+    last_by_kind: HashMap<(u8, u32), (&'static str, Duration)>,
     frames_out: u64,
     bytes_out: u64,
 }
@@ -317,8 +319,28 @@ impl LinkCore {
         self.arrivals.push_back(now);
         self.prune_arrivals(now);
         self.last_by_kind
-            .insert(h.message_id, (msg.message_name(), now));
+            .insert((h.component_id, h.message_id), (msg.message_name(), now));
         account_sender(&mut self.senders, h);
+    }
+
+    /// Seconds since the last message of each kind by name: the heartbeat peer's components
+    /// under the plain name, any other component's as `NAME@COMPONENT` (a body's own IMU).
+    /// Before a peer is heard every component goes under the plain name, freshest kept.
+    fn ages_by_name(&self, now: Duration) -> BTreeMap<String, f64> {
+        let main = self.peer.map(|p| p.1);
+        let mut ages = BTreeMap::new();
+        for ((component, _), (name, t)) in &self.last_by_kind {
+            let key = if main.is_none_or(|m| m == *component) {
+                (*name).to_string()
+            } else {
+                format!("{name}@{component}")
+            };
+            let age = now.saturating_sub(*t).as_secs_f64();
+            ages.entry(key)
+                .and_modify(|a: &mut f64| *a = a.min(age))
+                .or_insert(age);
+        }
+        ages
     }
 
     fn prune_arrivals(&mut self, now: Duration) {
@@ -462,11 +484,7 @@ impl LinkCore {
             bytes_discarded: d.bytes_discarded,
             packet_loss_pct,
             senders,
-            last_message_age_s: self
-                .last_by_kind
-                .values()
-                .map(|(name, t)| ((*name).to_string(), now.saturating_sub(*t).as_secs_f64()))
-                .collect(),
+            last_message_age_s: self.ages_by_name(now),
             decoder: d,
             duplicates_dropped,
             paths,
