@@ -6,6 +6,7 @@
 
 import * as THREE from "three";
 import { coneRadius, type V3 } from "../lib/scene3d";
+import { drawPoints, dynamicLine } from "./lines3d";
 
 const MAX_PATH = 64;
 
@@ -23,12 +24,8 @@ export class Plan3D {
 
   constructor() {
     const line = (positions: Float32Array, color: number, dashed: boolean): THREE.Line => {
-      const g = new THREE.BufferGeometry();
-      g.setAttribute("position", new THREE.BufferAttribute(positions, 3));
-      g.setDrawRange(0, 0);
       const material = dashed ? new THREE.LineDashedMaterial({ color, dashSize: 20, gapSize: 12 }) : new THREE.LineBasicMaterial({ color });
-      const l = new THREE.Line(g, material);
-      l.frustumCulled = false;
+      const l = dynamicLine(THREE.Line, positions, material);
       this.group.add(l);
       return l;
     };
@@ -48,16 +45,12 @@ export class Plan3D {
     const first = corners[0];
     const loop = first && corners.length >= 2 ? [...corners, first].slice(0, MAX_PATH) : [];
     loop.forEach((p, i) => this.pathPositions.set(p, i * 3));
-    this.path.geometry.getAttribute("position").needsUpdate = true;
-    this.path.geometry.setDrawRange(0, loop.length);
+    drawPoints(this.path, loop.length);
     if (loop.length > 1) this.path.computeLineDistances();
     this.pathPoints = loop.length;
     this.finalShown = finalEntry !== null && target !== null;
-    if (finalEntry && target) {
-      this.finalPositions.set([...finalEntry, ...target]);
-      this.final.geometry.getAttribute("position").needsUpdate = true;
-    }
-    this.final.geometry.setDrawRange(0, this.finalShown ? 2 : 0);
+    if (finalEntry && target) this.finalPositions.set([...finalEntry, ...target]);
+    drawPoints(this.final, this.finalShown ? 2 : 0);
   }
 
   /** The glide cone on `target` up to the drone's `height_m` above it; hidden without a glide ratio. */

@@ -7,6 +7,7 @@
 import * as THREE from "three";
 import { applyBasis, bodyBasis, enuToScene, type V3 } from "../lib/scene3d";
 import type { Stack, StackBody } from "../lib/types";
+import { drawPoints, dynamicLine } from "./lines3d";
 
 const COLOURS: Record<StackBody["body"], number> = { canopy: 0xe07000, drone: 0xffc400, capsule: 0x1f77b4, transponder: 0x2ca02c };
 
@@ -47,11 +48,7 @@ export class Stack3D {
   magnification = 1;
 
   constructor() {
-    const geom = new THREE.BufferGeometry();
-    geom.setAttribute("position", new THREE.BufferAttribute(this.linePositions, 3));
-    geom.setDrawRange(0, 0);
-    this.lines = new THREE.LineSegments(geom, new THREE.LineBasicMaterial({ color: 0x333333 }));
-    this.lines.frustumCulled = false;
+    this.lines = dynamicLine(THREE.LineSegments, this.linePositions, new THREE.LineBasicMaterial({ color: 0x333333 }));
     this.group.add(this.lines);
     this.group.visible = false;
   }
@@ -109,9 +106,7 @@ export class Stack3D {
       this.linePositions.set([...enuToScene(l.top_enu_m), ...enuToScene(l.bottom_enu_m)], n * 6);
       n += 1;
     }
-    const attr = this.lines.geometry.getAttribute("position") as THREE.BufferAttribute;
-    attr.needsUpdate = true;
-    this.lines.geometry.setDrawRange(0, n * 2);
+    drawPoints(this.lines, n * 2);
     this.drawn = drawn;
   }
 

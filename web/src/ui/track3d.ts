@@ -2,6 +2,7 @@
 // past `MAX_POINTS`, with the box that bounds it for framing.
 
 import * as THREE from "three";
+import { drawPoints, dynamicLine } from "./lines3d";
 
 const MAX_POINTS = 20_000;
 
@@ -11,11 +12,7 @@ export class Track3D {
   count = 0;
 
   constructor() {
-    const geom = new THREE.BufferGeometry();
-    geom.setAttribute("position", new THREE.BufferAttribute(this.positions, 3));
-    geom.setDrawRange(0, 0);
-    this.line = new THREE.Line(geom, new THREE.LineBasicMaterial({ color: 0x0b2f8a }));
-    this.line.frustumCulled = false;
+    this.line = dynamicLine(THREE.Line, this.positions, new THREE.LineBasicMaterial({ color: 0x0b2f8a }));
   }
 
   clear(): void {
@@ -32,9 +29,7 @@ export class Track3D {
     }
     this.positions.set([v.x, v.y, v.z], this.count * 3);
     this.count += 1;
-    const attr = this.line.geometry.getAttribute("position") as THREE.BufferAttribute;
-    attr.needsUpdate = true;
-    this.line.geometry.setDrawRange(0, this.count);
+    drawPoints(this.line, this.count);
   }
 
   /** The box around the track. */
