@@ -9,6 +9,7 @@ use stx_link::telemetry::Attitude;
 use stx_types::stack::BodyImu;
 
 use super::*;
+use crate::core::StationCore;
 
 fn attitude(euler: Vector3<f64>) -> Attitude {
     Attitude {
@@ -151,4 +152,40 @@ fn bodies_not_heard_or_heard_too_long_ago_hang_straight_by_the_rigging() {
     );
     let view = stack_view(&vehicle, drone, 0.0, &bodies, 4.0);
     assert_eq!(view.bodies[0].source, BodySource::Rigging);
+}
+
+#[test]
+fn a_body_imus_attitude_is_that_bodys_never_the_drones() {
+    use stx_link::endpoint::GroundEvent;
+    use stx_link::telemetry::Telemetry;
+    let mut core = crate::core::tests::core();
+    let heard = |core: &mut StationCore, now_s: f64, component: u8, roll_rad: f64| {
+        let mut a = attitude(Vector3::new(roll_rad, 0.0, 0.0));
+        a.time_boot_ms = (now_s * 1000.0) as u32;
+        let telemetry = Telemetry::Attitude(a);
+        core.on_link_event(
+            now_s,
+            GroundEvent::Telemetry {
+                from: (1, component),
+                telemetry,
+            },
+        );
+    };
+    // The canopy alone: nothing of the drone is known, so there is no vehicle and no stack.
+    heard(&mut core, 1.0, BodyImu::Canopy.component_id(), 0.4);
+    let s = core.state_msg_now(1.0);
+    assert!(s.vehicle.is_none() && s.stack.is_none() && s.estimate.is_none());
+    // The drone's AHRS: its attitude is the drone's, the canopy keeps its own.
+    heard(&mut core, 1.25, 1, -0.1);
+    let s = core.state_msg_now(1.3);
+    let shown = s
+        .vehicle
+        .and_then(|v| v.attitude)
+        .expect("the drone's attitude");
+    assert!((shown.roll_deg + 0.1_f64.to_degrees()).abs() < 1e-9);
+    let stack = s.stack.expect("a stack once the drone is heard");
+    assert_eq!(stack.bodies[0].source, BodySource::Measured);
+    assert!((stack.bodies[0].roll_deg - 0.4_f64.to_degrees()).abs() < 1e-9);
+    assert!((stack.bodies[1].roll_deg + 0.1_f64.to_degrees()).abs() < 1e-9);
+    assert_eq!(stack.bodies[2].source, BodySource::Rigging);
 }
