@@ -73,12 +73,15 @@ struct Placed {
 
 /// The stack around a drone at attitude `drone_euler_rad` (roll, pitch, yaw) whose AHRS
 /// sample is `drone_age_s` old, with the body IMUs heard so far, at station time `now_s`.
+/// `canopy_out`: the parafoil flies (deploying or deployed); before it, and once landed, the
+/// canopy and its main lines are not drawn in the air above the drone.
 pub(crate) fn stack_view(
     vehicle: &Vehicle,
     drone_euler_rad: Vector3<f64>,
     drone_age_s: f64,
     bodies: &BodyAttitudes,
     now_s: f64,
+    canopy_out: bool,
 ) -> StackView {
     // Hanging straight: level, facing where the drone faces.
     let hanging = t_from_euler(&Vector3::new(0.0, 0.0, drone_euler_rad.z));
@@ -174,7 +177,20 @@ pub(crate) fn stack_view(
             pendant(&c.transponder),
         ),
     ];
-    StackView { bodies, lines }
+    if canopy_out {
+        StackView { bodies, lines }
+    } else {
+        StackView {
+            bodies: bodies
+                .into_iter()
+                .filter(|b| b.body != StackBody::Canopy)
+                .collect(),
+            lines: lines
+                .into_iter()
+                .filter(|l| !matches!(l.line, StackLine::MainRight | StackLine::MainLeft))
+                .collect(),
+        }
+    }
 }
 
 #[cfg(test)]

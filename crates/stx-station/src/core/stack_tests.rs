@@ -55,7 +55,7 @@ fn measured_view(vehicle: &Vehicle, k: &Kinematics, now_s: f64) -> StackView {
         );
     }
     let drone = euler_from_t(&k.t_i_body[Body::Drone as usize]);
-    stack_view(vehicle, drone, 0.1, &bodies, now_s)
+    stack_view(vehicle, drone, 0.1, &bodies, now_s, true)
 }
 
 fn from_drone_enu(k: &Kinematics, p_ned: Vector3<f64>) -> Vector3<f64> {
@@ -121,7 +121,14 @@ fn bodies_not_heard_or_heard_too_long_ago_hang_straight_by_the_rigging() {
     bodies.heard(BodyImu::Capsule, attitude(tilted), 0.0);
     // A level drone heading east; the capsule's attitude is older than the limit.
     let drone = Vector3::new(0.0, 0.0, 90_f64.to_radians());
-    let view = stack_view(&vehicle, drone, 0.0, &bodies, BODY_MEASURED_WITHIN_S + 0.5);
+    let view = stack_view(
+        &vehicle,
+        drone,
+        0.0,
+        &bodies,
+        BODY_MEASURED_WITHIN_S + 0.5,
+        true,
+    );
     let sources: Vec<_> = view.bodies.iter().map(|b| b.source).collect();
     assert_eq!(
         sources,
@@ -150,8 +157,17 @@ fn bodies_not_heard_or_heard_too_long_ago_hang_straight_by_the_rigging() {
         attitude(Vector3::new(f64::NAN, 0.0, 0.0)),
         4.0,
     );
-    let view = stack_view(&vehicle, drone, 0.0, &bodies, 4.0);
+    let view = stack_view(&vehicle, drone, 0.0, &bodies, 4.0, true);
     assert_eq!(view.bodies[0].source, BodySource::Rigging);
+    // Before the parafoil flies, no canopy and no main lines above the drone.
+    let packed = stack_view(&vehicle, drone, 0.0, &bodies, 4.0, false);
+    let names: Vec<_> = packed.bodies.iter().map(|b| b.body).collect();
+    assert_eq!(
+        names,
+        [StackBody::Drone, StackBody::Capsule, StackBody::Transponder]
+    );
+    let lines: Vec<_> = packed.lines.iter().map(|l| l.line).collect();
+    assert_eq!(lines, [StackLine::Capsule, StackLine::Transponder]);
 }
 
 #[test]
@@ -175,7 +191,8 @@ fn a_body_imus_attitude_is_that_bodys_never_the_drones() {
     heard(&mut core, 1.0, BodyImu::Canopy.component_id(), 0.4);
     let s = core.state_msg_now(1.0);
     assert!(s.vehicle.is_none() && s.stack.is_none() && s.estimate.is_none());
-    // The drone's AHRS: its attitude is the drone's, the canopy keeps its own.
+    // Under the parafoil, the drone's AHRS: its attitude is the drone's, the canopy keeps its own.
+    crate::core::tests::hear_stage(&mut core, 1.2, stx_gnc::mission::FlightStage::Parafoil);
     heard(&mut core, 1.25, 1, -0.1);
     let s = core.state_msg_now(1.3);
     let shown = s
@@ -188,4 +205,8 @@ fn a_body_imus_attitude_is_that_bodys_never_the_drones() {
     assert!((stack.bodies[0].roll_deg - 0.4_f64.to_degrees()).abs() < 1e-9);
     assert!((stack.bodies[1].roll_deg + 0.1_f64.to_degrees()).abs() < 1e-9);
     assert_eq!(stack.bodies[2].source, BodySource::Rigging);
+    // Landed: the bodies lie where they fell, no stack is drawn hanging into the ground.
+    crate::core::tests::hear_stage(&mut core, 1.5, stx_gnc::mission::FlightStage::Landed);
+    heard(&mut core, 1.75, 1, 0.0);
+    assert!(core.state_msg_now(1.8).stack.is_none());
 }
