@@ -21,7 +21,6 @@ import {
 registerRest("GET", /^\/api\/readiness$/, null, "ReadinessView");
 registerRest("POST", /^\/api\/readiness\/[^/]+$/, "TickBody", "ReadinessView");
 registerRest("GET", /^\/api\/plan\/defaults$/, null, "PreflightDefaults");
-registerRest("GET", /^\/api\/sharing$/, null, "SharingBody");
 registerRest("POST", /^\/api\/plan$/, "PreflightBody", "PreflightReport");
 
 const SPEED = 4;
@@ -136,12 +135,15 @@ async function flight() {
   const forwardText = await text(page, "sharing-forward-watcher");
   const sharing = (await api("/api/sharing", VIEWER)).body;
   const shownSent = Number(/: (\d+) datagrams sent/.exec(chaseText)?.[1] ?? NaN);
+  await until(async () => chaseEar.heard.length, (n) => n >= shownSent, 5000, 100);
   const callsigns = new Set(chaseEar.heard.map((m) => JSON.parse(m.toString()).callsign));
   check("shared: the chase broadcast is shown with its callsigns, where it goes and what it sent, as the test's own socket heard it",
     sharing.chase?.to === `127.0.0.1:${chaseEar.port}` && chaseText.includes(`GONOGO1 and GONOGO1_LANDING to 127.0.0.1:${chaseEar.port} every 1 s`)
       && shownSent > 0 && shownSent <= sharing.chase.sent && callsigns.has("GONOGO1") && chaseEar.heard.length >= shownSent,
     `page "${chaseText}"; station sent ${sharing.chase?.sent}; heard ${chaseEar.heard.length} (${[...callsigns].join(", ")})`);
   const shownFrames = Number(/(\d+) frames sent/.exec(forwardText)?.[1] ?? NaN);
+  // The test's sockets hear datagrams as its event loop gets to them: give it a moment.
+  await until(async () => forwardEar.heard.length, (n) => n >= shownFrames, 5000, 100);
   const f = sharing.forwards?.[0];
   check("shared: the MAVLink forward is shown read-only with the frames it sent, which reached the test's socket",
     /watcher → udpout:127\.0\.0\.1:\d+ · read-only · /.test(forwardText) && f?.name === "watcher" && f.may_send_to_drone.length === 0

@@ -66,7 +66,7 @@ export function registerRest(method, path, requestName, responseName) {
 /** What the contract calls a REST body: `[request body or null, response body]` for one call. */
 function restNames(method, path, status) {
   if (status >= 400) return [null, "ErrorBody"];
-  const gets = { "/api/session": "Session", "/api/state": "StateMsg", "/api/params": "ParamsMsg", "/api/ascent_wind": "AscentWindMsg", "/api/keep-out": "KeepOutMsg", "/api/events": "EventsBody", "/api/track": "TrackBody", "/api/clients": "ClientsBody" };
+  const gets = { "/api/session": "Session", "/api/state": "StateMsg", "/api/params": "ParamsMsg", "/api/ascent_wind": "AscentWindMsg", "/api/keep-out": "KeepOutMsg", "/api/events": "EventsBody", "/api/track": "TrackBody", "/api/clients": "ClientsBody", "/api/sharing": "SharingBody" };
   if (method === "GET" && gets[path]) return [null, gets[path]];
   if (method === "GET" && /^\/api\/commands\/[^/]+$/.test(path)) return [null, "CommandResultMsg"];
   const commands = { mode: "ModeBody", heading: "HeadingBody", course: "CourseBody", localizer: "LocalizerBody", target: "TargetBody", plan: "PlanBody" };

@@ -55,7 +55,9 @@ pub(super) async fn run(config: ChaseConfig, shared: Arc<Shared>, mut stop: watc
             let Ok(bytes) = serde_json::to_vec(&summary) else {
                 continue;
             };
-            match socket.send_to(&bytes, to).await {
+            let sent = socket.send_to(&bytes, to).await;
+            note(&shared, &sent, state.wall_ms);
+            match sent {
                 Ok(_) => failing = false,
                 Err(e) if !failing => {
                     failing = true;
@@ -64,5 +66,21 @@ pub(super) async fn run(config: ChaseConfig, shared: Arc<Shared>, mut stop: watc
                 Err(_) => {}
             }
         }
+    }
+}
+
+/// What the pages are shown of a send at `wall_ms`.
+fn note(shared: &Shared, sent: &std::io::Result<usize>, wall_ms: u64) {
+    let Ok(mut guard) = shared.chase.lock() else {
+        return;
+    };
+    let Some(view) = guard.as_mut() else { return };
+    match sent {
+        Ok(_) => {
+            view.sent += 1;
+            view.last_sent_wall_ms = Some(wall_ms);
+            view.error = None;
+        }
+        Err(e) => view.error = Some(e.to_string()),
     }
 }

@@ -5,7 +5,7 @@
 use std::path::PathBuf;
 use std::process::{Command, Output};
 
-use crate::common::{get_json, serve, sigterm, stx, temp_dir};
+use crate::common::{get_value, serve, sigterm, stx, temp_dir};
 
 fn testdata(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -182,7 +182,7 @@ fn the_station_plans_from_its_configured_gfs_file_and_refuses_a_bad_one() {
         "--link",
         "udpin:127.0.0.1:0",
     ]);
-    let defaults = get_json(&address, "/api/plan/defaults", &token);
+    let defaults = get_value(&address, "/api/plan/defaults", &token);
     sigterm(&child);
     let rows = defaults["request"]["forecast"].as_array().expect("rows");
     assert_eq!(rows.len(), 11, "{defaults}");

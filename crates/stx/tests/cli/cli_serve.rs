@@ -4,7 +4,7 @@
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-use crate::common::{banner, get, get_json, serve, sigterm, spawn_serve};
+use crate::common::{banner, get, get_value, serve, sigterm, spawn_serve};
 
 #[test]
 fn serve_prints_its_url_answers_and_stops_on_sigterm() {
@@ -147,7 +147,7 @@ fn serve_sim_flies_the_simulated_drone_to_a_landing_the_station_sees() {
     let mut last = serde_json::Value::Null;
     let mut phases = std::collections::BTreeSet::new();
     while Instant::now() < deadline {
-        last = get_json(&address, "/api/state", &token);
+        last = get_value(&address, "/api/state", &token);
         if let Some(phase) = last["guidance"]["phase"].as_str() {
             phases.insert(phase.to_string());
         }
@@ -178,7 +178,7 @@ fn serve_sim_flies_the_simulated_drone_to_a_landing_the_station_sees() {
     // At `max` the final approach and the flare last a fraction of a second of wall time, and
     // a 100 ms poll of the state can miss them both: the station's event log keeps the
     // replica's phase changes.
-    let events = get_json(&address, "/api/events", &token);
+    let events = get_value(&address, "/api/events", &token);
     let said: Vec<&str> = events["events"]
         .as_array()
         .map(|es| es.iter().filter_map(|e| e["text"].as_str()).collect())
@@ -192,7 +192,7 @@ fn serve_sim_flies_the_simulated_drone_to_a_landing_the_station_sees() {
         "{phases:?}; events {said:?}"
     );
     // The drone's parameters arrive described from the shared catalogue.
-    let params = get_json(&address, "/api/params", &token);
+    let params = get_value(&address, "/api/params", &token);
     let hk1 = params["params"]
         .as_array()
         .and_then(|p| p.iter().find(|p| p["name"] == "GN_HK1"))

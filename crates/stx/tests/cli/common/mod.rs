@@ -142,16 +142,11 @@ pub fn spawn_serve(args: &[&str]) -> std::process::Child {
 /// Starts `stx serve` with `args` and returns the child and the address and token it printed.
 pub fn serve(args: &[&str]) -> (std::process::Child, String, String) {
     let mut child = spawn_serve(args);
-    let line = banner(&mut child);
-    let url = line.trim().rsplit(' ').next().expect("a URL").to_string();
-    let rest = url.strip_prefix("http://").expect("http URL");
-    let (address, token) = rest.split_once("/?token=").expect("address and token");
-    (child, address.to_string(), token.to_string())
+    let (address, token) = read_started(&mut child);
+    (child, address, token)
 }
 
-pub fn get_json(address: &str, path: &str, token: &str) -> serde_json::Value {
-    let response = get(address, path, token);
-    let body = response.split_once("\r\n\r\n").map_or("", |(_, b)| b);
-    // The station answers with a content length, so the body is the JSON itself.
-    serde_json::from_str(body).unwrap_or(serde_json::Value::Null)
+/// `GET path` as JSON, `null` when there is none (see [`get_json`]).
+pub fn get_value(address: &str, path: &str, token: &str) -> serde_json::Value {
+    get_json(address, token, path).unwrap_or(serde_json::Value::Null)
 }
