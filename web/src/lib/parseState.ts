@@ -4,7 +4,6 @@
 import { parseReadiness } from "./readiness";
 import { parseFlightPath } from "./flightPath";
 import { zonesOf } from "./zones";
-import { parseStack } from "./stack";
 import type {
   Estimate,
   FlightMode,
@@ -340,7 +339,6 @@ export function parseState(v: Obj): Parsed<State> {
     link: parseLink(obj(v, "link")),
     vehicle: sub(v, "vehicle", parseVehicle),
     estimate: sub(v, "estimate", parseEstimate),
-    stack: sub(v, "stack", parseStack),
     guidance: sub(v, "guidance", parseGuidance),
     prediction: sub(v, "prediction", parsePrediction),
     footprint: sub(v, "footprint", parseFootprint),

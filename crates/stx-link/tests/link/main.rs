@@ -3,7 +3,6 @@
 
 mod common;
 
-mod body_imu;
 mod datagram_source;
 mod decoder_props;
 mod endpoint;
