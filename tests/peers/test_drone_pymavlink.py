@@ -5,7 +5,8 @@ Usage: test_drone_pymavlink.py STX_BINARY [SCENARIO]
 Listens with `udpin` on a free loopback port, starts `stx drone --connect udpout:…` at real
 time, and, as a ground station would:
   1. reads HEARTBEAT (a parafoil, custom mode = mode | stage << 8 | phase << 16), GPS_RAW_INT,
-     ATTITUDE and the rest of the telemetry, and measures each message's rate over a window;
+     ATTITUDE and the rest of the telemetry, and measures each message's rate over a window
+     (the other bodies' ATTITUDE from their own components, apart);
   2. lists the parameters (PARAM_REQUEST_LIST → every PARAM_VALUE, by index), sets one and reads
      it back (the PARAM_SET echo and a PARAM_REQUEST_READ), and checks an out-of-range set, and
      one within its range that breaks a rule between parameters, are answered only with the
@@ -100,6 +101,9 @@ def exercise(conn):
         if m is None or m.get_srcSystem() != 1:
             continue
         t = m.get_type()
+        if m.get_srcComponent() != 1:
+            # Another body's own IMU (stx_types::stack::BodyImu): its stream, counted apart.
+            t = f"{t}@{m.get_srcComponent()}"
         now = time.monotonic()
         n, t_first, _ = counts.get(t, (0, now, now))
         counts[t] = (n + 1, t_first, now)
@@ -120,6 +124,11 @@ def exercise(conn):
         assert 3.5 <= rates[t] <= 4.5, (t, rates)
     for t in ("SYS_STATUS", "BATTERY_STATUS", "WIND_COV"):
         assert 0.8 <= rates[t] <= 1.25, (t, rates)
+    # Under the parafoil the canopy, capsule and transponder IMUs (MAV_COMP_ID_IMU, _2, _3)
+    # send their attitudes at 2 Hz; nothing else comes from another component.
+    for c in (200, 201, 202):
+        assert 1.6 <= rates.get(f"ATTITUDE@{c}", 0) <= 2.4, (c, rates)
+    assert all(t.startswith("ATTITUDE@20") for t in rates if "@" in t), rates
     gps = latest["GPS_RAW_INT"]
     assert gps.fix_type == mavutil.mavlink.GPS_FIX_TYPE_3D_FIX, gps
     # Near Évora (the rehearsal's site), a few hundred metres from its origin.

@@ -16,11 +16,13 @@ mod flight_path;
 mod footprint;
 mod mission;
 mod readiness;
+mod stack;
 mod vehicle;
 pub use flight_path::{FlightPathView, PathPointView};
 pub use footprint::{FootprintContourView, FootprintView, FootprintZoneHit};
 pub use mission::{DisagreementView, LandingView};
 pub use readiness::{CheckStatus, CheckView, ReadinessView, TickBody};
+pub use stack::{BodySource, StackBody, StackBodyView, StackLine, StackLineView, StackView};
 pub use vehicle::{
     AirView, AttitudeView, GpsView, OnboardLandingView, PowerView, ServosView, VehicleView,
 };
@@ -299,6 +301,9 @@ pub struct StateMsg {
     pub vehicle: Option<VehicleView>,
     /// Estimate.
     pub estimate: Option<EstimateView>,
+    /// The four bodies and their lines around the drone; `null` before the drone's
+    /// attitude is heard.
+    pub stack: Option<StackView>,
     /// Guidance.
     pub guidance: Option<GuidanceView>,
     /// Prediction.

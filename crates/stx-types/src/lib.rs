@@ -20,6 +20,7 @@
 //! - [`atmosphere`] is the air over altitude (US Standard Atmosphere 1976) and [`wind`] the
 //!   air's velocity (the [`wind::WindField`] trait and the mean winds; the simulator's
 //!   turbulence stays in `stx-dynamics`);
+//! - [`stack`] maps the bodies that carry an IMU of their own to their MAVLink components;
 //! - [`table_text`] finds the data lines of a hand-edited table, with their line numbers;
 //! - [`validate`] checks one setting against its rule, for every settings type of the
 //!   workspace (the vehicle, the flight path, the estimator, the sensors, …).
@@ -35,6 +36,7 @@ pub mod keep_out;
 pub mod mission;
 pub mod plan;
 pub mod rotation;
+pub mod stack;
 pub mod table_text;
 pub mod validate;
 pub mod wind;

@@ -102,6 +102,18 @@ export type RecordingState = "on" | "off" | "failing";
  */
 export type ReplayMode = "rerun" | "recorded";
 /**
+ * A body of the stack.
+ */
+export type StackBody = "canopy" | "drone" | "capsule" | "transponder";
+/**
+ * Where a body's attitude comes from.
+ */
+export type BodySource = "measured" | "rigging";
+/**
+ * A line of the rigging.
+ */
+export type StackLine = "main_right" | "main_left" | "capsule" | "transponder";
+/**
  * GNSS fix type (GPS_FIX_TYPE).
  */
 export type GpsFix = "no_gps" | "no_fix" | "fix2d" | "fix3d" | "dgps" | "rtk_float" | "rtk_fixed" | "static" | "ppp";
@@ -733,6 +745,11 @@ export interface StateMsg {
    * The replay this station is showing (`stx replay`); `null` when live.
    */
   replay: ReplayView | null;
+  /**
+   * The four bodies and their lines around the drone; `null` before the drone's
+   * attitude is heard.
+   */
+  stack: StackView | null;
   /**
    * The station's clock: s since it started (its timers and ages run on it).
    */
@@ -1508,6 +1525,86 @@ export interface ReplayView {
    * Unix time of the recording's first message, ms.
    */
   start_ms: number;
+}
+/**
+ * The four bodies and their lines; present once the drone's attitude is heard.
+ */
+export interface StackView {
+  /**
+   * Canopy, drone, capsule, transponder.
+   */
+  bodies: StackBodyView[];
+  /**
+   * Right and left main lines, the capsule's and the transponder's.
+   */
+  lines: StackLineView[];
+}
+/**
+ * One body.
+ */
+export interface StackBodyView {
+  /**
+   * Age of its attitude, s; `null` for a body placed by the rigging.
+   */
+  age_s: number | null;
+  /**
+   * Which.
+   */
+  body: StackBody;
+  /**
+   * Pitch, degrees.
+   */
+  pitch_deg: number;
+  /**
+   * Its centre of mass from the drone's, east/north/up, m.
+   *
+   * @minItems 3
+   * @maxItems 3
+   */
+  position_enu_m: [number, number, number];
+  /**
+   * Roll, degrees.
+   */
+  roll_deg: number;
+  /**
+   * Its size along its own x (forward), y (right), z (down) axes, m: the canopy's chord,
+   * span and arc height plus thickness; the other bodies' boxes.
+   *
+   * @minItems 3
+   * @maxItems 3
+   */
+  size_m: [number, number, number];
+  /**
+   * Where its attitude comes from.
+   */
+  source: BodySource;
+  /**
+   * Yaw (heading of its x axis), degrees.
+   */
+  yaw_deg: number;
+}
+/**
+ * One line between two attachment points.
+ */
+export interface StackLineView {
+  /**
+   * Its lower end, east/north/up, m.
+   *
+   * @minItems 3
+   * @maxItems 3
+   */
+  bottom_enu_m: [number, number, number];
+  /**
+   * Which.
+   */
+  line: StackLine;
+  /**
+   * Its upper end from the drone's centre of mass, east/north/up, m.
+   *
+   * @minItems 3
+   * @maxItems 3
+   */
+  top_enu_m: [number, number, number];
 }
 /**
  * What the drone reports about itself.

@@ -23,6 +23,7 @@ function state(stage: FlightStage, extra: Partial<State> = {}): State {
     },
     prediction: { planned: { ...at(10, 5), time_to_land_s: 100, semi_major_m: 50, semi_minor_m: 20, major_axis_deg: 0 }, uncontrolled: { ...at(900, 1200), time_to_land_s: 90, semi_major_m: 150, semi_minor_m: 100, major_axis_deg: 30 }, age_s: 0.5, stale: false },
     footprint: null,
+    stack: null,
     flight_path: null,
     keep_out_alarms: [],
     forecast_wind: [],

@@ -23,6 +23,20 @@ const STATE = {
   estimate: { lat_deg: 38.53, lon_deg: -7.88, alt_msl_m: 812.4, height_m: 567.4, velocity_ned_mps: [5.1, -1.2, 2.9], ground_speed_mps: 5.3, course_deg: -12.0,
     heading_deg: -10.5, heading_rate_dps: 2.1, airspeed_mps: 6.7, sink_rate_mps: 2.95, glide_ratio_air: 2.04, glide_ratio_ground: 1.8,
     wind_ned_mps: [-1.2, 0.4, 0.0], wind_speed_mps: 1.26, wind_from_deg: 341.6, wind_sigma_mps: 0.15, position_sigma_m: 1.8, gps_ok: true, age_s: 0.05, stale: false },
+  stack: {
+    bodies: [
+      { body: "canopy", roll_deg: -8.1, pitch_deg: -6.0, yaw_deg: 141.0, position_enu_m: [-0.3, 0.2, 3.3], size_m: [0.9, 3.3, 0.82], source: "measured", age_s: 0.3 },
+      { body: "drone", roll_deg: -12.0, pitch_deg: -3.1, yaw_deg: 141.2, position_enu_m: [0, 0, 0], size_m: [0.365, 0.155, 0.34], source: "measured", age_s: 0.05 },
+      { body: "capsule", roll_deg: 0, pitch_deg: 0, yaw_deg: 141.2, position_enu_m: [0.03, -0.04, -3.15], size_m: [0.41, 0.41, 0.315], source: "rigging", age_s: null },
+      { body: "transponder", roll_deg: 0, pitch_deg: 0, yaw_deg: 141.2, position_enu_m: [0.03, -0.04, -8.15], size_m: [0.32, 0.32, 0.158], source: "rigging", age_s: null },
+    ],
+    lines: [
+      { line: "main_right", top_enu_m: [0.5, 0.6, 2.7], bottom_enu_m: [0.01, 0.02, 0.18] },
+      { line: "main_left", top_enu_m: [-0.9, -0.5, 2.7], bottom_enu_m: [-0.02, -0.03, 0.18] },
+      { line: "capsule", top_enu_m: [0.03, -0.04, -0.15], bottom_enu_m: [0.03, -0.04, -3.15] },
+      { line: "transponder", top_enu_m: [0.03, -0.04, -3.15], bottom_enu_m: [0.03, -0.04, -8.15] },
+    ],
+  },
   guidance: { mode: "spiral_landing", phase: "branch2", target: { lat_deg: 38.5333, lon_deg: -7.8889, alt_msl_m: 245 }, target_source: "drone_plan",
     localizer: { point: [38.5333, -7.8889], course_deg: 80.0, glide_slope: 0.3 },
     pattern: { corners: [[38.531, -7.889], [38.532, -7.887], [38.534, -7.888], [38.533, -7.890]], final_entry: [38.531, -7.889], final_course_deg: 161.6,

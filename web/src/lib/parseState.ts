@@ -4,6 +4,7 @@
 import { parseReadiness } from "./readiness";
 import { parseFlightPath } from "./flightPath";
 import { zonesOf } from "./zones";
+import { parseStack } from "./stack";
 import type {
   Estimate,
   FlightMode,
@@ -339,6 +340,7 @@ export function parseState(v: Obj): Parsed<State> {
     link: parseLink(obj(v, "link")),
     vehicle: sub(v, "vehicle", parseVehicle),
     estimate: sub(v, "estimate", parseEstimate),
+    stack: sub(v, "stack", parseStack),
     guidance: sub(v, "guidance", parseGuidance),
     prediction: sub(v, "prediction", parsePrediction),
     footprint: sub(v, "footprint", parseFootprint),

@@ -122,8 +122,9 @@ export type Readiness = Omit<Wire.ReadinessView, "checks" | "checklist_error"> &
 
 export type State = Omit<
   Lenient<Wire.StateMsg, "type" | "time_s" | "link" | "forecast_wind" | "mission">,
-  "link" | "vehicle" | "guidance" | "prediction" | "forecast_wind" | "recording" | "replay" | "footprint" | "keep_out_alarms" | "flight_path" | "mission" | "readiness"
+  "link" | "vehicle" | "guidance" | "prediction" | "forecast_wind" | "recording" | "replay" | "footprint" | "keep_out_alarms" | "flight_path" | "mission" | "readiness" | "stack"
 > & {
+  stack: Stack | null;
   mission: Mission;
   readiness: Readiness;
   recording: Recording | null;
@@ -137,6 +138,31 @@ export type State = Omit<
   keep_out_alarms: KeepOutAlarm[];
   forecast_wind: ForecastWind[];
 };
+
+/** One body of the stack as the 3-D view draws it (`state.stack`, lib/stack.ts parses it). */
+export interface StackBody {
+  body: Wire.StackBody;
+  roll_deg: number;
+  pitch_deg: number;
+  yaw_deg: number;
+  /** From the drone's centre of mass, east/north/up, m. */
+  position_enu_m: Vec3;
+  /** Along its own forward, right, down axes, m. */
+  size_m: Vec3;
+  source: Wire.BodySource;
+  age_s: N;
+}
+/** A line of the rigging between two attachment points, east/north/up from the drone, m. */
+export interface StackLine {
+  line: Wire.StackLine;
+  top_enu_m: Vec3;
+  bottom_enu_m: Vec3;
+}
+/** The four bodies (canopy, drone, capsule, transponder) and their lines. */
+export interface Stack {
+  bodies: StackBody[];
+  lines: StackLine[];
+}
 
 /** `state.flight_path` as the page reads it (flightPath.ts parses and summarises it). */
 /** A point of the path: where, how high and in how long. */

@@ -168,6 +168,7 @@ function build(session: Session): void {
           break;
         case "keep_out":
           map.setZones(m);
+          view3d.setZones(m);
           break;
         case "lagged":
           // The station dropped messages for this page: say so rather than show a silent gap.
@@ -397,6 +398,7 @@ function build(session: Session): void {
         const k = isObj(r) ? parseKeepOut(r) : null;
         if (!k?.ok) return;
         map.setZones(k.value);
+        view3d.setZones(k.value);
         if (k.value.load_error) localEvent("error", `keep-out zones NOT loaded: ${k.value.load_error}`);
       },
       (e: unknown) => localEvent("warning", `keep-out zones not loaded: ${e instanceof Error ? e.message : String(e)}`),

@@ -2,7 +2,7 @@
 //! heartbeat timer, the peer's liveness and the statistics ([`LinkStats`]). The ground and
 //! vehicle endpoints each own one and add their protocols on top.
 
-use std::collections::{HashMap, VecDeque};
+use std::collections::{BTreeMap, HashMap, VecDeque};
 use std::time::Duration;
 
 use mavlink::Message;
@@ -12,6 +12,7 @@ use super::senders::{SenderStats, SenderTable, account_sender, loss_pct};
 use super::stats::LinkStats;
 use crate::frame::{
     DecoderPolicy, DecoderStats, Frame, FrameDecoder, FrameEncoder, FrameError, FrameHeader,
+    FrameIds, encode_frame_into,
 };
 use crate::paths::{Deduplicator, PathStats, RadioPath, signature_failures, transmit_path};
 use crate::signing::SigningConfig;
@@ -100,6 +101,9 @@ pub(super) struct LinkCore {
     paths: Vec<RadioPath>,
     copies: Deduplicator,
     encoder: FrameEncoder,
+    /// Sequence of each other component of our system that speaks through this link (a
+    /// body's IMU): MAVLink counts sequences per component, and a receiver counts gaps so.
+    other_sequences: HashMap<u8, u8>,
     pub(super) out: VecDeque<Vec<u8>>,
     pub(super) events: VecDeque<LinkEvent>,
     next_heartbeat: Duration,
@@ -108,7 +112,9 @@ pub(super) struct LinkCore {
     pub(super) connected: bool,
     arrivals: VecDeque<Duration>,
     senders: SenderTable,
-    last_by_kind: HashMap<u32, (&'static str, Duration)>,
+    /// Last arrival of each message kind from each component: a body IMU's ATTITUDE must not
+    /// keep the autopilot's fresh in the ages the operators watch.
+    last_by_kind: HashMap<(u8, u32), (&'static str, Duration)>,
     frames_out: u64,
     bytes_out: u64,
     /// The wire bytes of each frame accepted (checked, signature verified, not a copy from
@@ -141,6 +147,7 @@ impl LinkCore {
             paths,
             copies: Deduplicator::default(),
             encoder,
+            other_sequences: HashMap::new(),
             out: VecDeque::new(),
             events: VecDeque::new(),
             next_heartbeat: now,
@@ -213,6 +220,26 @@ impl LinkCore {
 
     pub(super) fn send(&mut self, now: Duration, msg: &MavMessage) {
         let bytes = self.encoder.encode(now, msg);
+        self.frames_out += 1;
+        self.bytes_out += bytes.len() as u64;
+        self.out.push_back(bytes);
+        self.check_persist();
+    }
+
+    /// Sends `msg` as component `component_id` of our system (signed as our own frames are).
+    pub(super) fn send_from(&mut self, now: Duration, component_id: u8, msg: &MavMessage) {
+        if component_id == self.config.component_id {
+            return self.send(now, msg);
+        }
+        let sequence = self.other_sequences.entry(component_id).or_insert(0);
+        let ids = FrameIds {
+            system_id: self.config.system_id,
+            component_id,
+            sequence: *sequence,
+        };
+        *sequence = sequence.wrapping_add(1);
+        let mut bytes = Vec::with_capacity(64);
+        encode_frame_into(now, msg, ids, self.encoder.signer_mut(), &mut bytes);
         self.frames_out += 1;
         self.bytes_out += bytes.len() as u64;
         self.out.push_back(bytes);
@@ -326,8 +353,28 @@ impl LinkCore {
         self.arrivals.push_back(now);
         self.prune_arrivals(now);
         self.last_by_kind
-            .insert(h.message_id, (msg.message_name(), now));
+            .insert((h.component_id, h.message_id), (msg.message_name(), now));
         account_sender(&mut self.senders, h);
+    }
+
+    /// Seconds since the last message of each kind by name: the heartbeat peer's components
+    /// under the plain name, any other component's as `NAME@COMPONENT` (a body's own IMU).
+    /// Before a peer is heard every component goes under the plain name, freshest kept.
+    fn ages_by_name(&self, now: Duration) -> BTreeMap<String, f64> {
+        let main = self.peer.map(|p| p.1);
+        let mut ages = BTreeMap::new();
+        for ((component, _), (name, t)) in &self.last_by_kind {
+            let key = if main.is_none_or(|m| m == *component) {
+                (*name).to_string()
+            } else {
+                format!("{name}@{component}")
+            };
+            let age = now.saturating_sub(*t).as_secs_f64();
+            ages.entry(key)
+                .and_modify(|a: &mut f64| *a = a.min(age))
+                .or_insert(age);
+        }
+        ages
     }
 
     fn prune_arrivals(&mut self, now: Duration) {
@@ -471,11 +518,7 @@ impl LinkCore {
             bytes_discarded: d.bytes_discarded,
             packet_loss_pct,
             senders,
-            last_message_age_s: self
-                .last_by_kind
-                .values()
-                .map(|(name, t)| ((*name).to_string(), now.saturating_sub(*t).as_secs_f64()))
-                .collect(),
+            last_message_age_s: self.ages_by_name(now),
             decoder: d,
             duplicates_dropped,
             paths,

@@ -265,6 +265,13 @@ impl VehicleEndpoint {
         self.core.send(now, &telemetry.to_mavlink());
     }
 
+    /// Sends a telemetry item now as another component of the drone's system (a body's own
+    /// IMU, `stx_types::stack::BodyImu`).
+    pub fn send_telemetry_from(&mut self, now: Duration, component_id: u8, telemetry: &Telemetry) {
+        self.core
+            .send_from(now, component_id, &telemetry.to_mavlink());
+    }
+
     /// Sends a text of any length (split into STATUSTEXT chunks when over 50 bytes).
     pub fn send_status_text(&mut self, now: Duration, severity: Severity, text: &str) {
         let id = self.next_text_id;

@@ -3,6 +3,7 @@
 
 mod common;
 
+mod body_imu;
 mod datagram_source;
 mod decoder_props;
 mod endpoint;

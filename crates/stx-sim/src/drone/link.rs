@@ -293,6 +293,10 @@ impl LinkedDrone {
                     }
                     self.endpoint.send_telemetry(link_now, &t);
                 }
+                Output::Body { body, telemetry } => {
+                    self.endpoint
+                        .send_telemetry_from(link_now, body.component_id(), &telemetry);
+                }
                 Output::Text { severity, text } => {
                     self.endpoint.send_status_text(link_now, severity, &text);
                     self.event(DroneEvent::Text {

@@ -79,6 +79,7 @@ use stx_gnc::measurement::{AirDataSample, AttitudeSample};
 use stx_gnc::mission::{FlightMode, FlightStage};
 use stx_link::param::{ParamSpec, ParamTableError};
 use stx_link::telemetry::{Severity, SystemState, Telemetry, VehicleStatus};
+use stx_types::stack::BodyImu;
 
 use crate::closed_loop::{NavigationError, phase_name};
 use crate::guided::CONTROL_PERIOD_S;
@@ -127,6 +128,8 @@ pub enum Output {
     Telemetry(Telemetry),
     /// A text for the operator's log (STATUSTEXT, split by the link when long).
     Text { severity: Severity, text: String },
+    /// A telemetry message from another body's own IMU, sent as that body's component.
+    Body { body: BodyImu, telemetry: Telemetry },
 }
 
 /// The simulated drone.
@@ -161,6 +164,8 @@ pub struct Drone {
     texts_sent: u64,
     last_phase_text_s: Option<f64>,
     phase_texts_held: u32,
+    /// Mission time the body IMUs' next attitudes are due, s.
+    next_body_attitude_s: f64,
 }
 
 impl std::fmt::Debug for Drone {
@@ -243,6 +248,7 @@ impl Drone {
             texts_sent: 0,
             last_phase_text_s: None,
             phase_texts_held: 0,
+            next_body_attitude_s: 0.0,
             config,
         };
         drone.say(

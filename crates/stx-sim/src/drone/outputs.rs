@@ -4,14 +4,18 @@
 
 use nalgebra::Vector3;
 use stx_dynamics::atmosphere::StandardAtmosphere;
+use stx_dynamics::model::{Body, Kinematics};
+use stx_dynamics::rotation::euler_from_t;
+use stx_dynamics::state::idx;
 use stx_gnc::estimate::Estimate;
 use stx_gnc::measurement::Measurement;
 use stx_gnc::mission::{FlightMode, FlightStage};
 use stx_gnc::predict::{PredictorConfig, predict};
-use stx_link::telemetry::{GuidanceStatus, PredictedLanding, SystemStatus, Telemetry};
+use stx_link::telemetry::{Attitude, GuidanceStatus, PredictedLanding, SystemStatus, Telemetry};
+use stx_types::stack::{BODY_ATTITUDE_PERIOD_S, BodyImu};
 
-use super::Drone;
 use super::telemetry::{self, msg};
+use super::{Drone, Output};
 
 /// SYS_STATUS sensor bits (MAV_SYS_STATUS_SENSOR): magnetometer (the AHRS's heading),
 /// absolute and differential pressure, GPS, motor outputs (the servos), AHRS, battery.
@@ -58,7 +62,43 @@ impl Drone {
         }
     }
 
+    /// Each other body's attitude as its own IMU would report it (see
+    /// [`super::telemetry`]): the 14-DOF model's truth, every [`BODY_ATTITUDE_PERIOD_S`],
+    /// under the parafoil until touchdown. Before deployment the stack hangs as one swinging
+    /// mass in the simulator, so there is no other body's attitude to report.
+    fn body_attitudes(&mut self, t: f64) {
+        if t + 1e-6 < self.next_body_attitude_s || self.physics.touchdown().is_some() {
+            return;
+        }
+        let Some((_, x)) = self.physics.parafoil() else {
+            return;
+        };
+        self.next_body_attitude_s = t + BODY_ATTITUDE_PERIOD_S;
+        let k = Kinematics::new(self.physics.vehicle(), x, x[idx::MAIN_LINE]);
+        for body in BodyImu::ALL {
+            let i = match body {
+                BodyImu::Canopy => Body::Canopy,
+                BodyImu::Capsule => Body::Capsule,
+                BodyImu::Transponder => Body::Transponder,
+            } as usize;
+            let euler = euler_from_t(&k.t_i_body[i]);
+            let omega = k.omega_body[i];
+            let telemetry = Telemetry::Attitude(Attitude {
+                time_boot_ms: telemetry::boot_ms(t),
+                roll_rad: euler.x,
+                pitch_rad: euler.y,
+                yaw_rad: euler.z,
+                // A gyro measures the body rates.
+                roll_rate_radps: omega.x,
+                pitch_rate_radps: omega.y,
+                yaw_rate_radps: omega.z,
+            });
+            self.push(Output::Body { body, telemetry });
+        }
+    }
+
     pub(super) fn periodic_telemetry(&mut self, t: f64, stage: FlightStage) {
+        self.body_attitudes(t);
         let travel = self.physics.vehicle().main_line_travel_m;
         let est = self.estimate;
         // Messages asked for while the sensor-driven ones had nothing new.

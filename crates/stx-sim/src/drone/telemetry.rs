@@ -1,6 +1,7 @@
 //! What the drone tells the station, built from what the drone itself knows — its sensors'
 //! measurements, its estimate, its servo commands, its guidance — never from the simulator's
-//! truth, and scheduled on mission time.
+//! truth, and scheduled on mission time. The one exception is the other bodies' IMUs (last
+//! row): sensors of their own, modelled as perfect, so their attitudes are the model's.
 //!
 //! | message | rate | content |
 //! |---|---|---|
@@ -10,6 +11,7 @@
 //! | WIND_COV, NAV_CONTROLLER_OUTPUT, SYS_STATUS, BATTERY_STATUS | 1 Hz | wind estimate, guidance state, health and battery |
 //! | POSITION_TARGET_GLOBAL_INT (predicted landing) | every `telemetry.prediction_period_s` (2 s) | see `Drone` |
 //! | STATUSTEXT | as they happen | stage changes, guidance phase changes with their reasons, failsafes, refusals |
+//! | ATTITUDE from components 200–202 (`stx_types::stack::BodyImu`) | 2 Hz under the parafoil, until touchdown | the canopy's, capsule's and transponder's attitudes and body rates, from the 14-DOF truth (what an IMU on each would report); not affected by the rate commands |
 //!
 //! Rates can be changed by MAV_CMD_SET_MESSAGE_INTERVAL (intervals of at least one control
 //! period, 0.25 s; −1 stops a message, 0 restores its rate) and a message asked for by

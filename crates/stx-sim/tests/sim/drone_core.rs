@@ -40,6 +40,8 @@ impl Log {
             match o {
                 Output::Text { text, .. } => self.texts.push((t, text)),
                 Output::Telemetry(m) => self.telemetry.push((t, m)),
+                // The other bodies' IMUs: their own stream (body_imus.rs).
+                Output::Body { .. } => {}
             }
         }
     }

@@ -18,6 +18,7 @@ use stx_link::plan::{PlanEvent, PlanItem};
 use stx_link::telemetry::{Actuators, Telemetry, VehicleStatus};
 use stx_sim::drone::link::{DroneEvent, LinkedDrone};
 use stx_sim::drone::{BalloonEnd, Drone, MissionConfig};
+use stx_types::stack::BodyImu;
 
 /// A linked drone and a ground endpoint exchanging every frame at once.
 struct Bench {
@@ -283,17 +284,19 @@ fn the_station_sees_every_stage_of_mission_short_in_order_and_the_landing_on_the
 fn heartbeats_come_at_1_hz_of_link_time_and_sensors_at_4_hz_of_mission_time() {
     let mut bench = Bench::new("rehearsal", |_| {});
     bench.run_for(30.0);
-    let count = |name: &str| {
+    // Per second, from component `component` of the drone's system (1: the autopilot).
+    let count_from = |component: u8, name: &str| {
         bench
             .ground_events
             .iter()
             .filter(|(t, e)| {
                 *t > 10.0
-                    && matches!(e, GroundEvent::Telemetry { telemetry, .. } if telemetry.message_name() == name)
+                    && matches!(e, GroundEvent::Telemetry { from: (1, c), telemetry } if *c == component && telemetry.message_name() == name)
             })
             .count() as f64
             / (bench.time_s() - 10.0)
     };
+    let count = |name: &str| count_from(1, name);
     // One heartbeat a second, plus one at each change of guidance phase.
     assert!(
         (1.0..1.5).contains(&count("HEARTBEAT")),
@@ -307,6 +310,11 @@ fn heartbeats_come_at_1_hz_of_link_time_and_sensors_at_4_hz_of_mission_time() {
         "SERVO_OUTPUT_RAW",
     ] {
         assert!((count(name) - 4.0).abs() < 0.25, "{name}: {}", count(name));
+    }
+    // The other bodies' IMUs, each from its own component at 2 Hz of mission time.
+    for body in BodyImu::ALL {
+        let rate = count_from(body.component_id(), "ATTITUDE");
+        assert!((rate - 2.0).abs() < 0.15, "{body:?}: {rate}");
     }
     let now = bench.now();
     assert!(bench.ground.is_connected());

@@ -2,6 +2,7 @@
 //! link instead of thirteen, and the long campaigns run beside the short checks.
 //! `cargo test -p stx-sim --test sim seed_behaviour::` runs one file's tests.
 
+mod body_imus;
 mod campaign_regression;
 mod drone_core;
 mod drone_vehicle;

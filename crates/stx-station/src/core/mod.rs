@@ -40,6 +40,7 @@ mod phase_sync;
 mod readiness;
 mod replica;
 mod requests;
+mod stack;
 mod sync;
 pub(crate) mod views;
 
@@ -70,6 +71,7 @@ pub(crate) use navigation::{MAX_TRACK_POINTS, thin_track};
 pub use navigation::{PREDICTION_EVERY_S, Predicted, PredictionJob};
 pub use readiness::TickError;
 pub use requests::{ApiError, CommandRequest};
+pub use stack::BODY_MEASURED_WITHIN_S;
 pub use sync::TargetSource;
 
 /// Most events kept for the log.
@@ -179,6 +181,11 @@ pub struct StationCore {
     readiness: readiness::Readiness,
     /// The unsteered flight path from the balloon or the round chute.
     live_path: flight_path::LivePath,
+    /// The other bodies' own attitudes, as their IMUs report them.
+    pub(crate) body_attitudes: stack::BodyAttitudes,
+    /// The rigging that places the bodies around the drone (the shipped vehicle's, as the
+    /// main-line travel above).
+    pub(crate) rigging: stx_dynamics::vehicle::Vehicle,
 }
 
 impl StationCore {
@@ -221,6 +228,8 @@ impl StationCore {
             last_connected: None,
             replica_command: stx_dynamics::state::Controls::default(),
             main_line_travel_m: stx_dynamics::vehicle::Vehicle::straplex().main_line_travel_m,
+            body_attitudes: stack::BodyAttitudes::default(),
+            rigging: stx_dynamics::vehicle::Vehicle::straplex(),
             keep_out: keep_out::KeepOut::default(),
             fence: fence::FenceSync::default(),
             readiness: readiness::Readiness::default(),
@@ -358,7 +367,20 @@ impl StationCore {
     /// Handles one event of the ground endpoint.
     pub fn on_link_event(&mut self, now_s: f64, event: GroundEvent) {
         match event {
-            GroundEvent::Telemetry { telemetry, .. } => self.on_telemetry(now_s, telemetry),
+            // A body's own IMU speaks as its own component of the drone's system: its
+            // ATTITUDE is that body's, never the drone's (the estimator reads the drone's).
+            GroundEvent::Telemetry { from, telemetry } => {
+                match (
+                    stx_types::stack::BodyImu::from_component_id(from.1),
+                    telemetry,
+                ) {
+                    (Some(body), stx_link::telemetry::Telemetry::Attitude(a)) => {
+                        self.body_attitudes.heard(body, a, now_s);
+                    }
+                    (Some(_), _) => {}
+                    (None, telemetry) => self.on_telemetry(now_s, telemetry),
+                }
+            }
             GroundEvent::StatusText { severity, text, .. } => {
                 let level = match severity {
                     Severity::Emergency

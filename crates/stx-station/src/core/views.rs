@@ -273,6 +273,32 @@ impl StationCore {
             link,
             vehicle,
             estimate,
+            // On the ground the bodies lie where they fell, not where the rigging hangs them.
+            stack: self
+                .latest
+                .attitude
+                .filter(|_| {
+                    self.latest
+                        .status
+                        .is_none_or(|(st, _)| st.stage != FlightStage::Landed)
+                })
+                .map(|(a, at)| {
+                    let euler = nalgebra::Vector3::new(a.roll_rad, a.pitch_rad, a.yaw_rad);
+                    let canopy_out = self.latest.status.is_some_and(|(st, _)| {
+                        matches!(
+                            st.stage,
+                            FlightStage::ParafoilDeploy | FlightStage::Parafoil
+                        )
+                    });
+                    super::stack::stack_view(
+                        &self.rigging,
+                        euler,
+                        (now_s - at).max(0.0),
+                        &self.body_attitudes,
+                        now_s,
+                        canopy_out,
+                    )
+                }),
             guidance,
             prediction,
             footprint: self.footprint_view(now_s),

@@ -189,8 +189,13 @@ fn on_driver_event(shared: &Shared, event: DriverEvent<LinkReport>) -> bool {
     let mut core = shared.core();
     match event {
         DriverEvent::Endpoint(LinkReport::Event(e)) => {
-            let telemetry = if let GroundEvent::Telemetry { telemetry, .. } = &e {
-                shared.recording.telemetry(telemetry);
+            let telemetry = if let GroundEvent::Telemetry { from, telemetry } = &e {
+                // The telemetry topics are the drone's own (flight logs read the drone's
+                // attitude there); a body IMU's ATTITUDE stays in the recorded link bytes,
+                // which a re-run replay decodes again.
+                if stx_types::stack::BodyImu::from_component_id(from.1).is_none() {
+                    shared.recording.telemetry(telemetry);
+                }
                 true
             } else {
                 false
