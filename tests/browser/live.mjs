@@ -633,6 +633,7 @@ async function replay(rehearsalStation) {
       trackLastS: Number(map?.dataset.trackLastS), trackPoints: Number(map?.dataset.trackPoints),
       plotLastS: u ? Math.max(...Array.from(u.data[0])) : null, plotPoints: u ? u.data[0].length : 0,
       freshness: document.body.dataset.freshness, banner: document.querySelector('[data-testid="banner"]')?.hidden,
+      tail: u ? Array.from(u.data[0]).slice(-6) : null,
     };
   });
   const modeText = await text(page, "hdr-mode");
