@@ -1,4 +1,4 @@
-// Vite builds the pages (live dashboard, recovery, pre-flight plan and the Lab) into dist/, which the daemon serves.
+// Vite builds the pages (live dashboard, recovery, pre-flight plan, the Lab and a relay's public page) into dist/, which the daemon serves.
 // In development the dev server proxies the API, the KML feed and the tiles to a daemon
 // (`stx serve --sim` for a simulated drone, or `stx serve`) at STX_DAEMON (default http://127.0.0.1:8080).
 import { defineConfig } from "vitest/config";
@@ -21,6 +21,7 @@ export default defineConfig({
         recovery: here("./recovery.html"),
         plan: here("./plan.html"),
         lab: here("./lab.html"),
+        public: here("./public.html"),
       },
     },
   },

@@ -54,7 +54,7 @@ export function conform(where, name, value) {
     }
     return;
   }
-  const key = name === "ServerMessage" || name === "ClientMessage" ? `${name}:${value.type}` : name;
+  const key = ["ServerMessage", "ClientMessage", "RelayMessage"].includes(name) ? `${name}:${value.type}` : name;
   seen.set(key, (seen.get(key) ?? 0) + 1);
 }
 /** REST calls other test scripts add to the contract's map: `[method, path RegExp, request name or null, response name]`. */
@@ -92,7 +92,7 @@ function conformRest(where, method, path, status, request, body) {
   if (responseName === "CommandAccepted" && typeof body?.request_id === "string") lastRequestId = body.request_id;
 }
 /** Validates everything a browser context's pages exchange with the station. */
-export function watchContract(ctx, label) {
+export function watchContract(ctx, label, server = "ServerMessage") {
   const frames = (page) => page.on("websocket", (ws) => {
     if (!new URL(ws.url()).pathname.startsWith("/api/ws")) return;
     const json = (f, dir) => {
@@ -105,7 +105,7 @@ export function watchContract(ctx, label) {
     };
     ws.on("framereceived", (f) => {
       const m = json(f, "received");
-      if (m !== undefined) conform(`${label} WebSocket, station → page`, "ServerMessage", m);
+      if (m !== undefined) conform(`${label} WebSocket, station → page`, server, m);
     });
     ws.on("framesent", (f) => {
       const m = json(f, "sent");
@@ -138,9 +138,9 @@ export function watchContract(ctx, label) {
     ));
   });
 }
-export async function newContext(label, options) {
+export async function newContext(label, options, server = "ServerMessage") {
   const ctx = await browser.newContext(options);
-  watchContract(ctx, label);
+  watchContract(ctx, label, server);
   await watchPolicy(ctx, label);
   return ctx;
 }

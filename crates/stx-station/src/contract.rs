@@ -67,6 +67,17 @@ pub enum ServerMessage {
     KeepOut(KeepOutMsg),
 }
 
+// Only its schema is used, as for the station's.
+/// Every message a relay (`stx relay`) sends its viewers on its WebSocket, told apart by `type`.
+#[derive(JsonSchema)]
+#[schemars(untagged)]
+pub enum RelayMessage {
+    /// First on connecting.
+    History(crate::relay::public::PublicHistoryMsg),
+    /// Each new state.
+    State(crate::relay::public::PublicStateMsg),
+}
+
 /// Why the contract could not be assembled (a bug in the types, caught by the tests).
 #[derive(Debug, Error)]
 pub enum ContractError {
@@ -162,6 +173,8 @@ pub fn schema() -> Result<Value, ContractError> {
         sent.subschema_for::<LabRehearsalBody>(),
         sent.subschema_for::<ReadinessView>(),
         sent.subschema_for::<crate::forward::SharingBody>(),
+        sent.subschema_for::<RelayMessage>(),
+        sent.subschema_for::<crate::relay::public::RelayStatusBody>(),
     ];
     let read_messages = vec![
         read.subschema_for::<ClientMessage>(),

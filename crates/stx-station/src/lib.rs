@@ -24,7 +24,8 @@
 //!   stx-lab's); [`limits`]: requests per token, wrong tokens per address and pages at once,
 //!   as token buckets on the station's clock; [`preflight`]: the Plan page's pre-flight plans
 //!   (`POST /api/plan`); [`recording`]: what a flight's MCAP recording
-//!   holds, under which topics; [`replay`]: a recording played back through the station.
+//!   holds, under which topics; [`replay`]: a recording played back through the station;
+//!   [`relay`]: `stx relay`, the public picture for any audience (its server is the daemon's).
 //!
 //! With the default feature `daemon`, the adapters:
 //! - `http`: the axum routes (auth, REST, WebSocket, KML, static files);
@@ -57,6 +58,7 @@ pub mod preflight;
 #[cfg(feature = "daemon")]
 pub mod recorder;
 pub mod recording;
+pub mod relay;
 pub mod replay;
 pub mod replies;
 pub mod requests;

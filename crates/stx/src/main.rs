@@ -16,6 +16,7 @@ mod logging;
 mod montecarlo;
 mod plan;
 mod record;
+mod relay;
 mod replay;
 mod serve;
 mod sim;
@@ -65,6 +66,9 @@ enum Command {
     Import(import::ImportArgs),
     /// Play a recording through a station into the dashboard (pause, seek, speed; no commands).
     Replay(replay::ReplayArgs),
+    /// The public face of a station for any audience: its page, public state and KML, from one
+    /// connection upstream (a station or another relay), optionally delayed and coarsened.
+    Relay(relay::RelayArgs),
     /// Pre-flight plan: burst, deploy and landing regions and the target's reachability from a
     /// forecast (and an earlier recording's measured ascent wind).
     Plan(plan::PlanArgs),
@@ -98,7 +102,7 @@ fn main() -> ExitCode {
     // The benches run the station in their own process: as the daemon does.
     if matches!(
         cli.command,
-        Command::Serve(_) | Command::Replay(_) | Command::Bench(_)
+        Command::Serve(_) | Command::Replay(_) | Command::Relay(_) | Command::Bench(_)
     ) {
         large_buffers_back_to_the_system();
     }
@@ -114,6 +118,7 @@ fn main() -> ExitCode {
         Command::Export(args) => export::run(args),
         Command::Import(args) => import::run(args),
         Command::Replay(args) => replay::run(args),
+        Command::Relay(args) => relay::run(args),
         Command::Token(args) => token::run(args),
         Command::Plan(args) => plan::run(args),
         Command::Compare(args) => compare::run(args),

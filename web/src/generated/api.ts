@@ -29,6 +29,8 @@ export type StxStationAPI =
   | LabRehearsalBody
   | ReadinessView
   | SharingBody
+  | RelayMessage
+  | RelayStatusBody
   | ClientMessage
   | ModeBody
   | HeadingBody
@@ -394,6 +396,10 @@ export type LabResult =
        */
       vehicle_toml: string;
     };
+/**
+ * Every message a relay (`stx relay`) sends its viewers on its WebSocket, told apart by `type`.
+ */
+export type RelayMessage = PublicHistoryMsg | PublicStateMsg;
 /**
  * A message from the page on the WebSocket.
  */
@@ -3017,6 +3023,157 @@ export interface ForwardView {
    * Frames sent to the watcher.
    */
   out_passed: number;
+}
+/**
+ * A viewer's first message: the track so far.
+ */
+export interface PublicHistoryMsg {
+  /**
+   * The track, oldest first, a point a second at most.
+   */
+  track: PublicTrackPoint[];
+  /**
+   * Always `public_history`.
+   */
+  type: "public_history";
+}
+/**
+ * A point of the public track.
+ */
+export interface PublicTrackPoint {
+  /**
+   * Altitude above mean sea level, m.
+   */
+  alt_msl_m: number;
+  /**
+   * Latitude, degrees.
+   */
+  lat_deg: number;
+  /**
+   * Longitude, degrees.
+   */
+  lon_deg: number;
+  /**
+   * The mission clock, s.
+   */
+  mission_time_s: number;
+}
+/**
+ * The public state, sent to a relay's viewers at most four times a second.
+ */
+export interface PublicStateMsg {
+  /**
+   * Positions are rounded to a grid this coarse, m (0: as the station has them).
+   */
+  coarsen_m: number;
+  /**
+   * How long after the station this is shown, s (the relays' delays added up).
+   */
+  delay_s: number;
+  /**
+   * The predicted landing under the parafoil; `null` while there is none.
+   */
+  landing: PublicPoint | null;
+  /**
+   * The station hears the drone no more (what is shown is the last known).
+   */
+  link_stale: boolean;
+  /**
+   * The mission clock (the drone's, s since its boot); `null` before the drone is heard.
+   */
+  mission_time_s: number | null;
+  /**
+   * The payload; `null` before the first fix.
+   */
+  position: PublicPosition | null;
+  /**
+   * Mission stage (`ascent`, `descent`, `parafoil`, `landed`, …); `null` before the drone
+   * reports one.
+   */
+  stage: string | null;
+  /**
+   * The landing target; `null` while it is not known.
+   */
+  target: PublicPoint | null;
+  /**
+   * Always `public_state`.
+   */
+  type: "public_state";
+  /**
+   * Unix time the station sent it, ms (a delayed relay shows it that much later).
+   */
+  wall_ms: number;
+}
+/**
+ * A point on the map.
+ */
+export interface PublicPoint {
+  /**
+   * Latitude, degrees.
+   */
+  lat_deg: number;
+  /**
+   * Longitude, degrees.
+   */
+  lon_deg: number;
+}
+/**
+ * Where the payload is and how it moves.
+ */
+export interface PublicPosition {
+  /**
+   * Altitude above mean sea level, m.
+   */
+  alt_msl_m: number;
+  /**
+   * Vertical speed, m/s, positive up.
+   */
+  climb_mps: number;
+  /**
+   * Course over the ground, degrees clockwise from north.
+   */
+  course_deg: number;
+  /**
+   * Speed over the ground, m/s.
+   */
+  ground_speed_mps: number;
+  /**
+   * Latitude, degrees.
+   */
+  lat_deg: number;
+  /**
+   * Longitude, degrees.
+   */
+  lon_deg: number;
+}
+/**
+ * `GET /api/relay` on a relay: what it serves and how it is fed.
+ */
+export interface RelayStatusBody {
+  /**
+   * This relay's own grid, m.
+   */
+  coarsen_m: number;
+  /**
+   * This relay's own delay, s.
+   */
+  delay_s: number;
+  /**
+   * Most viewers this relay serves at once.
+   */
+  max_viewers: number;
+  /**
+   * The upstream's address, without its token.
+   */
+  upstream: string;
+  /**
+   * The upstream's WebSocket is open.
+   */
+  upstream_connected: boolean;
+  /**
+   * Viewers connected to this relay now.
+   */
+  viewers: number;
 }
 /**
  * `POST /api/commands/mode`.

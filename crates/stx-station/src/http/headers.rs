@@ -51,6 +51,14 @@ impl SecurityHeaders {
         }
     }
 
+    /// For a server with neither TLS nor online tiles (`stx relay`).
+    pub(crate) fn plain() -> Self {
+        Self {
+            socket_scheme: "ws",
+            tile_source: None,
+        }
+    }
+
     /// The policy for a page asked for under `host` (the request's `Host`, when it is one).
     pub(crate) fn policy(&self, host: Option<&str>) -> String {
         let tiles = self

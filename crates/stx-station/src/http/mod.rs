@@ -19,7 +19,7 @@
 
 mod auth;
 mod commands;
-mod headers;
+pub(crate) mod headers;
 mod keep_out;
 mod kml;
 mod lab;
