@@ -6,6 +6,9 @@
 // checked, with the points, ellipses, samples and region drawn on the map; the target's
 // reachability is shown (none at the launch site, far upwind; all at the centre of the reach
 // disc); a malformed box is named by the page, and a request the station refuses shows its reason.
+// A GFS GRIB2 file sent from the page (issue 31, item 1) fills the forecast with its wind over the
+// launch site (a file without HGT is refused, naming it), and the launch window over it (item 3)
+// is drawn as a strip whose times, shares, ranks and best marks are the station's own answer.
 // First the station's own defaults are planned as they come (a 35-km ascent whose wind spread
 // carries the samples tens of kilometres apart): the region steering reaches is drawn in green
 // with an area, the whole sample cloud is in view, every number has its unit, and the legend
@@ -13,11 +16,14 @@
 //
 // Usage: node tests/browser/plan.mjs [path/to/stx]   (default target/release/stx)
 
+import { readFile } from "node:fs/promises";
 import { join } from "node:path";
-import { OPERATOR, VIEWER, out, check, newContext, startStation, apiOf, until, text, attr, watchErrors, runFlights, registerRest, legendAgainstMap, checkLegend, rad } from "./harness.mjs";
+import { OPERATOR, VIEWER, root, out, check, newContext, startStation, apiOf, until, text, attr, watchErrors, runFlights, registerRest, legendAgainstMap, checkLegend, rad } from "./harness.mjs";
 
 registerRest("GET", /^\/api\/plan\/defaults$/, null, "PreflightDefaults");
 registerRest("POST", /^\/api\/plan$/, "PreflightBody", "PreflightReport");
+registerRest("POST", /^\/api\/plan\/forecast$/, null, "ForecastUploadReport");
+registerRest("POST", /^\/api\/plan\/window$/, "WindowBody", "WindowReport");
 
 const WIND = 10;
 const RATE = 5;
@@ -156,6 +162,8 @@ async function flight() {
   check("plan: the page shows the station's plan (the same landing as POST /api/plan)", (await text(page, "plan-landing")).includes(latLonText(l.lat_deg, l.lon_deg)), `${await text(page, "plan-landing")} vs ${l.lat_deg}, ${l.lon_deg}`);
   await page.screenshot({ path: join(out, "plan.png") });
 
+  await launchWindow(page, api, fill, box);
+
   // A box that is no number is named by the page; a rule the station enforces comes back as its reason.
   await fill({ ascent_rate_mps: "fast" });
   await page.locator('[data-testid="plan-submit"]').click();
@@ -168,4 +176,52 @@ async function flight() {
   await ctx.close();
 }
 
-await runFlights(flight, ["Session", "PreflightDefaults", "RecordingsBody", "PreflightReport", "ErrorBody"]);
+/** A GFS file from the page, then the launch window over it, against the station's own answers. */
+async function launchWindow(page, api, fill, box) {
+  const testdata = (name) => join(root, "crates/stx-weather/testdata", name);
+  const read = async (file) => {
+    await page.locator('[data-testid="plan-file"]').setInputFiles(testdata(file));
+    await page.locator('[data-testid="plan-file-read"]').click();
+    return until(() => text(page, "plan-file-status"), (t) => /GFS run|sounding|\d{3} /.test(t), 30000);
+  };
+  const refused = await read("no_hgt.grib2");
+  check("plan: a GRIB2 file without HGT is refused, naming what it lacks", /^400 bad_request: no HGT on isobaric levels/.test(refused), refused);
+  const said = await read("gfs_0p25_subset.grib2");
+  // The station's answer for the same file, asked directly.
+  const site = `lat=${await box("launch_lat_deg").inputValue()}&lon=${await box("launch_lon_deg").inputValue()}`;
+  const up = (await api(`/api/plan/forecast?${site}`, VIEWER, { method: "POST", body: await readFile(testdata("gfs_0p25_subset.grib2")), headers: { "content-type": "application/octet-stream" } })).body;
+  const shown = (await box("forecast").inputValue()).split("\n");
+  const line = (r) => [r.alt_msl_m, r.speed_mps, r.from_deg].join(",");
+  check("plan: the GFS file's wind over the launch site becomes the forecast rows (the station's answer for the file)",
+    up?.kind === "gfs" && up.rows.length === 11 && shown.length === 12 && up.rows.every((r, k) => shown[k + 1] === line(r)) && said.includes("GFS run 2026-11-30T06:00:00Z"),
+    `${said} | ${shown.slice(0, 3).join(" / ")}`);
+  const windowBoxes = { from: await page.locator('[data-testid="plan-window-from"]').inputValue(), to: await page.locator('[data-testid="plan-window-to"]').inputValue() };
+  check("plan: the window starts as the file's forecast hours", windowBoxes.from === "2026-11-30T06:00:00Z" && windowBoxes.to === "2026-11-30T12:00:00Z", JSON.stringify(windowBoxes));
+  await fill({ runs: 40, burst_altitude_msl_m: 20000, burst_altitude_sigma_m: 1000, default_wind_sigma_mps: 1.5, target_lat_deg: 38.37, target_lon_deg: -6.17 });
+  await page.locator('[data-testid="plan-window-every"]').fill("1.5");
+  const sent = page.waitForRequest((r) => r.url().endsWith("/api/plan/window"), { timeout: 30000 });
+  await page.locator('[data-testid="plan-window-submit"]').click();
+  const asked = (await sent).postDataJSON();
+  await until(() => text(page, "plan-window-status"), (t) => !/computing/.test(t), 120000);
+  // The same window asked of the API directly: the page must show the station's answer.
+  const report = (await api("/api/plan/window", VIEWER, { method: "POST", body: JSON.stringify(asked) })).body;
+  const strip = await page.locator('[data-testid="window-row"]').evaluateAll((els) => els.map((e) => ({
+    time: e.dataset.time, rank: Number(e.dataset.rank), share: Number(e.dataset.share), best: e.dataset.best === "true",
+    bar: e.querySelector(".plan-strip-bar").getBoundingClientRect().width / e.getBoundingClientRect().width, weight: getComputedStyle(e).fontWeight, text: e.innerText,
+  })));
+  const launches = report?.launches ?? [];
+  const mismatch = launches.map((l, k) => {
+    const r = strip[k];
+    const ok = r && r.time === l.launch_time && r.rank === l.rank && r.best === l.best && Math.abs(r.share - 100 * l.reach_share) < 1e-3
+      && Math.abs(r.bar - l.reach_share) < 0.02 && (r.best ? r.weight === "700" && r.text.includes("★") : !r.text.includes("★"));
+    return ok ? null : `${l.launch_time}: page ${JSON.stringify(r)} vs station rank ${l.rank}, share ${l.reach_share}, best ${l.best}`;
+  }).filter((m) => m !== null);
+  const uploadId = Number(await page.locator('[data-testid="plan-window-source"]').inputValue());
+  check("plan: the window strip shows every launch time with its share as a bar, rank and best mark, as the station answers the page's request",
+    asked.forecast?.upload === uploadId && launches.length === 5 && strip.length === 5 && mismatch.length === 0 && strip.filter((r) => r.best).length === 3
+      && new Set(launches.map((l) => l.reach_share)).size > 1,
+    `${strip.length} rows of ${launches.length}; ${mismatch.join("; ") || strip.map((r) => `${r.time.slice(11, 16)} ${r.share.toFixed(0)} % #${r.rank}${r.best ? "★" : ""}`).join(", ")}`);
+  await page.locator(".plan-result").screenshot({ path: join(out, "plan-window.png") });
+}
+
+await runFlights(flight, ["Session", "PreflightDefaults", "RecordingsBody", "PreflightReport", "ErrorBody", "ForecastUploadReport", "WindowReport"]);

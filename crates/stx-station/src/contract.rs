@@ -16,6 +16,7 @@ use serde_json::{Map, Value, json};
 use thiserror::Error;
 
 use crate::core::CutdownArm;
+use crate::forecast_upload::{ForecastUploadReport, WindowBody};
 use crate::keep_out::{KeepOutBody, KeepOutMsg};
 use crate::lab::LabJobBody;
 use crate::lab::bodies::{
@@ -23,6 +24,7 @@ use crate::lab::bodies::{
 };
 use crate::lab::jobs::LabStatusBody;
 use crate::lab::vehicle_fields::VehicleFieldsBody;
+use crate::launch_window::WindowReport;
 use crate::messages::{
     AscentWindMsg, CommandResultMsg, ErrorBody, EventMsg, ParamsMsg, ReadinessView, ReplayView,
     Session, StateMsg, TickBody,
@@ -36,6 +38,7 @@ use crate::requests::{
     ClientMessage, ConfirmBody, CourseBody, HeadingBody, LocalizerBody, ModeBody, ParamBody,
     PlanBody, ReplayBody, TargetBody,
 };
+use crate::tawhiri::{TawhiriAnswer, TawhiriErrorAnswer};
 
 /// Where the schema is committed, from the workspace root.
 pub const SCHEMA_PATH: &str = "web/src/generated/api.schema.json";
@@ -165,6 +168,10 @@ pub fn schema() -> Result<Value, ContractError> {
         sent.subschema_for::<KeepOutMsg>(),
         sent.subschema_for::<PreflightReport>(),
         sent.subschema_for::<PreflightDefaults>(),
+        sent.subschema_for::<ForecastUploadReport>(),
+        sent.subschema_for::<WindowReport>(),
+        sent.subschema_for::<TawhiriAnswer>(),
+        sent.subschema_for::<TawhiriErrorAnswer>(),
         sent.subschema_for::<LabStatusBody>(),
         sent.subschema_for::<LabStartedBody>(),
         sent.subschema_for::<VehicleFieldsBody>(),
@@ -189,6 +196,7 @@ pub fn schema() -> Result<Value, ContractError> {
         read.subschema_for::<ReplayBody>(),
         read.subschema_for::<KeepOutBody>(),
         read.subschema_for::<PreflightBody>(),
+        read.subschema_for::<WindowBody>(),
         read.subschema_for::<LabJobBody>(),
         read.subschema_for::<LabVehicleBody>(),
         read.subschema_for::<LabGainsBody>(),
@@ -233,7 +241,7 @@ pub fn schema() -> Result<Value, ContractError> {
     Ok(json!({
         "$schema": "http://json-schema.org/draft-07/schema#",
         "title": "stx station API",
-        "description": "Every message of the stx station's HTTP and WebSocket API (crates/stx-station/API.md), generated from the daemon's Rust types by `cargo run -p stx-station --example api_schema`: do not edit. The root is any one of them: on the WebSocket ServerMessage (station to page) and ClientMessage (page to station); over REST the bodies the station answers (Session, StateMsg, ParamsMsg, AscentWindMsg, EventsBody, TrackBody, ClientsBody, CommandResultMsg, CommandAccepted, CutdownArm, ErrorBody, ReplayView, RecordingsBody, ReplayOpened, KeepOutMsg, PreflightReport, PreflightDefaults, ReadinessView, SharingBody, the Lab's Lab*Body and VehicleFieldsBody) and the bodies of the commands (*Body).",
+        "description": "Every message of the stx station's HTTP and WebSocket API (crates/stx-station/API.md), generated from the daemon's Rust types by `cargo run -p stx-station --example api_schema`: do not edit. The root is any one of them: on the WebSocket ServerMessage (station to page) and ClientMessage (page to station); over REST the bodies the station answers (Session, StateMsg, ParamsMsg, AscentWindMsg, EventsBody, TrackBody, ClientsBody, CommandResultMsg, CommandAccepted, CutdownArm, ErrorBody, ReplayView, RecordingsBody, ReplayOpened, KeepOutMsg, PreflightReport, PreflightDefaults, ForecastUploadReport, WindowReport, TawhiriAnswer, TawhiriErrorAnswer, ReadinessView, SharingBody, the Lab's Lab*Body and VehicleFieldsBody) and the bodies of the commands (*Body).",
         "anyOf": messages,
         "definitions": definitions,
     }))

@@ -19,11 +19,14 @@
 //!   reads (parameter ranges, units and meanings come from the onboard catalogue,
 //!   `stx_gnc::params`, shared with the drone); [`contract`]: all of them as one JSON Schema,
 //!   the contract the dashboard's TypeScript types are generated from; [`forecast_file`]: a
-//!   GFS GRIB2 file or a sounding as forecast rows (`[forecast_file]`); [`kml`]: the Google
+//!   GFS GRIB2 file or a sounding as forecast rows (`[forecast_file]`), [`forecast_upload`]
+//!   the same sent from the Plan page; [`kml`]: the Google
 //!   Earth feed; [`keep_out`]: the keep-out zones' messages; [`lab`]: the Lab's jobs, requests and results (the work itself is
 //!   stx-lab's); [`limits`]: requests per token, wrong tokens per address and pages at once,
 //!   as token buckets on the station's clock; [`preflight`]: the Plan page's pre-flight plans
-//!   (`POST /api/plan`); [`recording`]: what a flight's MCAP recording
+//!   (`POST /api/plan`); [`launch_window`]: that plan for every launch time of a window over a
+//!   GFS forecast; [`tawhiri`]: Tawhiri's prediction API (`GET /api/v1/`) flown over the
+//!   station's forecast; [`recording`]: what a flight's MCAP recording
 //!   holds, under which topics; [`replay`]: a recording played back through the station;
 //!   [`relay`]: `stx relay`, the public picture for any audience (its server is the daemon's).
 //!
@@ -45,12 +48,14 @@ pub mod core;
 pub mod daemon;
 pub mod exposure;
 pub mod forecast_file;
+pub mod forecast_upload;
 pub mod forward;
 #[cfg(feature = "daemon")]
 pub mod http;
 pub mod keep_out;
 pub mod kml;
 pub mod lab;
+pub mod launch_window;
 pub mod limits;
 pub mod link;
 pub mod messages;
@@ -62,5 +67,6 @@ pub mod relay;
 pub mod replay;
 pub mod replies;
 pub mod requests;
+pub mod tawhiri;
 #[cfg(feature = "daemon")]
 pub mod tile_pack;

@@ -246,7 +246,7 @@ impl WindProfile {
     fn north_east_at(&self, altitude_m: f64) -> (f64, f64) {
         let table = &self.components;
         // Rows strictly below the altitude; for NaN this is 0 and the result is NaN below.
-        let above = table.partition_point(|&(a, _, _)| a < altitude_m);
+        let above = count_below(table.iter().map(|&(a, _, _)| a), altitude_m);
         if altitude_m.is_nan() {
             return (f64::NAN, f64::NAN);
         }
@@ -266,6 +266,14 @@ impl WindProfile {
             e0 * (1.0 - fraction) + e1 * fraction,
         )
     }
+}
+
+/// How many of the increasing `values` are below `x` (what `partition_point(|v| v < x)`
+/// gives on them), counted without branching: a profile's few dozen rows are compared faster
+/// than a binary search's unpredictable branches are taken, and the planner asks the wind at
+/// every step of every sample.
+pub fn count_below(values: impl Iterator<Item = f64>, x: f64) -> usize {
+    values.map(|v| usize::from(v < x)).sum()
 }
 
 impl WindField for WindProfile {

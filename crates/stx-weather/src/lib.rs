@@ -35,7 +35,7 @@ pub mod sounding;
 pub use gfs::{GfsError, GfsField};
 pub use height::{EARTH_RADIUS_M, geometric_height_m};
 pub use sounding::{Sounding, SoundingError};
-pub use time::OffsetDateTime;
+pub use time::{OffsetDateTime, UtcOffset};
 
 /// The wind at one height, from a forecast level or a sounding's line.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -5,6 +5,7 @@ stx's decoding with ecCodes' without Python.
 
     .venv/bin/python crates/stx-weather/testdata/make_fixtures.py             # the fixtures
     .venv/bin/python crates/stx-weather/testdata/make_fixtures.py --bench OUT # the benchmark's file
+    .venv/bin/python crates/stx-weather/testdata/make_fixtures.py --window-bench OUT # the window's
 
 The fields are made up but shaped like GFS: geopotential height near the standard atmosphere's
 at each pressure level, winds growing to a jet near 200 hPa, a little deterministic noise so the
@@ -157,26 +158,43 @@ def fixtures() -> None:
         json.dump(reads, f, indent=0)
 
 
-def bench(path: str) -> None:
-    """The benchmark's subset: 50 × 50 points at 0.25°, 31 levels, 20 forecast hours."""
-    gfs_levels_hpa = [
-        1000, 975, 950, 925, 900, 850, 800, 750, 700, 650, 600, 550, 500, 450, 400, 350, 300,
-        250, 200, 150, 100, 70, 50, 40, 30, 20, 15, 10, 7, 5, 3,
-    ]
+# GFS' isobaric levels from 1000 to 3 hPa.
+GFS_LEVELS_HPA = [
+    1000, 975, 950, 925, 900, 850, 800, 750, 700, 650, 600, 550, 500, 450, 400, 350, 300,
+    250, 200, 150, 100, 70, 50, 40, 30, 20, 15, 10, 7, 5, 3,
+]
+
+
+def gfs_subset(path: str, north: float, west: float, points: int, hours: list, seed: int) -> None:
+    """A 0.25° subset of `points` × `points` from `north`, `west`, on GFS' 31 levels, at
+    `hours`, in GFS' complex packing."""
     write(
         path,
-        lats=axis(50.0, -0.25, 50),
-        lons=axis(0.0, 0.25, 50),
-        levels_pa=[p * 100 for p in gfs_levels_hpa],
-        steps=list(range(0, 60, 3)),
+        lats=axis(north, -0.25, points),
+        lons=axis(west, 0.25, points),
+        levels_pa=[p * 100 for p in GFS_LEVELS_HPA],
+        steps=hours,
         names=["u", "v", "gh"],
         packing="grid_complex_spatial_differencing",
-        seed=4,
+        seed=seed,
     )
+
+
+def bench(path: str) -> None:
+    """The benchmark's subset: 50 × 50 points at 0.25°, 31 levels, 20 forecast hours."""
+    gfs_subset(path, 50.0, 0.0, 50, list(range(0, 60, 3)), seed=4)
+
+
+def window_bench(path: str) -> None:
+    """The launch window benchmark's subset: 20 × 20 points at 0.25°, 31 levels, forecast hours
+    0 to 75 every 3 (a 72-hour window and the hours around it)."""
+    gfs_subset(path, 46.0, 3.0, 20, list(range(0, 78, 3)), seed=5)
 
 
 if __name__ == "__main__":
     if sys.argv[1:2] == ["--bench"]:
         bench(sys.argv[2])
+    elif sys.argv[1:2] == ["--window-bench"]:
+        window_bench(sys.argv[2])
     else:
         fixtures()

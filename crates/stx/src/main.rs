@@ -15,6 +15,7 @@ mod inputs;
 mod logging;
 mod montecarlo;
 mod plan;
+mod plan_window;
 mod record;
 mod relay;
 mod replay;

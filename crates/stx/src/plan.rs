@@ -40,6 +40,20 @@ pub struct PlanArgs {
     /// their first forecast time.
     #[arg(long, value_name = "RFC3339", requires = "gfs", value_parser = parse_time)]
     launch_time: Option<stx_weather::OffsetDateTime>,
+    /// A launch window over the GFS files: the plan for every launch time from FROM to TO
+    /// (RFC 3339) every --every, printed as a table with the best times marked (needs
+    /// --target).
+    #[arg(
+        long,
+        value_name = "FROM..TO",
+        requires_all = ["gfs", "target"],
+        conflicts_with_all = ["launch_time", "from_recording"],
+        value_parser = crate::plan_window::parse_window
+    )]
+    window: Option<(String, String)>,
+    /// Between launch times of --window: 1h, 30m, 3h, 2h30m.
+    #[arg(long, value_name = "DURATION", default_value = "1h", requires = "window", value_parser = crate::plan_window::parse_every)]
+    every: u32,
     /// A radiosonde sounding as the University of Wyoming prints it (TEXT:LIST).
     #[arg(long, value_name = "FILE")]
     sounding: Option<PathBuf>,
@@ -111,6 +125,10 @@ pub fn run(args: PlanArgs) -> anyhow::Result<()> {
     let forecast = match &args.forecast {
         None if !args.gfs.is_empty() => {
             let field = forecast_file::read_gfs(&args.gfs).map_err(bad_input)?;
+            if let Some(window) = args.window.clone() {
+                let request = request_of(&args, Vec::new());
+                return crate::plan_window::run(&field, &request, window, args.every, args.json);
+            }
             let at = args.launch_time.unwrap_or_else(|| field.valid_times()[0]);
             let rows =
                 forecast_file::gfs_rows(&field, args.launch.lat_deg, args.launch.lon_deg, Some(at))
@@ -140,18 +158,7 @@ pub fn run(args: PlanArgs) -> anyhow::Result<()> {
         // clap requires --from-recording then, whose bands make the forecast.
         None => Vec::new(),
     };
-    let mut request = PlanRequest::new(args.launch, forecast);
-    request.ascent_rate_mps = args.ascent_rate;
-    request.ascent_rate_sigma_mps = args.ascent_rate_sigma;
-    request.burst_altitude_msl_m = args.burst_alt;
-    request.burst_altitude_sigma_m = args.burst_alt_sigma;
-    if let Some(h) = args.deploy_height {
-        request.deploy_height_m = h;
-    }
-    request.default_wind_sigma_mps = args.wind_sigma;
-    request.target_lat_lon_deg = args.target;
-    request.runs = args.runs;
-    request.seed = args.seed;
+    let request = request_of(&args, forecast);
     let recording = args
         .from_recording
         .as_ref()
@@ -218,6 +225,23 @@ pub fn run(args: PlanArgs) -> anyhow::Result<()> {
         );
     }
     Ok(())
+}
+
+/// The plan request of the flags, over `forecast`.
+fn request_of(args: &PlanArgs, forecast: Vec<stx_gnc::flight_path::ForecastRow>) -> PlanRequest {
+    let mut request = PlanRequest::new(args.launch, forecast);
+    request.ascent_rate_mps = args.ascent_rate;
+    request.ascent_rate_sigma_mps = args.ascent_rate_sigma;
+    request.burst_altitude_msl_m = args.burst_alt;
+    request.burst_altitude_sigma_m = args.burst_alt_sigma;
+    if let Some(h) = args.deploy_height {
+        request.deploy_height_m = h;
+    }
+    request.default_wind_sigma_mps = args.wind_sigma;
+    request.target_lat_lon_deg = args.target;
+    request.runs = args.runs;
+    request.seed = args.seed;
+    request
 }
 
 /// The recording's bands on stderr, each merged or refused with its reason.

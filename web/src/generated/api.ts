@@ -2,7 +2,7 @@
 // the daemon's Rust types by `cargo run -p stx-station --example api_schema`): do not edit.
 
 /**
- * Every message of the stx station's HTTP and WebSocket API (crates/stx-station/API.md), generated from the daemon's Rust types by `cargo run -p stx-station --example api_schema`: do not edit. The root is any one of them: on the WebSocket ServerMessage (station to page) and ClientMessage (page to station); over REST the bodies the station answers (Session, StateMsg, ParamsMsg, AscentWindMsg, EventsBody, TrackBody, ClientsBody, CommandResultMsg, CommandAccepted, CutdownArm, ErrorBody, ReplayView, RecordingsBody, ReplayOpened, KeepOutMsg, PreflightReport, PreflightDefaults, ReadinessView, SharingBody, the Lab's Lab*Body and VehicleFieldsBody) and the bodies of the commands (*Body).
+ * Every message of the stx station's HTTP and WebSocket API (crates/stx-station/API.md), generated from the daemon's Rust types by `cargo run -p stx-station --example api_schema`: do not edit. The root is any one of them: on the WebSocket ServerMessage (station to page) and ClientMessage (page to station); over REST the bodies the station answers (Session, StateMsg, ParamsMsg, AscentWindMsg, EventsBody, TrackBody, ClientsBody, CommandResultMsg, CommandAccepted, CutdownArm, ErrorBody, ReplayView, RecordingsBody, ReplayOpened, KeepOutMsg, PreflightReport, PreflightDefaults, ForecastUploadReport, WindowReport, TawhiriAnswer, TawhiriErrorAnswer, ReadinessView, SharingBody, the Lab's Lab*Body and VehicleFieldsBody) and the bodies of the commands (*Body).
  */
 export type StxStationAPI =
   | ServerMessage
@@ -21,6 +21,10 @@ export type StxStationAPI =
   | KeepOutMsg
   | PreflightReport
   | PreflightDefaults
+  | ForecastUploadReport
+  | WindowReport
+  | TawhiriAnswer
+  | TawhiriErrorAnswer
   | LabStatusBody
   | LabStartedBody
   | VehicleFieldsBody
@@ -43,6 +47,7 @@ export type StxStationAPI =
   | ReplayBody
   | KeepOutBody
   | PreflightBody
+  | WindowBody
   | LabJobBody
   | LabVehicleBody
   | LabGainsBody
@@ -470,6 +475,14 @@ export type PlanItemBody =
        * Longitude, degrees.
        */
       lon_deg: number;
+    };
+/**
+ * Which GFS forecast a window flies.
+ */
+export type WindowForecast =
+  | "configured"
+  | {
+      upload: number;
     };
 /**
  * What an operator asks the Lab to run (`POST /api/lab/jobs`).
@@ -2667,6 +2680,298 @@ export interface PreflightDefaults {
   target_source: string | null;
 }
 /**
+ * The answer to an upload.
+ */
+export interface ForecastUploadReport {
+  /**
+   * The instant the rows are taken at, RFC 3339; `null` for a sounding.
+   */
+  at: string | null;
+  /**
+   * A GFS file's run, RFC 3339; `null` for a sounding.
+   */
+  gfs_run: string | null;
+  /**
+   * The upload's id, for `POST /api/plan/window`.
+   */
+  id: number;
+  /**
+   * `gfs` or `sounding`.
+   */
+  kind: string;
+  /**
+   * The wind over the launch site, lowest first, to plan with.
+   */
+  rows: ForecastRow[];
+  /**
+   * A GFS file's forecast times, RFC 3339, earliest first; empty for a sounding.
+   */
+  valid_times: string[];
+}
+/**
+ * `POST /api/plan/window`'s answer and `stx plan --window --json`'s output.
+ */
+export interface WindowReport {
+  /**
+   * The forecast hours the files cover, first and last, RFC 3339.
+   *
+   * @minItems 2
+   * @maxItems 2
+   */
+  forecast_span: [string, string];
+  /**
+   * The GFS run the winds come from (its reference time), RFC 3339.
+   */
+  gfs_run: string;
+  /**
+   * Every launch time, earliest first.
+   */
+  launches: WindowLaunch[];
+  /**
+   * The request every launch flew (its `forecast` empty: each launch flies the GFS wind
+   * over the launch site at its own time).
+   */
+  request: PlanRequest;
+  /**
+   * The window asked for.
+   */
+  window: WindowTimes;
+}
+/**
+ * One launch time of the window.
+ */
+export interface WindowLaunch {
+  /**
+   * Whether it is among the [`BEST_MARKED`] best-ranked.
+   */
+  best: boolean;
+  /**
+   * Where the balloon bursts.
+   */
+  burst: WindowPoint;
+  /**
+   * Semi-major axis of the unsteered landing's 1-σ ellipse, m.
+   */
+  landing_sigma_m: number;
+  /**
+   * Where the parafoil lands unsteered.
+   */
+  landing_unsteered: WindowPoint;
+  /**
+   * The launch time, RFC 3339.
+   */
+  launch_time: string;
+  /**
+   * 1 for the best launch of the window, then 2, … (highest `reach_share` first, ties by
+   * the smaller `target_from_landing_m`, then the earlier time).
+   */
+  rank: number;
+  /**
+   * Fraction of the samples from whose deploy point steering reaches the target, 0…1.
+   */
+  reach_share: number;
+  /**
+   * Distance from the target to the mean unsteered landing, m.
+   */
+  target_from_landing_m: number;
+}
+/**
+ * A point of one launch's plan: the mean over its samples.
+ */
+export interface WindowPoint {
+  /**
+   * Altitude above mean sea level, m.
+   */
+  alt_msl_m: number;
+  /**
+   * Latitude, degrees north.
+   */
+  lat_deg: number;
+  /**
+   * Longitude, degrees east.
+   */
+  lon_deg: number;
+  /**
+   * Mean time after launch, s.
+   */
+  time_s: number;
+}
+/**
+ * The launch times of a window: from `from` to `to` (both RFC 3339, `to` included when the
+ * step lands on it) every `every_s` seconds.
+ */
+export interface WindowTimes {
+  /**
+   * Between launch times, s (≥ 60).
+   */
+  every_s: number;
+  /**
+   * The first launch time, RFC 3339.
+   */
+  from: string;
+  /**
+   * The last launch time at most, RFC 3339.
+   */
+  to: string;
+}
+/**
+ * The answer to a prediction.
+ */
+export interface TawhiriAnswer {
+  /**
+   * When the prediction started and completed.
+   */
+  metadata: TawhiriMetadata;
+  /**
+   * The stages, `ascent` then `descent`.
+   */
+  prediction: TawhiriStage[];
+  /**
+   * The request with its defaults filled in.
+   */
+  request: TawhiriRequest;
+  /**
+   * Warnings by name (Tawhiri's `altitude_too_high`; stx's `station_profile`), each with
+   * how many times it fired and what it means; empty: none.
+   */
+  warnings: {
+    [k: string]: TawhiriWarning | undefined;
+  };
+}
+/**
+ * Start and end of the computation, RFC 3339.
+ */
+export interface TawhiriMetadata {
+  /**
+   * When the answer was ready.
+   */
+  complete_datetime: string;
+  /**
+   * When the request arrived.
+   */
+  start_datetime: string;
+}
+/**
+ * One stage of the flight.
+ */
+export interface TawhiriStage {
+  /**
+   * `ascent` or `descent`.
+   */
+  stage: string;
+  /**
+   * Its points, in time order; a stage starts where the one before ended.
+   */
+  trajectory: TawhiriPoint[];
+}
+/**
+ * A point of a trajectory.
+ */
+export interface TawhiriPoint {
+  /**
+   * Altitude above mean sea level, m.
+   */
+  altitude: number;
+  /**
+   * When, RFC 3339.
+   */
+  datetime: string;
+  /**
+   * Latitude, degrees north.
+   */
+  latitude: number;
+  /**
+   * Longitude, degrees east, 0–360.
+   */
+  longitude: number;
+}
+/**
+ * The request as flown (Tawhiri's names and units).
+ */
+export interface TawhiriRequest {
+  /**
+   * Ascent rate, m/s.
+   */
+  ascent_rate: number;
+  /**
+   * Burst altitude above mean sea level, m.
+   */
+  burst_altitude: number;
+  /**
+   * The forecast flown: the GFS run's time (hour), or with forecast rows the launch's
+   * hour (the rows carry no time; `warnings.station_profile` says so).
+   */
+  dataset: string;
+  /**
+   * Descent rate at sea level, m/s.
+   */
+  descent_rate: number;
+  /**
+   * Launch altitude above mean sea level, m (given, or the station's launch site's).
+   */
+  launch_altitude: number;
+  /**
+   * Launch time, RFC 3339.
+   */
+  launch_datetime: string;
+  /**
+   * Launch latitude, degrees north.
+   */
+  launch_latitude: number;
+  /**
+   * Launch longitude, degrees east, 0–360.
+   */
+  launch_longitude: number;
+  /**
+   * `standard_profile`.
+   */
+  profile: string;
+  /**
+   * The API version, 1.
+   */
+  version: number;
+}
+/**
+ * A warning that fired.
+ */
+export interface TawhiriWarning {
+  /**
+   * How many times.
+   */
+  count: number;
+  /**
+   * What it means.
+   */
+  description: string;
+}
+/**
+ * An error answer: `{error: {type, description}, metadata}`.
+ */
+export interface TawhiriErrorAnswer {
+  /**
+   * What went wrong.
+   */
+  error: TawhiriErrorDetail;
+  /**
+   * When the request arrived and was answered.
+   */
+  metadata: TawhiriMetadata;
+}
+/**
+ * Tawhiri's error fragment.
+ */
+export interface TawhiriErrorDetail {
+  /**
+   * Why, in Tawhiri's words where it has them.
+   */
+  description: string;
+  /**
+   * `RequestException` (400), `InvalidDatasetException` (404), `PredictionException`
+   * (500) or `NotYetImplementedException` (501).
+   */
+  type: string;
+}
+/**
  * `GET /api/lab`: the Lab's state for every page.
  */
 export interface LabStatusBody {
@@ -3372,6 +3677,24 @@ export interface PlanRequestInput {
    * @maxItems 2
    */
   target_lat_lon_deg?: [number, number] | null;
+}
+/**
+ * `POST /api/plan/window`.
+ */
+export interface WindowBody {
+  /**
+   * The GFS forecast to fly.
+   */
+  forecast: WindowForecast;
+  /**
+   * What each launch plans (its `forecast` is ignored: each launch flies the GFS wind at
+   * its time); it needs a target.
+   */
+  request: PlanRequestInput;
+  /**
+   * The launch times.
+   */
+  window: WindowTimes;
 }
 /**
  * `POST /api/lab/vehicle/check`, `/save` and `POST /api/lab/rehearse`: a vehicle as edited.

@@ -47,6 +47,11 @@ export class Api {
     return this.request<T>("PUT", path, body);
   }
 
+  /** POST of a file's bytes as the raw body (a forecast file for the Plan page). */
+  upload<T = unknown>(path: string, bytes: Blob): Promise<T> {
+    return this.request<T>("POST", path, bytes, true);
+  }
+
   /** POST of a command: resolves to the request id of the 202. */
   async command<P extends CommandPath>(path: P, body: CommandBodies[P]): Promise<string> {
     const r = await this.post(path, body);
@@ -54,13 +59,14 @@ export class Api {
     throw new ApiError(200, "bad_response", "no request_id in the station's answer");
   }
 
-  private async request<T>(method: string, path: string, body?: unknown): Promise<T> {
+  private async request<T>(method: string, path: string, body?: unknown, raw = false): Promise<T> {
     const headers: Record<string, string> = { Accept: "application/json" };
     if (this.token !== null) headers.Authorization = `Bearer ${this.token}`;
-    if (body !== undefined) headers["Content-Type"] = "application/json";
+    if (body !== undefined) headers["Content-Type"] = raw ? "application/octet-stream" : "application/json";
+    const payload = body === undefined ? null : raw ? (body as Blob) : JSON.stringify(body);
     let res: Response;
     try {
-      res = await this.fetchFn(path, { method, headers, body: body === undefined ? null : JSON.stringify(body), cache: "no-store" });
+      res = await this.fetchFn(path, { method, headers, body: payload, cache: "no-store" });
     } catch (e) {
       throw new ApiError(0, "network", `station unreachable (${e instanceof Error ? e.message : String(e)})`);
     }

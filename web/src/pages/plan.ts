@@ -5,7 +5,10 @@
 // landing points with their 1-σ ellipses on the station's map, the unsteered landings, the region
 // steering likely reaches and the target's reachability, and with a recording the wind bands its
 // ascent measured, each merged into the forecast or refused with the reason. Errors, the page's or the station's,
-// are shown beside the form.
+// are shown beside the form. A forecast file (GFS GRIB2 or a Wyoming sounding) sent to the
+// station (`POST /api/plan/forecast`) becomes the forecast rows over the launch site; over it or
+// the station's configured GFS file the launch window (`POST /api/plan/window`) plans every
+// launch time and shows them as a strip, the best marked ★.
 
 import "../styles/common.css";
 import "../styles/plan.css";
@@ -13,7 +16,8 @@ import type * as Wire from "../generated/api";
 import { Api, ApiError } from "../lib/api";
 import { fmtLatLon } from "../lib/format";
 import { parseSession } from "../lib/parse";
-import { type PlanForm, buildRequest, formOf, measuredLines } from "../lib/preflight";
+import { buildWindow, stripRows } from "../lib/launchWindow";
+import { type PlanForm, buildRequest, forecastText, formOf, measuredLines } from "../lib/preflight";
 import { resolveToken, searchWithoutToken } from "../lib/token";
 import { h, setText } from "../ui/dom";
 import { PreflightMap } from "../ui/preflightMap";
@@ -49,16 +53,42 @@ const submit = h("button", { type: "submit", "data-testid": "plan-submit" }, "Pl
 const error = h("div", { class: "plan-error", role: "alert", "data-testid": "plan-error", hidden: true });
 const status = h("div", { class: "small muted wide", role: "status", "data-testid": "plan-status" });
 
+const fileBox = h("input", { type: "file", id: "plan-file", "data-testid": "plan-file", title: "a GFS GRIB2 file (pgrb2, or a NOMADS filter subset with UGRD, VGRD, HGT) or a University of Wyoming sounding (TEXT:LIST)" });
+const fileRead = h("button", { type: "button", "data-testid": "plan-file-read" }, "Use file as forecast");
+const fileStatus = h("div", { class: "small wide", role: "status", "data-testid": "plan-file-status" });
+const windowFrom = h("input", { type: "text", id: "plan-window-from", "data-testid": "plan-window-from", placeholder: "2026-11-30T06:00:00Z", title: "first launch time, UTC (RFC 3339)" });
+const windowTo = h("input", { type: "text", id: "plan-window-to", "data-testid": "plan-window-to", placeholder: "2026-12-03T06:00:00Z", title: "last launch time, UTC (RFC 3339)" });
+const windowEvery = h("input", { type: "text", inputmode: "decimal", id: "plan-window-every", "data-testid": "plan-window-every", value: "1", title: "hours between launch times" });
+const windowSource = h("select", { id: "plan-window-source", "data-testid": "plan-window-source" }, h("option", { value: "configured" }, "the station's GFS file"));
+const windowSubmit = h("button", { type: "button", "data-testid": "plan-window-submit" }, "Launch window");
+const windowStatus = h("div", { class: "small", role: "status", "data-testid": "plan-window-status" });
+const strip = h("section", { class: "plan-strip", "data-testid": "plan-window", hidden: true });
+
 const form = h("form", { class: "plan-form", "data-testid": "plan-form", novalidate: true });
 for (const [field, label, unit] of BOXES) form.append(h("label", { for: `plan-${field}`, "data-unit": unit ?? "" }, label, unit === null ? "" : h("span", { class: "unit" }, ` (${unit})`)), inputs.get(field)!);
 form.append(
   h("label", { for: "plan-forecast", class: "wide" }, "Forecast (alt_msl_m,speed_mps,from_deg[,sigma_mps]; from: where the wind blows from)"),
   forecastBox,
+  h("label", { for: "plan-file" }, "Forecast file"),
+  fileBox,
+  h("div", { class: "wide" }, fileRead),
+  fileStatus,
   h("label", { for: "plan-from_recording" }, "Measured ascent"),
   recordingBox,
   h("div", { class: "wide" }, submit),
   status,
   error,
+  h("strong", { class: "wide" }, "Launch window (GFS; the plan above at every launch time)"),
+  h("label", { for: "plan-window-from" }, "From", h("span", { class: "unit" }, " (UTC)")),
+  windowFrom,
+  h("label", { for: "plan-window-to" }, "To", h("span", { class: "unit" }, " (UTC)")),
+  windowTo,
+  h("label", { for: "plan-window-every" }, "Every", h("span", { class: "unit" }, " (h)")),
+  windowEvery,
+  h("label", { for: "plan-window-source" }, "Winds from"),
+  windowSource,
+  h("div", { class: "wide" }, windowSubmit),
+  windowStatus,
 );
 
 const out = {
@@ -75,7 +105,7 @@ const mapSlot = h("div", {});
 const app = document.getElementById("app")!;
 app.replaceChildren(
   h("header", {}, h("strong", {}, "STRAPLEX pre-flight plan"), h("a", { href: "index.html", class: "small" }, "live page")),
-  h("main", { class: "plan-main" }, form, h("div", { class: "plan-result" }, result, mapSlot)),
+  h("main", { class: "plan-main" }, form, h("div", { class: "plan-result" }, strip, result, mapSlot)),
 );
 
 let map: PreflightMap | null = null;
@@ -126,8 +156,7 @@ form.addEventListener("submit", (ev) => {
 });
 
 async function plan(): Promise<void> {
-  const values = Object.fromEntries([...inputs].map(([f, el]) => [f, el.value])) as unknown as PlanForm;
-  const built = buildRequest(values);
+  const built = buildRequest(formValues());
   if (!built.ok) {
     showError(built.error, built.field);
     return;
@@ -147,6 +176,88 @@ async function plan(): Promise<void> {
   } finally {
     submit.disabled = false;
   }
+}
+
+/** The form's values, as typed. */
+const formValues = (): PlanForm => Object.fromEntries([...inputs].map(([f, el]) => [f, el.value])) as unknown as PlanForm;
+
+fileRead.addEventListener("click", () => void readFile());
+
+/** Sends the chosen file to the station and takes its rows over the launch site as the forecast. */
+async function readFile(): Promise<void> {
+  const file = fileBox.files?.[0];
+  if (!file) {
+    setText(fileStatus, "choose a file first");
+    return;
+  }
+  const q = new URLSearchParams({ lat: inputs.get("launch_lat_deg")!.value.trim(), lon: inputs.get("launch_lon_deg")!.value.trim() });
+  const from = windowFrom.value.trim();
+  if (from !== "") q.set("time", from);
+  setText(fileStatus, `sending ${file.name} (${(file.size / 1e6).toFixed(1)} MB)…`);
+  fileRead.disabled = true;
+  try {
+    const up = await api.upload<Wire.ForecastUploadReport>(`/api/plan/forecast?${q}`, file);
+    forecastBox.value = forecastText(up.rows);
+    windowSource.querySelector("option[data-upload]")?.remove();
+    if (up.kind === "gfs") {
+      windowSource.prepend(h("option", { value: String(up.id), "data-upload": "" }, `${file.name} (upload ${up.id})`));
+      windowSource.value = String(up.id);
+      if (from === "") windowFrom.value = up.valid_times[0] ?? "";
+      if (windowTo.value.trim() === "") windowTo.value = up.valid_times[up.valid_times.length - 1] ?? "";
+    }
+    setText(fileStatus, up.kind === "gfs" ? `${file.name}: GFS run ${up.gfs_run}, the wind at ${up.at} over the launch site, ${up.rows.length} levels (forecast hours ${up.valid_times[0]} to ${up.valid_times[up.valid_times.length - 1]})` : `${file.name}: a sounding, ${up.rows.length} levels`);
+  } catch (e) {
+    setText(fileStatus, e instanceof ApiError ? `${e.status} ${e.error}: ${e.reason}` : String(e));
+  } finally {
+    fileRead.disabled = false;
+  }
+}
+
+windowSubmit.addEventListener("click", () => void planWindow());
+
+/** Plans every launch time of the window and shows the strip. */
+async function planWindow(): Promise<void> {
+  const built = buildRequest(formValues());
+  if (!built.ok) {
+    showError(built.error, built.field);
+    return;
+  }
+  const source: Wire.WindowForecast = windowSource.value === "configured" ? "configured" : { upload: Number(windowSource.value) };
+  const body = buildWindow(built.body.request, windowFrom.value, windowTo.value, windowEvery.value, source);
+  if (!body.ok) {
+    setText(windowStatus, body.error);
+    return;
+  }
+  windowSubmit.disabled = true;
+  setText(windowStatus, "computing…");
+  const started = performance.now();
+  try {
+    const report = await api.post<Wire.WindowReport>("/api/plan/window", body.body);
+    showStrip(report);
+    setText(windowStatus, `${report.launches.length} launch times × ${report.request.runs} samples in ${((performance.now() - started) / 1000).toFixed(1)} s (GFS run ${report.gfs_run})`);
+  } catch (e) {
+    setText(windowStatus, e instanceof ApiError ? `${e.status} ${e.error}: ${e.reason}` : String(e));
+  } finally {
+    windowSubmit.disabled = false;
+  }
+}
+
+function showStrip(report: Wire.WindowReport): void {
+  strip.replaceChildren(
+    h("div", { class: "line" }, "Launch times: the share of samples from which steering reaches the target (bar), the unsteered landing and the burst; ★ the best 3 (highest share, then the landing nearest the target)"),
+    ...stripRows(report).map((r) => {
+      const bar = h("span", { class: "plan-strip-bar" });
+      // Through the CSSOM: the station's Content-Security-Policy refuses style attributes.
+      bar.style.width = `${r.sharePct.toFixed(1)}%`;
+      return h(
+        "div",
+        { class: r.best ? "plan-strip-row best" : "plan-strip-row", "data-testid": "window-row", "data-time": r.time, "data-rank": String(r.rank), "data-share": r.sharePct.toFixed(3), "data-best": String(r.best) },
+        bar,
+        h("span", { class: "plan-strip-text" }, r.text),
+      );
+    }),
+  );
+  strip.hidden = false;
 }
 
 async function start(): Promise<void> {

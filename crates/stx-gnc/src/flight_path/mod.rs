@@ -345,10 +345,28 @@ pub fn propagate(
 fn rise_or_fall(
     air: Air<'_>,
     step_m: f64,
+    p: Vector3<f64>,
+    t: f64,
+    to_height_m: f64,
+    speed_mps: impl Fn(f64) -> f64,
+) -> (Vector3<f64>, f64) {
+    vertical_leg(air, step_m, p, t, to_height_m, speed_mps, |_, _| {})
+}
+
+/// [`propagate`]'s balloon ascent and round-chute fall as one leg, for callers that want the
+/// trajectory and not only its end (the station's Tawhiri API): from `p` (local NED, m) at
+/// time `t` (s) to `to_height_m` above the origin at the vertical speed
+/// `speed_mps(air density)`, drifting with the wind, in altitude steps of about `step_m` with
+/// the midpoint rule; `each_step` sees the position and time after every step. Returns the
+/// end.
+pub fn vertical_leg(
+    air: Air<'_>,
+    step_m: f64,
     mut p: Vector3<f64>,
     mut t: f64,
     to_height_m: f64,
     speed_mps: impl Fn(f64) -> f64,
+    mut each_step: impl FnMut(&Vector3<f64>, f64),
 ) -> (Vector3<f64>, f64) {
     let span_m = to_height_m + p.z;
     if span_m == 0.0 {
@@ -365,6 +383,7 @@ fn rise_or_fall(
         let w = air.wind(t + dt / 2.0, &mid);
         p += Vector3::new(w.x * dt, w.y * dt, -dh);
         t += dt;
+        each_step(&p, t);
     }
     (p, t)
 }

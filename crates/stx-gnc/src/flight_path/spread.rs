@@ -74,7 +74,7 @@ impl Dispersion {
 
     fn wind_sigma_at(&self, height_m: f64) -> f64 {
         let rows = &self.wind_sigma;
-        let above = rows.partition_point(|&(h, _)| h < height_m);
+        let above = stx_types::wind::count_below(rows.iter().map(|&(h, _)| h), height_m);
         match (above, rows.len()) {
             (_, 0) => 0.0,
             (0, _) => rows[0].1,

@@ -276,6 +276,8 @@ async fn run_with(
         replay_requests,
         keep_out_edit: Default::default(),
         planning: Default::default(),
+        uploads: Default::default(),
+        forecast_field: Default::default(),
         lab: Default::default(),
         rehearsal: Default::default(),
         forwards,

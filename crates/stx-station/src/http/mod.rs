@@ -7,6 +7,7 @@
 //! - `keep_out`: the keep-out zones, read by anyone, edited by operators;
 //! - `plan`: the Plan page's pre-flight plans, for anyone, one at a time, off the async
 //!   workers;
+//! - `tawhiri`: Tawhiri's prediction API (`/api/v1/`) over the station's forecast, for anyone;
 //! - `ws`: the WebSocket (state, events, command results; operators' sticks);
 //! - `kml`: the Google Earth feed; `replay`: the replay's pause, seek and speed;
 //! - `recordings`: the past recordings: list, download, open in a replay;
@@ -30,6 +31,7 @@ mod rehearse;
 mod replay;
 mod rest;
 mod shared;
+mod tawhiri;
 mod tiles;
 mod ws;
 
@@ -74,6 +76,15 @@ pub fn router(state: std::sync::Arc<Shared>) -> Router {
         )
         .route("/api/plan", post(plan::make_plan))
         .route("/api/plan/defaults", get(plan::plan_defaults))
+        .route(
+            "/api/plan/forecast",
+            post(plan::upload_forecast).layer(axum::extract::DefaultBodyLimit::max(
+                crate::forecast_upload::MAX_BYTES,
+            )),
+        )
+        .route("/api/plan/window", post(plan::plan_window))
+        .route("/api/v1/", get(tawhiri::prediction))
+        .route("/api/v1", get(tawhiri::prediction))
         .route("/api/readiness", get(readiness::board))
         .route("/api/readiness/{id}", post(readiness::tick))
         .route("/api/sharing", get(readiness::sharing))

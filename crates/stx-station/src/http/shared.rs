@@ -64,6 +64,12 @@ pub struct Shared {
     /// Held while a pre-flight plan is computed (up to a second of a core): one at a time,
     /// so pages cannot take the cores the link and the telemetry need.
     pub planning: Arc<tokio::sync::Mutex<()>>,
+    /// Forecast files the Plan page sent, for its launch windows.
+    pub uploads: Mutex<crate::forecast_upload::Uploads>,
+    /// The configured `[forecast_file] gfs` as a field, read at its first use (the launch
+    /// windows and the Tawhiri API fly it; the rows at start are only its launch-site
+    /// profile), or why it cannot be read.
+    pub forecast_field: std::sync::OnceLock<Result<Arc<stx_weather::GfsField>, String>>,
     /// The Lab, set once with stx-lab's jobs by the binary (`stx serve`, and `stx bench
     /// station` for its Lab load); unset, the Lab's endpoints answer that there is none.
     pub lab: std::sync::OnceLock<Arc<crate::lab::LabService>>,
@@ -186,6 +192,25 @@ impl Shared {
     /// The request limits, for a moment.
     pub fn limits(&self) -> std::sync::MutexGuard<'_, Limits> {
         self.limits.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    /// The uploads, for a moment.
+    pub fn uploads(&self) -> std::sync::MutexGuard<'_, crate::forecast_upload::Uploads> {
+        self.uploads.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    /// The configured GFS field (reads the files the first time: call it off the async
+    /// workers); `None` without `[forecast_file] gfs`.
+    pub fn configured_field(&self) -> Option<Result<Arc<stx_weather::GfsField>, String>> {
+        let files = &self.config.forecast_file.as_ref()?.gfs;
+        if files.is_empty() {
+            return None;
+        }
+        Some(
+            self.forecast_field
+                .get_or_init(|| crate::forecast_file::read_gfs(files).map(Arc::new))
+                .clone(),
+        )
     }
 
     /// The core, for a moment.

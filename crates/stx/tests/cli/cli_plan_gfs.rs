@@ -7,13 +7,13 @@ use std::process::{Command, Output};
 
 use crate::common::{get_value, serve, sigterm, stx, temp_dir};
 
-fn testdata(name: &str) -> PathBuf {
+pub(crate) fn testdata(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
         .join("../stx-weather/testdata")
         .join(name)
 }
 
-fn stx_plan(args: &[&str]) -> Output {
+pub(crate) fn stx_plan(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_stx"))
         .arg("plan")
         .args(["--runs", "20"])
@@ -22,7 +22,7 @@ fn stx_plan(args: &[&str]) -> Output {
         .expect("stx runs")
 }
 
-fn path(name: &str) -> String {
+pub(crate) fn path(name: &str) -> String {
     testdata(name).display().to_string()
 }
 
@@ -143,7 +143,7 @@ fn bad_gfs_files_and_times_exit_2_naming_what_is_missing() {
 }
 
 /// The shipped station config with its `[[forecast_wind]]` rows replaced by `table`.
-fn station_config(dir: &std::path::Path, table: &str) -> PathBuf {
+pub(crate) fn station_config(dir: &std::path::Path, table: &str) -> PathBuf {
     let shipped = std::fs::read_to_string(concat!(
         env!("CARGO_MANIFEST_DIR"),
         "/../../config/station.toml"

@@ -96,6 +96,43 @@ pub fn request_json(
     serde_json::from_str(text.split_once("\r\n\r\n")?.1).ok()
 }
 
+/// `method path` with `body` as `content_type` to the station at `http` with `token` (`None`:
+/// no `Authorization`): the status and the body as JSON (`null` if it is none).
+#[allow(dead_code)]
+pub fn exchange(
+    http: &str,
+    token: Option<&str>,
+    method: &str,
+    path: &str,
+    content_type: &str,
+    body: &[u8],
+) -> (u16, serde_json::Value) {
+    let mut s = TcpStream::connect(http).expect("connect");
+    s.set_read_timeout(Some(std::time::Duration::from_secs(60)))
+        .expect("timeout");
+    let auth = token.map_or(String::new(), |t| format!("Authorization: Bearer {t}\r\n"));
+    let head = format!(
+        "{method} {path} HTTP/1.1\r\nHost: {http}\r\n{auth}Content-Type: {content_type}\r\n\
+         Content-Length: {}\r\nConnection: close\r\n\r\n",
+        body.len()
+    );
+    s.write_all(head.as_bytes()).expect("write");
+    s.write_all(body).expect("write");
+    let mut answer = Vec::new();
+    s.read_to_end(&mut answer).expect("read");
+    let text = String::from_utf8_lossy(&answer);
+    let status = text
+        .split(' ')
+        .nth(1)
+        .and_then(|c| c.parse().ok())
+        .unwrap_or(0);
+    let json = text
+        .split_once("\r\n\r\n")
+        .and_then(|(_, b)| serde_json::from_str(b).ok())
+        .unwrap_or(serde_json::Value::Null);
+    (status, json)
+}
+
 /// `GET path` from the station at `address` with `token`: the whole HTTP response.
 pub fn get(address: &str, path: &str, token: &str) -> String {
     let mut stream = TcpStream::connect(address).expect("connect");
