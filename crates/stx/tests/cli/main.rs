@@ -29,3 +29,4 @@ mod hostile_link;
 mod http_abuse;
 mod identify_rehearsal;
 mod record_station;
+mod sondehub_upload;
