@@ -11,6 +11,8 @@ import type { LatLon } from "../lib/types";
 import { h, setText } from "./dom";
 
 const EVERY_MS = 10_000;
+/** A page opened without network asks again this often whether the station uploads. */
+const PROBE_EVERY_MS = 30_000;
 
 export class ChaseCarShare {
   readonly root: HTMLElement;
@@ -18,6 +20,8 @@ export class ChaseCarShare {
   private readonly status: HTMLElement;
   private position: LatLon | null = null;
   private lastSentMs = -Infinity;
+  private probedMs = -Infinity;
+  private known = false;
 
   constructor(private readonly api: Api) {
     this.box = h("input", { type: "checkbox", "data-testid": "rec-chase-share" });
@@ -32,10 +36,12 @@ export class ChaseCarShare {
 
   /** Asks the station whether it uploads to SondeHub; the box shows only if it does. */
   async probe(): Promise<void> {
+    this.probedMs = Date.now();
     try {
       const sharing: unknown = await this.api.get("/api/sharing");
       const s = isObj(sharing) ? parseSondehub(sharing.sondehub) : null;
       this.root.hidden = s === null;
+      this.known = true;
     } catch {
       // no network: asked again on the next probe
     }
@@ -46,8 +52,9 @@ export class ChaseCarShare {
     this.position = p;
   }
 
-  /** Sends the position when ticked and due. */
+  /** Sends the position when ticked and due (and asks again whether to show, until known). */
   async tick(): Promise<void> {
+    if (!this.known && Date.now() - this.probedMs >= PROBE_EVERY_MS) await this.probe();
     if (!this.box.checked) return;
     if (this.position === null) {
       setText(this.status, "waiting for the phone's GPS position");
