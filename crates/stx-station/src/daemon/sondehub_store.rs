@@ -87,3 +87,41 @@ impl Store {
         tokio::fs::rename(&tmp, self.dir.join(name)).await
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sondehub::{Queue, Sample};
+
+    #[tokio::test]
+    async fn a_line_cut_by_a_crash_is_skipped_and_what_follows_is_read_back() {
+        let dir = std::env::temp_dir().join(format!("stx-sondehub-store-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        let (store, found) = Store::open(&dir).await.expect("opens");
+        assert!(found.journal.is_empty() && found.mark == 0);
+        let mut q = Queue::new(10);
+        for i in 0..3 {
+            store.apply(q.push(Sample::bare(i))).await.expect("appends");
+        }
+        store.apply(q.done_through(1)).await.expect("marks");
+        // The station died in the middle of the next append.
+        std::fs::OpenOptions::new()
+            .append(true)
+            .open(dir.join(JOURNAL))
+            .and_then(|mut f| std::io::Write::write_all(&mut f, b"{\"seq\":4,\"fi"))
+            .expect("a cut line");
+        let (store, found) = Store::open(&dir).await.expect("reopens");
+        let (mut q, restored) = Queue::restore(10, found.journal.lines(), found.mark);
+        assert_eq!((restored.points, restored.unreadable), (2, 1));
+        store
+            .apply(q.push(Sample::bare(9)))
+            .await
+            .expect("appends after the cut");
+        let (_, found) = Store::open(&dir).await.expect("opens again");
+        let (q, restored) = Queue::restore(10, found.journal.lines(), found.mark);
+        assert_eq!((restored.points, restored.unreadable), (3, 1));
+        let fixes: Vec<u64> = q.head(5).map(|x| x.sample.fix_ms).collect();
+        assert_eq!(fixes, vec![1, 2, 9]);
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}
