@@ -6,10 +6,13 @@
 // made on purpose (a parameter changed away from the saved set, a plan made); an operator ticks
 // an item in the page and every page shows who; a viewer cannot; the launch comes with items open
 // and every page says which. Beside the board, what the station shares: a chase broadcast and a
-// MAVLink forward, each to a UDP socket of the test's own, shown as the station counts them.
+// MAVLink forward, each to a UDP socket of the test's own, shown as the station counts them, and
+// the SondeHub upload to the test server written from SondeHub's API
+// (tests/peers/sondehub_server.py), with a 202 carrying an error.
 //
 // Usage: node tests/browser/gonogo.mjs [path/to/stx]   (default target/release/stx)
 
+import { spawn } from "node:child_process";
 import { createSocket } from "node:dgram";
 import { mkdtemp, readFile, writeFile } from "node:fs/promises";
 import { tmpdir } from "node:os";
@@ -38,7 +41,24 @@ async function listener() {
   return { port: sock.address().port, heard, close: () => sock.close() };
 }
 
-async function setup(chasePort, forwardPort) {
+/** The SondeHub test server (Python's standard library only), on loopback. */
+async function sondehubServer() {
+  const proc = spawn("python3", [join(root, "tests/peers/sondehub_server.py")], { stdio: ["pipe", "pipe", "inherit"] });
+  let line = "";
+  await new Promise((resolve, reject) => {
+    proc.stdout.on("data", (d) => {
+      line += d;
+      if (line.includes("\n")) resolve();
+    });
+    proc.on("exit", () => reject(new Error("the SondeHub test server stopped")));
+  });
+  const ports = JSON.parse(line.split("\n")[0]);
+  const control = async (method, path, body) =>
+    (await fetch(`http://127.0.0.1:${ports.control}${path}`, { method, body: body === undefined ? undefined : JSON.stringify(body) })).json();
+  return { api: ports.api, received: () => control("GET", "/"), fault: (f) => control("POST", "/fault", f), close: () => proc.kill() };
+}
+
+async function setup(chasePort, forwardPort, sondehubPort) {
   const dir = await mkdtemp(join(tmpdir(), "stx-browser-gonogo-"));
   const params = join(dir, "flight-params.toml");
   await writeFile(params, `GN_HK1 = ${HK1}\n`);
@@ -46,7 +66,10 @@ async function setup(chasePort, forwardPort) {
   const withParams = toml.replace(/^checklist = .*$/m, (line) => `${line}\nparams_file = ${JSON.stringify(params)}`);
   if (withParams === toml) throw new Error("config/station.toml has no [readiness] checklist line");
   const station = `${withParams}\n[chase]\ncallsign = "GONOGO1"\naddress = "127.0.0.1"\nport = ${chasePort}\nperiod_s = 1.0\n`
-    + `\n[[forward]]\nname = "watcher"\naddress = "udpout:127.0.0.1:${forwardPort}"\n`;
+    + `\n[[forward]]\nname = "watcher"\naddress = "udpout:127.0.0.1:${forwardPort}"\n`
+    + `\n[sondehub]\nurl = "http://127.0.0.1:${sondehubPort}"\nuploader_callsign = "GONOGOTEST"\npayload_callsign = "GONOGO1"\n`
+    + `period_s = 2.0\nqueue_dir = ${JSON.stringify(join(dir, "sondehub"))}\n`
+    + `station_position = { lat_deg = 38.53, lon_deg = -7.89, alt_m = 245.0 }\n`;
   const stationFile = join(dir, "station.toml");
   await writeFile(stationFile, station);
   const scenario = (await readFile(join(root, "config/scenarios/mission-short.toml"), "utf8")).replace(/^launch_delay_s = .*$/m, `launch_delay_s = ${ON_PAD_S}.0`);
@@ -58,9 +81,10 @@ async function setup(chasePort, forwardPort) {
 async function flight() {
   const chaseEar = await listener();
   const forwardEar = await listener();
-  const { stationFile, scenarioFile } = await setup(chaseEar.port, forwardEar.port);
+  const sondehub = await sondehubServer();
+  const { stationFile, scenarioFile } = await setup(chaseEar.port, forwardEar.port, sondehub.api);
   const port = await freeUdpPort();
-  const { base } = await startStation(["--config", stationFile, "--link", `udpin:127.0.0.1:${port}`]);
+  const { base, io: stationIo } = await startStation(["--config", stationFile, "--link", `udpin:127.0.0.1:${port}`]);
   const api = apiOf(base);
   run(["drone", "--connect", `udpout:127.0.0.1:${port}`, "--scenario", scenarioFile, "--speed", String(SPEED)], "stx drone");
   const board = async () => (await api("/api/readiness", VIEWER)).body;
@@ -149,9 +173,48 @@ async function flight() {
     /watcher → udpout:127\.0\.0\.1:\d+ · read-only · /.test(forwardText) && f?.name === "watcher" && f.may_send_to_drone.length === 0
       && shownFrames > 0 && shownFrames <= f.out_passed && forwardEar.heard.length >= shownFrames,
     `page "${forwardText}"; station ${JSON.stringify(f)}; heard ${forwardEar.heard.length} datagrams`);
+  // SondeHub: what the page says was taken, against the API and what the test server holds.
+  await until(async () => (await api("/api/sharing", VIEWER)).body?.sondehub, (s) => s?.sent >= 2, 30000, 300);
+  await page.waitForFunction(() => /^[1-9]\d* points taken/.test(document.querySelector('[data-testid="sharing-sondehub-counts"]')?.textContent ?? ""), null, { timeout: 10000 }).catch(() => {});
+  const shText = await text(page, "sharing-sondehub");
+  const shCounts = await text(page, "sharing-sondehub-counts");
+  const shListeners = await text(page, "sharing-sondehub-listeners");
+  const shApi = (await api("/api/sharing", VIEWER)).body?.sondehub;
+  const taken = Number(/^(\d+) points taken/.exec(shCounts)?.[1] ?? NaN);
+  const held = (await sondehub.received()).points.filter((p) => p.software_name === "stx" && p.payload_callsign === "GONOGO1");
+  check("shared: the SondeHub upload is shown with its callsigns, its last upload and the points taken, as the test server holds them",
+    shText.startsWith(`GONOGO1 by GONOGOTEST to http://127.0.0.1:${sondehub.api} every 2 s: last upload`) && taken > 0 && taken <= shApi?.sent
+      && held.length >= taken && shApi?.failing === false && /station position uploaded/.test(shListeners),
+    `page "${shText}" / "${shCounts}" / "${shListeners}"; station ${JSON.stringify(shApi)}; server holds ${held.length}`);
+  await sondehub.fault({ reject_first: true, count: 1 });
+  await page.waitForFunction(() => /test fault: refused/.test(document.querySelector('[data-testid="sharing-sondehub-notes"]')?.textContent ?? ""), null, { timeout: 20000 }).catch(() => {});
+  const shNotes = await text(page, "sharing-sondehub-notes");
+  const shAfter = (await api("/api/sharing", VIEWER)).body?.sondehub;
+  check("shared: an error in SondeHub's 202 is on the page, in /api/sharing and in the station's log",
+    shNotes.includes("error: test fault: refused") && shAfter?.refused === 1 && shAfter.errors.some((e) => e.text.includes("test fault: refused"))
+      && stationIo.err.includes("test fault: refused"),
+    `page notes "${shNotes}"; station ${JSON.stringify(shAfter)}`);
+  // The recovery page, on a viewer's phone with a GPS position, shares it as a chase car once ticked.
+  const phoneAt = { latitude: 38.5412, longitude: -7.8801 };
+  const rctx = await newContext("gonogo recovery", { viewport: { width: 400, height: 800 }, geolocation: phoneAt, permissions: ["geolocation"] });
+  const phone = await rctx.newPage();
+  watchErrors(phone, "gonogo recovery");
+  await phone.goto(`${base}/recovery.html?token=${VIEWER}`);
+  await phone.locator('[data-testid="rec-chase-share"]').check({ timeout: 10000 }).catch(() => {});
+  const car = await until(async () => (await sondehub.received()).listeners.find((l) => l.mobile === true), (l) => l !== undefined, 20000, 300);
+  await phone.waitForFunction(() => /^shared as /.test(document.querySelector('[data-testid="rec-chase-status"]')?.textContent ?? ""), null, { timeout: 15000 }).catch(() => {});
+  const carStatus = await text(phone, "rec-chase-status");
+  await page.waitForFunction(() => /chase car GONOGOTEST_CHASE/.test(document.querySelector('[data-testid="sharing-sondehub-listeners"]')?.textContent ?? ""), null, { timeout: 10000 }).catch(() => {});
+  const carShown = await text(page, "sharing-sondehub-listeners");
+  check("shared: a recovery phone that ticks the box is a chase car on SondeHub at its GPS position, and the panel says so",
+    car?.uploader_callsign === "GONOGOTEST_CHASE" && Math.abs(car.uploader_position[0] - phoneAt.latitude) < 1e-6 && Math.abs(car.uploader_position[1] - phoneAt.longitude) < 1e-6
+      && /^shared as GONOGOTEST_CHASE/.test(carStatus) && carShown.includes("chase car GONOGOTEST_CHASE at 38.54120, -7.88010"),
+    `server ${JSON.stringify(car)}; phone "${carStatus}"; panel "${carShown}"`);
+  await rctx.close();
   await page.locator('[data-testid="panel-sharing"]').screenshot({ path: join(out, "gonogo-sharing.png") });
   chaseEar.close();
   forwardEar.close();
+  sondehub.close();
 
   // ---------------------------------------------------------------- the launch, with items open
   const atLaunch = await until(async () => (await api("/api/state")).body, (s) => s?.mission?.stage === "ascent", (ON_PAD_S / SPEED) * 1000 + 30000, 300);
@@ -169,4 +232,4 @@ async function flight() {
   await vctx.close();
 }
 
-await runFlights(flight, ["ReadinessView", "TickBody", "ServerMessage:state", "StateMsg", "ErrorBody", "SharingBody"]);
+await runFlights(flight, ["ReadinessView", "TickBody", "ServerMessage:state", "StateMsg", "ErrorBody", "SharingBody", "ChaseCarBody", "SondehubView"]);

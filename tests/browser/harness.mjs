@@ -78,6 +78,7 @@ function restNames(method, path, status) {
   if (path === "/api/replay") return [method === "POST" ? "ReplayBody" : null, "ReplayView"];
   if (method === "GET" && path === "/api/recordings") return [null, "RecordingsBody"];
   if (method === "POST" && /^\/api\/recordings\/[^/]+\/replay$/.test(path)) return [null, "ReplayOpened"];
+  if (method === "POST" && path === "/api/sondehub/chase") return ["ChaseCarBody", "SondehubView"];
   for (const [m, p, req, res] of extraRest) if (m === method && p.test(path)) return [req, res];
   return [null, null];
 }

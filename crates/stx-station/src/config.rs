@@ -242,6 +242,9 @@ pub struct StationConfig {
     /// The broadcast for chase cars' maps (`[chase]`, see [`crate::chase`]); off without it.
     #[serde(default)]
     pub chase: Option<crate::chase::settings::ChaseConfig>,
+    /// The upload to SondeHub-Amateur (`[sondehub]`, see [`crate::sondehub`]); off without it.
+    #[serde(default)]
+    pub sondehub: Option<crate::sondehub::SondehubConfig>,
     /// Test-only: loopback addresses treated as not loopback, from the environment's
     /// [`NOT_LOOPBACK_ENV`] (see [`crate::exposure`]); empty in the field.
     #[serde(skip)]
@@ -283,6 +286,9 @@ pub fn not_loopback_from_env(
         .map(|a| a.parse().map_err(|_| format!("`{a}` is not an IP address")))
         .collect()
 }
+
+/// Where the SondeHub queue waits in the state directory unless `sondehub.queue_dir` says.
+pub const SONDEHUB_QUEUE_DIR_NAME: &str = "sondehub";
 
 /// The shipped configuration: the simulated drone on loopback, demo tokens.
 pub const DEFAULT_STATION_TOML: &str = include_str!("../../../config/station.toml");
@@ -340,6 +346,12 @@ impl StationConfig {
             field: NOT_LOOPBACK_ENV.into(),
             rule,
         })?;
+        if let Some(sondehub) = self.sondehub.as_mut()
+            && sondehub.queue_dir.is_none()
+        {
+            sondehub.queue_dir = stx_link::signing::persist::default_state_dir(&env)
+                .map(|dir| dir.join(SONDEHUB_QUEUE_DIR_NAME));
+        }
         if self.recording.enabled && self.recording.dir.is_none() {
             self.recording.dir = stx_link::signing::persist::default_state_dir(&env)
                 .map(|dir| stx_record::file::recordings_dir(&dir));
@@ -381,6 +393,9 @@ impl StationConfig {
             return invalid(&field, &rule);
         }
         if let Some((field, rule)) = self.chase.as_ref().and_then(|c| c.invalid()) {
+            return invalid(field, rule);
+        }
+        if let Some((field, rule)) = self.sondehub.as_ref().and_then(|c| c.invalid()) {
             return invalid(field, rule);
         }
         let mut seen: HashMap<&str, usize> = HashMap::new();

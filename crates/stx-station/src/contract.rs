@@ -201,6 +201,7 @@ pub fn schema() -> Result<Value, ContractError> {
         read.subschema_for::<LabVehicleBody>(),
         read.subschema_for::<LabGainsBody>(),
         read.subschema_for::<TickBody>(),
+        read.subschema_for::<crate::sondehub::ChaseCarBody>(),
     ];
     let mut definitions: Map<String, Value> = sent.take_definitions(true);
     let read_definitions = read.take_definitions(true);

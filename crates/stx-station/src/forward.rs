@@ -117,13 +117,15 @@ pub struct ChaseView {
 }
 
 /// `GET /api/sharing`: what the station shares beyond its pages: the forwards, in the order
-/// of the configuration, and the chase cars' broadcast.
+/// of the configuration, the chase cars' broadcast and the SondeHub upload.
 #[derive(Debug, Clone, PartialEq, Serialize, schemars::JsonSchema)]
 pub struct SharingBody {
     /// The forwards; empty when the configuration has none.
     pub forwards: Vec<ForwardView>,
     /// The chase broadcast; `null` when it is off.
     pub chase: Option<ChaseView>,
+    /// The SondeHub-Amateur upload; `null` when it is off.
+    pub sondehub: Option<crate::sondehub::SondehubView>,
 }
 
 #[cfg(test)]

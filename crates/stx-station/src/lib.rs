@@ -7,7 +7,8 @@
 //!   lets through beyond this machine (rehearsal tokens on loopback only, plain HTTP only when
 //!   asked for); [`checklist`]: the go/no-go board's settings and files; [`forward`]: the
 //!   read-only MAVLink outputs for watching ground stations (their sockets are the daemon's);
-//!   [`chase`]: the Horus UDP summaries for chase cars' maps;
+//!   [`chase`]: the Horus UDP summaries for chase cars' maps; [`sondehub`]: the upload to
+//!   SondeHub-Amateur (points, queue, retries; its HTTP client is the daemon's);
 //! - [`core`]: the station's state and logic: telemetry, link events and operators' requests
 //!   in, with the mission clock; messages for the dashboards and link actions (with ids and
 //!   deadlines) out; the link's outcome of each action back in; retries and time-outs are its
@@ -67,6 +68,7 @@ pub mod relay;
 pub mod replay;
 pub mod replies;
 pub mod requests;
+pub mod sondehub;
 pub mod tawhiri;
 #[cfg(feature = "daemon")]
 pub mod tile_pack;

@@ -51,7 +51,8 @@ export type StxStationAPI =
   | LabJobBody
   | LabVehicleBody
   | LabGainsBody
-  | TickBody;
+  | TickBody
+  | ChaseCarBody;
 /**
  * Every message the station sends on the WebSocket, told apart by `type`.
  */
@@ -3247,7 +3248,7 @@ export interface LabSavedBody {
 }
 /**
  * `GET /api/sharing`: what the station shares beyond its pages: the forwards, in the order
- * of the configuration, and the chase cars' broadcast.
+ * of the configuration, the chase cars' broadcast and the SondeHub upload.
  */
 export interface SharingBody {
   /**
@@ -3258,6 +3259,10 @@ export interface SharingBody {
    * The forwards; empty when the configuration has none.
    */
   forwards: ForwardView[];
+  /**
+   * The SondeHub-Amateur upload; `null` when it is off.
+   */
+  sondehub: SondehubView | null;
 }
 /**
  * The chase cars' broadcast as the pages show it.
@@ -3328,6 +3333,130 @@ export interface ForwardView {
    * Frames sent to the watcher.
    */
   out_passed: number;
+}
+/**
+ * The SondeHub-Amateur upload as the pages show it.
+ */
+export interface SondehubView {
+  /**
+   * The chase car (a recovery phone's position); `null` before one was given.
+   */
+  chase_car: ChaseCarView | null;
+  /**
+   * Points dropped as the oldest of a full queue.
+   */
+  dropped: number;
+  /**
+   * The server's latest errors (points refused) and the failed tries, newest last.
+   */
+  errors: SondehubNote[];
+  /**
+   * The server cannot be reached or fails: uploads wait and are tried again.
+   */
+  failing: boolean;
+  /**
+   * Of them, sent as `historical` (older than the server's window when sent).
+   */
+  historical: number;
+  /**
+   * The last answer or failure, in words; `null` before the first try.
+   */
+  last_result: string | null;
+  /**
+   * When the server last took an upload, Unix ms; `null` before the first.
+   */
+  last_upload_wall_ms: number | null;
+  /**
+   * Points made since the station started.
+   */
+  made: number;
+  /**
+   * The queue is kept on disk (survives a restart).
+   */
+  on_disk: boolean;
+  /**
+   * The payload's callsign.
+   */
+  payload_callsign: string;
+  /**
+   * Time between two points, s.
+   */
+  period_s: number;
+  /**
+   * Points the queue holds at most.
+   */
+  queue_max: number;
+  /**
+   * Points waiting for the server (on disk with a queue directory).
+   */
+  queued: number;
+  /**
+   * Points the server refused (its 202's errors, or a 400 for the whole batch): never
+   * sent again.
+   */
+  refused: number;
+  /**
+   * Points found waiting on disk at start.
+   */
+  restored: number;
+  /**
+   * When the next try is due while failing, Unix ms.
+   */
+  retry_wall_ms: number | null;
+  /**
+   * Points the server took.
+   */
+  sent: number;
+  /**
+   * When the station's position was last uploaded, Unix ms; `null` without
+   * `station_position` or before it was.
+   */
+  station_uploaded_wall_ms: number | null;
+  /**
+   * The station's callsign.
+   */
+  uploader_callsign: string;
+  /**
+   * The API's address.
+   */
+  url: string;
+  /**
+   * The server's latest warnings (points taken but hidden), newest last.
+   */
+  warnings: SondehubNote[];
+}
+/**
+ * The chase car as last uploaded.
+ */
+export interface ChaseCarView {
+  /**
+   * Its callsign on the map.
+   */
+  callsign: string;
+  /**
+   * Where it was, `[lat °, lon °, alt m]`.
+   *
+   * @minItems 3
+   * @maxItems 3
+   */
+  position: [number, number, number];
+  /**
+   * When the position was uploaded, Unix ms; `null` while it waits.
+   */
+  uploaded_wall_ms: number | null;
+}
+/**
+ * Something the server said or a try that failed, with when.
+ */
+export interface SondehubNote {
+  /**
+   * What.
+   */
+  text: string;
+  /**
+   * When, Unix ms.
+   */
+  wall_ms: number;
 }
 /**
  * A viewer's first message: the track so far.
@@ -3747,4 +3876,22 @@ export interface TickBody {
    * `true` to tick, `false` to take the tick back.
    */
   ticked: boolean;
+}
+/**
+ * `POST /api/sondehub/chase`: where the recovery phone is.
+ */
+export interface ChaseCarBody {
+  /**
+   * Altitude above mean sea level, m, if the phone gives one (else the station's
+   * origin's).
+   */
+  alt_m?: number | null;
+  /**
+   * Latitude, ° (−90…90).
+   */
+  lat_deg: number;
+  /**
+   * Longitude, ° (−180…180).
+   */
+  lon_deg: number;
 }

@@ -1,5 +1,5 @@
 import { describe, expect, it } from "vitest";
-import { chaseLine, forwardCounts, forwardRights, parseSharing, type ForwardView } from "./sharing";
+import { chaseLine, forwardCounts, forwardRights, parseSharing, sondehubCounts, sondehubLine, sondehubListeners, type ForwardView, type SondehubView } from "./sharing";
 
 function only(fs: ForwardView[]): ForwardView {
   const [f] = fs;
@@ -30,5 +30,27 @@ describe("sharing", () => {
     expect(chaseLine(s.chase, 0)).toBe("A and A_LANDING to 10.0.0.255:55672 every 1 s: FAILING (Network is unreachable)");
     expect(chaseLine(parseSharing(null).chase, 0)).toMatch(/^chase broadcast off/);
     expect(chaseLine(parseSharing({ chase: { callsign: "B", to: "x", period_s: 2, sent: 0, last_sent_wall_ms: null, error: null } }).chase, 0)).toMatch(/nothing sent yet/);
+  });
+
+  it("reads the SondeHub upload: working, failing with its queue on disk, and off", () => {
+    const wire = {
+      url: "https://api.v2.sondehub.org", uploader_callsign: "CT1ABC", payload_callsign: "STRAPLEX1", period_s: 10,
+      made: 12, sent: 10, historical: 0, refused: 1, queued: 1, queue_max: 20000, dropped: 0, restored: 0, on_disk: true,
+      last_upload_wall_ms: 100_000, last_result: "202: 2 of 3 points taken, 1 refused, 0 warnings", failing: false, retry_wall_ms: null,
+      errors: [{ wall_ms: 90_000, text: "Missing lat field" }, { text: 3 }], warnings: [], station_uploaded_wall_ms: 50_000,
+      chase_car: { callsign: "CT1ABC_CHASE", position: [38.5, -7.9, 200], uploaded_wall_ms: null },
+    };
+    const s = parseSharing({ forwards: [], chase: null, sondehub: wire }).sondehub;
+    if (s === null) throw new Error("sondehub expected");
+    expect(s.errors).toEqual([{ wall_ms: 90_000, text: "Missing lat field" }]);
+    expect(sondehubLine(s, 103_000)).toBe("STRAPLEX1 by CT1ABC to https://api.v2.sondehub.org every 10 s: last upload 3 s ago (202: 2 of 3 points taken, 1 refused, 0 warnings)");
+    expect(sondehubCounts(s)).toBe("10 points taken, 1 queued on disk (of 20000), 1 refused by the server");
+    expect(sondehubListeners(s, 103_000)).toBe("station position uploaded 53 s ago; chase car CT1ABC_CHASE at 38.50000, -7.90000 waiting to upload");
+    const failing: SondehubView = { ...s, failing: true, last_result: "no answer: timed out", retry_wall_ms: 108_000, dropped: 4, last_upload_wall_ms: null, chase_car: null };
+    expect(sondehubLine(failing, 103_000)).toBe("STRAPLEX1 by CT1ABC to https://api.v2.sondehub.org every 10 s: FAILING (no answer: timed out, next try in 5 s); nothing uploaded yet");
+    expect(sondehubCounts(failing)).toContain("4 DROPPED (queue full)");
+    expect(sondehubListeners(failing, 0)).toMatch(/no chase car/);
+    expect(sondehubLine(parseSharing({}).sondehub, 0)).toMatch(/^SondeHub upload off/);
+    expect(parseSharing({ sondehub: { url: "x" } }).sondehub).toBeNull();
   });
 });

@@ -16,6 +16,7 @@ import { parsePosition, positionUnavailable } from "../lib/position";
 import { landedText, recoveryPoint } from "../lib/recovery";
 import { resolveToken, searchWithoutToken } from "../lib/token";
 import type { LatLon, State, Station } from "../lib/types";
+import { ChaseCarShare } from "../ui/chaseCarShare";
 import { h, setText } from "../ui/dom";
 import { RecoveryMap } from "../ui/recoveryMap";
 
@@ -41,6 +42,9 @@ let deviceHeading: number | null = null;
 let fetchError = "";
 /** Made once the station's map settings are known (from the session, or the saved copy). */
 let map: RecoveryMap | null = null;
+
+/** The opt-in to show this phone on SondeHub as a chase car. */
+const chaseShare = new ChaseCarShare(api);
 
 const el = {
   kind: h("div", { class: "kind", "data-testid": "rec-kind" }),
@@ -76,7 +80,7 @@ document.getElementById("app")!.replaceChildren(
   h("header", {}, h("strong", {}, "STRAPLEX recovery"), h("a", { href: "index.html", class: "muted small" }, "live page")),
   el.stale,
   h("main", {}, el.kind, el.arrow, el.arrowNote, el.distance, el.bearing, el.point, el.decimal, el.ttl,
-    h("div", { class: "links" }, el.geo, el.osm, el.copy), el.copyStatus, el.mapBox, el.updated, el.phone, el.why, el.manualBox),
+    h("div", { class: "links" }, el.geo, el.osm, el.copy), el.copyStatus, el.mapBox, el.updated, el.phone, el.why, el.manualBox, chaseShare.root),
 );
 
 el.copy.addEventListener("click", () => void copyPoint());
@@ -105,6 +109,8 @@ render();
 void poll();
 setInterval(() => void poll(), POLL_MS);
 setInterval(render, 1000);
+setInterval(() => void chaseShare.tick(), 1000);
+void chaseShare.probe();
 watchPhone();
 watchHeading();
 if ("serviceWorker" in navigator && window.isSecureContext) {
@@ -183,6 +189,7 @@ function watchPhone(): void {
   navigator.geolocation.watchPosition(
     (p) => {
       phone = { lat_deg: p.coords.latitude, lon_deg: p.coords.longitude, accuracy_m: p.coords.accuracy };
+      chaseShare.setPosition(phone);
       geoErrorCode = null;
       render();
     },
@@ -191,6 +198,7 @@ function watchPhone(): void {
       // a refusal, which is final.
       geoErrorCode = e.code;
       if (e.code === 1) phone = null;
+      chaseShare.setPosition(phone);
       render();
     },
     { enableHighAccuracy: true, maximumAge: 5000, timeout: 30000 },

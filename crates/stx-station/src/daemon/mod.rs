@@ -3,14 +3,17 @@
 //! between the driver, the core and the pages), and the HTTP server (HTTPS with `[tls]`, see
 //! `tls`), all stopped together by one shutdown signal; `pages` sends the pages their states
 //! and messages. A replay station's core is fed by the recording's feeder thread instead of
-//! the link (`replay_feed`); the live station opens them (`replay_sessions`). Nothing here
-//! decides anything: the core does.
+//! the link (`replay_feed`); the live station opens them (`replay_sessions`). What is shared
+//! beyond the pages runs beside: `forward`, `chase`, and `sondehub` with its queue's files
+//! (`sondehub_store`). Nothing here decides anything: the core does.
 
 mod chase;
 mod forward;
 mod pages;
 mod replay_feed;
 mod replay_sessions;
+mod sondehub;
+mod sondehub_store;
 mod station_loop;
 mod tls;
 
@@ -179,6 +182,8 @@ pub async fn run_replay(
     // A replay is not the flight: chase cars and watchers must not take it for the drone.
     config.chase = None;
     config.forward.clear();
+    // Nor SondeHub: a replay's points would go on the public map as a second flight.
+    config.sondehub = None;
     run_with(config, Some(replay), shutdown, started).await
 }
 
@@ -258,6 +263,13 @@ async fn run_with(
     if let Some(path) = &config.readiness.params_file {
         core.load_saved_params(0.0, &path.display().to_string(), read(path).await);
     }
+    let (sondehub_share, sondehub) = match config.sondehub.clone() {
+        Some(c) => {
+            let (share, prepared) = sondehub::prepare(c, 0.0).await;
+            (Some(share), Some(prepared))
+        }
+        None => (None, None),
+    };
     let shared = Arc::new(Shared {
         core: Mutex::new(core),
         config: config.clone(),
@@ -282,6 +294,7 @@ async fn run_with(
         rehearsal: Default::default(),
         forwards,
         chase: Mutex::new(config.chase.as_ref().map(chase::view)),
+        sondehub: sondehub_share,
     });
     let sessions_task = replay_requests_rx.map(|rx| {
         tokio::spawn(replay_sessions::replay_sessions(
@@ -293,6 +306,9 @@ async fn run_with(
     });
     if let Some(chase_config) = config.chase.clone() {
         tokio::spawn(chase::run(chase_config, shared.clone(), stop_rx.clone()));
+    }
+    if let Some(prepared) = sondehub {
+        tokio::spawn(sondehub::run(prepared, shared.clone(), stop_rx.clone()));
     }
     let station_task = tokio::spawn(station_loop::station_loop(station_loop::StationLoop {
         shared: shared.clone(),

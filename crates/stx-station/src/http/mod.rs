@@ -12,7 +12,8 @@
 //! - `kml`: the Google Earth feed; `replay`: the replay's pause, seek and speed;
 //! - `recordings`: the past recordings: list, download, open in a replay;
 //! - `tiles`: the offline map's tiles, from the tile pack and the tiles directory;
-//! - `lab`: the Lab's jobs, vehicle and gains files.
+//! - `lab`: the Lab's jobs, vehicle and gains files;
+//! - `sondehub`: a recovery phone's position for the SondeHub upload's chase car.
 //!
 //! Handlers only lock the core for a moment, build their answer, and wake the daemon when they
 //! gave the core something for the link ([`Shared::link_due`]); nothing here waits on the
@@ -31,6 +32,7 @@ mod rehearse;
 mod replay;
 mod rest;
 mod shared;
+mod sondehub;
 mod tawhiri;
 mod tiles;
 mod ws;
@@ -42,7 +44,7 @@ use tower_http::services::{ServeDir, ServeFile};
 pub use auth::Caller;
 pub use shared::{
     ClientCounters, HttpError, RehearsalRequest, Rehearsals, ReplayRefusal, ReplayRequest, Shared,
-    StateFrame, SummaryCache,
+    SondehubShare, StateFrame, SummaryCache,
 };
 
 use crate::requests::{CourseBody, HeadingBody, LocalizerBody, ModeBody, PlanBody, TargetBody};
@@ -88,6 +90,7 @@ pub fn router(state: std::sync::Arc<Shared>) -> Router {
         .route("/api/readiness", get(readiness::board))
         .route("/api/readiness/{id}", post(readiness::tick))
         .route("/api/sharing", get(readiness::sharing))
+        .route("/api/sondehub/chase", post(sondehub::chase_car))
         .route("/api/cutdown/arm", post(arm_cutdown))
         .route("/api/cutdown/confirm", post(confirm_cutdown))
         .route("/api/clients", get(clients))

@@ -1,7 +1,7 @@
 //! `GET /api/readiness`: the go/no-go board (any role); `POST /api/readiness/{id}`: an
 //! operator ticks or unticks a checklist item. The board also rides in every `state` message.
-//! `GET /api/sharing`: what the station shares with watching ground stations and chase cars
-//! (the board's neighbour on the Go/no-go tab).
+//! `GET /api/sharing`: what the station shares with watching ground stations, chase cars and
+//! SondeHub (the board's neighbour on the Go/no-go tab).
 
 use axum::Json;
 use axum::extract::rejection::JsonRejection;
@@ -19,11 +19,21 @@ pub(crate) async fn board(State(state): State<AppState>, _caller: Caller) -> Res
     Json(state.core().state_msg_now(now).readiness).into_response()
 }
 
-/// `GET /api/sharing` (any role): the read-only MAVLink outputs and the chase broadcast.
+/// `GET /api/sharing` (any role): the read-only MAVLink outputs, the chase broadcast and
+/// the SondeHub upload.
 pub(crate) async fn sharing(State(state): State<AppState>, _caller: Caller) -> Response {
     let forwards = state.forwards.lock().map(|f| f.clone()).unwrap_or_default();
     let chase = state.chase.lock().ok().and_then(|c| c.clone());
-    Json(crate::forward::SharingBody { forwards, chase }).into_response()
+    let sondehub = state
+        .sondehub
+        .as_ref()
+        .and_then(|s| s.view.lock().ok().map(|v| v.clone()));
+    Json(crate::forward::SharingBody {
+        forwards,
+        chase,
+        sondehub,
+    })
+    .into_response()
 }
 
 pub(crate) async fn tick(

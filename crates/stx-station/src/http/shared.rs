@@ -27,6 +27,8 @@ pub struct Shared {
     pub forwards: Arc<Mutex<Vec<crate::forward::ForwardView>>>,
     /// The chase broadcast as its task last reported it; `None` when it is off.
     pub chase: Mutex<Option<crate::forward::ChaseView>>,
+    /// The SondeHub upload; `None` when it is off.
+    pub sondehub: Option<SondehubShare>,
     /// Configuration (immutable).
     pub config: StationConfig,
     /// Mission clock origin.
@@ -76,6 +78,15 @@ pub struct Shared {
     /// The simulated drone's restarts, set once by a binary that flies one beside the station
     /// (`stx serve --sim`); unset, `POST /api/lab/rehearse` answers that there is none.
     pub rehearsal: std::sync::OnceLock<Rehearsals>,
+}
+
+/// The SondeHub upload's side of [`Shared`]: what its task last reported, and where a
+/// recovery phone's position goes (the newest wins: an older one is worth nothing).
+pub struct SondehubShare {
+    /// The upload as its task last reported it.
+    pub view: Mutex<crate::sondehub::SondehubView>,
+    /// The chase car's position, `[lat °, lon °, alt m]`.
+    pub chase_car: watch::Sender<Option<[f64; 3]>>,
 }
 
 /// Where the Lab asks for the simulated drone to fly its mission again with another vehicle.

@@ -80,7 +80,16 @@ async fn replay_station(file: &Path, mode: ReplayMode) -> (Running, oneshot::Sen
         let started = move |r: &Running| {
             let _ = started_tx.send(r.clone());
         };
-        serve_replay(config(|_| {}), prepared, shutdown, started)
+        // Configured to share, as the live station is: a replay must share nothing.
+        let sharing = config(|c| {
+            c.sondehub = toml::from_str(
+                "url = \"http://127.0.0.1:9\"\nuploader_callsign = \"STXTEST\"\n\
+                 payload_callsign = \"STRAPLEX1\"\n",
+            )
+            .ok();
+            c.chase = toml::from_str("callsign = \"STRAPLEX1\"\naddress = \"127.0.0.1\"").ok();
+        });
+        serve_replay(sharing, prepared, shutdown, started)
             .await
             .expect("replay station");
     });
@@ -146,6 +155,11 @@ async fn a_seek_back_while_paused_shows_the_flight_as_it_was_then() {
 
     // --- re-run
     let (station, _stop) = replay_station(&file, ReplayMode::Rerun).await;
+    let (_, sharing) = http(station.http, "GET", "/api/sharing", Some(VIEWER), None).await;
+    assert!(
+        sharing["sondehub"].is_null() && sharing["chase"].is_null(),
+        "a replay uploads to SondeHub and broadcasts to chase cars nothing: {sharing}"
+    );
     let view = steer(&station, json!({"paused": true})).await;
     let duration_ms = view["duration_ms"].as_u64().expect("duration");
     // To the end first (a replay that has played through), then back while paused.

@@ -4,12 +4,9 @@
 //! station's GPS says it is, the time of day in UTC, and the predicted landing as its own
 //! callsign where the station predicts it.
 
-use std::path::Path;
-use std::process::Command;
-
 use serde_json::Value;
 
-use crate::common::mavproxy::python;
+use crate::common::mavproxy::run_peer;
 use crate::common::station::{Station, free_udp_port};
 use crate::common::temp_dir;
 
@@ -53,19 +50,8 @@ fn chase_cars_hear_the_payload_and_its_landing_as_horusdemodlib_sends_them() {
             "[chase]\ncallsign = \"STRAPLEX1\"\naddress = \"127.0.0.1\"\nport = {port}\nperiod_s = 1.0\n"
         ),
     );
-    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/peers/chase_horus.py");
-    let out = Command::new(python())
-        .arg(&script)
-        .arg(port.to_string())
-        .arg("40")
-        .output()
-        .expect("python runs");
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let heard: Value = serde_json::from_slice(&out.stdout).expect("the script's JSON");
+    let out = run_peer("chase_horus.py", &[&port.to_string(), "40"]);
+    let heard: Value = serde_json::from_slice(&out).expect("the script's JSON");
     let state = station.get("/api/state").expect("the station's state");
 
     let stx = heard["stx"].as_array().expect("datagrams");

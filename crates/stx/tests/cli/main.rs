@@ -30,4 +30,5 @@ mod hostile_link;
 mod http_abuse;
 mod identify_rehearsal;
 mod record_station;
+mod sondehub_upload;
 mod tawhiri_api;

@@ -24,6 +24,26 @@ pub fn python() -> PathBuf {
     p
 }
 
+/// Runs the peer script `tests/peers/NAME` with `args` under [`python`] and gives its stdout;
+/// a script that fails fails the test with what it printed on stderr.
+#[allow(dead_code)]
+pub fn run_peer(name: &str, args: &[&str]) -> Vec<u8> {
+    let script = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../tests/peers")
+        .join(name);
+    let out = Command::new(python())
+        .arg(&script)
+        .args(args)
+        .output()
+        .expect("python runs");
+    assert!(
+        out.status.success(),
+        "{name}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out.stdout
+}
+
 /// MAVProxy's console: lines in, everything it printed kept.
 pub struct Console {
     stdin: ChildStdin,

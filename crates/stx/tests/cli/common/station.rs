@@ -19,6 +19,17 @@ impl Station {
     /// loopback ports with the shipped `config/station.toml` followed by `extra` (TOML tables),
     /// written into `dir`.
     pub fn start(dir: &Path, extra: &str) -> Self {
+        Self::start_with(dir, extra, Stdio::null())
+    }
+
+    /// As [`Station::start`], its log (stderr) written to `log`.
+    #[allow(dead_code)]
+    pub fn start_logged(dir: &Path, extra: &str, log: &Path) -> Self {
+        let file = std::fs::File::create(log).expect("log file");
+        Self::start_with(dir, extra, Stdio::from(file))
+    }
+
+    fn start_with(dir: &Path, extra: &str, stderr: Stdio) -> Self {
         let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
         let shipped =
             std::fs::read_to_string(root.join("config/station.toml")).expect("shipped config");
@@ -39,7 +50,7 @@ impl Station {
             .args(["--listen", "127.0.0.1:0", "--link", "udpin:127.0.0.1:0"])
             .current_dir(&root)
             .stdout(Stdio::piped())
-            .stderr(Stdio::null())
+            .stderr(stderr)
             .spawn()
             .expect("stx serve starts");
         let (http, token) = super::read_started(&mut child);
