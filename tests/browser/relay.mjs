@@ -130,6 +130,20 @@ async function flight() {
     setTimeout(() => res("no answer"), 5000);
   }), relay2);
   check("with --max-viewers 2 and two viewers on, the next is refused", fourth === "refused", fourth);
+  // The audience travels up: relay 2's two pages and relay 1's one reach the station's panel.
+  const opCtx = await newContext("relay-station", { viewport: { width: 1280, height: 800 } });
+  const opPage = await opCtx.newPage();
+  await opPage.goto(`${base}/?token=${OPERATOR}`);
+  await opPage.click('[data-testid="tab-readiness"]');
+  await opPage.waitForFunction(() => document.querySelector('[data-testid="sharing-relays"]')?.dataset.viewers === "3", null, { timeout: 20000 }).catch(() => {});
+  const relaysText = await opPage.locator('[data-testid="sharing-relays"]').innerText();
+  const sharing = (await api("/api/sharing", VIEWER)).body;
+  const status1 = (await getJson(`${relay1}/api/relay`)).body;
+  check("the station's Go/no-go tab counts the public pages of the whole relay tree",
+    sharing?.relays?.length === 1 && sharing.relays[0].viewers === 3 && status1?.audience === 3 && /^3 public pages through 1 relay/.test(relaysText),
+    `page "${relaysText}"; /api/sharing ${JSON.stringify(sharing?.relays)}; relay 1 audience ${status1?.audience}`);
+  await opPage.screenshot({ path: join(out, "relay-station-sharing.png") });
+  await opCtx.close();
   await page.screenshot({ path: join(out, "relay.png") });
   await page2.screenshot({ path: join(out, "relay-delayed.png") });
   await ctx.close();

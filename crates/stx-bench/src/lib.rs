@@ -11,6 +11,9 @@
 //! - [`memory`]: the daemon and the drone as `stx serve` and `stx drone` child processes
 //!   through a three-hour day, the daemon's memory and file descriptors read from `/proc`
 //!   (Linux only), which [`abuse`] reads too;
+//! - [`relay`]: the station and a public relay as child processes (the station's child is
+//!   [`memory`]'s), the drone and [`station`]'s timing pages here, and a thousand viewers on
+//!   the relay: what the audience costs the station;
 //! - [`agreement`]: whole missions flown by `stx_agreement`, held against its goals.
 //!
 //! `stx bench dynamics` is `stx_sim::speed` itself and needs nothing here.
@@ -23,4 +26,5 @@ pub mod agreement;
 pub mod http;
 pub mod lab_load;
 pub mod memory;
+pub mod relay;
 pub mod station;

@@ -224,8 +224,74 @@ pub(crate) fn memory_mb(pid: u32) -> anyhow::Result<(f64, f64)> {
     Ok((field("VmRSS:")?, field("VmHWM:")?))
 }
 
+/// `stx serve` on loopback ports in a child process, killed when dropped.
+pub(crate) struct ServeChild {
+    pub child: tokio::process::Child,
+    pub pid: u32,
+    /// `127.0.0.1:PORT` of its HTTP side.
+    pub address: String,
+    /// The operator's token it printed.
+    pub token: String,
+    /// Its drone link's UDP address.
+    pub link: String,
+}
+
+impl ServeChild {
+    /// Starts `exe serve` with `extra` arguments and reads its address and link from the
+    /// banner it prints.
+    pub async fn start(exe: &std::path::Path, extra: &[&std::ffi::OsStr]) -> anyhow::Result<Self> {
+        let mut child = Command::new(exe)
+            .args([
+                "serve",
+                "--listen",
+                "127.0.0.1:0",
+                "--link",
+                "udpin:127.0.0.1:0",
+            ])
+            .args(extra)
+            .env("RUST_LOG", "warn")
+            .stdout(Stdio::piped())
+            .stderr(Stdio::null())
+            .kill_on_drop(true)
+            .spawn()
+            .context("starting stx serve")?;
+        let pid = child.id().context("the daemon's pid")?;
+        let mut out = BufReader::new(child.stdout.take().context("the daemon's stdout")?);
+        let mut line = String::new();
+        out.read_line(&mut line).await?;
+        let mut link_line = String::new();
+        out.read_line(&mut link_line).await?;
+        // "stx station: drone link listening on 127.0.0.1:PORT"
+        let Some(link) = link_line
+            .trim()
+            .strip_prefix("stx station: drone link listening on ")
+        else {
+            bail!("stx serve did not print its link: {link_line:?}");
+        };
+        // "stx station: open http://127.0.0.1:PORT/?token=TOKEN"
+        let url = line.trim().rsplit(' ').next().unwrap_or_default();
+        let Some((address, token)) = url
+            .strip_prefix("http://")
+            .and_then(|rest| rest.split_once("/?token="))
+        else {
+            bail!("stx serve did not print its URL: {line:?}");
+        };
+        Ok(Self {
+            child,
+            pid,
+            address: address.to_string(),
+            token: token.to_string(),
+            link: link.to_string(),
+        })
+    }
+}
+
 /// GET `path` with a bearer token, the body as JSON.
-async fn get_json(address: &str, path: &str, token: &str) -> anyhow::Result<serde_json::Value> {
+pub(crate) async fn get_json(
+    address: &str,
+    path: &str,
+    token: &str,
+) -> anyhow::Result<serde_json::Value> {
     let mut stream = tokio::net::TcpStream::connect(address).await?;
     stream
         .write_all(
@@ -271,35 +337,13 @@ async fn measure(options: &MemoryBenchOptions) -> anyhow::Result<MemoryReport> {
     // The station records, as it does in the field; into a directory of its own.
     let record_dir = std::env::temp_dir().join(format!("stx-bench-memory-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&record_dir);
-    let mut child = Command::new(exe)
-        .args([
-            "serve",
-            "--listen",
-            "127.0.0.1:0",
-            "--link",
-            "udpin:127.0.0.1:0",
-            "--record-dir",
-        ])
-        .arg(&record_dir)
-        .env("RUST_LOG", "warn")
-        .stdout(Stdio::piped())
-        .stderr(Stdio::null())
-        .kill_on_drop(true)
-        .spawn()
-        .context("starting stx serve")?;
-    let pid = child.id().context("the daemon's pid")?;
-    let mut out = BufReader::new(child.stdout.take().context("the daemon's stdout")?);
-    let mut line = String::new();
-    out.read_line(&mut line).await?;
-    let mut link_line = String::new();
-    out.read_line(&mut link_line).await?;
-    // "stx station: drone link listening on 127.0.0.1:PORT"
-    let Some(link) = link_line
-        .trim()
-        .strip_prefix("stx station: drone link listening on ")
-    else {
-        bail!("stx serve did not print its link: {link_line:?}");
-    };
+    let ServeChild {
+        mut child,
+        pid,
+        address,
+        token,
+        link,
+    } = ServeChild::start(exe, &["--record-dir".as_ref(), record_dir.as_os_str()]).await?;
     let mut drone = Command::new(exe)
         .args(["drone", "--connect", &format!("udpout:{link}")])
         .arg("--scenario")
@@ -312,16 +356,6 @@ async fn measure(options: &MemoryBenchOptions) -> anyhow::Result<MemoryReport> {
         .spawn()
         .context("starting stx drone")?;
     let drone_pid = drone.id().context("the drone's pid")?;
-    // "stx station: open http://127.0.0.1:PORT/?token=TOKEN"
-    let url = line.trim().rsplit(' ').next().unwrap_or_default();
-    let Some((address, token)) = url
-        .strip_prefix("http://")
-        .and_then(|rest| rest.split_once("/?token="))
-    else {
-        bail!("stx serve did not print its URL: {line:?}");
-    };
-    let (address, token) = (address.to_string(), token.to_string());
-
     let messages = Arc::new(AtomicU64::new(0));
     let bytes = Arc::new(AtomicU64::new(0));
     for _ in 0..options.clients {

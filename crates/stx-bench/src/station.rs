@@ -69,7 +69,7 @@ pub struct Latency {
 }
 
 impl Latency {
-    fn of(mut samples_ms: Vec<f64>) -> Self {
+    pub(crate) fn of(mut samples_ms: Vec<f64>) -> Self {
         samples_ms.sort_by(f64::total_cmp);
         let at = |q: f64| percentile(&samples_ms, q);
         Latency {
@@ -232,10 +232,10 @@ fn start_station(
 /// What the benchmark reads of the drone's flight: when each ATTITUDE stamp left, when each
 /// command arrived, whether it landed.
 #[derive(Clone)]
-struct Clocks {
-    sent_at: Arc<Mutex<HashMap<u32, Instant>>>,
-    commands: mpsc::UnboundedSender<Instant>,
-    landed: Arc<AtomicBool>,
+pub(crate) struct Clocks {
+    pub sent_at: Arc<Mutex<HashMap<u32, Instant>>>,
+    pub commands: mpsc::UnboundedSender<Instant>,
+    pub landed: Arc<AtomicBool>,
 }
 
 impl FlightObserver for Clocks {
@@ -260,7 +260,7 @@ impl FlightObserver for Clocks {
 }
 
 /// A page: records when each attitude stamp first arrives in a `state`.
-async fn page(
+pub(crate) async fn page(
     http: SocketAddr,
     token: String,
     seen: Arc<Mutex<HashMap<u32, Instant>>>,
@@ -281,6 +281,36 @@ async fn page(
         }
     }
     Ok(())
+}
+
+/// Each page's delay from a burst sent within `window` to the first `state` carrying it, ms;
+/// the bursts some page never saw; and how many bursts were sent in the window.
+pub(crate) fn page_latencies(
+    sent_at: &Mutex<HashMap<u32, Instant>>,
+    seen_by_page: &[Arc<Mutex<HashMap<u32, Instant>>>],
+    window: std::ops::RangeInclusive<Instant>,
+) -> (Vec<f64>, usize, usize) {
+    let timed: Vec<(u32, Instant)> = sent_at
+        .lock()
+        .unwrap_or_else(|e| e.into_inner())
+        .iter()
+        .filter(|(_, at)| window.contains(*at))
+        .map(|(s, at)| (*s, *at))
+        .collect();
+    let mut samples = Vec::new();
+    let mut missed = 0;
+    for seen in seen_by_page {
+        let seen = seen.lock().unwrap_or_else(|e| e.into_inner());
+        for (stamp, sent) in &timed {
+            match seen.get(stamp) {
+                Some(arrived) => {
+                    samples.push(arrived.saturating_duration_since(*sent).as_secs_f64() * 1e3)
+                }
+                None => missed += 1,
+            }
+        }
+    }
+    (samples, missed, timed.len())
 }
 
 /// The attitude stamp of a `state` message. A page of the benchmark reads only this, so that
@@ -431,33 +461,15 @@ pub fn run(options: &StationBenchOptions) -> anyhow::Result<StationReport> {
             bail!("the drone landed before the telemetry window ended: time fewer frames");
         }
         tokio::time::sleep(Duration::from_millis(500)).await;
-        let timed: Vec<(u32, Instant)> = sent_at
-            .lock()
-            .unwrap_or_else(|e| e.into_inner())
-            .iter()
-            .filter(|(_, at)| (timed_from..=timed_to).contains(*at))
-            .map(|(s, at)| (*s, *at))
-            .collect();
-        let mut samples = Vec::new();
-        let mut missed = 0;
-        for seen in &seen_by_page {
-            let seen = seen.lock().unwrap_or_else(|e| e.into_inner());
-            for (stamp, sent) in &timed {
-                match seen.get(stamp) {
-                    Some(arrived) => {
-                        samples.push(arrived.saturating_duration_since(*sent).as_secs_f64() * 1e3)
-                    }
-                    None => missed += 1,
-                }
-            }
-        }
+        let (samples, missed, frames_sent) =
+            page_latencies(&sent_at, &seen_by_page, timed_from..=timed_to);
         let (state_bytes, not_run) = station_view(&running);
         if !not_run.is_empty() {
             bail!("the station's pipeline did not run on the telemetry: no {not_run}");
         }
         let telemetry = TelemetryReport {
             clients: options.clients,
-            frames_sent: timed.len(),
+            frames_sent,
             frame_rate_hz: options.frame_rate_hz,
             state_bytes,
             missed,

@@ -126,6 +126,21 @@ pub struct SharingBody {
     pub chase: Option<ChaseView>,
     /// The SondeHub-Amateur upload; `null` when it is off.
     pub sondehub: Option<crate::sondehub::SondehubView>,
+    /// The public relays (`stx relay`) connected to the station, in order of connection.
+    pub relays: Vec<RelayShare>,
+}
+
+/// A public relay on one of the station's WebSockets and the audience it reports.
+#[derive(Debug, Clone, PartialEq, Serialize, schemars::JsonSchema)]
+pub struct RelayShare {
+    /// The socket's number, as `GET /api/clients` has it.
+    pub id: u64,
+    /// The name of the token the relay connected with.
+    pub name: String,
+    /// Mission time it connected, s.
+    pub connected_s: f64,
+    /// Public pages served through it, its own and those of the relays below it.
+    pub viewers: u32,
 }
 
 #[cfg(test)]

@@ -98,6 +98,8 @@ pub struct ClientView {
     pub messages_behind: u64,
     /// Times it fell that far behind.
     pub lag_episodes: u64,
+    /// When the socket is a public relay's (`stx relay`): the pages it serves, as it last said.
+    pub relay_viewers: Option<u32>,
 }
 
 /// `GET /api/clients`.

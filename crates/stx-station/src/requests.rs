@@ -139,6 +139,13 @@ pub enum ClientMessage {
     ManualRelease,
     /// Answered with `pong`.
     Ping,
+    /// From a public relay (`stx relay`) on this socket: the pages it serves, its own and those
+    /// of the relays below it, for the station's sharing panel. Sent when the figure changes
+    /// (at most once a second) and every 10 s. Any role; a page never sends it.
+    RelayViewers {
+        /// Pages served through the relay.
+        viewers: u32,
+    },
 }
 
 /// `POST /api/replay` (only while replaying): any of pause/play, speed and position; what is

@@ -1,14 +1,14 @@
 //! `stx bench`: measured speed figures, printed as a table or JSON.
 //!
 //! `stx bench dynamics` is `stx_sim::speed` (derivative evaluations per second, and the
-//! stratospheric descent's real-time factor per integrator); `stx bench memory` and
-//! `stx bench station` measure the station daemon, and `stx bench agreement` flies whole
+//! stratospheric descent's real-time factor per integrator); `stx bench memory`,
+//! `stx bench station` and `stx bench relay` measure the station daemon, and `stx bench agreement` flies whole
 //! missions and holds what the station shows against the truth: the measuring is `stx_bench`'s,
 //! the flags, the printing and the exit code are here.
 
 use anyhow::{Context, bail};
 use clap::{Args, Subcommand};
-use stx_bench::{agreement, memory, station};
+use stx_bench::{agreement, memory, relay, station};
 
 use crate::BadInput;
 
@@ -77,6 +77,26 @@ enum BenchWhat {
         /// Dashboard pages connected throughout.
         #[arg(long, default_value_t = 5)]
         clients: usize,
+    },
+    /// What a public relay's audience costs the station: telemetry → station page without
+    /// and with `stx relay` serving its viewers, the station's and the relay's memory (exits
+    /// 1 if a goal is not met).
+    Relay {
+        /// Print one JSON object instead of a table.
+        #[arg(long)]
+        json: bool,
+        /// Viewers on the relay.
+        #[arg(long, default_value_t = 1000)]
+        viewers: usize,
+        /// Operator pages on the station timing telemetry.
+        #[arg(long, default_value_t = 4)]
+        pages: usize,
+        /// Telemetry bursts timed in each window (without and with the relay).
+        #[arg(long, default_value_t = 240)]
+        frames: usize,
+        /// Telemetry bursts per second (the drone's control rate).
+        #[arg(long, default_value_t = 4.0)]
+        frame_rate_hz: f64,
     },
     /// The station's latencies on loopback: telemetry → WebSocket pages, command → MAVLink.
     Station {
@@ -200,6 +220,31 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
                 println!("{}", serde_json::to_string_pretty(&report)?);
             } else {
                 print!("{report}");
+            }
+            Ok(())
+        }
+        BenchWhat::Relay {
+            json,
+            viewers,
+            pages,
+            frames,
+            frame_rate_hz,
+        } => {
+            let report = relay::run(&relay::RelayBenchOptions {
+                stx: std::env::current_exe().context("this program's path")?,
+                viewers,
+                pages,
+                frames,
+                frame_rate_hz,
+            })?;
+            if json {
+                println!("{}", serde_json::to_string_pretty(&report)?);
+            } else {
+                print!("{report}");
+            }
+            let unmet = report.unmet();
+            if !unmet.is_empty() {
+                bail!("goals not met: {}", unmet.join("; "));
             }
             Ok(())
         }

@@ -8,16 +8,21 @@ use anyhow::Context;
 use clap::Args;
 use stx_station::relay::feed::RelaySettings;
 use stx_station::relay::serve::{self, RelayOptions};
+use stx_station::relay::upstream::{Upstream, tls_connector};
 
 use crate::BadInput;
 use crate::serve::{announce, shutdown_signal};
 
 #[derive(Args, Debug)]
 pub struct RelayArgs {
-    /// The station, `http://HOST:PORT/?token=VIEWER-TOKEN` (a viewer's token: a relay never
-    /// commands), or another relay, `http://HOST:PORT/`.
+    /// The station, `http(s)://HOST:PORT/?token=VIEWER-TOKEN` (a viewer's token: a relay
+    /// never commands), or another relay, `http(s)://HOST:PORT/`.
     #[arg(long, value_name = "URL")]
     upstream: String,
+    /// PEM certificates to trust for an https:// upstream besides Mozilla's roots (the
+    /// station's own self-signed `[tls] cert_path`).
+    #[arg(long, value_name = "FILE")]
+    upstream_ca: Option<PathBuf>,
     /// Where the viewers connect (no token).
     #[arg(long, value_name = "ADDR", default_value = "0.0.0.0:8090")]
     listen: SocketAddr,
@@ -37,9 +42,15 @@ pub struct RelayArgs {
 
 pub fn run(args: RelayArgs) -> anyhow::Result<()> {
     let settings = RelaySettings::new(args.delay, args.coarsen).map_err(|e| BadInput(e.into()))?;
-    let (_, shown) = serve::upstream_ws(&args.upstream).map_err(|e| BadInput(e.into()))?;
+    let shown = Upstream::parse(&args.upstream)
+        .map_err(|e| BadInput(e.into()))?
+        .shown;
+    if let Some(ca) = &args.upstream_ca {
+        tls_connector(Some(ca)).map_err(|e| BadInput(e.into()))?;
+    }
     let options = RelayOptions {
         upstream: args.upstream,
+        upstream_ca: args.upstream_ca,
         web_dir: args.web_dir,
         settings,
         max_viewers: args.max_viewers.max(1),

@@ -438,6 +438,13 @@ export type ClientMessage =
     }
   | {
       type: "ping";
+    }
+  | {
+      type: "relay_viewers";
+      /**
+       * Pages served through the relay.
+       */
+      viewers: number;
     };
 /**
  * A plan item as the API spells it (`approach_course_deg`, like the target endpoint).
@@ -2246,6 +2253,10 @@ export interface ClientView {
    */
   name: string;
   /**
+   * When the socket is a public relay's (`stx relay`): the pages it serves, as it last said.
+   */
+  relay_viewers: number | null;
+  /**
    * The token's role.
    */
   role: Role | null;
@@ -3260,6 +3271,10 @@ export interface SharingBody {
    */
   forwards: ForwardView[];
   /**
+   * The public relays (`stx relay`) connected to the station, in order of connection.
+   */
+  relays: RelayShare[];
+  /**
    * The SondeHub-Amateur upload; `null` when it is off.
    */
   sondehub: SondehubView | null;
@@ -3333,6 +3348,27 @@ export interface ForwardView {
    * Frames sent to the watcher.
    */
   out_passed: number;
+}
+/**
+ * A public relay on one of the station's WebSockets and the audience it reports.
+ */
+export interface RelayShare {
+  /**
+   * Mission time it connected, s.
+   */
+  connected_s: number;
+  /**
+   * The socket's number, as `GET /api/clients` has it.
+   */
+  id: number;
+  /**
+   * The name of the token the relay connected with.
+   */
+  name: string;
+  /**
+   * Public pages served through it, its own and those of the relays below it.
+   */
+  viewers: number;
 }
 /**
  * The SondeHub-Amateur upload as the pages show it.
@@ -3585,6 +3621,11 @@ export interface PublicPosition {
  */
 export interface RelayStatusBody {
   /**
+   * Pages served through this relay: its own viewers, a relay below counted by the pages it
+   * reports. This is what the relay reports to its upstream.
+   */
+  audience: number;
+  /**
    * This relay's own grid, m.
    */
   coarsen_m: number;
@@ -3605,7 +3646,7 @@ export interface RelayStatusBody {
    */
   upstream_connected: boolean;
   /**
-   * Viewers connected to this relay now.
+   * Viewers connected to this relay now (a relay below counts one).
    */
   viewers: number;
 }

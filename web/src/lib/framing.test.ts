@@ -1,6 +1,6 @@
 import { describe, expect, it } from "vitest";
 import { NO_READINESS } from "./readiness";
-import { boxAround, keyPoints, MIN_SPAN_M, needsFraming, type Box } from "./framing";
+import { boxAround, keyPoints, MIN_SPAN_M, needsFraming, shareOfView, type Box } from "./framing";
 import { distanceM } from "./geo";
 import type { FlightStage, State } from "./types";
 
@@ -76,5 +76,14 @@ describe("needsFraming", () => {
     expect(needsFraming(view, box(100, 100, 300, 300))).toBe(true);
     // After framing, the wanted box fills ~85 % of the view.
     expect(needsFraming(view, box(-850, -850, 850, 850))).toBe(false);
+  });
+});
+
+describe("shareOfView", () => {
+  const view: Box = { south: at(-1000, 0).lat_deg, north: at(1000, 0).lat_deg, west: at(0, -1000).lon_deg, east: at(0, 1000).lon_deg };
+  it("is the larger of the box's two shares of the view", () => {
+    const tall: Box = { south: at(-500, 0).lat_deg, north: at(500, 0).lat_deg, west: at(0, -100).lon_deg, east: at(0, 100).lon_deg };
+    expect(shareOfView(view, tall)).toBeCloseTo(0.5, 3);
+    expect(shareOfView(view, view)).toBeCloseTo(1, 6);
   });
 });

@@ -64,6 +64,13 @@ function sizeM(b: Box): { w: number; h: number } {
   return { w: Math.abs(ne.east_m), h: Math.abs(ne.north_m) };
 }
 
+/** How much of the view `want` spans, the larger of its two shares (1: it just fills the view). */
+export function shareOfView(view: Box, want: Box): number {
+  const v = sizeM(view);
+  const w = sizeM(want);
+  return Math.max(w.w / v.w, w.h / v.h);
+}
+
 /**
  * Whether the view must be framed again to show `want` (the box of the key points): when a key
  * point is within `EDGE_MARGIN` of the view's edge or outside it, or when `want` has shrunk below

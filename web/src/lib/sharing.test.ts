@@ -1,5 +1,5 @@
 import { describe, expect, it } from "vitest";
-import { chaseLine, forwardCounts, forwardRights, parseSharing, sondehubCounts, sondehubLine, sondehubListeners, type ForwardView, type SondehubView } from "./sharing";
+import { chaseLine, forwardCounts, forwardRights, parseSharing, relaysLine, sondehubCounts, sondehubLine, sondehubListeners, type ForwardView, type SondehubView } from "./sharing";
 
 function only(fs: ForwardView[]): ForwardView {
   const [f] = fs;
@@ -52,5 +52,11 @@ describe("sharing", () => {
     expect(sondehubListeners(failing, 0)).toMatch(/no chase car/);
     expect(sondehubLine(parseSharing({}).sondehub, 0)).toMatch(/^SondeHub upload off/);
     expect(parseSharing({ sondehub: { url: "x" } }).sondehub).toBeNull();
+  });
+  it("sums the public relays' pages and drops a relay without a name", () => {
+    const s = parseSharing({ relays: [{ id: 4, name: "school", connected_s: 12, viewers: 37 }, { id: 9, name: "club", viewers: 5 }, { id: 10, viewers: 3 }] });
+    expect(s.relays.map((r) => r.viewers)).toEqual([37, 5]);
+    expect(relaysLine(s.relays)).toBe("42 public pages through 2 relays (school #4: 37, club #9: 5)");
+    expect(relaysLine(parseSharing({}).relays)).toMatch(/^no public relay connected/);
   });
 });

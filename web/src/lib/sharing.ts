@@ -4,9 +4,9 @@
 // the Go/no-go tab shows.
 
 import { bool, isObj, num, str, type Obj } from "./parseFields";
-import type { ChaseCarView, ChaseView, ForwardView, SharingBody, SondehubNote, SondehubView } from "../generated/api";
+import type { ChaseCarView, ChaseView, ForwardView, RelayShare, SharingBody, SondehubNote, SondehubView } from "../generated/api";
 
-export type { ChaseView, ForwardView, SharingBody as Sharing, SondehubView };
+export type { ChaseView, ForwardView, RelayShare, SharingBody as Sharing, SondehubView };
 
 const count = (o: Obj, k: string): number => Math.max(0, Math.round(num(o, k) ?? 0));
 
@@ -44,7 +44,7 @@ export function parseSondehub(v: unknown): SondehubView | null {
 }
 
 export function parseSharing(v: unknown): SharingBody {
-  if (!isObj(v)) return { forwards: [], chase: null, sondehub: null };
+  if (!isObj(v)) return { forwards: [], chase: null, sondehub: null, relays: [] };
   const forwards: ForwardView[] = [];
   for (const f of Array.isArray(v.forwards) ? v.forwards : []) {
     if (!isObj(f)) continue;
@@ -67,7 +67,23 @@ export function parseSharing(v: unknown): SharingBody {
       period_s: num(c, "period_s") ?? 0, sent: count(c, "sent"), last_sent_wall_ms: num(c, "last_sent_wall_ms"), error: str(c, "error"),
     };
   }
-  return { forwards, chase, sondehub: parseSondehub(v.sondehub) };
+  return { forwards, chase, sondehub: parseSondehub(v.sondehub), relays: parseRelays(v.relays) };
+}
+
+function parseRelays(v: unknown): RelayShare[] {
+  if (!Array.isArray(v)) return [];
+  return v.filter(isObj).flatMap((r) => {
+    const name = str(r, "name");
+    return name === null ? [] : [{ id: count(r, "id"), name, connected_s: num(r, "connected_s") ?? 0, viewers: count(r, "viewers") }];
+  });
+}
+
+/** The public relays' audience in one line. */
+export function relaysLine(relays: readonly RelayShare[]): string {
+  if (relays.length === 0) return "no public relay connected (stx relay --upstream …)";
+  const pages = relays.reduce((n, r) => n + r.viewers, 0);
+  const each = relays.map((r) => `${r.name} #${r.id}: ${r.viewers}`).join(", ");
+  return `${pages} public page${pages === 1 ? "" : "s"} through ${relays.length} relay${relays.length === 1 ? "" : "s"} (${each})`;
 }
 
 /** What a watcher on `f` may do to the drone, in words. */

@@ -141,7 +141,8 @@ async function viewers(): Promise<void> {
   try {
     const r = await fetch("/api/relay");
     const b: unknown = await r.json();
-    const n = typeof b === "object" && b !== null && "viewers" in b ? Number(b.viewers) : NaN;
+    // The pages watching through this relay, those of relays below it included.
+    const n = typeof b === "object" && b !== null && "audience" in b ? Number(b.audience) : NaN;
     setText(el.viewers, Number.isFinite(n) ? `${n} watching` : "");
   } catch {
     setText(el.viewers, "");

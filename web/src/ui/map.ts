@@ -17,7 +17,7 @@ import { DRAFT_LOCALIZER, DRAFT_PLAN, ELLIPSE_PLANNED, ELLIPSE_UNCONTROLLED, FIN
 import { MetricGrid } from "./metricGrid";
 import { ellipsePoints, fromLocal, toLocal } from "../lib/geo";
 import { fmt, fmtDir } from "../lib/format";
-import { boxAround, keyPoints, needsFraming, type Box } from "../lib/framing";
+import { boxAround, keyPoints, needsFraming, shareOfView, type Box } from "../lib/framing";
 import { isLanded, landedText } from "../lib/recovery";
 import { trackPositions, vehiclePosition } from "../lib/fix";
 import { packNote, tilesBadge } from "../lib/tiles";
@@ -296,6 +296,7 @@ export class MapView {
     } else setText(this.windText, "wind —");
     this.lastWant = boxAround(keyPoints(s));
     if (this.follow && this.lastWant && needsFraming(this.viewBox(), this.lastWant)) this.frame(this.lastWant);
+    this.noteView();
     this.showLegend();
   }
 
@@ -376,5 +377,8 @@ export class MapView {
     const c = this.map.getCenter();
     this.root.dataset.center = `${c.lat.toFixed(7)},${c.lng.toFixed(7)}`;
     this.root.dataset.zoom = String(this.map.getZoom());
+    // How much of the view the key geometry's box spans, as the page frames it (for the tests:
+    // the markers alone understate it, the box holds the ellipses and the smallest span too).
+    this.root.dataset.keyShare = this.lastWant && this.map.getSize().x > 0 ? shareOfView(this.viewBox(), this.lastWant).toFixed(3) : "";
   }
 }

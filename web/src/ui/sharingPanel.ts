@@ -1,10 +1,10 @@
 // What the station shares beyond its pages, under the go/no-go board: each read-only MAVLink
 // forward (where it goes, what its watcher may send the drone, its traffic), the chase cars'
-// broadcast and the SondeHub upload (its state, queue and the server's latest errors and
-// warnings). Read from `GET /api/sharing` by the page every few seconds.
+// broadcast, the SondeHub upload (its state, queue and the server's latest errors and
+// warnings) and the public relays with the pages they serve. Read from `GET /api/sharing` by the page every few seconds.
 
 import { h, panel, setText } from "./dom";
-import { chaseLine, forwardCounts, forwardRights, sondehubCounts, sondehubLine, sondehubListeners, type Sharing } from "../lib/sharing";
+import { chaseLine, forwardCounts, relaysLine, forwardRights, sondehubCounts, sondehubLine, sondehubListeners, type Sharing } from "../lib/sharing";
 
 export class SharingPanel {
   readonly root: HTMLElement;
@@ -14,6 +14,7 @@ export class SharingPanel {
   private readonly sondehubCounts: HTMLElement;
   private readonly sondehubListeners: HTMLElement;
   private readonly sondehubNotes: HTMLElement;
+  private readonly relays: HTMLElement;
 
   constructor() {
     this.chase = h("p", { "data-testid": "sharing-chase" }, "…");
@@ -22,8 +23,10 @@ export class SharingPanel {
     this.sondehubCounts = h("p", { class: "muted", "data-testid": "sharing-sondehub-counts" });
     this.sondehubListeners = h("p", { class: "muted", "data-testid": "sharing-sondehub-listeners" });
     this.sondehubNotes = h("ul", { class: "sharing-notes", "data-testid": "sharing-sondehub-notes" });
+    this.relays = h("p", { "data-testid": "sharing-relays" }, "…");
     this.root = panel("Shared with", "panel-sharing", h("h3", {}, "Chase cars"), this.chase,
       h("h3", {}, "SondeHub-Amateur"), this.sondehub, this.sondehubCounts, this.sondehubListeners, this.sondehubNotes,
+      h("h3", {}, "Public relays"), this.relays,
       h("h3", {}, "Other ground stations (MAVLink forwards)"), this.forwards);
   }
 
@@ -41,6 +44,8 @@ export class SharingPanel {
         h("strong", {}, f.name), ` → ${f.address} · ${forwardRights(f)} · ${forwardCounts(f)}`));
     this.forwards.replaceChildren(...(items.length > 0 ? items : [h("li", {}, "none (no [[forward]] in the station's config)")]));
     this.updateSondehub(s, nowMs);
+    setText(this.relays, relaysLine(s.relays));
+    this.relays.dataset.viewers = String(s.relays.reduce((n, r) => n + r.viewers, 0));
   }
 
   private updateSondehub(s: Sharing, nowMs: number): void {

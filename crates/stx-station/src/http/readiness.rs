@@ -1,7 +1,7 @@
 //! `GET /api/readiness`: the go/no-go board (any role); `POST /api/readiness/{id}`: an
 //! operator ticks or unticks a checklist item. The board also rides in every `state` message.
 //! `GET /api/sharing`: what the station shares with watching ground stations, chase cars and
-//! SondeHub (the board's neighbour on the Go/no-go tab).
+//! SondeHub, and the public relays' audience (the board's neighbour on the Go/no-go tab).
 
 use axum::Json;
 use axum::extract::rejection::JsonRejection;
@@ -19,8 +19,8 @@ pub(crate) async fn board(State(state): State<AppState>, _caller: Caller) -> Res
     Json(state.core().state_msg_now(now).readiness).into_response()
 }
 
-/// `GET /api/sharing` (any role): the read-only MAVLink outputs, the chase broadcast and
-/// the SondeHub upload.
+/// `GET /api/sharing` (any role): the read-only MAVLink outputs, the chase broadcast, the
+/// SondeHub upload and the public relays.
 pub(crate) async fn sharing(State(state): State<AppState>, _caller: Caller) -> Response {
     let forwards = state.forwards.lock().map(|f| f.clone()).unwrap_or_default();
     let chase = state.chase.lock().ok().and_then(|c| c.clone());
@@ -28,10 +28,26 @@ pub(crate) async fn sharing(State(state): State<AppState>, _caller: Caller) -> R
         .sondehub
         .as_ref()
         .and_then(|s| s.view.lock().ok().map(|v| v.clone()));
+    let relays = state
+        .clients
+        .lock()
+        .unwrap_or_else(|e| e.into_inner())
+        .iter()
+        .filter_map(|(&id, c)| {
+            let viewers = (*c.relay_viewers.lock().unwrap_or_else(|e| e.into_inner()))?;
+            Some(crate::forward::RelayShare {
+                id,
+                name: c.name.clone(),
+                connected_s: c.connected_s,
+                viewers,
+            })
+        })
+        .collect();
     Json(crate::forward::SharingBody {
         forwards,
         chase,
         sondehub,
+        relays,
     })
     .into_response()
 }

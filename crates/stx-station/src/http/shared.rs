@@ -162,6 +162,8 @@ pub struct ClientCounters {
     pub messages_missed: AtomicU64,
     /// Times it fell that far behind.
     pub lag_episodes: AtomicU64,
+    /// A public relay's last `relay_viewers` figure; `None` for a page.
+    pub relay_viewers: Mutex<Option<u32>>,
 }
 
 impl ClientCounters {
@@ -179,6 +181,7 @@ impl ClientCounters {
             messages_missed: n(&self.messages_missed),
             messages_behind: total.saturating_sub(done),
             lag_episodes: n(&self.lag_episodes),
+            relay_viewers: *self.relay_viewers.lock().unwrap_or_else(|e| e.into_inner()),
         }
     }
 }

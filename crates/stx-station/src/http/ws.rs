@@ -149,7 +149,7 @@ async fn serve_socket(state: AppState, caller: Caller, mut socket: WebSocket) {
             }
             incoming = socket.recv() => match incoming {
                 Some(Ok(Message::Text(text))) => {
-                    handle_client(&state, &caller, &mut socket, text.as_str()).await;
+                    handle_client(&state, &caller, &counters, &mut socket, text.as_str()).await;
                 }
                 Some(Ok(Message::Close(_))) | None | Some(Err(_)) => break,
                 Some(Ok(_)) => {}
@@ -182,7 +182,13 @@ fn refusal(state: &Shared, text: &str) -> Message {
     Message::Text(serde_json::to_string(&reply).unwrap_or_default().into())
 }
 
-async fn handle_client(state: &Shared, caller: &Caller, socket: &mut WebSocket, text: &str) {
+async fn handle_client(
+    state: &Shared,
+    caller: &Caller,
+    counters: &ClientCounters,
+    socket: &mut WebSocket,
+    text: &str,
+) {
     let message = serde_json::from_str::<ClientMessage>(text);
     if matches!(
         message,
@@ -205,6 +211,16 @@ async fn handle_client(state: &Shared, caller: &Caller, socket: &mut WebSocket, 
             let now = state.now_s();
             state.core().manual_release(now);
             state.link_due.notify_one();
+        }
+        Ok(ClientMessage::RelayViewers { viewers }) => {
+            let mut held = counters
+                .relay_viewers
+                .lock()
+                .unwrap_or_else(|e| e.into_inner());
+            if held.is_none() {
+                tracing::info!(name = %caller.name, viewers, "a public relay is on this socket");
+            }
+            *held = Some(viewers);
         }
         Ok(ClientMessage::Ping) => {
             let pong = serde_json::to_string(&PongMsg { kind: "pong" }).unwrap_or_default();

@@ -7,13 +7,16 @@
 //! - [`public`]: the public state and track (what a viewer may see), read from the upstream;
 //! - [`feed`]: the relay's picture on its own clock: the delay, the grid, the track (pure);
 //! - [`kml`]: the Google Earth document of the public picture;
-//! - `serve` (daemon): the upstream's socket and the viewers' server.
+//! - `upstream` (daemon): the socket to the upstream (plain or TLS), reporting the audience up;
+//! - `serve` (daemon): the viewers' server.
 
 pub mod feed;
 pub mod kml;
 pub mod public;
 #[cfg(feature = "daemon")]
 pub mod serve;
+#[cfg(feature = "daemon")]
+pub mod upstream;
 
 #[cfg(test)]
 mod tests;

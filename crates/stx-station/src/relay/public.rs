@@ -94,8 +94,11 @@ pub struct RelayStatusBody {
     pub upstream: String,
     /// The upstream's WebSocket is open.
     pub upstream_connected: bool,
-    /// Viewers connected to this relay now.
+    /// Viewers connected to this relay now (a relay below counts one).
     pub viewers: u32,
+    /// Pages served through this relay: its own viewers, a relay below counted by the pages it
+    /// reports. This is what the relay reports to its upstream.
+    pub audience: u32,
     /// Most viewers this relay serves at once.
     pub max_viewers: u32,
     /// This relay's own delay, s.

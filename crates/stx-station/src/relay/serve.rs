@@ -1,8 +1,7 @@
-//! The relay's tokio adapter: one WebSocket to the upstream (a station, through a viewer's
-//! token, or another relay), reconnected with back-off while it is down, fed into the
-//! [`Feed`]; an axum server for the viewers with the public page, its WebSocket, the KML feed
-//! and the relay's status. There is no token and no command route: a relay has nothing to
-//! command with (its upstream token is a viewer's, and it never sends on that socket).
+//! The relay's tokio adapter: an axum server for the viewers with the public page, its
+//! WebSocket, the KML feed and the relay's status, fed by the upstream's socket
+//! ([`super::upstream`]). There is no token and no command route: a relay has nothing to
+//! command with (its upstream token is a viewer's, and all it sends up is its audience).
 //!
 //! Each viewer gets the newest state through a `watch` channel (a slow one skips to the newest,
 //! it never queues), serialised once per state for all of them, so a thousand viewers cost the
@@ -17,31 +16,35 @@ use std::time::{Duration, Instant};
 
 use axum::Router;
 use axum::extract::State;
-use axum::extract::ws::{Message, WebSocket, WebSocketUpgrade};
+use axum::extract::ws::{Message, Utf8Bytes, WebSocket, WebSocketUpgrade};
 use axum::http::{StatusCode, header};
 use axum::response::{IntoResponse, Response};
 use axum::routing::{any, get};
-use futures_util::StreamExt;
-use thiserror::Error;
 use tokio::net::TcpListener;
 use tokio::sync::watch;
 use tower_http::services::{ServeDir, ServeFile};
 
 use super::feed::{Feed, RelaySettings};
-use super::public::{RelayStatusBody, read_upstream};
+use super::public::RelayStatusBody;
+use super::upstream::{Follower, Upstream};
 use crate::http::headers::SecurityHeaders;
 
 /// How often held states are looked at for being due, s.
 const RELEASE_EVERY: Duration = Duration::from_millis(100);
-/// Longest wait between attempts to reach the upstream.
-const MAX_BACKOFF: Duration = Duration::from_secs(5);
+/// A viewer socket's read buffer, bytes.
+const VIEWER_BUFFER: usize = 4096;
+/// The largest message a viewer may send, bytes.
+const VIEWER_MESSAGE_MAX: usize = 16 * 1024;
 
 /// What `stx relay` runs.
 #[derive(Debug, Clone)]
 pub struct RelayOptions {
-    /// The upstream, `http://HOST:PORT/?token=VIEWER-TOKEN` for a station or
-    /// `http://HOST:PORT/` for a relay (`ws://` works as well).
+    /// The upstream, `http(s)://HOST:PORT/?token=VIEWER-TOKEN` for a station or
+    /// `http(s)://HOST:PORT/` for a relay (`ws://` and `wss://` work as well).
     pub upstream: String,
+    /// A PEM file of certificates trusted for an `https://` upstream besides Mozilla's roots
+    /// (a field station's self-signed certificate).
+    pub upstream_ca: Option<PathBuf>,
     /// The built dashboard (`web/dist`): the public page and its assets.
     pub web_dir: PathBuf,
     /// Delay and grid.
@@ -50,53 +53,18 @@ pub struct RelayOptions {
     pub max_viewers: usize,
 }
 
-/// Why the relay cannot run.
-#[derive(Debug, Error)]
-pub enum RelayError {
-    /// The upstream address is not one the relay can reach.
-    #[error("upstream {0}: {1}")]
-    Upstream(String, &'static str),
-    /// The listening socket.
-    #[error("serving viewers: {0}")]
-    Serve(#[from] std::io::Error),
-}
-
-/// The upstream's WebSocket address and how it is shown (without its token).
-pub fn upstream_ws(upstream: &str) -> Result<(String, String), RelayError> {
-    let bad = |why| RelayError::Upstream(upstream.to_string(), why);
-    let rest = if let Some(r) = upstream.strip_prefix("http://") {
-        r
-    } else if let Some(r) = upstream.strip_prefix("ws://") {
-        r
-    } else if upstream.starts_with("https://") || upstream.starts_with("wss://") {
-        return Err(bad(
-            "TLS upstreams are not supported yet: relay from the station's plain-HTTP address",
-        ));
-    } else {
-        return Err(bad("not an http:// or ws:// address"));
-    };
-    let (host, tail) = rest.split_at(rest.find(['/', '?']).unwrap_or(rest.len()));
-    if host.is_empty() {
-        return Err(bad("no host"));
-    }
-    let query = tail.split_once('?').map(|(_, q)| q).unwrap_or("");
-    let token = form_urlencoded::parse(query.as_bytes())
-        .find(|(k, _)| k == "token")
-        .map(|(_, v)| v.into_owned());
-    let url = match &token {
-        Some(t) => format!(
-            "ws://{host}/api/ws?token={}",
-            form_urlencoded::byte_serialize(t.as_bytes()).collect::<String>()
-        ),
-        None => format!("ws://{host}/api/ws"),
-    };
-    Ok((url, format!("http://{host}/")))
-}
+pub use super::upstream::RelayError;
 
 struct Relay {
     feed: Mutex<Feed>,
-    latest: watch::Sender<Option<Arc<str>>>,
+    /// The newest public state as sent, shared by every viewer's socket (a reference count,
+    /// not a copy each).
+    latest: watch::Sender<Option<Utf8Bytes>>,
+    /// Viewer sockets open.
     viewers: AtomicUsize,
+    /// Pages served through this relay: a viewer socket counts one, a relay below counts what
+    /// it last reported.
+    audience: AtomicUsize,
     connected: AtomicBool,
     shown_upstream: String,
     max_viewers: usize,
@@ -112,6 +80,12 @@ impl Relay {
         self.started.elapsed().as_secs_f64()
     }
 
+    /// A viewer socket that counted `old` pages now counts `new`.
+    fn recount(&self, old: usize, new: usize) {
+        self.audience.fetch_add(new, Ordering::Relaxed);
+        self.audience.fetch_sub(old, Ordering::Relaxed);
+    }
+
     /// Sends the viewers the newest state come due.
     fn release(&self) {
         let due = self.feed().due(self.now_s());
@@ -121,23 +95,46 @@ impl Relay {
     }
 }
 
+impl Follower for Relay {
+    fn set_connected(&self, up: bool) {
+        self.connected.store(up, Ordering::Relaxed);
+    }
+
+    fn on_upstream(&self, news: super::public::UpstreamNews) {
+        self.feed().on_upstream(self.now_s(), news);
+        self.release();
+    }
+
+    fn audience(&self) -> usize {
+        self.audience.load(Ordering::Relaxed)
+    }
+}
+
 /// Serves viewers on `listener` from the upstream until `shutdown` resolves.
 pub async fn run(
     options: RelayOptions,
     listener: TcpListener,
     shutdown: impl std::future::Future<Output = ()> + Send + 'static,
 ) -> Result<(), RelayError> {
-    let (ws_url, shown_upstream) = upstream_ws(&options.upstream)?;
+    let upstream = Upstream::parse(&options.upstream)?;
+    let connector = if upstream.tls {
+        Some(super::upstream::tls_connector(
+            options.upstream_ca.as_deref(),
+        )?)
+    } else {
+        None
+    };
     let relay = Arc::new(Relay {
         feed: Mutex::new(Feed::new(options.settings)),
         latest: watch::channel(None).0,
         viewers: AtomicUsize::new(0),
+        audience: AtomicUsize::new(0),
         connected: AtomicBool::new(false),
-        shown_upstream,
+        shown_upstream: upstream.shown.clone(),
         max_viewers: options.max_viewers,
         started: Instant::now(),
     });
-    let upstream = tokio::spawn(follow_upstream(relay.clone(), ws_url));
+    let upstream = tokio::spawn(super::upstream::follow(relay.clone(), upstream, connector));
     let ticker = tokio::spawn({
         let relay = relay.clone();
         async move {
@@ -172,46 +169,6 @@ pub async fn run(
     served.map_err(RelayError::Serve)
 }
 
-/// Keeps the upstream's WebSocket open, reconnecting with back-off, and feeds what it says.
-async fn follow_upstream(relay: Arc<Relay>, url: String) {
-    let mut backoff = Duration::from_millis(250);
-    loop {
-        match tokio_tungstenite::connect_async(url.as_str()).await {
-            Ok((mut socket, _)) => {
-                tracing::info!(upstream = %relay.shown_upstream, "relay: upstream connected");
-                relay.connected.store(true, Ordering::Relaxed);
-                backoff = Duration::from_millis(250);
-                while let Some(message) = socket.next().await {
-                    let text = match message {
-                        Ok(tokio_tungstenite::tungstenite::Message::Text(t)) => t,
-                        Ok(_) => continue,
-                        Err(e) => {
-                            tracing::warn!(error = %e, "relay: upstream socket failed");
-                            break;
-                        }
-                    };
-                    match read_upstream(&text) {
-                        Ok(news) => {
-                            relay.feed().on_upstream(relay.now_s(), news);
-                            relay.release();
-                        }
-                        Err(e) => {
-                            tracing::warn!(error = %e, "relay: an upstream message did not parse")
-                        }
-                    }
-                }
-                relay.connected.store(false, Ordering::Relaxed);
-                tracing::warn!(upstream = %relay.shown_upstream, "relay: upstream lost; reconnecting");
-            }
-            Err(e) => {
-                tracing::warn!(upstream = %relay.shown_upstream, error = %e, "relay: upstream unreachable");
-            }
-        }
-        tokio::time::sleep(backoff).await;
-        backoff = (backoff * 2).min(MAX_BACKOFF);
-    }
-}
-
 async fn viewer_socket(State(relay): State<Arc<Relay>>, upgrade: WebSocketUpgrade) -> Response {
     if relay.viewers.load(Ordering::Relaxed) >= relay.max_viewers {
         let body = format!("this relay serves {} viewers at once", relay.max_viewers);
@@ -222,20 +179,31 @@ async fn viewer_socket(State(relay): State<Arc<Relay>>, upgrade: WebSocketUpgrad
         )
             .into_response();
     }
-    upgrade.on_upgrade(move |socket| serve_viewer(relay, socket))
+    // A viewer sends at most a relay's audience report: small buffers and a small limit keep a
+    // thousand viewers within a relay's memory (the defaults, 128 KiB read buffer each, are
+    // 130 MB at 1,000) and a hostile one from sending megabytes.
+    upgrade
+        .read_buffer_size(VIEWER_BUFFER)
+        .write_buffer_size(0)
+        .max_message_size(VIEWER_MESSAGE_MAX)
+        .max_frame_size(VIEWER_MESSAGE_MAX)
+        .on_upgrade(move |socket| serve_viewer(relay, socket))
 }
 
 async fn serve_viewer(relay: Arc<Relay>, mut socket: WebSocket) {
     relay.viewers.fetch_add(1, Ordering::Relaxed);
+    // A page counts one; a relay below says how many it serves.
+    let mut counts = 1;
+    relay.recount(0, counts);
     let mut states = relay.latest.subscribe();
     let history = serde_json::to_string(&relay.feed().history());
-    let mut first = history.ok().map(|h| vec![h]).unwrap_or_default();
+    let mut first: Vec<Utf8Bytes> = history.ok().map(|h| vec![h.into()]).unwrap_or_default();
     if let Some(s) = states.borrow_and_update().clone() {
-        first.push(s.to_string());
+        first.push(s);
     }
     let mut open = true;
     for text in first {
-        open &= socket.send(Message::Text(text.into())).await.is_ok();
+        open &= socket.send(Message::Text(text)).await.is_ok();
     }
     while open {
         tokio::select! {
@@ -243,16 +211,35 @@ async fn serve_viewer(relay: Arc<Relay>, mut socket: WebSocket) {
                 let Ok(()) = changed else { break };
                 let text = states.borrow_and_update().clone();
                 if let Some(text) = text {
-                    open = socket.send(Message::Text(text.to_string().into())).await.is_ok();
+                    open = socket.send(Message::Text(text)).await.is_ok();
                 }
             }
-            incoming = socket.recv() => {
-                // Viewers have nothing to say: anything but a close is read and dropped.
-                open = matches!(incoming, Some(Ok(m)) if !matches!(m, Message::Close(_)));
-            }
+            incoming = socket.recv() => match incoming {
+                Some(Ok(Message::Text(text))) => {
+                    // Pages have nothing to say; a relay below reports its audience. Anything
+                    // else is read and dropped.
+                    if let Some(n) = audience_report(text.as_str()) {
+                        relay.recount(counts, n);
+                        counts = n;
+                    }
+                }
+                Some(Ok(Message::Close(_))) | None | Some(Err(_)) => open = false,
+                Some(Ok(_)) => {}
+            },
         }
     }
+    relay.recount(counts, 0);
     relay.viewers.fetch_sub(1, Ordering::Relaxed);
+}
+
+/// The pages a relay below serves, from its `relay_viewers` message.
+fn audience_report(text: &str) -> Option<usize> {
+    match serde_json::from_str::<crate::requests::ClientMessage>(text) {
+        Ok(crate::requests::ClientMessage::RelayViewers { viewers }) => {
+            usize::try_from(viewers).ok()
+        }
+        _ => None,
+    }
 }
 
 async fn status(State(relay): State<Arc<Relay>>) -> Response {
@@ -261,6 +248,7 @@ async fn status(State(relay): State<Arc<Relay>>) -> Response {
         upstream: relay.shown_upstream.clone(),
         upstream_connected: relay.connected.load(Ordering::Relaxed),
         viewers: u32::try_from(relay.viewers.load(Ordering::Relaxed)).unwrap_or(u32::MAX),
+        audience: u32::try_from(relay.audience()).unwrap_or(u32::MAX),
         max_viewers: u32::try_from(relay.max_viewers).unwrap_or(u32::MAX),
         delay_s: settings.delay_s,
         coarsen_m: settings.coarsen_m,

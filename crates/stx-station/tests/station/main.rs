@@ -14,6 +14,7 @@ mod lab;
 mod plan;
 mod radios;
 mod recordings;
+mod relay;
 mod replay;
 mod replica;
 mod tiles;

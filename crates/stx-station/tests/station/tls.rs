@@ -14,13 +14,13 @@ use tokio_rustls::TlsConnector;
 use tokio_rustls::rustls;
 
 /// A self-signed certificate for `localhost` and 127.0.0.1, written to a fresh directory.
-struct TestCert {
-    dir: std::path::PathBuf,
+pub(crate) struct TestCert {
+    pub(crate) dir: std::path::PathBuf,
     der: rustls::pki_types::CertificateDer<'static>,
 }
 
 impl TestCert {
-    fn new(tag: &str) -> Self {
+    pub(crate) fn new(tag: &str) -> Self {
         let certified =
             rcgen::generate_simple_self_signed(vec!["localhost".into(), "127.0.0.1".into()])
                 .expect("certificate");
@@ -38,14 +38,14 @@ impl TestCert {
         }
     }
 
-    fn settings(&self) -> TlsSettings {
+    pub(crate) fn settings(&self) -> TlsSettings {
         TlsSettings {
             cert_path: self.dir.join("station.crt"),
             key_path: self.dir.join("station.key"),
         }
     }
 
-    async fn connect(
+    pub(crate) async fn connect(
         &self,
         addr: std::net::SocketAddr,
     ) -> tokio_rustls::client::TlsStream<TcpStream> {
