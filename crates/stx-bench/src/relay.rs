@@ -302,12 +302,13 @@ async fn measure(options: &RelayBenchOptions) -> anyhow::Result<RelayReport> {
         start_relay(&options.stx, &upstream, options.viewers).await?;
     let open = Arc::new(AtomicU64::new(0));
     let mut per_viewer = Vec::new();
-    // The viewers stand for other people's machines: they run on a runtime of their own, so
-    // a thousand of them waking at each state do not queue ahead of the timing pages' tasks
-    // (the OS still shares the cores between them, the relay and the station).
+    // The viewers stand for other people's machines: they run on a runtime of their own at
+    // the lowest priority, so a thousand of them waking at each state neither queue ahead of
+    // the timing pages' tasks nor take a core from the station.
     let viewer_runtime = tokio::runtime::Builder::new_multi_thread()
         .worker_threads(1)
         .thread_name("viewers")
+        .on_thread_start(|| stx_station::priority::lower_this_thread("the bench's viewers"))
         .enable_all()
         .build()
         .context("the viewers' runtime")?;

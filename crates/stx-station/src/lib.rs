@@ -29,6 +29,7 @@
 //!   GFS forecast; [`tawhiri`]: Tawhiri's prediction API (`GET /api/v1/`) flown over the
 //!   station's forecast; [`recording`]: what a flight's MCAP recording
 //!   holds, under which topics; [`replay`]: a recording played back through the station;
+//!   [`priority`] (daemon): the lowest priority for the Lab and a relay;
 //!   [`relay`]: `stx relay`, the public picture for any audience (its server is the daemon's).
 //!
 //! With the default feature `daemon`, the adapters:
@@ -61,6 +62,8 @@ pub mod limits;
 pub mod link;
 pub mod messages;
 pub mod preflight;
+#[cfg(feature = "daemon")]
+pub mod priority;
 #[cfg(feature = "daemon")]
 pub mod recorder;
 pub mod recording;

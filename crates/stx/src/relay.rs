@@ -35,6 +35,11 @@ pub struct RelayArgs {
     /// Most viewers at once.
     #[arg(long, value_name = "N", default_value_t = 5000)]
     max_viewers: usize,
+    /// Run at the usual priority. By default the relay runs at the lowest (nice 19, the idle
+    /// class): beside the station it never takes a core the flight's telemetry needs, and on a
+    /// machine of its own it makes no difference.
+    #[arg(long)]
+    full_priority: bool,
     /// The built dashboard (its public page and assets).
     #[arg(long, value_name = "DIR", default_value = "web/dist")]
     web_dir: PathBuf,
@@ -55,6 +60,10 @@ pub fn run(args: RelayArgs) -> anyhow::Result<()> {
         settings,
         max_viewers: args.max_viewers.max(1),
     };
+    if !args.full_priority {
+        // Before the runtime: its threads inherit it.
+        stx_station::priority::lower_this_thread("stx relay");
+    }
     let runtime = tokio::runtime::Builder::new_multi_thread()
         .enable_all()
         .build()

@@ -2,7 +2,7 @@
 //! cancelling a job, saving a vehicle or gains file and sending gains to the drone for
 //! operators. A job's work runs on a thread of its own (named `stx-lab`), never on the runtime that
 //! carries the telemetry, at the lowest priority (the idle scheduling class and
-//! [`LAB_NICE`]), and reports to the pure runner ([`crate::lab::LabJobs`]). A comparison's
+//! [`crate::priority::LOWEST_NICE`]), and reports to the pure runner ([`crate::lab::LabJobs`]). A comparison's
 //! recording is checked before its job starts: a plain name of the recordings directory (as
 //! `GET /api/recordings` lists them), a readable file, holding a flight, and one in the
 //! window asked for, if any (the work reads it: [`crate::lab::LabWorker::check_window`]).
@@ -75,42 +75,6 @@ fn status_body(state: &Shared) -> crate::lab::jobs::LabStatusBody {
     s
 }
 
-/// The nice value of the Lab's thread and of the threads it starts: the lowest priority. A
-/// Monte Carlo batch keeps a core busy for minutes; at the station's own priority the
-/// scheduler shares that core evenly between it and the runtime carrying telemetry, so on a
-/// two-core machine a page's `state` could wait out the Lab's time slice. Nice 19 alone left
-/// `stx bench station --lab-montecarlo 100`'s telemetry p99 at 12.2 and 11.6 ms (8.1 and 7.7
-/// without the Lab); with the idle class too, 6.2 and 7.6 ms.
-pub const LAB_NICE: i32 = 19;
-
-/// Lowers the calling thread (not the process: Linux schedules each thread on its own) to
-/// [`LAB_NICE`] and the idle scheduling class; threads it starts inherit both. The class is
-/// what matters on Linux's EEVDF scheduler (6.6 on): a thread of any nice value runs out its
-/// slice before a woken one gets the core, while a thread of the idle class is preempted by
-/// any other the moment it wakes. Elsewhere, or when refused, the job runs at the station's
-/// priority and the log says so.
-fn lower_this_thread() {
-    #[cfg(target_os = "linux")]
-    {
-        let param = libc::sched_param { sched_priority: 0 };
-        // SAFETY: gettid, setpriority and sched_setscheduler only read and set the calling
-        // thread's scheduling attributes; `param` lives across the call.
-        let refused = unsafe {
-            let tid = libc::gettid();
-            libc::setpriority(libc::PRIO_PROCESS, tid as libc::id_t, LAB_NICE) != 0
-                || libc::sched_setscheduler(0, libc::SCHED_IDLE, &param) != 0
-        };
-        if refused {
-            tracing::warn!(
-                error = %std::io::Error::last_os_error(),
-                "the Lab's thread runs at the station's priority"
-            );
-        }
-    }
-    #[cfg(not(target_os = "linux"))]
-    tracing::warn!("the Lab's thread runs at the station's priority (Linux only lowers it)");
-}
-
 struct Control {
     shared: Arc<Shared>,
     lab: Arc<LabService>,
@@ -174,7 +138,7 @@ pub(crate) async fn start(
     let spawned = std::thread::Builder::new()
         .name("stx-lab".into())
         .spawn(move || {
-            lower_this_thread();
+            crate::priority::lower_this_thread("the Lab");
             let worker = control.lab.worker();
             let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
                 worker.run(&job, &inputs, &control)
@@ -450,49 +414,4 @@ pub(crate) async fn gains_send(
         }),
     )
         .into_response())
-}
-
-#[cfg(all(test, target_os = "linux"))]
-mod tests {
-    use super::{LAB_NICE, lower_this_thread};
-
-    /// The nice value of the calling thread, from `/proc/thread-self/stat` (field 19).
-    fn nice_of_this_thread() -> i32 {
-        let stat = std::fs::read_to_string("/proc/thread-self/stat").expect("stat");
-        // The command name (field 2) may hold spaces; the fields after it do not.
-        let after_name = &stat[stat.rfind(')').expect("name") + 2..];
-        after_name
-            .split(' ')
-            .nth(16)
-            .expect("nice")
-            .parse()
-            .expect("a number")
-    }
-
-    #[test]
-    fn the_lab_s_thread_and_those_it_starts_run_at_the_lowest_priority_alone() {
-        let before = nice_of_this_thread();
-        // SAFETY: sched_getscheduler(0) only reads the calling thread's policy.
-        let policy = || unsafe { libc::sched_getscheduler(0) };
-        let both = move || (nice_of_this_thread(), policy());
-        let (own, started) = std::thread::spawn(move || {
-            lower_this_thread();
-            let started = std::thread::spawn(both).join().expect("joins");
-            (both(), started)
-        })
-        .join()
-        .expect("joins");
-        let lowest = (LAB_NICE, libc::SCHED_IDLE);
-        assert_eq!((own, started), (lowest, lowest));
-        assert_ne!(
-            policy(),
-            libc::SCHED_IDLE,
-            "the station's threads keep theirs"
-        );
-        assert_eq!(
-            nice_of_this_thread(),
-            before,
-            "the station's threads keep theirs"
-        );
-    }
 }

@@ -19,6 +19,7 @@ mod cli_plan;
 mod cli_plan_gfs;
 mod cli_plan_window;
 mod cli_record;
+mod cli_relay;
 mod cli_serve;
 mod cli_sim;
 mod cli_token;
