@@ -323,14 +323,26 @@ fn print_table(r: &MonteCarloReport) {
         r.wind_estimate_rmse_per_run_mps.median,
         r.wind_estimate_rmse_per_run_mps.max
     );
+    println!(
+        "payload miss where guidance found the target within reach ({} runs): median {:.1} m, \
+         95th percentile {:.1} m, worst {:.1} m",
+        r.runs - r.unreachable_runs,
+        r.reachable_payload_miss_m.median,
+        r.reachable_payload_miss_m.p95,
+        r.reachable_payload_miss_m.max
+    );
     println!("target out of reach in {} runs", r.unreachable_runs);
     if r.unreachable_runs > 0 {
         println!(
-            "  touchdown from the best reachable point announced first: median {:.0} m, worst \
-             {:.0} m; announced last: median {:.0} m, worst {:.0} m",
+            "  their payload miss: median {:.0} m, worst {:.0} m; touchdown from the best \
+             reachable point announced first: median {:.0} m, worst {:.0} m; announced last: \
+             median {:.0} m, 95th percentile {:.0} m, worst {:.0} m",
+            r.unreachable_payload_miss_m.median,
+            r.unreachable_payload_miss_m.max,
             r.unreachable_from_best_m.median,
             r.unreachable_from_best_m.max,
             r.unreachable_from_last_best_m.median,
+            r.unreachable_from_last_best_m.p95,
             r.unreachable_from_last_best_m.max
         );
     }
@@ -342,10 +354,12 @@ fn print_table(r: &MonteCarloReport) {
     }
     for w in &r.worst {
         println!(
-            "worst: run {} missed by {:.1} m ({:+.1} m long, {:+.1} m right), heading {:+.0}° \
-             from upwind, wind {:.1} m/s (--replay {})",
+            "worst: run {} missed by {:.1} m, {}{} ({:+.1} m long, {:+.1} m right), heading \
+             {:+.0}° from upwind, wind {:.1} m/s (--replay {})",
             w.index,
             w.miss_m,
+            w.cause,
+            if w.unreachable { ", out of reach" } else { "" },
             w.long_short_m,
             w.left_right_m,
             w.heading_vs_upwind_deg,

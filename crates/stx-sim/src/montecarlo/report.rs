@@ -22,8 +22,28 @@ pub struct WorstRun {
     pub left_right_m: f64,
     /// Heading at touchdown minus upwind, degrees.
     pub heading_vs_upwind_deg: f64,
+    /// The miss in a word: `long`, `short`, `left` or `right`, whichever component is larger.
+    pub cause: &'static str,
+    /// Whether guidance found the target out of reach (its miss is then the wind's and the
+    /// stack's, not guidance's).
+    pub unreachable: bool,
     /// Its conditions.
     pub conditions: RunConditions,
+}
+
+/// A miss in a word: the larger of its along-wind (`long` / `short`) and cross-wind (`right` /
+/// `left`) components.
+pub fn miss_in_a_word(long_short_m: f64, left_right_m: f64) -> &'static str {
+    match (
+        long_short_m.abs() >= left_right_m.abs(),
+        long_short_m >= 0.0,
+        left_right_m >= 0.0,
+    ) {
+        (true, true, _) => "long",
+        (true, false, _) => "short",
+        (false, _, true) => "right",
+        (false, _, false) => "left",
+    }
 }
 
 /// Median, 95th percentile, maximum and mean of a sample.
@@ -142,6 +162,11 @@ pub struct MonteCarloReport {
     pub wind_estimate_rmse_mps: f64,
     /// Per-run wind-estimate RMS errors, m/s.
     pub wind_estimate_rmse_per_run_mps: Stats,
+    /// The payload's miss over the runs guidance found the target within reach (failed runs
+    /// count among them, as [`Self::miss_m`] says), m.
+    pub reachable_payload_miss_m: Stats,
+    /// The payload's miss over the runs guidance found the target out of reach, m.
+    pub unreachable_payload_miss_m: Stats,
     /// Runs in which guidance found the target out of reach.
     pub unreachable_runs: usize,
     /// Over those runs, the distance from the best reachable point guidance first announced
@@ -200,6 +225,8 @@ impl MonteCarloReport {
                 long_short_m: r.long_short_m,
                 left_right_m: r.left_right_m,
                 heading_vs_upwind_deg: r.heading_vs_upwind_deg,
+                cause: miss_in_a_word(r.long_short_m, r.left_right_m),
+                unreachable: r.unreachable,
                 conditions: r.conditions.clone(),
             })
             .collect();
@@ -230,6 +257,21 @@ impl MonteCarloReport {
             touchdown_vertical_speed_mps: of_landings(|r| r.touchdown_vertical_speed_mps),
             wind_estimate_rmse_mps: pooled,
             wind_estimate_rmse_per_run_mps: Stats::of(&wind_errors),
+            reachable_payload_miss_m: Stats::of(
+                &results
+                    .iter()
+                    .filter(|r| !r.unreachable)
+                    .map(|r| r.payload_miss_m)
+                    .chain(failed_runs.iter().map(|_| f64::INFINITY))
+                    .collect::<Vec<_>>(),
+            ),
+            unreachable_payload_miss_m: Stats::of(
+                &results
+                    .iter()
+                    .filter(|r| r.unreachable)
+                    .map(|r| r.payload_miss_m)
+                    .collect::<Vec<_>>(),
+            ),
             unreachable_runs: results.iter().filter(|r| r.unreachable).count(),
             unreachable_from_best_m: announced(|r| r.from_best_reachable_m),
             unreachable_from_last_best_m: announced(|r| r.from_last_best_reachable_m),
@@ -338,6 +380,47 @@ mod tests {
     }
 
     #[test]
+    fn reachable_and_unreachable_runs_are_reported_apart_and_each_worst_run_named() {
+        let run = |index, miss, unreachable, long_short_m, left_right_m| RunResult {
+            index,
+            miss_m: miss,
+            payload_miss_m: miss,
+            unreachable,
+            long_short_m,
+            left_right_m,
+            ..landed(0.0, false)
+        };
+        let report = MonteCarloReport::assemble(
+            CampaignHeader::of(&MonteCarloConfig::default()),
+            vec![
+                run(0, 4.0, false, 3.0, -2.0),
+                run(1, 6.0, false, -1.0, 5.9),
+                run(2, 40.0, true, -39.0, 8.0),
+                run(3, 8.0, false, 2.0, -7.7),
+            ],
+            Vec::new(),
+            0.0,
+        );
+        assert_eq!(report.reachable_payload_miss_m.median, 6.0);
+        assert_eq!(report.reachable_payload_miss_m.max, 8.0);
+        assert_eq!(report.unreachable_payload_miss_m.max, 40.0);
+        let named: Vec<_> = report
+            .worst
+            .iter()
+            .map(|w| (w.index, w.cause, w.unreachable))
+            .collect();
+        assert_eq!(
+            named,
+            vec![
+                (2, "short", true),
+                (3, "left", false),
+                (1, "right", false),
+                (0, "long", false)
+            ]
+        );
+    }
+
+    #[test]
     fn into_the_wind_means_within_30_degrees_of_upwind_on_either_side() {
         let runs = [
             landed(29.0, false),
@@ -378,5 +461,6 @@ mod failed_run_tests {
         );
         assert_eq!(report.runs, 1);
         assert!(report.miss_m.median.is_infinite());
+        assert!(report.reachable_payload_miss_m.median.is_infinite());
     }
 }
