@@ -14,7 +14,7 @@
 
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
-use stx_gnc::flight_path::{PlanError, PlanReport, PlanRequest, plan};
+use stx_gnc::flight_path::{PlanError, PlanReport, PlanRequest, plan_each};
 use stx_weather::{GfsError, GfsField, OffsetDateTime, format_time};
 
 /// Most launch times one window may ask for (a week, hourly).
@@ -194,27 +194,32 @@ pub fn plan_window(
     // The launch site outside the files' box is said once, before any plan.
     field.profile(request.launch_lat_deg, request.launch_lon_deg, from)?;
     let threads = threads.clamp(1, times.len());
-    // Interleaved, so each thread gets early and late launches alike.
-    let results: Vec<Vec<(usize, Result<PlanReport, WindowError>)>> = std::thread::scope(|s| {
+    let batch = PATHS_AT_ONCE / (request.runs as usize).max(1);
+    // Interleaved, so each thread gets early and late launches alike. Each thread works its
+    // samples' wind-free part out once for all its launches (`plan_each`): the same draws at
+    // every launch are what lets it.
+    let results: Vec<Result<Vec<(usize, PlanReport)>, WindowError>> = std::thread::scope(|s| {
         let handles: Vec<_> = (0..threads)
             .map(|k| {
                 let times = &times;
                 s.spawn(move || {
-                    (k..times.len())
-                        .step_by(threads)
-                        .map(|i| (i, plan_at(field, request, times[i])))
-                        .collect()
+                    let mine: Vec<usize> = (k..times.len()).step_by(threads).collect();
+                    let at: Vec<OffsetDateTime> = mine.iter().map(|&i| times[i]).collect();
+                    plan_at(field, request, &at, batch)
+                        .map(|reports| mine.into_iter().zip(reports).collect())
                 })
             })
             .collect();
         handles
             .into_iter()
-            .map(|h| h.join().unwrap_or_default())
+            .map(|h| h.join().unwrap_or_else(|_| Ok(Vec::new())))
             .collect()
     });
     let mut reports: Vec<Option<PlanReport>> = vec![None; times.len()];
-    for (i, r) in results.into_iter().flatten() {
-        reports[i] = Some(r?);
+    for r in results {
+        for (i, report) in r? {
+            reports[i] = Some(report);
+        }
     }
     let mut launches = Vec::with_capacity(times.len());
     for (time, report) in times.iter().zip(reports) {
@@ -235,20 +240,36 @@ pub fn plan_window(
     })
 }
 
-/// The plan of `request` over the wind at the launch site at `at`.
+/// The plans of `request` over the wind at the launch site at each of `times`, `batch`
+/// launches at a time.
 fn plan_at(
     field: &GfsField,
     request: &PlanRequest,
-    at: OffsetDateTime,
-) -> Result<PlanReport, WindowError> {
-    let mut request = request.clone();
-    let levels = field.profile(request.launch_lat_deg, request.launch_lon_deg, at)?;
-    request.forecast = crate::forecast_file::rows(&levels);
-    plan(&request).map_err(|source| WindowError::Plan {
-        time: format_time(at),
-        source,
-    })
+    times: &[OffsetDateTime],
+    batch: usize,
+) -> Result<Vec<PlanReport>, WindowError> {
+    let mut forecasts = Vec::with_capacity(times.len());
+    for &at in times {
+        let levels = field.profile(request.launch_lat_deg, request.launch_lon_deg, at)?;
+        forecasts.push(crate::forecast_file::rows(&levels));
+    }
+    let batch = batch.max(1);
+    let mut reports = Vec::with_capacity(times.len());
+    for (b, forecasts) in forecasts.chunks(batch).enumerate() {
+        let planned = plan_each(request, forecasts).map_err(|(i, source)| WindowError::Plan {
+            time: format_time(times[b * batch + i]),
+            source,
+        })?;
+        reports.extend(planned);
+    }
+    Ok(reports)
 }
+
+/// Most sample paths one thread holds at once (about 170 bytes each): `plan_each` holds every
+/// sample's path of every launch it is given until it takes their spreads, so launches go to it
+/// in batches, and a week of 5000-sample launches stays within tens of megabytes for a
+/// wind-free part worked out once a batch.
+const PATHS_AT_ONCE: usize = 100_000;
 
 fn launch_of(at: OffsetDateTime, report: &PlanReport) -> WindowLaunch {
     let point = |p: &stx_gnc::flight_path::plan::PlannedPoint| WindowPoint {
@@ -293,6 +314,7 @@ fn rank(launches: &mut [WindowLaunch]) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use stx_gnc::flight_path::plan;
 
     fn window(from: &str, to: &str, every_s: u32) -> WindowTimes {
         WindowTimes {
@@ -450,6 +472,93 @@ mod tests {
             e.contains("launch at 2026-11-30T06:00:00Z: request: `runs`"),
             "{e}"
         );
+    }
+
+    /// Pins the window's output from before each sample's wind-free part was worked out once
+    /// for all launches (`stx plan --window` of that commit, 1ba4461): the restructuring
+    /// does the same arithmetic in the same order, so the figures are the same to the last
+    /// bit.
+    #[test]
+    fn regression_window_landings_are_those_of_the_launch_by_launch_planner() {
+        let field = field();
+        let mut r = request();
+        r.target_lat_lon_deg = Some([37.85, -6.3]);
+        let w = window("2026-11-30T06:00:00Z", "2026-11-30T12:00:00Z", 5400);
+        let report = plan_window(&field, &r, &w, 2).unwrap();
+        // Landing (lat, lon), burst (lat, lon), landing 1-σ, reach share, rank.
+        let pinned: [([f64; 5], f64, u32); 5] = [
+            (
+                [
+                    37.88831652607354,
+                    -6.375257017427966,
+                    37.958321594302866,
+                    -6.948447913596561,
+                    13512.862843124914,
+                ],
+                0.025,
+                4,
+            ),
+            (
+                [
+                    37.85218876220431,
+                    -6.319409076446586,
+                    37.936024871074714,
+                    -6.912893699083407,
+                    13667.768772783755,
+                ],
+                0.1,
+                1,
+            ),
+            (
+                [
+                    37.816093039804045,
+                    -6.263558640139682,
+                    37.913716531468516,
+                    -6.877347560469708,
+                    13844.986886075898,
+                ],
+                0.025,
+                3,
+            ),
+            (
+                [
+                    37.782600860746996,
+                    -6.208971397021413,
+                    37.89280373676746,
+                    -6.843275176982188,
+                    14004.200647046306,
+                ],
+                0.1,
+                2,
+            ),
+            (
+                [
+                    37.749157345399425,
+                    -6.154360164564028,
+                    37.87189011284021,
+                    -6.809198119160678,
+                    14182.008937246273,
+                ],
+                0.025,
+                5,
+            ),
+        ];
+        for (l, (figures, share, rank)) in report.launches.iter().zip(pinned) {
+            let got = [
+                l.landing_unsteered.lat_deg,
+                l.landing_unsteered.lon_deg,
+                l.burst.lat_deg,
+                l.burst.lon_deg,
+                l.landing_sigma_m,
+            ];
+            assert_eq!(got, figures, "{}", l.launch_time);
+            assert_eq!((l.reach_share, l.rank), (share, rank), "{}", l.launch_time);
+            assert_eq!(l.burst.time_s, 3961.9560255401475);
+        }
+        // Launches batched apart are planned as launches planned together.
+        let times = launch_times(&w).unwrap();
+        let one_by_one = plan_at(&field, &r, &times, 1).unwrap();
+        assert_eq!(one_by_one, plan_at(&field, &r, &times, 5).unwrap());
     }
 
     #[test]

@@ -24,6 +24,8 @@
 //!   altitude above ground that [`WindProfile`] uses is `−z`. Callers that need altitude above
 //!   sea level for the atmosphere add the ground's elevation themselves.
 
+use std::sync::atomic::{AtomicUsize, Ordering};
+
 use nalgebra::Vector3;
 use thiserror::Error;
 /// The air's velocity as a deterministic function of time and position.
@@ -31,17 +33,49 @@ pub trait WindField: Send + Sync {
     /// Air velocity in NED, m/s, at `time_s` (s) and `position_ned_m` (NED, m, origin on the
     /// ground so that altitude above ground is `−position_ned_m.z`).
     fn wind_ned_mps(&self, time_s: f64, position_ned_m: &Vector3<f64>) -> Vector3<f64>;
+
+    /// [`WindField::wind_ned_mps`], to the last bit, for a caller that asks again and again
+    /// close to where it asked last (a path, step by step): `hint` keeps where the field found
+    /// the last answer (a profile: its row), so that it may look there first. Any value of
+    /// `hint` gives the same answer; an atomic, so that a field stays `Sync`.
+    fn wind_ned_mps_near(
+        &self,
+        time_s: f64,
+        position_ned_m: &Vector3<f64>,
+        hint: &AtomicUsize,
+    ) -> Vector3<f64> {
+        let _ = hint;
+        self.wind_ned_mps(time_s, position_ned_m)
+    }
 }
 
 impl<W: WindField + ?Sized> WindField for &W {
     fn wind_ned_mps(&self, time_s: f64, position_ned_m: &Vector3<f64>) -> Vector3<f64> {
         (**self).wind_ned_mps(time_s, position_ned_m)
     }
+
+    fn wind_ned_mps_near(
+        &self,
+        time_s: f64,
+        position_ned_m: &Vector3<f64>,
+        hint: &AtomicUsize,
+    ) -> Vector3<f64> {
+        (**self).wind_ned_mps_near(time_s, position_ned_m, hint)
+    }
 }
 
 impl<W: WindField + ?Sized> WindField for Box<W> {
     fn wind_ned_mps(&self, time_s: f64, position_ned_m: &Vector3<f64>) -> Vector3<f64> {
         (**self).wind_ned_mps(time_s, position_ned_m)
+    }
+
+    fn wind_ned_mps_near(
+        &self,
+        time_s: f64,
+        position_ned_m: &Vector3<f64>,
+        hint: &AtomicUsize,
+    ) -> Vector3<f64> {
+        (**self).wind_ned_mps_near(time_s, position_ned_m, hint)
     }
 }
 
@@ -247,6 +281,19 @@ impl WindProfile {
         let table = &self.components;
         // Rows strictly below the altitude; for NaN this is 0 and the result is NaN below.
         let above = count_below(table.iter().map(|&(a, _, _)| a), altitude_m);
+        self.north_east_above(above, altitude_m)
+    }
+
+    /// [`Self::north_east_at`] with `hint` the rows below the altitude last asked.
+    fn north_east_near(&self, altitude_m: f64, hint: &AtomicUsize) -> (f64, f64) {
+        let table = &self.components;
+        let above = count_below_near(table.len(), |i| table[i].0, altitude_m, hint);
+        self.north_east_above(above, altitude_m)
+    }
+
+    /// The components at `altitude_m`, which `above` rows lie strictly below.
+    fn north_east_above(&self, above: usize, altitude_m: f64) -> (f64, f64) {
+        let table = &self.components;
         if altitude_m.is_nan() {
             return (f64::NAN, f64::NAN);
         }
@@ -276,9 +323,39 @@ pub fn count_below(values: impl Iterator<Item = f64>, x: f64) -> usize {
     values.map(|v| usize::from(v < x)).sum()
 }
 
+/// [`count_below`] of the `len` strictly increasing values `value(i)`, with `hint` the count
+/// last time: the same count, in two comparisons when `x` lies in the same interval as then
+/// (a path asks a few metres apart, a profile's rows lie hundreds apart).
+pub fn count_below_near(
+    len: usize,
+    value: impl Fn(usize) -> f64,
+    x: f64,
+    hint: &AtomicUsize,
+) -> usize {
+    let c = hint.load(Ordering::Relaxed);
+    // For increasing values the count is `c` exactly when the value before `c` is below `x`
+    // and the one at `c` is not (NaN compares false both ways, so it is counted in full).
+    if c <= len && (c == 0 || value(c - 1) < x) && (c == len || value(c) >= x) {
+        return c;
+    }
+    let c = count_below((0..len).map(&value), x);
+    hint.store(c, Ordering::Relaxed);
+    c
+}
+
 impl WindField for WindProfile {
     fn wind_ned_mps(&self, _time_s: f64, position_ned_m: &Vector3<f64>) -> Vector3<f64> {
         let (north, east) = self.north_east_at(-position_ned_m.z);
+        Vector3::new(north, east, 0.0)
+    }
+
+    fn wind_ned_mps_near(
+        &self,
+        _time_s: f64,
+        position_ned_m: &Vector3<f64>,
+        hint: &AtomicUsize,
+    ) -> Vector3<f64> {
+        let (north, east) = self.north_east_near(-position_ned_m.z, hint);
         Vector3::new(north, east, 0.0)
     }
 }

@@ -33,6 +33,7 @@ pub mod plan;
 pub mod reach;
 pub mod region;
 pub mod spread;
+mod vertical;
 
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
@@ -45,10 +46,14 @@ use crate::performance::GlidePerformance;
 use crate::pointmass::{Conditions, PointMass};
 pub use forecast::{Forecast, ForecastError, ForecastRow, merge_measured};
 pub use models::{Balloon, RoundChute};
-pub use plan::{PlanError, PlanReport, PlanRequest, plan};
+pub use plan::{PlanError, PlanReport, PlanRequest, plan, plan_each};
 pub use reach::ReachDisc;
 pub use region::SteeredRegion;
-pub use spread::{Dispersion, Ellipse, PlanInputs, PlanSpread, PointSpread, monte_carlo};
+pub use spread::{
+    Dispersion, Ellipse, PlanInputs, PlanSpread, PointSpread, WindCase, monte_carlo,
+    monte_carlo_each,
+};
+pub use vertical::VerticalPath;
 
 /// Mass of the STRAPLEX stack under its round chute (the four bodies, 9.1 kg, plus the chute
 /// and the balloon's remains, 0.3 kg), kg: the simulated drone's default.
@@ -284,73 +289,8 @@ pub fn propagate(
     air: Air<'_>,
     perf: &GlidePerformance,
 ) -> Result<FlightPath, FlightPathError> {
-    stack.validate()?;
-    check("ground_msl_m", air.ground_msl_m, true, "finite")?;
-    let (mut p, ascending) = match start {
-        Start::Ascending(p) => (p, true),
-        Start::UnderRoundChute(p) => (p, false),
-    };
-    if !(p.iter().all(|v| v.is_finite()) && p.z <= 0.0) {
-        return Err(FlightPathError::StartBelowGround { height_m: -p.z });
-    }
-    let mut t = 0.0;
-    let mut burst = None;
-    if ascending {
-        let burst_height = stack.burst_altitude_msl_m - air.ground_msl_m;
-        let balloon = Balloon::with_mean_rate(
-            stack.mean_ascent_rate_mps,
-            stack.ascent_density_exponent,
-            air.atmosphere,
-            air.ground_msl_m,
-            stack.burst_altitude_msl_m,
-        );
-        if burst_height > -p.z {
-            (p, t) = rise_or_fall(air, stack.step_m, p, t, burst_height, |rho| {
-                balloon.ascent_rate_mps(rho)
-            });
-        }
-        burst = Some(PathPoint::at(&p, t));
-    }
-    let chute = stack.chute();
-    let fall = |p: Vector3<f64>, t: f64, to_height_m: f64| {
-        if -p.z <= to_height_m {
-            return (p, t);
-        }
-        rise_or_fall(air, stack.step_m, p, t, to_height_m, |rho| {
-            chute.terminal_speed_mps(rho)
-        })
-    };
-    let (p_deploy, t_deploy) = fall(p, t, stack.deploy_height_m);
-    let (p_chute, t_chute) = fall(p_deploy, t_deploy, 0.0);
-    let drift = air.wind(t_deploy, &p_deploy);
-    let heading = match stack.deploy_heading_deg {
-        Some(h) => h.to_radians(),
-        None if drift.x.hypot(drift.y) > 0.1 => drift.y.atan2(drift.x),
-        None => 0.0,
-    };
-    let (landing, air_travel) = glide(perf, air, stack, p_deploy, t_deploy, heading);
-    Ok(FlightPath {
-        burst,
-        deploy: PathPoint::at(&p_deploy, t_deploy),
-        landing,
-        round_chute_landing: PathPoint::at(&p_chute, t_chute),
-        deploy_heading_rad: heading,
-        reach: ReachDisc::from_unsteered_glide(landing.ne_m(), air_travel),
-    })
-}
-
-/// Moves the stack vertically from `p` at time `t` to `to_height_m` above the origin (no-op
-/// if already there) at the vertical speed `speed_mps(density)`, drifting with the wind, in
-/// altitude steps of about `step_m` with the midpoint rule.
-fn rise_or_fall(
-    air: Air<'_>,
-    step_m: f64,
-    p: Vector3<f64>,
-    t: f64,
-    to_height_m: f64,
-    speed_mps: impl Fn(f64) -> f64,
-) -> (Vector3<f64>, f64) {
-    vertical_leg(air, step_m, p, t, to_height_m, speed_mps, |_, _| {})
+    let vertical = VerticalPath::new(start, stack, air.atmosphere, air.ground_msl_m)?;
+    Ok(vertical.fly(air, perf))
 }
 
 /// [`propagate`]'s balloon ascent and round-chute fall as one leg, for callers that want the

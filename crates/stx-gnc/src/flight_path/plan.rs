@@ -14,7 +14,7 @@ use serde::{Deserialize, Serialize};
 use stx_types::atmosphere::StandardAtmosphere;
 use stx_types::validate::check;
 
-use super::spread::{PlanInputs, PlanSample, PointSpread, monte_carlo};
+use super::spread::{PlanInputs, PlanSample, PlanSpread, PointSpread, WindCase, monte_carlo_each};
 use super::{Air, Dispersion, Ellipse, Forecast, ForecastRow, StackConfig, Start};
 use crate::geo::LocalFrame;
 use crate::performance::GlidePerformance;
@@ -210,7 +210,74 @@ stx_types::invalid_into!(PlanError);
 
 /// Makes the plan `request` asks for (see the module doc).
 pub fn plan(request: &PlanRequest) -> Result<PlanReport, PlanError> {
+    let forecasts = std::slice::from_ref(&request.forecast);
+    let mut reports = plan_each(request, forecasts).map_err(|(_, e)| e)?;
+    Ok(reports.remove(0))
+}
+
+/// The plans of `request` over each of `forecasts` in place of its own (a launch window's
+/// winds): report `i` is, to the last bit, [`plan`]'s for `request` with `forecasts[i]`, and
+/// each sample's wind-free part is worked out once for all of them
+/// ([`super::monte_carlo_each`]). A refusal names the forecast it is about (0 when it is the
+/// request's own).
+pub fn plan_each(
+    request: &PlanRequest,
+    forecasts: &[Vec<ForecastRow>],
+) -> Result<Vec<PlanReport>, (usize, PlanError)> {
     let r = request;
+    let (frame, target_ne_m) = checked(r).map_err(|e| (0, e))?;
+    let alt = r.launch_alt_msl_m;
+    let sigma = r.default_wind_sigma_mps;
+    let mut winds = Vec::with_capacity(forecasts.len());
+    for (i, rows) in forecasts.iter().enumerate() {
+        let forecast = Forecast::new(rows.clone()).map_err(|e| (i, e.into()))?;
+        let wind = forecast
+            .profile(alt)
+            .map_err(|e| (i, super::ForecastError::from(e).into()))?;
+        winds.push((wind, forecast.sigma_rows(alt, sigma)));
+    }
+    let Some((first_wind, _)) = winds.first() else {
+        return Ok(Vec::new());
+    };
+    let stack = StackConfig {
+        mean_ascent_rate_mps: r.ascent_rate_mps,
+        burst_altitude_msl_m: r.burst_altitude_msl_m,
+        deploy_height_m: r.deploy_height_m,
+        ..StackConfig::default()
+    };
+    let inputs = PlanInputs {
+        start: Start::pad(),
+        stack,
+        dispersion: Dispersion {
+            ascent_rate_sigma_mps: r.ascent_rate_sigma_mps,
+            burst_altitude_sigma_m: r.burst_altitude_sigma_m,
+            wind_sigma: Vec::new(),
+        },
+        runs: r.runs as usize,
+        target_ne_m,
+        region_share_of_best: 0.5,
+    };
+    let air = Air {
+        wind: first_wind,
+        atmosphere: &StandardAtmosphere,
+        ground_msl_m: alt,
+    };
+    let cases: Vec<WindCase<'_>> = winds
+        .iter()
+        .map(|(wind, wind_sigma)| WindCase { wind, wind_sigma })
+        .collect();
+    let mut rng = ChaCha8Rng::seed_from_u64(r.seed);
+    let spreads = monte_carlo_each(&inputs, &cases, air, &GlidePerformance::default(), &mut rng)
+        .map_err(|e| (0, e.into()))?;
+    Ok(spreads
+        .iter()
+        .zip(forecasts)
+        .map(|(spread, rows)| report(r, rows, frame, target_ne_m, spread))
+        .collect())
+}
+
+/// The request's own checks: its launch frame and its target (north, east), m.
+fn checked(r: &PlanRequest) -> Result<(LocalFrame, Option<[f64; 2]>), PlanError> {
     let alt = r.launch_alt_msl_m;
     let (rate, burst, deploy) = (r.ascent_rate_mps, r.burst_altitude_msl_m, r.deploy_height_m);
     let (rate_sigma, burst_sigma) = (r.ascent_rate_sigma_mps, r.burst_altitude_sigma_m);
@@ -309,33 +376,18 @@ pub fn plan(request: &PlanRequest) -> Result<PlanReport, PlanError> {
         }
         None => None,
     };
-    let forecast = Forecast::new(r.forecast.clone())?;
-    let wind = forecast.profile(alt).map_err(super::ForecastError::from)?;
-    let stack = StackConfig {
-        mean_ascent_rate_mps: r.ascent_rate_mps,
-        burst_altitude_msl_m: burst,
-        deploy_height_m: r.deploy_height_m,
-        ..StackConfig::default()
-    };
-    let inputs = PlanInputs {
-        start: Start::pad(),
-        stack,
-        dispersion: Dispersion {
-            ascent_rate_sigma_mps: r.ascent_rate_sigma_mps,
-            burst_altitude_sigma_m: r.burst_altitude_sigma_m,
-            wind_sigma: forecast.sigma_rows(alt, sigma),
-        },
-        runs: r.runs as usize,
-        target_ne_m,
-        region_share_of_best: 0.5,
-    };
-    let air = Air {
-        wind: &wind,
-        atmosphere: &StandardAtmosphere,
-        ground_msl_m: alt,
-    };
-    let mut rng = ChaCha8Rng::seed_from_u64(r.seed);
-    let spread = monte_carlo(&inputs, air, &GlidePerformance::default(), &mut rng)?;
+    Ok((frame, target_ne_m))
+}
+
+/// The report of `spread`, the plan of `r` over `forecast`.
+fn report(
+    r: &PlanRequest,
+    forecast: &[ForecastRow],
+    frame: LocalFrame,
+    target_ne_m: Option<[f64; 2]>,
+    spread: &PlanSpread,
+) -> PlanReport {
+    let alt = r.launch_alt_msl_m;
     let geo = |ne: [f64; 2]| {
         let (lat, lon, _) = frame.to_geodetic(&nalgebra::Vector3::new(ne[0], ne[1], 0.0));
         [lat, lon]
@@ -364,8 +416,11 @@ pub fn plan(request: &PlanRequest) -> Result<PlanReport, PlanError> {
             from_unsteered_landing_m: (ne[0] - landing.north_m).hypot(ne[1] - landing.east_m),
         });
     let samples: &[PlanSample] = &spread.samples;
-    Ok(PlanReport {
-        request: r.clone(),
+    PlanReport {
+        request: PlanRequest {
+            forecast: forecast.to_vec(),
+            ..r.clone()
+        },
         burst: point(spread.burst.as_ref().expect("a plan from the pad bursts")),
         deploy: point(&spread.deploy),
         landing_unsteered: landing,
@@ -384,5 +439,5 @@ pub fn plan(request: &PlanRequest) -> Result<PlanReport, PlanError> {
             .to_string(),
         target,
         landing_samples_lat_lon_deg: samples.iter().map(|s| geo(s.landing_ne_m)).collect(),
-    })
+    }
 }

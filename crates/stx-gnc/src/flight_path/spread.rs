@@ -18,15 +18,17 @@
 //! The region steering reaches is the ground enough of the samples' reach discs cover
 //! ([`super::region`]).
 
+use std::sync::atomic::AtomicUsize;
+
 use nalgebra::{Matrix2, Vector2, Vector3};
 use rand::Rng;
 use rand_distr::{Distribution, StandardNormal};
 use serde::{Deserialize, Serialize};
 use stx_types::validate::check;
-use stx_types::wind::WindField;
+use stx_types::wind::{WindField, count_below_near};
 
 use super::region::{SteeredRegion, steered_region};
-use super::{Air, FlightPath, FlightPathError, ReachDisc, StackConfig, Start, propagate};
+use super::{Air, FlightPath, FlightPathError, ReachDisc, StackConfig, Start, VerticalPath};
 use crate::performance::GlidePerformance;
 
 /// Most samples returned one by one (for a scatter on the map).
@@ -64,26 +66,30 @@ impl Dispersion {
         check("ascent_rate_sigma_mps", s, s >= 0.0, "≥ 0")?;
         let s = self.burst_altitude_sigma_m;
         check("burst_altitude_sigma_m", s, s >= 0.0, "≥ 0")?;
-        for (i, &(h, s)) in self.wind_sigma.iter().enumerate() {
-            let increasing = i == 0 || h > self.wind_sigma[i - 1].0;
-            check("wind_sigma height", h, increasing, "finite, increasing")?;
-            check("wind_sigma", s, s >= 0.0, "≥ 0")?;
-        }
-        Ok(())
+        check_wind_sigma(&self.wind_sigma)
     }
+}
 
-    fn wind_sigma_at(&self, height_m: f64) -> f64 {
-        let rows = &self.wind_sigma;
-        let above = stx_types::wind::count_below(rows.iter().map(|&(h, _)| h), height_m);
-        match (above, rows.len()) {
-            (_, 0) => 0.0,
-            (0, _) => rows[0].1,
-            (a, n) if a == n => rows[n - 1].1,
-            (a, _) => {
-                let ((h0, s0), (h1, s1)) = (rows[a - 1], rows[a]);
-                let f = (height_m - h0) / (h1 - h0);
-                s0 * (1.0 - f) + s1 * f
-            }
+fn check_wind_sigma(rows: &[(f64, f64)]) -> Result<(), FlightPathError> {
+    for (i, &(h, s)) in rows.iter().enumerate() {
+        let increasing = i == 0 || h > rows[i - 1].0;
+        check("wind_sigma height", h, increasing, "finite, increasing")?;
+        check("wind_sigma", s, s >= 0.0, "≥ 0")?;
+    }
+    Ok(())
+}
+
+/// The 1-σ wind error at `height_m` of [`Dispersion::wind_sigma`]-like `rows`, `above` of
+/// which lie strictly below it.
+fn wind_sigma_at(rows: &[(f64, f64)], above: usize, height_m: f64) -> f64 {
+    match (above, rows.len()) {
+        (_, 0) => 0.0,
+        (0, _) => rows[0].1,
+        (a, n) if a == n => rows[n - 1].1,
+        (a, _) => {
+            let ((h0, s0), (h1, s1)) = (rows[a - 1], rows[a]);
+            let f = (height_m - h0) / (h1 - h0);
+            s0 * (1.0 - f) + s1 * f
         }
     }
 }
@@ -91,14 +97,34 @@ impl Dispersion {
 /// The forecast wind moved by one sample's error.
 struct PerturbedWind<'a> {
     base: &'a dyn WindField,
-    dispersion: &'a Dispersion,
+    wind_sigma: &'a [(f64, f64)],
     error: [f64; 2],
+    /// A path asks its wind step by step, a few metres apart: where the base wind and the
+    /// sigma rows found the last answer.
+    base_hint: AtomicUsize,
+    sigma_hint: AtomicUsize,
+}
+
+impl<'a> PerturbedWind<'a> {
+    fn new(base: &'a dyn WindField, wind_sigma: &'a [(f64, f64)], error: [f64; 2]) -> Self {
+        Self {
+            base,
+            wind_sigma,
+            error,
+            base_hint: AtomicUsize::new(0),
+            sigma_hint: AtomicUsize::new(0),
+        }
+    }
 }
 
 impl WindField for PerturbedWind<'_> {
     fn wind_ned_mps(&self, time_s: f64, position_ned_m: &Vector3<f64>) -> Vector3<f64> {
-        let s = self.dispersion.wind_sigma_at(-position_ned_m.z);
-        self.base.wind_ned_mps(time_s, position_ned_m)
+        let rows = self.wind_sigma;
+        let h = -position_ned_m.z;
+        let above = count_below_near(rows.len(), |i| rows[i].0, h, &self.sigma_hint);
+        let s = wind_sigma_at(rows, above, h);
+        self.base
+            .wind_ned_mps_near(time_s, position_ned_m, &self.base_hint)
             + Vector3::new(self.error[0] * s, self.error[1] * s, 0.0)
     }
 }
@@ -231,6 +257,15 @@ pub struct PlanInputs {
     pub region_share_of_best: f64,
 }
 
+/// One of the winds [`monte_carlo_each`] flies the samples through.
+#[derive(Clone, Copy)]
+pub struct WindCase<'a> {
+    /// The wind with no error.
+    pub wind: &'a dyn WindField,
+    /// Its 1-σ error by height, as [`Dispersion::wind_sigma`].
+    pub wind_sigma: &'a [(f64, f64)],
+}
+
 /// Flies `inputs.runs` samples of the path (see the module doc) through `air`, drawing from
 /// `rng`.
 pub fn monte_carlo<R: Rng + ?Sized>(
@@ -239,6 +274,25 @@ pub fn monte_carlo<R: Rng + ?Sized>(
     perf: &GlidePerformance,
     rng: &mut R,
 ) -> Result<PlanSpread, FlightPathError> {
+    let case = WindCase {
+        wind: air.wind,
+        wind_sigma: &inputs.dispersion.wind_sigma,
+    };
+    let mut spreads = monte_carlo_each(inputs, &[case], air, perf, rng)?;
+    Ok(spreads.remove(0))
+}
+
+/// [`monte_carlo`] through each of `winds` in turn (`air.wind` and
+/// `inputs.dispersion.wind_sigma` unused), with the same draws for every wind: each sample's
+/// [`VerticalPath`] is worked out once and flown through every wind. Spread `i` is the same to
+/// the last bit as [`monte_carlo`]'s through `winds[i]` from the same `rng`.
+pub fn monte_carlo_each<R: Rng + ?Sized>(
+    inputs: &PlanInputs,
+    winds: &[WindCase<'_>],
+    air: Air<'_>,
+    perf: &GlidePerformance,
+    rng: &mut R,
+) -> Result<Vec<PlanSpread>, FlightPathError> {
     let PlanInputs {
         start,
         ref stack,
@@ -248,6 +302,9 @@ pub fn monte_carlo<R: Rng + ?Sized>(
         region_share_of_best,
     } = *inputs;
     dispersion.validate()?;
+    for case in winds {
+        check_wind_sigma(case.wind_sigma)?;
+    }
     check("runs", runs as f64, runs >= 1, "≥ 1")?;
     let p = region_share_of_best;
     check("region_share_of_best", p, p > 0.0 && p <= 1.0, "in (0, 1]")?;
@@ -255,21 +312,46 @@ pub fn monte_carlo<R: Rng + ?Sized>(
         check("target north", t[0], true, "finite")?;
         check("target east", t[1], true, "finite")?;
     }
-    let nominal = propagate(start, stack, air, perf)?;
-    let mut paths = Vec::with_capacity(runs);
+    let vertical = |s: &StackConfig| VerticalPath::new(start, s, air.atmosphere, air.ground_msl_m);
+    let nominal = vertical(stack)?;
+    let mut paths: Vec<Vec<FlightPath>> = winds.iter().map(|_| Vec::with_capacity(runs)).collect();
     for _ in 0..runs {
         let mut s = *stack;
         let rate = stack.mean_ascent_rate_mps + normal(rng) * dispersion.ascent_rate_sigma_mps;
         s.mean_ascent_rate_mps = rate.max(0.25 * stack.mean_ascent_rate_mps);
         let burst = stack.burst_altitude_msl_m + normal(rng) * dispersion.burst_altitude_sigma_m;
         s.burst_altitude_msl_m = burst.max(air.ground_msl_m + 100.0);
-        let wind = PerturbedWind {
-            base: air.wind,
-            dispersion,
-            error: [normal(rng), normal(rng)],
-        };
-        paths.push(propagate(start, &s, Air { wind: &wind, ..air }, perf)?);
+        let error = [normal(rng), normal(rng)];
+        let sample = vertical(&s)?;
+        for (case, paths) in winds.iter().zip(&mut paths) {
+            let wind = PerturbedWind::new(case.wind, case.wind_sigma, error);
+            paths.push(sample.fly(Air { wind: &wind, ..air }, perf));
+        }
     }
+    Ok(winds
+        .iter()
+        .zip(paths)
+        .map(|(case, paths)| {
+            let nominal = nominal.fly(
+                Air {
+                    wind: case.wind,
+                    ..air
+                },
+                perf,
+            );
+            spread(nominal, &paths, target_ne_m, p)
+        })
+        .collect())
+}
+
+/// The spread of the samples' `paths` about the `nominal` one.
+fn spread(
+    nominal: FlightPath,
+    paths: &[FlightPath],
+    target_ne_m: Option<[f64; 2]>,
+    region_share_of_best: f64,
+) -> PlanSpread {
+    let runs = paths.len();
     let spread_of = |f: &dyn Fn(&FlightPath) -> super::PathPoint| {
         let points: Vec<TimedPoint> = paths
             .iter()
@@ -286,14 +368,14 @@ pub fn monte_carlo<R: Rng + ?Sized>(
     let discs: Vec<ReachDisc> = paths.iter().map(|p| p.reach).collect();
     let target_reachable_probability =
         target_ne_m.map(|t| discs.iter().filter(|d| d.contains(t)).count() as f64 / runs as f64);
-    Ok(PlanSpread {
+    PlanSpread {
         nominal,
         runs,
         burst,
         deploy: spread_of(&|p: &FlightPath| p.deploy),
         landing: spread_of(&|p: &FlightPath| p.landing),
         round_chute_landing: spread_of(&|p: &FlightPath| p.round_chute_landing),
-        steered_region: steered_region(&discs, p),
+        steered_region: steered_region(&discs, region_share_of_best),
         target_reachable_probability,
         samples: paths
             .iter()
@@ -306,5 +388,5 @@ pub fn monte_carlo<R: Rng + ?Sized>(
                 reach_radius_m: p.reach.radius_m,
             })
             .collect(),
-    })
+    }
 }

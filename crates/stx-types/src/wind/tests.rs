@@ -114,3 +114,40 @@ fn profile_validation_names_the_row_and_the_rule() {
     );
     assert!(error.to_string().contains("strictly increase"));
 }
+
+#[test]
+fn count_below_near_counts_as_count_below_whatever_its_hint() {
+    use std::sync::atomic::AtomicUsize;
+    let rows = [-50.0, 0.0, 120.0, 1500.0, 9000.0];
+    let xs = [
+        -1e9,
+        -50.0,
+        -49.9,
+        0.0,
+        60.0,
+        120.0,
+        1499.0,
+        9000.0,
+        9000.5,
+        f64::NAN,
+    ];
+    for x in xs {
+        let expected = count_below(rows.iter().copied(), x);
+        for start in [0, 2, 4, 5, 6, usize::MAX] {
+            let hint = AtomicUsize::new(start);
+            for _ in 0..2 {
+                let got = count_below_near(rows.len(), |i| rows[i], x, &hint);
+                assert_eq!(got, expected, "x {x}, hint {start}");
+            }
+        }
+    }
+    let profile = WindProfile::from_rows(&[[0.0, 3.0, 200.0], [900.0, 9.0, 250.0]]).unwrap();
+    let hint = AtomicUsize::new(7);
+    for h in [-10.0, 0.0, 450.0, 900.0, 2000.0, 450.0] {
+        let p = Vector3::new(0.0, 0.0, -h);
+        assert_eq!(
+            profile.wind_ned_mps_near(0.0, &p, &hint),
+            profile.wind_ned_mps(0.0, &p)
+        );
+    }
+}
