@@ -357,6 +357,11 @@ async function rehearsal() {
   await page.keyboard.down(" ");
   for (let i = 0; i < 7; i++) await page.keyboard.press("ArrowRight");
   const keyMark = await page.evaluate(() => performance.now());
+  // As with the gamepad: the sticks flow before manual is asked for (the drone refuses manual
+  // without them). Under load the page's first messages can lag the key presses, so wait for
+  // half a second of them (10 Hz) rather than a fixed time.
+  await until(() => sentSince(keyMark), (sent) => sent.filter((t) => t === "manual").length >= 5, 5000, 100);
+  await sleep(300);
   await api("/api/commands/mode", OPERATOR, { method: "POST", body: JSON.stringify({ mode: "manual" }) });
   const keyTurned = await until(vehicle, (v) => v?.mode === "manual" && (v?.servos?.main_line ?? 0) > 0.3, 10000);
   check("keyboard: Space held + → ×7 flies manual, the main line follows", keyTurned?.mode === "manual" && (keyTurned?.servos?.main_line ?? 0) > 0.3,
