@@ -193,6 +193,33 @@ pub fn predict_in_wind(
     }
 }
 
+/// Where the vehicle comes down flying its plan from `est` with `guidance` (cloned), the
+/// nominal flight of [`predict`] alone (no sigma points, no uncontrolled flight): one fast-time
+/// flight, for callers that need many predictions and no ellipse (the Monte Carlo's account
+/// of where a run's miss grew). North, east, m.
+pub fn planned_touchdown_ne_m(
+    est: &Estimate,
+    guidance: &Guidance,
+    perf: &GlidePerformance,
+    atmosphere: &dyn Atmosphere,
+    ground_altitude_msl_m: f64,
+    config: &PredictorConfig,
+) -> [f64; 2] {
+    let wind = DescentWind::below_estimate(est, None, config.profile_fade_height_m);
+    let (_, nominal) = sigma_points(est, config)[0];
+    fly_one(
+        est,
+        &wind,
+        Some(guidance),
+        perf,
+        atmosphere,
+        ground_altitude_msl_m,
+        config,
+        &nominal,
+    )
+    .0
+}
+
 #[allow(clippy::too_many_arguments)]
 fn fly_one(
     est: &Estimate,

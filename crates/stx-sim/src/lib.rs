@@ -11,6 +11,8 @@
 //! - [`dispersions`] draws each flight's vehicle, sensor and servo errors and wind shape from a
 //!   dispersion set, so that campaigns and the simulated drone fly a world guidance does not
 //!   know exactly;
+//! - [`anemometer`] is the ground anemometer by the target whose surface wind guidance may be
+//!   given;
 //! - [`summary`] reduces a run to the figures it is judged by;
 //! - [`montecarlo`] flies many spiral landings from random releases and winds;
 //! - [`speed`] measures the flight model's speed (`stx bench dynamics`);
@@ -24,6 +26,7 @@
 //! Pure without the `runner` feature: no sockets, no clocks other than the wall time a run
 //! reports about itself.
 
+pub mod anemometer;
 pub mod closed_loop;
 pub mod dispersions;
 pub mod drone;

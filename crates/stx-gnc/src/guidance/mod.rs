@@ -15,7 +15,9 @@ mod trim;
 
 pub use config::GuidanceConfig;
 pub use plan::{Plan, PlanRefused};
-pub use spiral::{FinalLaw, SpiralConfig, SpiralStatus};
+pub use spiral::{
+    FinalLaw, LearnedPolar, SURFACE_WIND_MAX_AGE_S, SpiralConfig, SpiralStatus, SurfaceWind,
+};
 
 use serde::{Deserialize, Serialize};
 use stx_types::controls::Controls;
@@ -72,6 +74,8 @@ pub struct Guidance {
     /// Where the payload must not land: the spiral keeps its low legs and its best reachable
     /// point clear of them.
     keep_out: KeepOutZones,
+    /// The wind at the ground by the target, uplinked, if any.
+    surface_wind: Option<SurfaceWind>,
 }
 
 impl Guidance {
@@ -88,6 +92,7 @@ impl Guidance {
             last_main_line_m: 0.0,
             turn_latch: control::TurnLatch::default(),
             keep_out: KeepOutZones::default(),
+            surface_wind: None,
         }
     }
 
@@ -102,6 +107,18 @@ impl Guidance {
     pub fn set_keep_out(&mut self, zones: KeepOutZones) {
         self.spiral.set_keep_out(zones.clone());
         self.keep_out = zones;
+    }
+
+    /// Replaces the wind measured at the ground by the target (`None`: none known). The
+    /// spiral mixes it into the wind it plans the final with, below the pattern.
+    pub fn set_surface_wind(&mut self, wind: Option<SurfaceWind>) {
+        self.spiral.set_surface_wind(wind);
+        self.surface_wind = wind;
+    }
+
+    /// The surface wind in force, if any.
+    pub fn surface_wind(&self) -> Option<&SurfaceWind> {
+        self.surface_wind.as_ref()
     }
 
     /// [`Guidance::set_plan`], refusing a plan whose target lies in a keep-out zone (the plan
@@ -220,6 +237,12 @@ impl Guidance {
         }
     }
 
+    /// What the spiral has learned in flight of the glide at each brake setting and of the
+    /// turn (nothing, scales of 1, before it has flown).
+    pub fn learned_polar(&self) -> LearnedPolar {
+        self.spiral.learned_polar()
+    }
+
     /// The main-line trim learned in flight, m: the offset the stack flies with (the command
     /// that flies straight is its negative).
     pub fn learned_trim_m(&self) -> f64 {
@@ -240,6 +263,7 @@ impl Guidance {
     fn new_spiral(&self) -> spiral::Spiral {
         let mut spiral = spiral::Spiral::new();
         spiral.set_keep_out(self.keep_out.clone());
+        spiral.set_surface_wind(self.surface_wind);
         spiral
     }
 

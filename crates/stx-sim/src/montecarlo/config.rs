@@ -44,6 +44,9 @@ pub struct MonteCarloConfig {
     /// Whether guidance is given [`Self::keep_out`] (false: the zones only count the landings
     /// in them, to measure what keeping out of them is worth).
     pub keep_out_guided: bool,
+    /// Whether a ground anemometer by the target ([`crate::anemometer`], its default settings)
+    /// reports the surface wind to guidance.
+    pub anemometer: bool,
 }
 
 impl Default for MonteCarloConfig {
@@ -63,6 +66,7 @@ impl Default for MonteCarloConfig {
             guidance: GuidanceConfig::default(),
             keep_out: KeepOutZones::default(),
             keep_out_guided: true,
+            anemometer: false,
         }
     }
 }

@@ -12,6 +12,7 @@
 //! the report counts the capsules that came down in one ([`ZoneLandings`]).
 
 mod config;
+mod growth;
 mod report;
 mod run;
 mod shard;
@@ -26,6 +27,7 @@ use stx_dynamics::vehicle::Vehicle;
 use crate::closed_loop::Navigator;
 use crate::sensors::SensorConfig;
 pub use config::{MonteCarloConfig, Shard};
+pub use growth::{GROWTH_MISS_M, MissGrowth};
 pub use report::{
     CampaignHeader, INTO_WIND_DEG, MonteCarloReport, Stats, WORST_RUNS, WorstRun,
     into_wind_fraction,

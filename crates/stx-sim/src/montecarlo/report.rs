@@ -5,6 +5,7 @@ use serde::{Deserialize, Serialize};
 use stx_gnc::stats::percentile;
 
 use super::config::MonteCarloConfig;
+use super::growth::MissGrowth;
 use super::run::{RunConditions, RunResult};
 use super::zones::ZoneLandings;
 use crate::dispersions::Dispersions;
@@ -27,6 +28,9 @@ pub struct WorstRun {
     /// Whether guidance found the target out of reach (its miss is then the wind's and the
     /// stack's, not guidance's).
     pub unreachable: bool,
+    /// The phase where its miss grew (payload misses of [`GROWTH_MISS_M`](super::GROWTH_MISS_M) or more).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub miss_grew: Option<MissGrowth>,
     /// Its conditions.
     pub conditions: RunConditions,
 }
@@ -103,6 +107,9 @@ pub struct CampaignHeader {
     /// Whether guidance knew the zones (false: they only counted the landings).
     #[serde(default = "yes")]
     pub keep_out_guided: bool,
+    /// Whether guidance was given a ground anemometer's surface wind.
+    #[serde(default)]
+    pub anemometer: bool,
 }
 
 fn yes() -> bool {
@@ -127,6 +134,7 @@ impl CampaignHeader {
                 .map(|z| z.name.clone())
                 .collect(),
             keep_out_guided: config.keep_out_guided,
+            anemometer: config.anemometer,
         }
     }
 }
@@ -154,6 +162,8 @@ pub struct MonteCarloReport {
     /// The same share with calm runs judged like the others, against the instantaneous wind
     /// (gusts included) where they touched down.
     pub into_wind_fraction_strict: f64,
+    /// The share among the runs not in calm air alone (the goal's figure).
+    pub into_wind_fraction_non_calm: f64,
     /// Runs that touched down in calm air (mean wind below [`CALM_WIND_MPS`]).
     pub calm_runs: usize,
     /// Vertical speed at touchdown, m/s.
@@ -227,6 +237,7 @@ impl MonteCarloReport {
                 heading_vs_upwind_deg: r.heading_vs_upwind_deg,
                 cause: miss_in_a_word(r.long_short_m, r.left_right_m),
                 unreachable: r.unreachable,
+                miss_grew: r.miss_grew,
                 conditions: r.conditions.clone(),
             })
             .collect();
@@ -253,6 +264,14 @@ impl MonteCarloReport {
             }),
             into_wind_fraction: into_wind_fraction(&results, true),
             into_wind_fraction_strict: into_wind_fraction(&results, false),
+            into_wind_fraction_non_calm: into_wind_fraction(
+                &results
+                    .iter()
+                    .filter(|r| !r.calm)
+                    .cloned()
+                    .collect::<Vec<_>>(),
+                false,
+            ),
             calm_runs: results.iter().filter(|r| r.calm).count(),
             touchdown_vertical_speed_mps: of_landings(|r| r.touchdown_vertical_speed_mps),
             wind_estimate_rmse_mps: pooled,
@@ -321,6 +340,8 @@ mod tests {
             calm,
             touchdown_vertical_speed_mps: 2.5,
             payload_miss_m: 1.0,
+            miss_grew: None,
+            learned: None,
             payload_touchdown_vertical_speed_mps: 2.0,
             payload_touchdown_ne_m: [1.0, 0.0],
             payload_zone: None,

@@ -17,10 +17,12 @@ use stx_dynamics::vehicle::Vehicle;
 use stx_dynamics::wind::{
     ProfileRow, Turbulence, TurbulenceParams, WindComposite, WindField, WindProfile,
 };
-use stx_gnc::guidance::{Guidance, PhaseEvent, Plan};
+use stx_gnc::guidance::{Guidance, LearnedPolar, PhaseEvent, Plan};
 use stx_gnc::mission::{FlightMode, GuidancePhase};
 
 use super::config::MonteCarloConfig;
+use super::growth::{MissGrowth, PhaseSnapshots};
+use crate::anemometer::{Anemometer, AnemometerConfig};
 use crate::closed_loop::{GuidedFlight, Navigator};
 use crate::dispersions::{DispersedFlight, DrawSummary, WindShape};
 use crate::guided::{CONTROL_PERIOD_S, STEP_S};
@@ -64,6 +66,14 @@ pub struct RunResult {
     /// Distance from the target to where the capsule (the payload) touched down, m: after
     /// the transponder's contact the stack flies on until it does.
     pub payload_miss_m: f64,
+    /// For a payload miss of [`GROWTH_MISS_M`](super::GROWTH_MISS_M) or more: the guidance phase over which the
+    /// landing guidance expected moved furthest from the target ([`MissGrowth`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub miss_grew: Option<MissGrowth>,
+    /// What guidance had learned of the glide at each brake setting and of the turn by the
+    /// touchdown.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub learned: Option<LearnedPolar>,
     /// The capsule's vertical speed at its touchdown, m/s.
     pub payload_touchdown_vertical_speed_mps: f64,
     /// Where the capsule touched down, north and east of the target, m.
@@ -313,9 +323,20 @@ pub fn run_one<N: Navigator>(
     let replay = config.only_run == Some(index);
     let mut track = Vec::new();
     let mut next_track_s = 0.0;
+    let mut anemometer = config
+        .anemometer
+        .then(|| Anemometer::new(AnemometerConfig::default(), c.seed));
+    let mut snapshots = PhaseSnapshots::default();
     let touchdown = loop {
         if let Some(t) = flight.advance().map_err(|e| with_draw(e.to_string()))? {
             break t;
+        }
+        snapshots.observe(&flight.guidance, flight.estimate.as_ref());
+        if let Some(report) = anemometer
+            .as_mut()
+            .and_then(|a| a.step(flight.time_s, &*wind))
+        {
+            flight.guidance.set_surface_wind(Some(report));
         }
         if replay
             && let Some(est) = flight.estimate
@@ -354,6 +375,12 @@ pub fn run_one<N: Navigator>(
         }
     };
     let payload = flight.land_payload(touchdown).map_err(with_draw)?;
+    let payload_miss_m = payload.position_ne_m[0].hypot(payload.position_ne_m[1]);
+    let miss_grew = snapshots.where_miss_grew(
+        payload.position_ne_m,
+        payload_miss_m,
+        stx_gnc::geo::LocalFrame::default().alt_msl_m,
+    );
     let heading_vs_upwind = if touchdown.upwind_rad.is_finite() {
         wrap_pi(touchdown.heading_rad - touchdown.upwind_rad).to_degrees()
     } else {
@@ -375,7 +402,9 @@ pub fn run_one<N: Navigator>(
         heading_vs_upwind_deg: heading_vs_upwind,
         calm: mean_wind_at_touchdown.x.hypot(mean_wind_at_touchdown.y) < CALM_WIND_MPS,
         touchdown_vertical_speed_mps: touchdown.vertical_speed_mps,
-        payload_miss_m: payload.position_ne_m[0].hypot(payload.position_ne_m[1]),
+        payload_miss_m,
+        miss_grew,
+        learned: Some(flight.guidance.learned_polar()),
         payload_touchdown_vertical_speed_mps: payload.vertical_speed_mps,
         payload_touchdown_ne_m: payload.position_ne_m,
         payload_zone: config

@@ -252,3 +252,32 @@ fn capsules_landed_in_keep_out_zones_are_counted_by_wind_and_bad_zones_are_refus
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `--anemometer` flies every run with the ground anemometer and says so; each run carries
+/// what guidance learned of the glide and the turn, and a different flight than without.
+#[test]
+fn a_campaign_with_the_ground_anemometer_says_so_and_every_run_shows_what_was_learned() {
+    let mut with = CAMPAIGN.to_vec();
+    with.extend(["--json", "--details", "--anemometer"]);
+    let mut without = CAMPAIGN.to_vec();
+    without.extend(["--json", "--details"]);
+    let (with, without) = (json(&stx(&with)), json(&stx(&without)));
+    assert_eq!(with["anemometer"], true);
+    assert_eq!(without["anemometer"], false);
+    let runs = with["results"].as_array().expect("results");
+    assert_eq!(runs.len(), 5);
+    for run in runs {
+        let learned = &run["learned"];
+        assert_eq!(learned["brake"], serde_json::json!([0.0, 0.5, 1.0]));
+        for k in 0..3 {
+            let sink = learned["sink_scale"][k].as_f64().expect("a scale");
+            assert!((0.6..=1.6).contains(&sink), "{learned}");
+        }
+        assert!(
+            learned["learned_s"].as_f64().expect("seconds") > 0.0,
+            "{learned}"
+        );
+    }
+    // Below the pattern guidance planned with another wind: the landings differ.
+    assert_ne!(with["results"], without["results"]);
+}

@@ -11,6 +11,8 @@
 //! track, which is what planning over the ground needs: flown into the wind, speed over the
 //! ground is then what the learned airspeed less the estimated wind predicts.
 
+use serde::{Deserialize, Serialize};
+
 use crate::estimate::Estimate;
 use crate::performance::{BRAKE_POINTS, GlidePerformance};
 
@@ -76,6 +78,27 @@ impl BrakeScale {
         let slope = (r1 - mean_brake * r0) / (spread + PRIOR_SLOPE_S);
         (level + slope * (brake - mean_brake)).clamp(SCALE_LIMITS[0], SCALE_LIMITS[1])
     }
+}
+
+/// The brake settings [`LearnedPolar`] shows the scales at.
+const SHOWN_AT: [f64; 3] = [0.0, 0.5, 1.0];
+
+/// What has been learned of the glide and the turn, at three brake settings: what the
+/// operator and the Monte Carlo report are shown.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct LearnedPolar {
+    /// The brake settings shown, 0…1.
+    pub brake: [f64; 3],
+    /// Horizontal airspeed flown over the polar's at each.
+    pub airspeed_scale: [f64; 3],
+    /// Sink rate flown over the polar's at each.
+    pub sink_scale: [f64; 3],
+    /// Seconds of straight, settled flight the glide was learned from, s.
+    pub learned_s: f64,
+    /// Turn rate flown over the rate the polar's turn model gives for the same commands.
+    pub turn_scale: f64,
+    /// Seconds of turning the turn rate was learned from, s.
+    pub turn_learned_s: f64,
 }
 
 /// The learned scales and what learning them needs to remember.
@@ -148,6 +171,19 @@ impl LearnedGlide {
         self.airspeed.add(brake, airspeed_ratio, dt, keep);
         self.sink.add(brake, sink_ratio, dt, keep);
         self.learned_s += dt;
+    }
+
+    /// The scales learned, at [`SHOWN_AT`]; the turn's fields are left for the turn learner
+    /// to fill.
+    pub fn polar(&self) -> LearnedPolar {
+        LearnedPolar {
+            brake: SHOWN_AT,
+            airspeed_scale: SHOWN_AT.map(|b| self.airspeed.at(b)),
+            sink_scale: SHOWN_AT.map(|b| self.sink.at(b)),
+            learned_s: self.learned_s,
+            turn_scale: 1.0,
+            turn_learned_s: 0.0,
+        }
     }
 
     /// Horizontal airspeed flown over the polar's at `brake`.
@@ -258,6 +294,13 @@ mod tests {
         let rho = perf.reference_density_kg_per_m3;
         let planned = learned.performance(&perf).sink_rate(0.6, 0.0, rho);
         assert!((planned / perf.sink_rate(0.6, 0.0, rho) - learned.sink_scale(0.6)).abs() < 1e-9);
+        // What the operator is shown: the same line at released, half and full brakes.
+        let shown = learned.polar();
+        assert_eq!(shown.brake, [0.0, 0.5, 1.0]);
+        for k in 0..3 {
+            assert_eq!(shown.sink_scale[k], learned.sink_scale(shown.brake[k]));
+        }
+        assert!(shown.sink_scale[2] > shown.sink_scale[1] && shown.sink_scale[1] > 1.2);
     }
 
     #[test]

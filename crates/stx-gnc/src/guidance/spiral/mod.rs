@@ -86,6 +86,7 @@ mod wind;
 
 pub use config::{FinalLaw, SpiralConfig};
 pub use turn_rate::corner_turn_rate_rad_s;
+pub use wind::{SURFACE_WIND_MAX_AGE_S, SurfaceWind};
 
 use serde::{Deserialize, Serialize};
 use stx_types::controls::Controls;
@@ -93,6 +94,7 @@ use stx_types::controls::Controls;
 use self::energy::Energy;
 use self::final_approach::{FinalApproach, FinalGeometry};
 use self::learned::LearnedGlide;
+pub use self::learned::LearnedPolar;
 use self::learned_turn::LearnedTurn;
 use self::pattern::{Axis, Pattern, WindFrame};
 use self::phases::{Change, PhaseMachine};
@@ -156,6 +158,8 @@ pub struct Spiral {
     glide: LearnedGlide,
     /// The turn rate learned in flight, which the corners are planned with.
     turn: LearnedTurn,
+    /// The wind at the ground by the target, uplinked, if any.
+    surface_wind: Option<SurfaceWind>,
     /// Symmetric brake of the last commands, 0…1.
     last_brake: f64,
     /// Main line of the last commands, m.
@@ -183,6 +187,7 @@ impl Spiral {
             announced: Announcement::default(),
             glide: LearnedGlide::default(),
             turn: LearnedTurn::default(),
+            surface_wind: None,
             last_brake: 0.0,
             last_main_line_m: 0.0,
             turn_latch: TurnLatch::default(),
@@ -191,6 +196,12 @@ impl Spiral {
             clear_approach: keep_clear::ClearApproach::default(),
             notes: Vec::new(),
         }
+    }
+
+    /// Replaces the surface wind at the target (`None`: none known); it counts in the wind
+    /// planned with below the pattern (see `wind.rs`).
+    pub fn set_surface_wind(&mut self, wind: Option<SurfaceWind>) {
+        self.surface_wind = wind;
     }
 
     /// Replaces the keep-out zones (see [`keep_clear`]); none flies the nominal spiral.
@@ -225,6 +236,15 @@ impl Spiral {
         perf: &crate::performance::GlidePerformance,
     ) -> crate::performance::GlidePerformance {
         self.turn.performance(&self.glide.performance(perf))
+    }
+
+    /// What has been learned in flight of the glide at each brake setting and of the turn.
+    pub fn learned_polar(&self) -> LearnedPolar {
+        LearnedPolar {
+            turn_scale: self.turn.scale(),
+            turn_learned_s: self.turn.learned_s,
+            ..self.glide.polar()
+        }
     }
 
     /// Whether it has run since it was made: before, its status is not a plan.
@@ -308,7 +328,11 @@ impl Spiral {
         let height = est.height_m() - ground_m;
         let phase = self.machine.phase;
 
-        let wind = self.wind.update(est, sc.wind_filter_s);
+        let wind = self.wind.update(est, sc.wind_filter_s).toward_surface(
+            self.surface_wind.as_ref(),
+            height - sc.hang_height_m,
+            est.time_s,
+        );
         let reorient = self.machine.take_reorient();
         let keep_clear_rad = if self.keep_out.zones.is_empty() || plan.approach_course_rad.is_some()
         {

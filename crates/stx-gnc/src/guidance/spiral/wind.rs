@@ -1,6 +1,8 @@
 //! The wind the spiral plans with: the estimator's, low-passed once the estimator trusts it,
 //! and whether it has been trusted long enough for energy decisions.
 
+use serde::{Deserialize, Serialize};
+
 use crate::estimate::Estimate;
 
 /// Wind uncertainty (1-σ per component) below which guidance trusts the wind for its energy
@@ -84,6 +86,57 @@ impl PlanningWind {
     }
 }
 
+/// A wind measured at the ground by the target (a surface anemometer the station reads, or a
+/// value the operator typed), uplinked to guidance.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct SurfaceWind {
+    /// The wind (north, east; the air's velocity, not where it comes from), m/s: the
+    /// anemometer's mean over its averaging time.
+    pub ne_mps: [f64; 2],
+    /// When it was measured, on guidance's clock (the estimate's time), s.
+    pub time_s: f64,
+}
+
+/// A surface wind older than this is not used, s: the low-level wind changes in minutes.
+pub const SURFACE_WIND_MAX_AGE_S: f64 = 120.0;
+/// Below this height of the lowest body the surface wind starts to count in the planning
+/// wind, m: about where the final is turned onto.
+const SURFACE_WIND_FROM_M: f64 = 250.0;
+/// At and below this height it counts half, m: what the rest of the descent flies through is
+/// then about the mean of the wind here (the estimator's) and at the ground (the
+/// anemometer's), for a wind that changes evenly with height.
+const SURFACE_WIND_HALF_M: f64 = 100.0;
+
+impl WindNow {
+    /// The planning wind with `surface` mixed in for the rest of the descent from a lowest
+    /// body `lowest_body_height` m up, at `now_s`: nothing above [`SURFACE_WIND_FROM_M`], half
+    /// at [`SURFACE_WIND_HALF_M`] and below; a stale surface wind is left out. The
+    /// estimator's own wind (`measured_ne_mps`, which the reach check uses) is kept.
+    pub(super) fn toward_surface(
+        self,
+        surface: Option<&SurfaceWind>,
+        lowest_body_height: f64,
+        now_s: f64,
+    ) -> Self {
+        let Some(surface) = surface.filter(|s| {
+            let age = now_s - s.time_s;
+            (-1.0..=SURFACE_WIND_MAX_AGE_S).contains(&age) && s.ne_mps.iter().all(|v| v.is_finite())
+        }) else {
+            return self;
+        };
+        let share = 0.5
+            * ((SURFACE_WIND_FROM_M - lowest_body_height)
+                / (SURFACE_WIND_FROM_M - SURFACE_WIND_HALF_M))
+                .clamp(0.0, 1.0);
+        let ne = [0, 1].map(|k| self.ne_mps[k] + share * (surface.ne_mps[k] - self.ne_mps[k]));
+        Self {
+            ne_mps: ne,
+            speed_mps: ne[0].hypot(ne[1]),
+            ..self
+        }
+    }
+}
+
 /// Direction a horizontal wind (north, east; the air's velocity) blows from, degrees 0…360.
 pub(super) fn wind_from_deg(wind_ne: [f64; 2]) -> f64 {
     (-wind_ne[1])
@@ -100,6 +153,32 @@ mod tests {
     use crate::mission::GuidancePhase;
     use crate::pointmass::PointMass;
     use nalgebra::Vector3;
+
+    #[test]
+    fn the_surface_wind_counts_below_the_pattern_and_half_near_the_ground() {
+        let aloft = WindNow {
+            measured_ne_mps: [-3.0, 0.0],
+            ne_mps: [-3.0, 0.0],
+            speed_mps: 3.0,
+            known: true,
+        };
+        let ground = SurfaceWind {
+            ne_mps: [-1.0, 0.0],
+            time_s: 100.0,
+        };
+        let at = |height: f64, now: f64| aloft.toward_surface(Some(&ground), height, now);
+        assert_eq!(at(400.0, 110.0).ne_mps, aloft.ne_mps);
+        assert!((at(175.0, 110.0).ne_mps[0] + 2.5).abs() < 1e-9);
+        assert!((at(50.0, 110.0).ne_mps[0] + 2.0).abs() < 1e-9);
+        assert!((at(50.0, 110.0).speed_mps - 2.0).abs() < 1e-9);
+        // The reach check keeps the estimator's wind; a stale surface wind is not used.
+        assert_eq!(at(50.0, 110.0).measured_ne_mps, aloft.measured_ne_mps);
+        assert_eq!(
+            at(50.0, 100.0 + SURFACE_WIND_MAX_AGE_S + 1.0).ne_mps,
+            aloft.ne_mps
+        );
+        assert_eq!(aloft.toward_surface(None, 50.0, 110.0).ne_mps, aloft.ne_mps);
+    }
 
     /// Regression (Monte Carlo seed 2, run 730): eight seconds after release the estimator's
     /// wind was 4 m/s off with a small uncertainty; guidance committed to a downwind leg on
