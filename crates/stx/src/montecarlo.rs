@@ -131,14 +131,29 @@ fn merge(paths: &[PathBuf], json: bool, details: bool) -> anyhow::Result<()> {
 }
 
 fn print_report(report: &MonteCarloReport, json: bool, details: bool) -> anyhow::Result<()> {
+    let nominal = stx_sim::montecarlo::nominal_single_landing().context("nominal landing")?;
     if json {
         let mut value = serde_json::to_value(report)?;
-        if !details && let Some(object) = value.as_object_mut() {
-            object.remove("results");
+        if let Some(object) = value.as_object_mut() {
+            if !details {
+                object.remove("results");
+            }
+            object.insert(
+                "nominal_single_landing".into(),
+                serde_json::to_value(nominal)?,
+            );
         }
         println!("{}", serde_json::to_string(&value)?);
     } else {
         print_table(report);
+        if let Some(landing) = nominal {
+            println!(
+                "nominal single landing (stx sim --scenario spiral-landing): {} touched {:.1} m \
+                 from the target",
+                landing.body,
+                landing.miss_m.unwrap_or(f64::NAN)
+            );
+        }
     }
     Ok(())
 }

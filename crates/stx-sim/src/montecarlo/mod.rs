@@ -8,6 +8,8 @@
 //! threads or machines: a campaign split into shards ([`Shard`], one [`CampaignPart`] each)
 //! and [`merge`]d gives the one-machine report.
 //!
+//! Beside a campaign, [`nominal_single_landing`] flies the one nominal landing its report names.
+//!
 //! With keep-out zones ([`MonteCarloConfig::keep_out`]) guidance flies every run with them and
 //! the report counts the capsules that came down in one ([`ZoneLandings`]).
 
@@ -38,6 +40,26 @@ pub use run::{
 };
 pub use shard::{CampaignPart, MergeError, merge};
 pub use zones::{WIND_BIN_MPS, ZoneCount, ZoneLanding, ZoneLandings};
+
+/// Why the nominal single landing could not be flown.
+#[derive(Debug, thiserror::Error)]
+pub enum NominalLandingError {
+    /// The built-in scenario did not load.
+    #[error("the built-in spiral-landing scenario: {0}")]
+    Scenario(#[from] crate::scenario::ScenarioError),
+    /// Its flight failed.
+    #[error("the nominal spiral landing: {0}")]
+    Run(#[from] crate::run::RunError),
+}
+
+/// The nominal single landing, which a campaign's report names beside its own figures: the
+/// built-in `spiral-landing` scenario (the shipped vehicle and no dispersions, the onboard
+/// software in closed loop; what `stx sim --scenario spiral-landing` flies), its first contact.
+pub fn nominal_single_landing() -> Result<Option<crate::summary::Landing>, NominalLandingError> {
+    let scenario = crate::scenario::Scenario::builtin("spiral-landing")?;
+    let run = crate::open_loop::run(&scenario, &Vehicle::straplex())?;
+    Ok(run.summary.landing)
+}
 
 /// Flies every run on `config.threads` threads, calling `progress(done)` as runs finish.
 pub fn run_all<N: Navigator>(

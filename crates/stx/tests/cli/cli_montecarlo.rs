@@ -254,7 +254,8 @@ fn capsules_landed_in_keep_out_zones_are_counted_by_wind_and_bad_zones_are_refus
 }
 
 /// `--anemometer` flies every run with the ground anemometer and says so; each run carries
-/// what guidance learned of the glide and the turn, and a different flight than without.
+/// what guidance learned of the glide and the turn, and a different flight than without; the
+/// report names the nominal single landing.
 #[test]
 fn a_campaign_with_the_ground_anemometer_says_so_and_every_run_shows_what_was_learned() {
     let mut with = CAMPAIGN.to_vec();
@@ -280,4 +281,10 @@ fn a_campaign_with_the_ground_anemometer_says_so_and_every_run_shows_what_was_le
     }
     // Below the pattern guidance planned with another wind: the landings differ.
     assert_ne!(with["results"], without["results"]);
+    // Beside the campaign, the nominal single landing, as `stx sim` flies it.
+    let sim = stx(&["sim", "--scenario", "spiral-landing", "--summary-json"]);
+    assert!(sim.status.success());
+    let sim: serde_json::Value = serde_json::from_slice(&sim.stdout).expect("summary");
+    assert_eq!(with["nominal_single_landing"], sim["landing"]);
+    assert!(with["nominal_single_landing"]["miss_m"].as_f64().is_some());
 }
