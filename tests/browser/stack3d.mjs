@@ -37,7 +37,7 @@ async function flight() {
   await page.goto(`${base}/?token=${OPERATOR}`);
   await page.click('[data-testid="tab-3d"]');
   const view = () => page.evaluate(() => window.__view3d ?? null);
-  const ready = await until(view, (v) => v?.bodies?.transponder && v.pattern_points > 0 && v.cone, 30000, 250);
+  const ready = await until(view, (v) => v?.bodies?.transponder && v.pattern_points > 0 && v.cone && v.frames > 0, 30000, 250);
   const unavailable = await page.locator('[data-testid="view3d-unavailable"]').count();
   check("WebGL renders in headless Chromium (SwiftShader): the view draws frames", ready?.webgl === true && unavailable === 0 && ready.frames > 0,
     `webgl ${ready?.webgl}, frames ${ready?.frames}, unavailable notice ${unavailable}`);

@@ -184,6 +184,25 @@ pub struct PatternView {
     pub reach_ratio: f64,
 }
 
+/// What the replica has learned in flight of the stack's glide and turn (the drone's guidance
+/// learns the same from the same data): scales on the polar guidance was given, which every
+/// plan of the spiral is made with.
+#[derive(Debug, Clone, Serialize, JsonSchema)]
+pub struct LearnedView {
+    /// The brake settings the scales are shown at, 0…1 (released, half, full).
+    pub brake: [f64; 3],
+    /// Horizontal airspeed flown over the polar's, at each brake setting.
+    pub airspeed_scale: [f64; 3],
+    /// Sink rate flown over the polar's, at each brake setting.
+    pub sink_scale: [f64; 3],
+    /// Seconds of straight, settled flight the glide was learned from, s.
+    pub learned_s: f64,
+    /// Turn rate flown over the polar's for the same main-line commands.
+    pub turn_scale: f64,
+    /// Seconds of turning the turn rate was learned from, s.
+    pub turn_learned_s: f64,
+}
+
 /// The localizer line the replica follows.
 #[derive(Debug, Clone, Serialize, JsonSchema)]
 pub struct LocalizerView {
@@ -215,6 +234,8 @@ pub struct GuidanceView {
     pub localizer: Option<LocalizerView>,
     /// Spiral plan, in spiral landing.
     pub pattern: Option<PatternView>,
+    /// What the spiral has learned of the glide and the turn, once it has flown.
+    pub learned: Option<LearnedView>,
     /// What the replica would command.
     pub commands: CommandsView,
     /// Seconds since the navigation data the replica ran on arrived; `null` without an

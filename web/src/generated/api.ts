@@ -1076,6 +1076,10 @@ export interface GuidanceView {
    */
   disagreement: DisagreementView | null;
   /**
+   * What the spiral has learned of the glide and the turn, once it has flown.
+   */
+  learned: LearnedView | null;
+  /**
    * The localizer line, once known.
    */
   localizer: LocalizerView | null;
@@ -1151,6 +1155,46 @@ export interface DisagreementView {
    * What they disagree on.
    */
   what: "phase";
+}
+/**
+ * What the replica has learned in flight of the stack's glide and turn (the drone's guidance
+ * learns the same from the same data): scales on the polar guidance was given, which every
+ * plan of the spiral is made with.
+ */
+export interface LearnedView {
+  /**
+   * Horizontal airspeed flown over the polar's, at each brake setting.
+   *
+   * @minItems 3
+   * @maxItems 3
+   */
+  airspeed_scale: [number, number, number];
+  /**
+   * The brake settings the scales are shown at, 0…1 (released, half, full).
+   *
+   * @minItems 3
+   * @maxItems 3
+   */
+  brake: [number, number, number];
+  /**
+   * Seconds of straight, settled flight the glide was learned from, s.
+   */
+  learned_s: number;
+  /**
+   * Sink rate flown over the polar's, at each brake setting.
+   *
+   * @minItems 3
+   * @maxItems 3
+   */
+  sink_scale: [number, number, number];
+  /**
+   * Seconds of turning the turn rate was learned from, s.
+   */
+  turn_learned_s: number;
+  /**
+   * Turn rate flown over the polar's for the same main-line commands.
+   */
+  turn_scale: number;
 }
 /**
  * The localizer line the replica follows.

@@ -19,7 +19,7 @@ function state(stage: FlightStage, extra: Partial<State> = {}): State {
     guidance: {
       mode: "spiral_landing", phase: "branch2", target: { ...at(0, 0), alt_msl_m: 245 }, target_source: "drone_plan", localizer: null,
       pattern: { corners: [pair(100, 100), pair(100, -100), pair(-100, -100), pair(-100, 100)], final_entry: pair(200, 300), final_course_deg: 250, final_approach_height_m: 100, target_reachable: true, reach_ratio: 0.5 },
-      commands: null, age_s: 0.1, stale: false, disagreement: null,
+      commands: null, age_s: 0.1, stale: false, disagreement: null, learned: null,
     },
     prediction: { planned: { ...at(10, 5), time_to_land_s: 100, semi_major_m: 50, semi_minor_m: 20, major_axis_deg: 0 }, uncontrolled: { ...at(900, 1200), time_to_land_s: 90, semi_major_m: 150, semi_minor_m: 100, major_axis_deg: 30 }, age_s: 0.5, stale: false },
     footprint: null,

@@ -41,6 +41,7 @@ const STATE = {
     localizer: { point: [38.5333, -7.8889], course_deg: 80.0, glide_slope: 0.3 },
     pattern: { corners: [[38.531, -7.889], [38.532, -7.887], [38.534, -7.888], [38.533, -7.890]], final_entry: [38.531, -7.889], final_course_deg: 161.6,
       final_approach_height_m: 172.0, target_reachable: true, reach_ratio: 0.41 },
+    learned: { brake: [0.0, 0.5, 1.0], airspeed_scale: [0.97, 0.97, 0.97], sink_scale: [1.08, 1.1, 1.12], learned_s: 84.0, turn_scale: 0.91, turn_learned_s: 36.5 },
     commands: { main_line: 0.35, brake: 0.0 }, age_s: 0.05, stale: false,
     disagreement: { what: "phase", replica: "branch3", drone: "branch2", since_s: 1102.25, for_s: 2.25, resolved: false, adopted: false } },
   prediction: { planned: { lat_deg: 38.5334, lon_deg: -7.8888, time_to_land_s: 187.0, semi_major_m: 12.1, semi_minor_m: 6.0, major_axis_deg: 40.0 },
@@ -97,6 +98,8 @@ describe("decodeMessage: the API.md example", () => {
     expect(s.estimate?.wind_from_deg).toBe(341.6);
     expect(s.guidance?.pattern?.corners).toHaveLength(4);
     expect(s.guidance?.pattern?.final_entry).toEqual([38.531, -7.889]);
+    expect(s.guidance?.learned?.sink_scale).toEqual([1.08, 1.1, 1.12]);
+    expect(s.guidance?.learned?.turn_scale).toBe(0.91);
     expect(s.prediction?.planned?.semi_major_m).toBe(12.1);
     // Forecast sorted by altitude for interpolation.
     expect(s.forecast_wind.map((f) => f.alt_msl_m)).toEqual([300, 1000]);
@@ -161,6 +164,15 @@ describe("decodeMessage: malformed input never throws", () => {
     const { link: _drop, ...noLink } = STATE;
     const d = decodeMessage(j(noLink));
     expect(d.ok && d.msg.type === "state" && d.msg.link.stale).toBe(true);
+  });
+
+  it("learned scales that are not three numbers read as unknown, and no block as null", () => {
+    const d = decodeMessage(j({ ...STATE, guidance: { ...STATE.guidance, learned: { ...STATE.guidance.learned, sink_scale: [1.0, "x", 1.2] } } }));
+    expect(d.ok && d.msg.type === "state" && d.msg.guidance?.learned?.sink_scale).toBeNull();
+    expect(d.ok && d.msg.type === "state" && d.msg.guidance?.learned?.airspeed_scale).toEqual([0.97, 0.97, 0.97]);
+    const { learned: _drop, ...noLearned } = STATE.guidance;
+    const n = decodeMessage(j({ ...STATE, guidance: noLearned }));
+    expect(n.ok && n.msg.type === "state" && n.msg.guidance?.learned).toBeNull();
   });
 
   it("pattern corners out of range are dropped", () => {

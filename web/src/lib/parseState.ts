@@ -16,6 +16,7 @@ import type {
   Gps,
   Disagreement,
   Guidance,
+  Learned,
   Landing,
   LandingPrediction,
   Link,
@@ -171,6 +172,15 @@ function parsePattern(o: Obj): Pattern {
   };
 }
 
+const parseLearned = (o: Obj): Learned => ({
+  brake: vec3(o, "brake"),
+  airspeed_scale: vec3(o, "airspeed_scale"),
+  sink_scale: vec3(o, "sink_scale"),
+  learned_s: num(o, "learned_s"),
+  turn_scale: num(o, "turn_scale"),
+  turn_learned_s: num(o, "turn_learned_s"),
+});
+
 function parseLocalizer(o: Obj): Localizer | null {
   const point = pair(o.point);
   return point === null ? null : { point, course_deg: num(o, "course_deg"), glide_slope: num(o, "glide_slope") };
@@ -196,6 +206,7 @@ const parseGuidance = (o: Obj): Guidance => ({
   target_source: oneOf(o, "target_source", TARGET_SOURCES),
   localizer: obj(o, "localizer") === null ? null : parseLocalizer(obj(o, "localizer") as Obj),
   pattern: sub(o, "pattern", parsePattern),
+  learned: sub(o, "learned", parseLearned),
   commands: sub(o, "commands", (c) => ({ main_line: num(c, "main_line"), brake: num(c, "brake") })),
   age_s: num(o, "age_s"),
   stale: bool(o, "stale"),

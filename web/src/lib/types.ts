@@ -86,11 +86,15 @@ export type Localizer = Lenient<Wire.LocalizerView, "point">;
 /** The guidance replica and the drone disagree (or did a few seconds ago). */
 export type Disagreement = Lenient<Wire.DisagreementView, "what" | "replica" | "drone">;
 
-export type Guidance = Omit<Lenient<Wire.GuidanceView>, "target" | "localizer" | "pattern" | "disagreement"> & {
+/** What the spiral has learned in flight of the stack's glide and turn. */
+export type Learned = Lenient<Wire.LearnedView>;
+
+export type Guidance = Omit<Lenient<Wire.GuidanceView>, "target" | "localizer" | "pattern" | "disagreement" | "learned"> & {
   target: Position | null;
   localizer: Localizer | null;
   pattern: Pattern | null;
   disagreement: Disagreement | null;
+  learned: Learned | null;
 };
 
 export type LandingPrediction = Lenient<Wire.TouchdownView, "lat_deg" | "lon_deg">;

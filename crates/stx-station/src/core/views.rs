@@ -8,9 +8,10 @@ use stx_gnc::predict::PredictedTouchdown;
 
 use super::StationCore;
 use crate::messages::{
-    AirView, AttitudeView, CommandsView, EstimateView, GpsView, GuidanceView, LatLonAlt, LinkView,
-    LocalizerView, MissionView, OnboardLandingView, ParamView, ParamsMsg, PatternView, PowerView,
-    PredictionView, RadioView, ReadinessView, ServosView, StateMsg, TouchdownView, VehicleView,
+    AirView, AttitudeView, CommandsView, EstimateView, GpsView, GuidanceView, LatLonAlt,
+    LearnedView, LinkView, LocalizerView, MissionView, OnboardLandingView, ParamView, ParamsMsg,
+    PatternView, PowerView, PredictionView, RadioView, ReadinessView, ServosView, StateMsg,
+    TouchdownView, VehicleView,
 };
 
 pub(crate) fn snake<T: serde::Serialize + std::fmt::Debug>(v: T) -> String {
@@ -236,6 +237,17 @@ impl StationCore {
                 } else {
                     -1.0
                 },
+            }),
+            learned: (flying && self.guidance.spiral_has_run()).then(|| {
+                let l = self.guidance.learned_polar();
+                LearnedView {
+                    brake: l.brake,
+                    airspeed_scale: l.airspeed_scale,
+                    sink_scale: l.sink_scale,
+                    learned_s: l.learned_s,
+                    turn_scale: l.turn_scale,
+                    turn_learned_s: l.turn_learned_s,
+                }
             }),
             commands: CommandsView {
                 main_line: (self.replica_command.main_line_m / self.main_line_travel_m)

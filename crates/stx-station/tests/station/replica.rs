@@ -143,6 +143,36 @@ async fn the_station_flies_the_drones_own_target_far_from_the_origin() {
     }
     assert!(seen, "no pattern and predictions in 30 s: {last}");
     assert_eq!(last["vehicle"]["predicted_landing"]["stale"], false);
+    // What the spiral learns of the stack is shown as it flies (nothing before).
+    assert!(
+        before["guidance"]["learned"].is_null(),
+        "{}",
+        before["guidance"]
+    );
+    let learned = &last["guidance"]["learned"];
+    assert_eq!(
+        learned["brake"],
+        serde_json::json!([0.0, 0.5, 1.0]),
+        "{learned}"
+    );
+    for key in ["airspeed_scale", "sink_scale"] {
+        let scales = learned[key].as_array().expect("three scales");
+        assert_eq!(scales.len(), 3, "{learned}");
+        assert!(
+            scales
+                .iter()
+                .all(|v| v.as_f64().is_some_and(|v| (0.5..=2.0).contains(&v))),
+            "{learned}"
+        );
+    }
+    assert!(
+        learned["learned_s"].as_f64().is_some_and(|s| s >= 0.0),
+        "{learned}"
+    );
+    assert!(
+        learned["turn_scale"].as_f64().is_some_and(|v| v > 0.0),
+        "{learned}"
+    );
 }
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
