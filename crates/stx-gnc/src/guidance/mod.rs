@@ -15,9 +15,7 @@ mod trim;
 
 pub use config::GuidanceConfig;
 pub use plan::{Plan, PlanRefused};
-pub use spiral::{
-    FinalLaw, LearnedPolar, SURFACE_WIND_MAX_AGE_S, SpiralConfig, SpiralStatus, SurfaceWind,
-};
+pub use spiral::{FinalLaw, LearnedPolar, SpiralConfig, SpiralStatus, SurfaceWind};
 
 use serde::{Deserialize, Serialize};
 use stx_types::controls::Controls;
@@ -114,11 +112,6 @@ impl Guidance {
     pub fn set_surface_wind(&mut self, wind: Option<SurfaceWind>) {
         self.spiral.set_surface_wind(wind);
         self.surface_wind = wind;
-    }
-
-    /// The surface wind in force, if any.
-    pub fn surface_wind(&self) -> Option<&SurfaceWind> {
-        self.surface_wind.as_ref()
     }
 
     /// [`Guidance::set_plan`], refusing a plan whose target lies in a keep-out zone (the plan

@@ -86,7 +86,7 @@ mod wind;
 
 pub use config::{FinalLaw, SpiralConfig};
 pub use turn_rate::corner_turn_rate_rad_s;
-pub use wind::{SURFACE_WIND_MAX_AGE_S, SurfaceWind};
+pub use wind::SurfaceWind;
 
 use serde::{Deserialize, Serialize};
 use stx_types::controls::Controls;

@@ -98,7 +98,7 @@ pub struct SurfaceWind {
 }
 
 /// A surface wind older than this is not used, s: the low-level wind changes in minutes.
-pub const SURFACE_WIND_MAX_AGE_S: f64 = 120.0;
+pub(super) const SURFACE_WIND_MAX_AGE_S: f64 = 120.0;
 /// Below this height of the lowest body the surface wind starts to count in the planning
 /// wind, m: about where the final is turned onto.
 const SURFACE_WIND_FROM_M: f64 = 250.0;
