@@ -12,9 +12,9 @@
 //     link can be cut for a while: the target shown off the origin, stale data shown stale (plots
 //     with a gap, the landing badge marked), and cutdown — refused by a click and an aborted hold,
 //     done by a completed hold — where the drone would accept it.
-//  2. `rehearsal` (`stx serve --sim`, under the parafoil): telemetry, viewer refusal, parameter
-//     read-back, modes, gamepad with dead-man and `manual_release`, layout at 1440×900 and on a
-//     phone, map framing, a target set in the page flown to, the landed state, and the recovery
+//  2. `rehearsal` (`stx serve --sim`, under the parafoil): telemetry, what guidance learned of the
+//     canopy, viewer refusal, parameter read-back, modes, gamepad with dead-man and
+//     `manual_release`, layout at 1440×900 and on a phone, map framing, a target set in the page flown to, the landed state, and the recovery
 //     page with and without the phone's position (its grid, its dots named, the location-denied
 //     box gone once a position is typed).
 // Then the rehearsal's recording replayed (`stx replay`: pause, seek, speed from the page), and a
@@ -205,6 +205,18 @@ async function rehearsal() {
   const windSpeed = await page.locator('[data-testid="wind-chart"] [data-testid="wind-forecast-speed"]').count();
   const windEst = await page.locator('[data-testid="wind-chart"] [data-testid="wind-est-dir"]').count();
   check("wind panel: forecast profiles of speed and direction, with the estimate", windDir >= 1 && windSpeed === 1 && windEst === 1, `${windSpeed} speed, ${windDir} direction profile(s), ${windEst} estimate dot`);
+
+  // ---------------------------------------------------------------- what guidance learned of the canopy
+  // The replica's spiral learns the glide within seconds of flying straight: Flight data shows it
+  // in percent of the polar, each brake setting's airspeed and sink and the turn, as the station has it.
+  await page.waitForFunction(() => /%/.test(document.querySelector('[data-testid="learned-polar"] tbody')?.textContent ?? ""), null, { timeout: 20000 }).catch(() => {});
+  const learnedShown = await page.evaluate(() => [...document.querySelectorAll('[data-testid="learned-polar"] tbody tr')].map((tr) => [...tr.querySelectorAll("td")].map((td) => td.textContent)));
+  const learned = (await api("/api/state")).body?.guidance?.learned ?? null;
+  // Rounded to 1 %, and read a moment apart from the station's figure (the scales drift slowly).
+  const near = (shown, scale) => Math.abs(parseFloat(shown ?? "") - scale * 100) <= 1.5;
+  check("Flight data shows what guidance learned: airspeed and sink at brakes 0, ½, 1 and the turn, in % of nominal", learned !== null && learnedShown.length === 2 && learnedShown[0].length === 4 && learnedShown[1].length === 3
+    && learned.airspeed_scale.every((v, i) => near(learnedShown[0][i], v)) && learned.sink_scale.every((v, i) => near(learnedShown[1][i], v)) && (learned.turn_learned_s === 0 || near(learnedShown[0][3], learned.turn_scale)),
+  `page ${JSON.stringify(learnedShown)}; station ${JSON.stringify(learned)}`);
 
   // ---------------------------------------------------------------- layout at 1440×900
   const layout = await page.evaluate(() => {

@@ -8,6 +8,9 @@
 //! a report is the vector mean of the last `averaging_s` of samples, its speed scaled by a
 //! calibration error drawn once per instrument and its direction off by a vane error drawn
 //! once, plus a little noise per report.
+//!
+//! [`mwv_sentence`] writes a report as the instrument would send it to the station; the
+//! runner (`stx drone --anemometer-to`) sends those sentences over UDP.
 
 use std::collections::VecDeque;
 
@@ -17,6 +20,7 @@ use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
 use serde::Serialize;
 use stx_gnc::guidance::SurfaceWind;
+use stx_types::mwv::{MwvReference, format_mwv};
 use stx_types::wind::WindField;
 
 /// The anemometer's settings, with units.
@@ -25,7 +29,9 @@ pub struct AnemometerConfig {
     /// Height of the cups above the target's ground, m (a 10-m mast is the meteorological
     /// standard; field masts are often lower).
     pub mast_height_m: f64,
-    /// Where the mast stands from the target (north, east), m.
+    /// Where the mast stands from the target (north, east), m, the target being the frame's
+    /// origin (as in Monte Carlo runs); [`AnemometerConfig::beside`] puts it by a target
+    /// elsewhere.
     pub offset_ne_m: [f64; 2],
     /// Each report is the mean wind over this long, s.
     pub averaging_s: f64,
@@ -49,6 +55,20 @@ impl Default for AnemometerConfig {
             speed_scale_sigma: 0.05,
             direction_bias_sigma_deg: 5.0,
             speed_noise_mps: 0.1,
+        }
+    }
+}
+
+impl AnemometerConfig {
+    /// The same instrument by a target at `target_ne_m` (north, east of the frame's origin,
+    /// m) instead of at the origin: its offset then counts from that target.
+    pub fn beside(self, target_ne_m: [f64; 2]) -> Self {
+        Self {
+            offset_ne_m: [
+                target_ne_m[0] + self.offset_ne_m[0],
+                target_ne_m[1] + self.offset_ne_m[1],
+            ],
+            ..self
         }
     }
 }
@@ -120,6 +140,27 @@ impl Anemometer {
     }
 }
 
+/// Where a report's wind blows from, degrees clockwise from true north in 0..360, and its
+/// speed, m/s: what an anemometer writes. The report's `ne_mps` is where the air goes, the
+/// opposite; a calm has no direction and is said to come from the north.
+pub fn from_deg_and_speed(report: &SurfaceWind) -> (f64, f64) {
+    let [north, east] = report.ne_mps;
+    let speed_mps = north.hypot(east);
+    if speed_mps == 0.0 {
+        return (0.0, 0.0);
+    }
+    // rem_euclid of a tiny negative angle rounds up to 360.0 itself, outside 0..360.
+    let from_deg = (-east).atan2(-north).to_degrees().rem_euclid(360.0);
+    (if from_deg >= 360.0 { 0.0 } else { from_deg }, speed_mps)
+}
+
+/// The NMEA 0183 MWV sentence of `report` (true reference, m/s), CR LF included, as the
+/// instrument sends it.
+pub fn mwv_sentence(report: &SurfaceWind) -> String {
+    let (from_deg, speed_mps) = from_deg_and_speed(report);
+    format_mwv(from_deg, MwvReference::True, speed_mps)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -158,6 +199,66 @@ mod tests {
             assert_eq!(r.time_s, *t);
             assert!((r.ne_mps[0] + 2.0).abs() < 1e-9 && (r.ne_mps[1] - 1.0).abs() < 1e-9);
         }
+    }
+
+    /// The air's velocity is where it is sampled, in km: a report says where the mast is.
+    struct WhereAmI;
+
+    impl WindField for WhereAmI {
+        fn wind_ned_mps(&self, _: f64, p: &Vector3<f64>) -> Vector3<f64> {
+            p / 1000.0
+        }
+    }
+
+    #[test]
+    fn an_instrument_beside_a_target_samples_the_wind_there() {
+        let config = AnemometerConfig {
+            offset_ne_m: [10.0, -20.0],
+            speed_scale_sigma: 0.0,
+            direction_bias_sigma_deg: 0.0,
+            speed_noise_mps: 0.0,
+            ..AnemometerConfig::default()
+        }
+        .beside([300.0, 2500.0]);
+        assert_eq!(config.offset_ne_m, [310.0, 2480.0]);
+        let mut anemometer = Anemometer::new(config, 3);
+        let report = (0..100)
+            .find_map(|k| anemometer.step(0.25 * k as f64, &WhereAmI))
+            .expect("a report within 25 s");
+        assert!((report.ne_mps[0] - 0.31).abs() < 1e-9, "{report:?}");
+        assert!((report.ne_mps[1] - 2.48).abs() < 1e-9, "{report:?}");
+    }
+
+    #[test]
+    fn a_report_turns_into_where_the_wind_comes_from_and_its_sentence() {
+        let report = |north: f64, east: f64| SurfaceWind {
+            ne_mps: [north, east],
+            time_s: 0.0,
+        };
+        // Air going south comes from the north; going east, from the west; going north-west,
+        // from the south-east.
+        for ((north, east), from, speed) in [
+            ((-3.0, 0.0), 0.0, 3.0),
+            ((0.0, 2.0), 270.0, 2.0),
+            ((1.0, -1.0), 135.0, 2f64.sqrt()),
+            ((0.0, -4.0), 90.0, 4.0),
+            ((2.0, 0.0), 180.0, 2.0),
+            ((-1.0, 1e-18), 0.0, 1.0),
+            ((0.0, 0.0), 0.0, 0.0),
+        ] {
+            let (from_deg, speed_mps) = from_deg_and_speed(&report(north, east));
+            assert!(
+                (0.0..360.0).contains(&from_deg) && (from_deg - from).abs() < 1e-9,
+                "({north}, {east}): from {from_deg}"
+            );
+            assert!((speed_mps - speed).abs() < 1e-12);
+        }
+        // A wind blowing from the mission profile's 300° at 2 m/s reads back as such.
+        let (sin, cos) = 300f64.to_radians().sin_cos();
+        let line = mwv_sentence(&report(-2.0 * cos, -2.0 * sin));
+        assert!(line.starts_with("$WIMWV,300.0,T,2.0,M,A*"), "{line}");
+        let reading = stx_types::mwv::parse_mwv(&line).expect("valid");
+        assert!((reading.from_deg - 300.0).abs() < 1e-9 && reading.speed_mps == 2.0);
     }
 
     #[test]

@@ -245,6 +245,10 @@ pub struct StationConfig {
     /// The upload to SondeHub-Amateur (`[sondehub]`, see [`crate::sondehub`]); off without it.
     #[serde(default)]
     pub sondehub: Option<crate::sondehub::SondehubConfig>,
+    /// The wind at the target (`[surface_wind]`, see [`crate::surface_wind`]): the ground
+    /// anemometer, if any, and how its wind or the operator's is sent to the drone.
+    #[serde(default)]
+    pub surface_wind: crate::surface_wind::SurfaceWindConfig,
     /// Test-only: loopback addresses treated as not loopback, from the environment's
     /// [`NOT_LOOPBACK_ENV`] (see [`crate::exposure`]); empty in the field.
     #[serde(skip)]
@@ -397,6 +401,9 @@ impl StationConfig {
         }
         if let Some((field, rule)) = self.sondehub.as_ref().and_then(|c| c.invalid()) {
             return invalid(field, rule);
+        }
+        if let Some((field, rule)) = self.surface_wind.invalid() {
+            return invalid(field, &rule);
         }
         let mut seen: HashMap<&str, usize> = HashMap::new();
         for (i, t) in self.tokens.iter().enumerate() {

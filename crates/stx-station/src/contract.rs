@@ -190,6 +190,7 @@ pub fn schema() -> Result<Value, ContractError> {
         read.subschema_for::<CourseBody>(),
         read.subschema_for::<LocalizerBody>(),
         read.subschema_for::<TargetBody>(),
+        read.subschema_for::<crate::requests::SurfaceWindBody>(),
         read.subschema_for::<PlanBody>(),
         read.subschema_for::<ParamBody>(),
         read.subschema_for::<ConfirmBody>(),

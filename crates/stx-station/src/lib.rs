@@ -9,6 +9,8 @@
 //!   read-only MAVLink outputs for watching ground stations (their sockets are the daemon's);
 //!   [`chase`]: the Horus UDP summaries for chase cars' maps; [`sondehub`]: the upload to
 //!   SondeHub-Amateur (points, queue, retries; its HTTP client is the daemon's);
+//!   [`surface_wind`]: the wind at the target (`[surface_wind]`), from a ground anemometer's
+//!   NMEA sentences (its reader is the daemon's) or the operator, uplinked to the drone;
 //! - [`core`]: the station's state and logic: telemetry, link events and operators' requests
 //!   in, with the mission clock; messages for the dashboards and link actions (with ids and
 //!   deadlines) out; the link's outcome of each action back in; retries and time-outs are its
@@ -72,6 +74,7 @@ pub mod replay;
 pub mod replies;
 pub mod requests;
 pub mod sondehub;
+pub mod surface_wind;
 pub mod tawhiri;
 #[cfg(feature = "daemon")]
 pub mod tile_pack;

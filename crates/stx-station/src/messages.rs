@@ -348,6 +348,9 @@ pub struct StateMsg {
     pub readiness: ReadinessView,
     /// The replay this station is showing (`stx replay`); `null` when live.
     pub replay: Option<ReplayView>,
+    /// The wind at the target (a ground anemometer's mean or the operator's value) and the
+    /// drone's copy of it.
+    pub surface_wind: crate::surface_wind::SurfaceWindView,
 }
 
 /// A replay of a recording, for the dashboard's REPLAY bar.

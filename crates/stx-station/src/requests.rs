@@ -22,6 +22,16 @@ pub struct HeadingBody {
     pub heading_deg: f64,
 }
 
+/// `POST /api/surface_wind`: the operator's reading of the wind at the target.
+#[derive(Debug, Clone, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct SurfaceWindBody {
+    /// Speed, m/s (0–60).
+    pub speed_mps: f64,
+    /// Where the wind blows from, degrees true.
+    pub from_deg: f64,
+}
+
 /// `POST /api/commands/course`.
 #[derive(Debug, Clone, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]

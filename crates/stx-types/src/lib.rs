@@ -20,6 +20,7 @@
 //! - [`atmosphere`] is the air over altitude (US Standard Atmosphere 1976) and [`wind`] the
 //!   air's velocity (the [`wind::WindField`] trait and the mean winds; the simulator's
 //!   turbulence stays in `stx-dynamics`);
+//! - [`mwv`] reads and writes NMEA 0183 `MWV`, the wind a ground anemometer reports;
 //! - [`stack`] maps the bodies that carry an IMU of their own to their MAVLink components;
 //! - [`table_text`] finds the data lines of a hand-edited table, with their line numbers;
 //! - [`validate`] checks one setting against its rule, for every settings type of the
@@ -34,6 +35,7 @@ pub mod controls;
 pub mod geo;
 pub mod keep_out;
 pub mod mission;
+pub mod mwv;
 pub mod plan;
 pub mod rotation;
 pub mod stack;

@@ -19,6 +19,10 @@
 //! `--gains FILE` (a gains file as `stx tune` writes it) sets the onboard guidance's control
 //! gains, which are also its parameters: the station reads and sets them over PARAM_*.
 //!
+//! `--anemometer-to HOST:PORT` puts the simulated world's ground anemometer (a 10-m mast by the
+//! mission's target, in the drone's true wind) on the air: each of its reports, every 5 s of
+//! mission time, goes to that UDP address as one NMEA 0183 MWV sentence.
+//!
 //! `--vehicle FILE` (a vehicle file, as `stx sim --vehicle` reads it) is the truth the drone
 //! flies; the onboard guidance keeps the mission's polar, so an operator rehearses guidance
 //! as it is against the stack they identified ([`stx_sim::drone::Drone::with_truth`]).
@@ -29,6 +33,7 @@
 
 use std::ffi::OsString;
 use std::io::IsTerminal;
+use std::net::{SocketAddr, ToSocketAddrs};
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
@@ -105,6 +110,25 @@ pub struct DroneArgs {
     /// Print the mission's figures as one JSON line on stdout at the end.
     #[arg(long)]
     summary_json: bool,
+    /// Send the simulated ground anemometer's NMEA MWV sentences to this UDP address.
+    #[arg(long, value_name = "HOST:PORT", value_parser = udp_address)]
+    anemometer_to: Option<SocketAddr>,
+}
+
+/// A UDP destination: an IP address and port, or a host name resolved now (its first
+/// address).
+fn udp_address(text: &str) -> Result<SocketAddr, String> {
+    if let Ok(address) = text.parse() {
+        return Ok(address);
+    }
+    let expected = "expected HOST:PORT, e.g. 127.0.0.1:10110 or [::1]:10110";
+    let addresses = text
+        .to_socket_addrs()
+        .map_err(|e| format!("{expected} ({e})"))?;
+    addresses
+        .into_iter()
+        .next()
+        .ok_or_else(|| format!("{expected} ({text:?} has no address)"))
 }
 
 /// The mission `scenario` (built-in name or file) with `overrides`, validated; every error is
@@ -215,6 +239,7 @@ impl DroneArgs {
         options.link.system_id = self.system_id;
         options.signing = signing;
         options.linger = Some(Duration::from_secs_f64(self.linger));
+        options.anemometer_to = self.anemometer_to;
         if let Some(path) = &self.vehicle {
             options.vehicle = load_vehicle_flag("--vehicle", path)?;
         }
@@ -443,6 +468,29 @@ mod tests {
         }
         let err = options(&["--scenario", "rehearsal", "--packet-loss", "120"]).expect_err("120 %");
         assert!(format!("{err:#}").contains("packet_loss_pct"), "{err:#}");
+    }
+
+    #[test]
+    fn the_anemometer_address_is_an_ip_and_port_or_a_host_and_port() {
+        assert_eq!(options(&[]).expect("valid").anemometer_to, None);
+        let to = |flag: &str| options(&["--anemometer-to", flag]).map(|o| o.anemometer_to);
+        assert_eq!(
+            to("127.0.0.1:10110").expect("valid"),
+            Some("127.0.0.1:10110".parse().expect("address"))
+        );
+        assert_eq!(
+            to("[::1]:10110").expect("valid"),
+            Some("[::1]:10110".parse().expect("address"))
+        );
+        let local = to("localhost:10110").expect("resolved").expect("given");
+        assert!(local.ip().is_loopback() && local.port() == 10110, "{local}");
+        for bad in ["10110", "127.0.0.1", "127.0.0.1:99999", "[::1]"] {
+            let err = to(bad).expect_err(bad).to_string();
+            assert!(
+                err.contains("--anemometer-to") && err.contains("HOST:PORT"),
+                "{bad}: {err}"
+            );
+        }
     }
 
     #[test]

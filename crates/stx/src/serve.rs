@@ -4,6 +4,8 @@
 //! With `--sim` the simulated drone of `stx drone` flies beside the station in the same process,
 //! over a real UDP socket on loopback to the station's `udpin` link (the same bytes a radio
 //! would carry), for rehearsals and demonstrations. One shutdown (Ctrl-C or SIGTERM) stops both.
+//! When the station reads a ground anemometer on a UDP port (`[surface_wind] anemometer =
+//! "udpin:…"`), the simulated world's anemometer sends its NMEA sentences there.
 
 use std::future::Future;
 use std::path::PathBuf;
@@ -224,6 +226,17 @@ fn sim_options(config: &StationConfig, args: &ServeArgs) -> anyhow::Result<FlyOp
         mission(&args.sim_scenario, &overrides)?,
     );
     options.speed = args.sim_speed;
+    if let Ok(Some(stx_link::address::Address::UdpIn(at))) =
+        config.surface_wind.anemometer_address()
+    {
+        // A port bound on every address is reached on loopback.
+        let ip = if at.ip().is_unspecified() {
+            std::net::Ipv4Addr::LOCALHOST.into()
+        } else {
+            at.ip()
+        };
+        options.anemometer_to = Some(std::net::SocketAddr::new(ip, at.port()));
+    }
     if let Some(path) = &args.sim_vehicle {
         options.vehicle = load_vehicle_flag("--sim-vehicle", path)?;
     }

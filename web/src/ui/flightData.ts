@@ -1,9 +1,11 @@
-// Key flight data: speeds, sink, glide, altitudes, position, GPS, power; and the actuators as bars.
+// Key flight data: speeds, sink, glide, altitudes, position, GPS, power, and what guidance has
+// learned of the canopy beside them; and the actuators as bars.
 
 import { h, panel, readout, setStyle, setText } from "./dom";
 import { vehiclePosition } from "../lib/fix";
 import { fmt, fmtLatLon, label } from "../lib/format";
-import type { N, State } from "../lib/types";
+import { learnedTable, type LearnedCell } from "../lib/learned";
+import type { Learned, N, State } from "../lib/types";
 
 /** "2.04 : 1", or a bare dash when there is no glide (on the ground, under the balloon). */
 const glide = (v: N | undefined): string => (v === null || v === undefined ? "—" : fmt(v, ": 1", 2));
@@ -13,6 +15,7 @@ type Row = { value: HTMLElement; get: (s: State) => string };
 export class FlightData {
   readonly root: HTMLElement;
   private readonly rows: Row[] = [];
+  private readonly learned = new LearnedPolar();
 
   constructor() {
     // Numbers in three columns, the longer texts (position, GPS, air, battery) as one line each
@@ -53,11 +56,39 @@ export class FlightData {
       const p = s.vehicle?.power;
       return p ? `${fmt(p.voltage_v, "V", 2)} · ${fmt(p.current_a, "A", 2)} · ${fmt(p.remaining_percent, "%", 0)}` : "—";
     });
-    this.root = panel("Flight data", "panel-flight", grid, list);
+    this.root = panel("Flight data", "panel-flight", grid, list, this.learned.root);
   }
 
   update(s: State): void {
     for (const r of this.rows) setText(r.value, r.get(s));
+    this.learned.update(s.guidance?.learned ?? null);
+  }
+}
+
+/**
+ * The replica's learned polar (lib/learned.ts) as a table under the readouts. Drawn before the
+ * first state, so the column's layout is settled from the start; rebuilt only when its text
+ * changes (the scales move slowly, the state comes at 4 Hz).
+ */
+class LearnedPolar {
+  readonly root = h("table", { class: "learned", "data-testid": "learned-polar" });
+  private drawn: string | null = null;
+
+  constructor() {
+    this.update(null);
+  }
+
+  update(l: Learned | null): void {
+    const t = learnedTable(l);
+    const key = JSON.stringify(t);
+    if (key === this.drawn) return;
+    this.drawn = key;
+    const cell = (tag: "th" | "td", c: LearnedCell, scope?: string): HTMLElement =>
+      h(tag, { colspan: c.cols ?? null, rowspan: c.rows ?? null, class: c.off ? "warn off" : null, title: c.title ?? null, scope: scope ?? null }, c.text);
+    this.root.replaceChildren(
+      h("thead", {}, h("tr", {}, ...t.head.map((c) => cell("th", c, "col")))),
+      h("tbody", {}, ...t.rows.map((r) => h("tr", {}, ...r.map((c, i) => (i === 0 ? cell("th", c, "row") : cell("td", c)))))),
+    );
   }
 }
 

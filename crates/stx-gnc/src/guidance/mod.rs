@@ -114,6 +114,12 @@ impl Guidance {
         self.surface_wind = wind;
     }
 
+    /// The wind measured at the ground that guidance holds (the drone's and the station's
+    /// replica's must agree).
+    pub fn surface_wind(&self) -> Option<SurfaceWind> {
+        self.surface_wind
+    }
+
     /// [`Guidance::set_plan`], refusing a plan whose target lies in a keep-out zone (the plan
     /// in force is kept).
     pub fn try_set_plan(&mut self, plan: Plan, time_s: f64) -> Result<(), PlanRefused> {

@@ -39,7 +39,21 @@ pub enum Command {
     RequestMessage { message_id: u32 },
     /// Set the rate of a message: interval µs, −1 stops it, 0 restores the default.
     SetMessageInterval { message_id: u32, interval_us: i32 },
+    /// The wind measured at the ground by the landing target (a mast anemometer's mean, or
+    /// the operator's reading): its speed, m/s, where it blows from, degrees true, and how
+    /// long ago it was measured when sent, s.
+    SetSurfaceWind {
+        speed_mps: f64,
+        from_deg: f64,
+        age_s: f64,
+    },
 }
+
+/// Most surface wind a command carries, m/s: far beyond what a parafoil lands in, so only a
+/// broken value is refused.
+pub const SURFACE_WIND_MAX_MPS: f64 = 60.0;
+/// Oldest surface wind a command carries, s.
+pub const SURFACE_WIND_MAX_AGE_S: f64 = 3600.0;
 
 /// Outcome of a command as reported by the vehicle (MAV_RESULT).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -175,6 +189,7 @@ impl Command {
             Self::Cutdown => MavCmd::MAV_CMD_DO_FLIGHTTERMINATION,
             Self::RequestMessage { .. } => MavCmd::MAV_CMD_REQUEST_MESSAGE,
             Self::SetMessageInterval { .. } => MavCmd::MAV_CMD_SET_MESSAGE_INTERVAL,
+            Self::SetSurfaceWind { .. } => MavCmd::MAV_CMD_USER_1,
         }
     }
 
@@ -288,6 +303,19 @@ impl Command {
                 0.0,
                 0.0,
             ]),
+            Self::SetSurfaceWind {
+                speed_mps,
+                from_deg,
+                age_s,
+            } => long([
+                speed_mps as f32,
+                from_deg as f32,
+                age_s as f32,
+                0.0,
+                0.0,
+                0.0,
+                0.0,
+            ]),
         }
     }
 
@@ -364,6 +392,21 @@ impl Command {
                 Ok(Command::SetMessageInterval {
                     message_id: id as u32,
                     interval_us: c.param2 as i32,
+                })
+            }
+            MavCmd::MAV_CMD_USER_1 => {
+                let speed = c.param1;
+                if !(speed.is_finite() && (0.0..=SURFACE_WIND_MAX_MPS as f32).contains(&speed)) {
+                    return Err(bad(1, speed));
+                }
+                let age = c.param3;
+                if !(age.is_finite() && (0.0..=SURFACE_WIND_MAX_AGE_S as f32).contains(&age)) {
+                    return Err(bad(3, age));
+                }
+                Ok(Command::SetSurfaceWind {
+                    speed_mps: f64::from(speed),
+                    from_deg: finite_angle(command, 2, c.param2)?,
+                    age_s: f64::from(age),
                 })
             }
             MavCmd::MAV_CMD_NAV_LAND | MavCmd::MAV_CMD_DO_REPOSITION => {
@@ -497,6 +540,11 @@ mod tests {
                 message_id: 33,
                 interval_us: 200_000,
             },
+            Command::SetSurfaceWind {
+                speed_mps: 3.5,
+                from_deg: 247.5,
+                age_s: 4.0,
+            },
         ]
     }
 
@@ -522,5 +570,39 @@ mod tests {
                 _ => assert_eq!(c, back),
             }
         }
+    }
+
+    #[test]
+    fn a_surface_wind_out_of_range_is_refused_naming_the_parameter() {
+        let refused = |speed_mps, from_deg, age_s| {
+            let c = Command::SetSurfaceWind {
+                speed_mps,
+                from_deg,
+                age_s,
+            };
+            match Command::from_mavlink(&c.to_mavlink(1, 1, 0)) {
+                Some(Err(CommandDecodeError::InvalidParam { param, .. })) => param,
+                other => panic!("{c:?} decoded as {other:?}"),
+            }
+        };
+        assert_eq!(refused(-1.0, 90.0, 0.0), 1);
+        assert_eq!(refused(f64::NAN, 90.0, 0.0), 1);
+        assert_eq!(refused(SURFACE_WIND_MAX_MPS + 1.0, 90.0, 0.0), 1);
+        assert_eq!(refused(3.0, f64::INFINITY, 0.0), 2);
+        assert_eq!(refused(3.0, 400.0, 0.0), 2);
+        assert_eq!(refused(3.0, 90.0, -5.0), 3);
+        assert_eq!(refused(3.0, 90.0, SURFACE_WIND_MAX_AGE_S + 1.0), 3);
+        // A direction of −90° is where 270° is.
+        let back = Command::from_mavlink(
+            &Command::SetSurfaceWind {
+                speed_mps: 2.0,
+                from_deg: -90.0,
+                age_s: 0.0,
+            }
+            .to_mavlink(1, 1, 0),
+        );
+        assert!(
+            matches!(back, Some(Ok(Command::SetSurfaceWind { from_deg, .. })) if from_deg == 270.0)
+        );
     }
 }

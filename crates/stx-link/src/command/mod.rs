@@ -17,6 +17,7 @@
 //! | `Cutdown` | COMMAND_LONG `MAV_CMD_DO_FLIGHTTERMINATION` | p1 = 1 |
 //! | `RequestMessage` | COMMAND_LONG `MAV_CMD_REQUEST_MESSAGE` | p1 = message id |
 //! | `SetMessageInterval` | COMMAND_LONG `MAV_CMD_SET_MESSAGE_INTERVAL` | p1 = message id, p2 = interval µs (−1 stop, 0 default) |
+//! | `SetSurfaceWind` | COMMAND_LONG `MAV_CMD_USER_1` | p1 = speed m/s (0…60), p2 = direction the wind blows from, degrees true, p3 = age of the measurement when sent, s (0…3600): the common dialect has no message for a wind measured on the ground, and USER_1 is the range it leaves to vehicle-specific commands |
 //!
 //! COMMAND_LONG retries carry an incremented `confirmation`; COMMAND_INT has no such field, so
 //! its retries are identical copies, which the vehicle recognises by content within
@@ -41,5 +42,7 @@ mod server;
 pub use client::{
     CommandClient, CommandConfig, CommandEvent, CommandOutcome, CommandSendError, RequestId,
 };
-pub use encoding::{Command, CommandDecodeError, CommandResult};
+pub use encoding::{
+    Command, CommandDecodeError, CommandResult, SURFACE_WIND_MAX_AGE_S, SURFACE_WIND_MAX_MPS,
+};
 pub use server::{CommandServer, CommandServerStats, IncomingCommand, IncomingId};

@@ -3,6 +3,7 @@
 
 use std::future::Future;
 use std::io;
+use std::net::SocketAddr;
 use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
 
 use serde::Serialize;
@@ -13,6 +14,7 @@ use stx_link_tokio::{Action, DriveOptions, DriverEvent, Transport, TransportErro
 use tokio::sync::mpsc;
 use tokio::task::{JoinError, JoinHandle};
 
+use super::anemometer::{AnemometerCounters, AnemometerLink};
 use super::observe::{FlightObserver, StepReport, log_event};
 use super::options::{FlyOptions, Speed};
 use super::pacing::Pacer;
@@ -50,6 +52,13 @@ pub enum FlyError {
         #[source]
         source: TransportError,
     },
+    /// No socket to send the ground anemometer's sentences to `to` from.
+    #[error("opening a UDP socket for the ground anemometer's sentences to {to}")]
+    Anemometer {
+        to: SocketAddr,
+        #[source]
+        source: io::Error,
+    },
     /// The system clock reads before 1970: no signing timestamp can be made.
     #[error("the system clock is before 1970")]
     Clock,
@@ -82,6 +91,7 @@ impl FlyError {
             Self::Drone { .. }
                 | Self::Dispersed { .. }
                 | Self::Open { .. }
+                | Self::Anemometer { .. }
                 | Self::Signing(_)
                 | Self::PersistMark(_)
         )
@@ -107,6 +117,9 @@ pub struct FlightReport {
     pub link: LinkCounters,
     /// The socket's counters.
     pub io: IoStats,
+    /// What the ground anemometer sent, if it was on ([`FlyOptions::anemometer_to`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub anemometer: Option<AnemometerCounters>,
 }
 
 /// A drone on the air, not yet paced: its link is up (heartbeats, answers), no step flown.
@@ -116,6 +129,7 @@ pub struct Flight {
     actions: mpsc::Sender<Action<LinkedDrone>>,
     events: mpsc::Receiver<DriverEvent<DroneEvent>>,
     driver: JoinHandle<(LinkedDrone, IoStats)>,
+    anemometer: Option<AnemometerLink>,
 }
 
 /// Reads the drone of a [`Flight`] between two of its steps.
@@ -141,7 +155,8 @@ impl FlightHandle {
 }
 
 impl Flight {
-    /// Builds the drone of `options.mission`, opens the link, starts signing and the driver.
+    /// Builds the drone of `options.mission`, opens the ground anemometer's socket (if
+    /// asked) and the link, starts signing and the driver.
     /// A refused input is an error for which [`FlyError::is_input`] holds; nothing is opened
     /// for a drone that cannot be built.
     pub async fn start(options: FlyOptions) -> Result<Self, FlyError> {
@@ -164,6 +179,14 @@ impl Flight {
                 source,
             },
         })?;
+        let anemometer = match options.anemometer_to {
+            Some(to) => Some(
+                AnemometerLink::open(to, &drone)
+                    .await
+                    .map_err(|source| FlyError::Anemometer { to, source })?,
+            ),
+            None => None,
+        };
         let transport = Transport::open_str(&options.connect)
             .await
             .map_err(|source| FlyError::Open {
@@ -215,6 +238,7 @@ impl Flight {
             actions,
             events,
             driver,
+            anemometer,
         })
     }
 
@@ -239,6 +263,7 @@ impl Flight {
             actions,
             mut events,
             mut driver,
+            mut anemometer,
         } = self;
         let started = Instant::now();
         let clock = tokio::time::Instant::now();
@@ -263,6 +288,9 @@ impl Flight {
                 Some(report) = reports.recv() => {
                     let r = report.map_err(FlyError::Simulation)?;
                     observer.step(&r);
+                    if let Some(a) = &mut anemometer {
+                        a.step(r.time_s).await;
+                    }
                     if r.landed && landed_at.is_none() {
                         landed_at = Some(Instant::now());
                         pacer.landed(clock.elapsed());
@@ -316,6 +344,7 @@ impl Flight {
             interrupted,
             link: linked.counters(),
             io,
+            anemometer: anemometer.as_ref().map(AnemometerLink::counters),
         })
     }
 }

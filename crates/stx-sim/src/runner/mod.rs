@@ -25,15 +25,21 @@
 //! [`FlightObserver`] — a progress bar, [`ProgressLog`]'s log lines, a benchmark's clock.
 //! [`FlightHandle::query`] reads the drone between two steps.
 //!
+//! With [`FlyOptions::anemometer_to`], the simulated world's ground anemometer by the target
+//! measures the drone's true wind at each step's mission time and sends each report as an
+//! NMEA MWV datagram to that address (`anemometer.rs`; counted in the report).
+//!
 //! Files: [`options`] (what to fly), [`pacing`] (when each step is due, sans-io), [`observe`]
-//! (step reports, observers, the log) and `flight.rs` (the tokio adapter, its errors and its
-//! report).
+//! (step reports, observers, the log), `anemometer.rs` (the ground anemometer's socket) and
+//! `flight.rs` (the tokio adapter, its errors and its report).
 
+mod anemometer;
 mod flight;
 pub mod observe;
 pub mod options;
 pub mod pacing;
 
+pub use anemometer::AnemometerCounters;
 pub use flight::{Flight, FlightHandle, FlightReport, FlyError, STEPS_IN_FLIGHT, fly};
 pub use observe::{FlightObserver, ProgressLog, StepReport};
 pub use options::{FlyOptions, Signing, Speed};

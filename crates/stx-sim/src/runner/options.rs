@@ -1,7 +1,9 @@
 //! What [`super::Flight`] flies, and how: the mission, where the station is, the speed, the
-//! drone's link settings and signing, and how long it stays on the air after landing.
+//! drone's link settings and signing, how long it stays on the air after landing, and where
+//! the simulated ground anemometer sends its wind.
 
 use std::fmt;
+use std::net::SocketAddr;
 use std::path::PathBuf;
 use std::str::FromStr;
 use std::time::Duration;
@@ -86,11 +88,15 @@ pub struct FlyOptions {
     /// around [`Self::vehicle`] instead of it and the mission's sensors; the servos stay
     /// perfect.
     pub dispersions: Option<crate::dispersions::Dispersions>,
+    /// Send the simulated world's ground anemometer (a 10-m mast by the mission's target, in
+    /// the wind the drone truly flies: [`crate::anemometer`]) to this UDP address, one NMEA
+    /// MWV sentence a datagram every report; `None`: no anemometer.
+    pub anemometer_to: Option<SocketAddr>,
 }
 
 impl FlyOptions {
     /// `mission` towards `connect` in real time, system id 1, no signing, the shipped vehicle,
-    /// stopping as soon as it has landed.
+    /// no ground anemometer, stopping as soon as it has landed.
     pub fn new(connect: &str, mission: MissionConfig) -> Self {
         Self {
             connect: connect.to_string(),
@@ -101,6 +107,7 @@ impl FlyOptions {
             linger: Some(Duration::ZERO),
             vehicle: stx_dynamics::vehicle::Vehicle::straplex(),
             dispersions: None,
+            anemometer_to: None,
         }
     }
 }

@@ -639,3 +639,35 @@ fn sys_status_reports_absent_subsystems_healthy_and_present_ones_as_they_are() {
     assert_eq!(last.sensors_present & GPS, GPS);
     assert_eq!(last.sensors_health & GPS, GPS, "GPS fixes arrive: healthy");
 }
+
+#[test]
+fn a_surface_wind_from_the_station_becomes_guidances_measured_when_it_says_and_is_told_once() {
+    let config = mission("rehearsal");
+    let mut d = drone(&config);
+    let mut log = Log::default();
+    fly(&mut d, &mut log, |d| d.time_s() >= 10.0);
+    assert!(d.onboard().guidance().surface_wind().is_none());
+    let wind = Command::SetSurfaceWind {
+        speed_mps: 3.0,
+        from_deg: 270.0,
+        age_s: 4.0,
+    };
+    assert_eq!(d.handle_command(&wind), CommandResult::Accepted);
+    let held = d.onboard().guidance().surface_wind().expect("held");
+    // From the west: the air goes east.
+    assert!(held.ne_mps[0].abs() < 1e-9 && (held.ne_mps[1] - 3.0).abs() < 1e-9);
+    assert!(
+        (held.time_s - (d.time_s() - 4.0)).abs() < 1e-9,
+        "{}",
+        held.time_s
+    );
+    fly(&mut d, &mut log, |d| d.time_s() >= 15.0);
+    assert_eq!(d.handle_command(&wind), CommandResult::Accepted);
+    log.drain(&mut d);
+    let told = log
+        .texts
+        .iter()
+        .filter(|(_, t)| t.contains("surface wind"))
+        .count();
+    assert_eq!(told, 1, "{:?}", log.texts);
+}

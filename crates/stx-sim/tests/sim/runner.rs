@@ -1,17 +1,21 @@
 //! The runner (`stx_sim::runner`) over real loopback sockets: it stops when told and reports
 //! the flight so far, signs above every timestamp of its last run after a restart with the
-//! clock set back, tells each step's ATTITUDE stamp, answers queries between steps, and
-//! refuses a drone it cannot build before opening anything.
+//! clock set back, tells each step's ATTITUDE stamp, answers queries between steps, refuses
+//! a drone it cannot build before opening anything, and sends the simulated ground
+//! anemometer's NMEA MWV sentences where asked.
 
 use std::path::PathBuf;
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
+use nalgebra::Vector3;
+use stx_dynamics::wind::{MeanWindConfig, WindConfig};
 use stx_link::signing::SigningKey;
 use stx_sim::drone::MissionConfig;
 use stx_sim::runner::{
     Flight, FlightObserver, FlyError, FlyOptions, Signing, Speed, StepReport, fly,
 };
+use stx_types::mwv::{MwvReference, parse_mwv};
 use tokio::net::UdpSocket;
 use tokio::time::timeout;
 
@@ -230,4 +234,90 @@ async fn a_drone_that_cannot_be_built_is_refused_before_the_link_opens() {
     .expect_err("refused");
     assert!(matches!(err, FlyError::Open { .. }), "{err}");
     assert!(err.is_input());
+}
+
+/// `anemometer_to`: the ground anemometer by the target measures the mission's wind and sends
+/// each report as one NMEA MWV datagram, counted in the flight's report.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn the_ground_anemometer_sends_the_mission_wind_as_mwv_datagrams() {
+    let (_station, connect) = station().await;
+    let receiver = UdpSocket::bind("127.0.0.1:0")
+        .await
+        .expect("anemometer's receiver");
+    let mission = rehearsal();
+    let mut options = FlyOptions::new(&connect, mission.clone());
+    // The first report comes 10 to 15 s of mission time in: a fraction of a second at max.
+    options.speed = Speed::Max;
+    options.linger = None;
+    options.anemometer_to = Some(receiver.local_addr().expect("bound"));
+    let (stop, stopped) = tokio::sync::oneshot::channel::<()>();
+    let flight = tokio::spawn(fly(
+        options,
+        async {
+            let _ = stopped.await;
+        },
+        (),
+    ));
+    let mut buf = [0_u8; 256];
+    let n = timeout(Duration::from_secs(20), receiver.recv(&mut buf))
+        .await
+        .expect("the anemometer sends")
+        .expect("recv");
+    stop.send(()).expect("flight running");
+    let report = timeout(Duration::from_secs(20), flight)
+        .await
+        .expect("fly returns after the shutdown")
+        .expect("task")
+        .expect("flight");
+    let counters = report.anemometer.expect("the anemometer was on");
+    assert!(
+        counters.sent >= 1 && counters.send_errors == 0,
+        "{counters:?}"
+    );
+
+    // One sentence a datagram, as an NMEA line ends.
+    let line = std::str::from_utf8(&buf[..n]).expect("ASCII");
+    assert!(line.starts_with("$WIMWV,"), "{line:?}");
+    assert_eq!(line.matches("\r\n").count(), 1, "{line:?}");
+    assert!(line.ends_with("\r\n"), "{line:?}");
+    let reading = parse_mwv(line).expect(line);
+    assert_eq!(reading.reference, MwvReference::True);
+
+    // What the mission's mean wind (no gusts) is at the top of the 10-m mast by the target.
+    let wind = mission.wind.as_ref().expect("the rehearsal has a wind");
+    let MeanWindConfig::Profile { rows } = &wind.mean else {
+        panic!("the rehearsal's wind is a profile");
+    };
+    let mean = WindConfig {
+        mean: wind.mean.clone(),
+        turbulence: None,
+    }
+    .build()
+    .expect("the mission's wind builds");
+    let target = mission.target_ned_m().expect("the rehearsal has a target");
+    let w = mean.wind_ned_mps(0.0, &Vector3::new(target.x, target.y, -10.0));
+    let mean_from_deg = (-w.y).atan2(-w.x).to_degrees().rem_euclid(360.0);
+    assert!(w.x.hypot(w.y) > 1.0, "a wind with a direction to compare");
+
+    // Speed: within the profile's speeds, widened by the instrument's calibration (clamped
+    // at 3 σ = 15 %) and 0.7 m/s, 3 σ of its report noise (0.1 m/s) and the gusts (0.2 m/s)
+    // together.
+    let (slowest, fastest) = rows.iter().fold((f64::INFINITY, 0.0_f64), |(lo, hi), r| {
+        (lo.min(r[1]), hi.max(r[1]))
+    });
+    let speed = reading.speed_mps;
+    assert!(
+        (0.85 * slowest - 0.7..=1.15 * fastest + 0.7).contains(&speed),
+        "{speed} m/s outside {slowest}..{fastest} m/s and the instrument's errors: {line:?}"
+    );
+    // Direction: within 30° of the mean wind's: the vane's bias is at most 15° (clamped at
+    // 3 σ of 5°) and gusts of 0.2 m/s across a 2 m/s wind swing a 10-s mean by a few degrees,
+    // 15° being more than 2 σ of their swing before any averaging.
+    let apart = (reading.from_deg - mean_from_deg).rem_euclid(360.0);
+    let apart = apart.min(360.0 - apart);
+    assert!(
+        apart <= 30.0,
+        "from {:.1}° vs the mean wind's {mean_from_deg:.1}°: {line:?}",
+        reading.from_deg
+    );
 }

@@ -92,6 +92,8 @@ pub(crate) enum Purpose {
     Manual,
     /// The station's own transfer of the keep-out fence.
     FenceUpload,
+    /// The station's own uplink of the surface wind.
+    SurfaceWind,
 }
 
 #[derive(Debug)]

@@ -51,6 +51,11 @@ impl MissionClock {
         }
     }
 
+    /// Drone seconds per station second (1 until measured).
+    pub(crate) fn rate(&self) -> f64 {
+        self.rate.unwrap_or(1.0)
+    }
+
     /// Forgets everything (the drone restarted: its clock began again).
     pub(crate) fn restart(&mut self) {
         *self = Self::default();

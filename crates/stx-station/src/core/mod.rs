@@ -19,6 +19,8 @@
 //! - `params`: the drone's parameter table; `views`: the `state` and `params` messages;
 //! - `keep_out`: the keep-out zones, the targets they refuse and the alarms they raise;
 //!   `fence`: the zones sent to the drone as its fence, until it acknowledges them;
+//! - `surface_wind`: the wind at the target (anemometer or operator) uplinked to the drone
+//!   and given to the replica once the drone holds it;
 //! - `readiness`: the go/no-go board (the station's checks, the checklist's ticks, a launch
 //!   with checks open announced).
 
@@ -41,6 +43,7 @@ mod readiness;
 mod replica;
 mod requests;
 mod stack;
+mod surface_wind;
 mod sync;
 pub(crate) mod views;
 
@@ -177,6 +180,8 @@ pub struct StationCore {
     pub(crate) keep_out: keep_out::KeepOut,
     /// The drone's copy of the zones.
     fence: fence::FenceSync,
+    /// The wind at the target and the drone's copy of it.
+    surface_wind: surface_wind::SurfaceWindState,
     /// The go/no-go board's checklist, ticks and what the daemon tells it.
     readiness: readiness::Readiness,
     /// The unsteered flight path from the balloon or the round chute.
@@ -232,6 +237,7 @@ impl StationCore {
             rigging: stx_dynamics::vehicle::Vehicle::straplex(),
             keep_out: keep_out::KeepOut::default(),
             fence: fence::FenceSync::default(),
+            surface_wind: Default::default(),
             readiness: readiness::Readiness::default(),
             live_path: flight_path::LivePath::default(),
             config,
@@ -395,6 +401,9 @@ impl StationCore {
                 }
                 self.log(now_s, level, "vehicle", text);
             }
+            GroundEvent::Command(e) if surface_wind::SurfaceWindState::owns(e.request_id) => {
+                self.on_surface_wind_answer(now_s, &e);
+            }
             GroundEvent::Command(e) => {
                 if let Some(msg) = self.commands.on_command_event(now_s, &e) {
                     self.after_command_result(now_s, &msg);
@@ -437,8 +446,12 @@ impl StationCore {
                 );
                 self.want_plan_download(now_s);
                 self.fence_link(now_s, true);
+                self.surface_wind_link(now_s, true);
             }
-            GroundEvent::Link(LinkEvent::Lost { .. }) => self.fence_link(now_s, false),
+            GroundEvent::Link(LinkEvent::Lost { .. }) => {
+                self.fence_link(now_s, false);
+                self.surface_wind_link(now_s, false);
+            }
             GroundEvent::Link(LinkEvent::PersistSigningTimestamp(_)) => {}
             GroundEvent::Other(_) => {}
         }
@@ -472,5 +485,7 @@ impl StationCore {
 
 #[cfg(test)]
 mod ascent_tests;
+#[cfg(test)]
+mod surface_wind_tests;
 #[cfg(test)]
 mod tests;

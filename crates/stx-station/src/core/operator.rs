@@ -103,6 +103,7 @@ impl StationCore {
         }
         self.manual_timeout(now_s);
         self.fence_timeout(now_s);
+        self.surface_wind_timeout(now_s);
         let upload_waiting = self.commands.upload_waiting();
         self.schedule_plan_download(now_s, upload_waiting);
     }
@@ -149,6 +150,11 @@ impl StationCore {
             Purpose::FenceUpload => {
                 if !late {
                     self.fence_applied(now_s, result);
+                }
+            }
+            Purpose::SurfaceWind => {
+                if !late {
+                    self.surface_wind_applied(now_s, result);
                 }
             }
         }

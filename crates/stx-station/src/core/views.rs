@@ -325,6 +325,7 @@ impl StationCore {
             recording: None,
             readiness: ReadinessView::default(),
             replay: None,
+            surface_wind: self.surface_wind_view(now_s),
         };
         msg.readiness = self.readiness_view(&msg);
         msg

@@ -7,6 +7,7 @@
 //! beyond the pages runs beside: `forward`, `chase`, and `sondehub` with its queue's files
 //! (`sondehub_store`). Nothing here decides anything: the core does.
 
+mod anemometer;
 mod chase;
 mod forward;
 mod pages;
@@ -304,6 +305,9 @@ async fn run_with(
             stop_rx.clone(),
         ))
     });
+    if let Ok(Some(address)) = config.surface_wind.anemometer_address() {
+        tokio::spawn(anemometer::run(address, shared.clone(), stop_rx.clone()));
+    }
     if let Some(chase_config) = config.chase.clone() {
         tokio::spawn(chase::run(chase_config, shared.clone(), stop_rx.clone()));
     }

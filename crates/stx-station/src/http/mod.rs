@@ -33,6 +33,7 @@ mod replay;
 mod rest;
 mod shared;
 mod sondehub;
+mod surface_wind;
 mod tawhiri;
 mod tiles;
 mod ws;
@@ -91,6 +92,12 @@ pub fn router(state: std::sync::Arc<Shared>) -> Router {
         .route("/api/readiness/{id}", post(readiness::tick))
         .route("/api/sharing", get(readiness::sharing))
         .route("/api/sondehub/chase", post(sondehub::chase_car))
+        .route(
+            "/api/surface_wind",
+            get(surface_wind::view)
+                .post(surface_wind::set)
+                .delete(surface_wind::clear),
+        )
         .route("/api/cutdown/arm", post(arm_cutdown))
         .route("/api/cutdown/confirm", post(confirm_cutdown))
         .route("/api/clients", get(clients))

@@ -17,5 +17,6 @@ mod recordings;
 mod relay;
 mod replay;
 mod replica;
+mod surface_wind;
 mod tiles;
 mod tls;

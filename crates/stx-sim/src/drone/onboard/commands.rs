@@ -4,6 +4,7 @@
 use nalgebra::Vector3;
 use stx_dynamics::rotation::wrap_pi;
 use stx_gnc::control::Localizer;
+use stx_gnc::guidance::SurfaceWind;
 use stx_gnc::mission::FlightMode;
 use stx_link::command::{Command, CommandResult};
 use stx_link::plan::{FenceItem, PlanItem, fence_to_zones};
@@ -114,6 +115,27 @@ impl Onboard {
                 self.has_localizer = true;
                 self.select(FlightMode::Localizer, time_s);
                 self.say(Severity::Info, format!("localizer course {course_deg:.0}°"));
+                CommandResult::Accepted
+            }
+            Command::SetSurfaceWind {
+                speed_mps,
+                from_deg,
+                age_s,
+            } => {
+                // Where the air goes is the opposite of where it comes from.
+                let to = from_deg.to_radians();
+                let wind = SurfaceWind {
+                    ne_mps: [-speed_mps * to.cos(), -speed_mps * to.sin()],
+                    time_s: time_s - age_s,
+                };
+                // Said once: the station sends a fresh mean every few seconds.
+                if self.guidance.surface_wind().is_none() {
+                    self.say(
+                        Severity::Info,
+                        format!("surface wind {speed_mps:.1} m/s from {from_deg:.0}°"),
+                    );
+                }
+                self.guidance.set_surface_wind(Some(wind));
                 CommandResult::Accepted
             }
             Command::Cutdown

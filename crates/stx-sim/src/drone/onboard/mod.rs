@@ -15,6 +15,7 @@
 //! | `HoldHeading` / `HoldCourse` | sets the heading / course and selects heading / course mode |
 //! | `SetLandingTarget` | sets the target and final-approach course; a spiral landing under way replans from its approximation |
 //! | `SetLocalizer` | sets the line (and glide slope) and selects localizer mode |
+//! | `SetSurfaceWind` | guidance's surface wind, measured `age_s` before it arrived (said once) |
 //! | plan upload | the `Land` item sets the target and approach; two waypoints (or one and the landing point) set the localizer line, their altitudes its glide slope |
 //!
 //! # Manual control

@@ -366,12 +366,23 @@ pub async fn sim_drone(
     config: &stx_sim::drone::config::MissionConfig,
     speed: f64,
 ) -> SimDrone {
+    sim_drone_with(station_link, config, speed, |_| {}).await
+}
+
+/// [`sim_drone`] with its options changed by `edit`.
+pub async fn sim_drone_with(
+    station_link: SocketAddr,
+    config: &stx_sim::drone::config::MissionConfig,
+    speed: f64,
+    edit: impl FnOnce(&mut stx_sim::runner::FlyOptions),
+) -> SimDrone {
     use stx_sim::runner::{Flight, FlyOptions, Speed};
     let mut options = FlyOptions::new(&format!("udpout:{station_link}"), config.clone());
     options.link = fast_link(LinkConfig::vehicle());
     options.speed = Speed::Times(speed);
     // On the ground it keeps answering until the test ends.
     options.linger = None;
+    edit(&mut options);
     let flight = Flight::start(options).await.expect("drone on the air");
     let handle = flight.handle();
     tokio::spawn(flight.run(std::future::pending(), ()));
