@@ -2,7 +2,9 @@
 //!
 //! How the parts fit:
 //! - [`trim`] finds the steady glide of the nonlinear 31-state model (`stx-dynamics`) for
-//!   held servo commands, pinning the states the dynamics do not depend on;
+//!   held servo commands, pinning the states the dynamics do not depend on; [`performance`]
+//!   trims a vehicle at each brake setting of the steady-glide table guidance plans with, so
+//!   that guidance can plan with an identified vehicle's glide instead of the shipped stack's;
 //! - [`linearize`] differentiates the model about it numerically ([`jacobian`]): `A`, `B` for
 //!   the two inputs (differential main line, symmetric brake), `C`, `D` for the drone's
 //!   measured outputs (seed eq. 6.4);
@@ -36,6 +38,7 @@ pub mod jacobian;
 pub mod linearize;
 pub mod lti;
 pub mod nelder_mead;
+pub mod performance;
 pub mod seed;
 pub mod svg;
 pub mod trim;

@@ -15,33 +15,12 @@ use std::sync::atomic::AtomicBool;
 
 use stx_analysis::flight_log::synthetic::{SyntheticFlight, simulate};
 use stx_analysis::identify::{IdentifyOptions, Param, identify};
-use stx_analysis::trim::trim;
-use stx_dynamics::state::{Controls, idx};
+use stx_analysis::performance::glide_performance_of;
 use stx_dynamics::vehicle::{Vehicle, VehicleConfig};
 use stx_gnc::performance::GlidePerformance;
 use stx_sim::closed_loop::PerfectNavigation;
 use stx_sim::dispersions::Dispersions;
 use stx_sim::montecarlo::{MonteCarloConfig, run_one, steady_glide_state};
-
-/// The steady glide table of `vehicle` by trimming it at each brake setting at the table's
-/// reference height (100 m); the turn terms kept from the shipped table.
-fn performance_of(vehicle: &Vehicle) -> GlidePerformance {
-    let mut p = GlidePerformance::default();
-    for k in 0..p.brake_points.len() {
-        let t = trim(
-            vehicle,
-            100.0,
-            Controls::symmetric_brake(p.brake_points[k].min(0.99)),
-        )
-        .expect("trim");
-        p.airspeed_mps[k] = t.airspeed_mps;
-        p.sink_rate_mps[k] = t.derivative[idx::POSITION + 2];
-    }
-    p.reference_density_kg_per_m3 = trim(vehicle, 100.0, Controls::default())
-        .expect("trim")
-        .density_kg_per_m3;
-    p
-}
 
 /// Mean payload miss of guidance planning with `performance` over `runs` flights of `flown`.
 /// Realistic dispersions are drawn around `flown` (the wind's shape, masses, rigging, servos,
@@ -105,7 +84,7 @@ fn guidance_with_the_identified_polar_lands_closer_than_with_the_nominal_one() {
     );
     // The trimmed table of the shipped vehicle is the shipped table (within 0.5 %): the
     // comparison is between vehicles, not between ways of making a table.
-    let trimmed = performance_of(&nominal);
+    let trimmed = glide_performance_of(&nominal).expect("trimmed table");
     let shipped = GlidePerformance::default();
     for k in 0..shipped.brake_points.len() {
         assert!((trimmed.airspeed_mps[k] / shipped.airspeed_mps[k] - 1.0).abs() < 0.006);
@@ -119,7 +98,12 @@ fn guidance_with_the_identified_polar_lands_closer_than_with_the_nominal_one() {
     let mut figures = Vec::new();
     for learn in [false, true] {
         let a = misses(&truth, trimmed, learn, runs);
-        let b = misses(&truth, performance_of(&identified), learn, runs);
+        let b = misses(
+            &truth,
+            glide_performance_of(&identified).expect("identified table"),
+            learn,
+            runs,
+        );
         let f = compare(&a, &b);
         eprintln!(
             "learning {learn}: mean payload miss over {runs} runs planning with the nominal \
