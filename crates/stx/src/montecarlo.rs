@@ -1,5 +1,11 @@
 //! `stx montecarlo`: many spiral landings with the full model, sensors and onboard software,
 //! from random release points and winds; prints the landing statistics.
+//!
+//! `--vehicle FILE` flies every run around a vehicle file (the truth, e.g. one `stx identify` or
+//! the Lab wrote); `--guidance-vehicle FILE` makes guidance plan with that file's steady glide,
+//! trimmed at each brake setting ([`stx_analysis::performance::glide_performance_of`]). Given
+//! both, a campaign measures what planning with an identified stack is worth against the
+//! shipped table; the report's header names each file given.
 
 use std::path::PathBuf;
 
@@ -16,6 +22,7 @@ use stx_sim::montecarlo::{
 };
 
 use crate::BadInput;
+use crate::drone::load_vehicle_flag;
 
 #[derive(Args)]
 #[command(args_conflicts_with_subcommands = true)]
@@ -100,6 +107,16 @@ struct CampaignArgs {
     /// plans the final with below the pattern
     #[arg(long)]
     anemometer: bool,
+    /// Fly every run around this vehicle file (the truth; e.g. one `stx identify` or the Lab
+    /// wrote) instead of the shipped STRAPLEX stack: the dispersions are drawn around it.
+    /// Guidance still plans with its shipped table unless `--guidance-vehicle` is given.
+    #[arg(long, value_name = "FILE")]
+    vehicle: Option<PathBuf>,
+    /// Guidance plans with the steady glide of this vehicle file (trimmed at each brake setting
+    /// 100 m above sea level; the turn terms stay the shipped table's, a trim does not identify
+    /// them) instead of the shipped table.
+    #[arg(long, value_name = "FILE")]
+    guidance_vehicle: Option<PathBuf>,
 }
 
 pub fn run(args: MonteCarloArgs) -> anyhow::Result<()> {
@@ -204,6 +221,14 @@ fn campaign(args: CampaignArgs) -> anyhow::Result<()> {
     if let Some(path) = &args.gains {
         config.guidance.gains = crate::inputs::load_gains(path)?;
     }
+    if let Some(path) = &args.vehicle {
+        config.vehicle = load_vehicle_flag("--vehicle", path)?;
+        config.vehicle_name = Some(path.display().to_string());
+    }
+    if let Some(path) = &args.guidance_vehicle {
+        config.guidance.performance = guidance_performance(path)?;
+        config.guidance_vehicle_name = Some(path.display().to_string());
+    }
     if let Some(path) = &args.keep_out {
         config.keep_out = load_zones(path)?;
         config.keep_out_guided = !args.keep_out_unguided;
@@ -251,6 +276,18 @@ fn campaign(args: CampaignArgs) -> anyhow::Result<()> {
         return Ok(());
     }
     print_report(&report, args.json, args.details)
+}
+
+/// The steady-glide table of the vehicle file `path` for guidance; a file that does not load,
+/// or a vehicle with no steady glide at one of the table's brake settings, is [`BadInput`].
+fn guidance_performance(
+    path: &std::path::Path,
+) -> anyhow::Result<stx_gnc::performance::GlidePerformance> {
+    const FLAG: &str = "--guidance-vehicle";
+    let vehicle = load_vehicle_flag(FLAG, path)?;
+    // The error's message holds its cause already: as text, so the chain is not printed twice.
+    stx_analysis::performance::glide_performance_of(&vehicle)
+        .map_err(|e| BadInput(anyhow::anyhow!("{FLAG} {}: {e}", path.display())).into())
 }
 
 /// The zones of `path` around the campaign's target, which must lie outside every one.
@@ -302,7 +339,8 @@ fn print_zone_landings(z: &ZoneLandings) {
 fn print_table(r: &MonteCarloReport) {
     let c = &r.campaign;
     println!(
-        "{} runs, seed {}, wind up to {} m/s, released {} m above the target{}{}, dispersions: {}",
+        "{} runs, seed {}, wind up to {} m/s, released {} m above the target{}{}, dispersions: \
+         {}, vehicle: {}, guidance planned with: {}",
         r.runs,
         c.seed,
         c.wind_max_mps,
@@ -313,7 +351,13 @@ fn print_table(r: &MonteCarloReport) {
         } else {
             ""
         },
-        c.dispersions.name
+        c.dispersions.name,
+        c.vehicle.as_deref().unwrap_or("shipped STRAPLEX"),
+        c.guidance_vehicle
+            .as_deref()
+            .map_or("the shipped table".to_string(), |f| format!(
+                "the glide of {f}"
+            ))
     );
     println!(
         "miss distance (first ground contact; {} failed runs count as misses): median {:.1} m, \

@@ -1,6 +1,7 @@
 //! [`MonteCarloConfig`]: what a campaign flies.
 
 use serde::Serialize;
+use stx_dynamics::vehicle::Vehicle;
 use stx_gnc::guidance::GuidanceConfig;
 use stx_gnc::keep_out::KeepOutZones;
 
@@ -34,9 +35,19 @@ pub struct MonteCarloConfig {
     /// The sensors' settings before dispersion.
     #[serde(skip)]
     pub sensors: SensorConfig,
+    /// The stack every run flies (the truth), before its dispersions are drawn around it.
+    #[serde(skip)]
+    pub vehicle: Vehicle,
+    /// Where [`Self::vehicle`] came from (a vehicle file, as the report names it); `None`: the
+    /// shipped STRAPLEX stack.
+    pub vehicle_name: Option<String>,
     /// Guidance settings.
     #[serde(skip)]
     pub guidance: GuidanceConfig,
+    /// The vehicle file whose steady glide `guidance.performance` was trimmed from, as the
+    /// report names it; `None`: guidance plans with the table it was given (by default the
+    /// shipped stack's). Only a name: setting it does not change the table.
+    pub guidance_vehicle_name: Option<String>,
     /// Keep-out zones in the target's frame (`LocalFrame::default()`): guidance keeps out of
     /// them, and the report counts the capsules that land in one.
     #[serde(skip)]
@@ -63,7 +74,10 @@ impl Default for MonteCarloConfig {
             shard: None,
             dispersions: Dispersions::nominal(),
             sensors: SensorConfig::default(),
+            vehicle: Vehicle::straplex(),
+            vehicle_name: None,
             guidance: GuidanceConfig::default(),
+            guidance_vehicle_name: None,
             keep_out: KeepOutZones::default(),
             keep_out_guided: true,
             anemometer: false,

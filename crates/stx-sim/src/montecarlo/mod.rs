@@ -10,6 +10,12 @@
 //!
 //! Beside a campaign, [`nominal_single_landing`] flies the one nominal landing its report names.
 //!
+//! Every run flies [`MonteCarloConfig::vehicle`] (by default the shipped stack) with its
+//! dispersions drawn around it, and guidance plans with the steady-glide table of its
+//! [`GuidanceConfig`](stx_gnc::guidance::GuidanceConfig); the report's header names both when
+//! they came from vehicle files, so a campaign flown around an identified stack, or planned
+//! with one, says so.
+//!
 //! With keep-out zones ([`MonteCarloConfig::keep_out`]) guidance flies every run with them and
 //! the report counts the capsules that came down in one ([`ZoneLandings`]).
 
@@ -96,8 +102,8 @@ pub fn run_until<N: Navigator>(
     stop: impl Fn() -> bool + Sync,
 ) -> Result<MonteCarloReport, IntegrateError> {
     let started = Instant::now();
-    let vehicle = Vehicle::straplex();
-    let template = steady_glide_state(&vehicle)?;
+    let vehicle = &config.vehicle;
+    let template = steady_glide_state(vehicle)?;
     let indices = config.indices();
     let next = AtomicUsize::new(0);
     let done = AtomicUsize::new(0);
@@ -115,7 +121,7 @@ pub fn run_until<N: Navigator>(
                         };
                         mine.push((
                             index,
-                            run_one(config, &vehicle, &template, index, &navigator),
+                            run_one(config, vehicle, &template, index, &navigator),
                         ));
                         progress(done.fetch_add(1, Ordering::Relaxed) + 1);
                     }

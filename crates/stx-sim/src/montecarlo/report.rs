@@ -110,6 +110,14 @@ pub struct CampaignHeader {
     /// Whether guidance was given a ground anemometer's surface wind.
     #[serde(default)]
     pub anemometer: bool,
+    /// The vehicle file every run flew (the truth, dispersions drawn around it); absent: the
+    /// shipped STRAPLEX stack.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub vehicle: Option<String>,
+    /// The vehicle file whose trimmed steady glide guidance planned with; absent: the table
+    /// guidance ships with (the shipped stack's).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub guidance_vehicle: Option<String>,
 }
 
 fn yes() -> bool {
@@ -135,6 +143,8 @@ impl CampaignHeader {
                 .collect(),
             keep_out_guided: config.keep_out_guided,
             anemometer: config.anemometer,
+            vehicle: config.vehicle_name.clone(),
+            guidance_vehicle: config.guidance_vehicle_name.clone(),
         }
     }
 }
@@ -483,5 +493,32 @@ mod failed_run_tests {
         assert_eq!(report.runs, 1);
         assert!(report.miss_m.median.is_infinite());
         assert!(report.reachable_payload_miss_m.median.is_infinite());
+    }
+}
+
+#[cfg(test)]
+mod vehicle_file_tests {
+    use super::*;
+
+    /// The header names the vehicle files only when a campaign was given them, so that a part
+    /// written before the fields existed still reads as the shipped stack planned with the
+    /// shipped table, and parts planned with different files are different campaigns.
+    #[test]
+    fn the_header_names_vehicle_files_only_when_given_and_parts_without_them_still_read() {
+        let plain = CampaignHeader::of(&MonteCarloConfig::default());
+        let written = serde_json::to_value(&plain).expect("serialises");
+        assert!(written.get("vehicle").is_none() && written.get("guidance_vehicle").is_none());
+        let read: CampaignHeader = serde_json::from_value(written).expect("reads");
+        assert_eq!(read, plain);
+        let named = CampaignHeader::of(&MonteCarloConfig {
+            vehicle_name: Some("identified.toml".into()),
+            guidance_vehicle_name: Some("identified.toml".into()),
+            ..MonteCarloConfig::default()
+        });
+        let written = serde_json::to_value(&named).expect("serialises");
+        assert_eq!(written["guidance_vehicle"], "identified.toml");
+        let read: CampaignHeader = serde_json::from_value(written).expect("reads");
+        assert_eq!(read, named);
+        assert_ne!(named, plain);
     }
 }

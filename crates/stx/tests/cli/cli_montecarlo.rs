@@ -1,6 +1,7 @@
 //! `stx montecarlo` over shards and dispersion files, through the real binary: a campaign split
 //! into shards and merged gives the one-machine report; bad parts and bad dispersion files are
-//! refused with a clear message and exit code 2; capsules landed in keep-out zones are counted.
+//! refused with a clear message and exit code 2; capsules landed in keep-out zones are counted;
+//! vehicle files flown around and planned with are named in the report.
 
 use crate::common;
 
@@ -287,4 +288,83 @@ fn a_campaign_with_the_ground_anemometer_says_so_and_every_run_shows_what_was_le
     let sim: serde_json::Value = serde_json::from_slice(&sim.stdout).expect("summary");
     assert_eq!(with["nominal_single_landing"], sim["landing"]);
     assert!(with["nominal_single_landing"]["miss_m"].as_f64().is_some());
+}
+
+/// `--vehicle` and `--guidance-vehicle` fly around, and plan with, vehicle files, and the
+/// report's header names each in the table and the JSON; a file that does not load is refused
+/// by the flag's name with exit code 2.
+#[test]
+fn a_campaign_planned_with_a_vehicle_file_names_it_and_a_bad_file_is_refused() {
+    let shipped = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../config/vehicle/straplex.toml");
+    let shipped = shipped.to_str().expect("utf-8 path");
+    let tiny = [
+        "montecarlo",
+        "--runs",
+        "2",
+        "--altitude",
+        "60",
+        "--threads",
+        "1",
+    ];
+    let mut args = tiny.to_vec();
+    args.extend(["--guidance-vehicle", shipped, "--vehicle", shipped]);
+    let table = stx(&args);
+    assert!(
+        table.status.success(),
+        "{}",
+        String::from_utf8_lossy(&table.stderr)
+    );
+    let header = String::from_utf8_lossy(&table.stdout)
+        .lines()
+        .next()
+        .unwrap_or_default()
+        .to_string();
+    assert!(
+        header.contains(&format!("guidance planned with: the glide of {shipped}"))
+            && header.contains(&format!("vehicle: {shipped}")),
+        "{header}"
+    );
+    args.push("--json");
+    let report = json(&stx(&args));
+    assert_eq!(report["guidance_vehicle"], shipped);
+    assert_eq!(report["vehicle"], shipped);
+    let mut plain = tiny.to_vec();
+    plain.push("--json");
+    let plain = json(&stx(&plain));
+    assert!(plain.get("guidance_vehicle").is_none() && plain.get("vehicle").is_none());
+
+    let dir = temp_dir("vehicle");
+    let not_a_vehicle = dir.join("bad.toml");
+    std::fs::write(&not_a_vehicle, "gravity_mps2 = \"down\"\n").expect("write");
+    // A vehicle that loads but has no lift has no steady glide to plan with.
+    let no_lift = dir.join("no-lift.toml");
+    let text = std::fs::read_to_string(shipped)
+        .expect("the shipped file")
+        .replace("cl0 = 0.250", "cl0 = 0.0")
+        .replace("cl_alpha = 2.300", "cl_alpha = 0.0")
+        .replace("cl_ds = 0.21", "cl_ds = 0.0");
+    std::fs::write(&no_lift, text).expect("write");
+    let mut args = tiny.to_vec();
+    args.extend(["--guidance-vehicle", no_lift.to_str().expect("path")]);
+    let out = stx(&args);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("--guidance-vehicle") && err.contains("no steady glide at symmetric brake 0"),
+        "{err}"
+    );
+    for flag in ["--guidance-vehicle", "--vehicle"] {
+        for file in [not_a_vehicle.to_str().expect("path"), "/nonexistent.toml"] {
+            let mut args = tiny.to_vec();
+            args.extend([flag, file]);
+            let out = stx(&args);
+            assert_eq!(out.status.code(), Some(2), "{flag} {file}");
+            let err = String::from_utf8_lossy(&out.stderr);
+            assert!(
+                err.contains(flag) && err.contains(file),
+                "{flag} {file}: {err}"
+            );
+        }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
 }
