@@ -73,6 +73,9 @@ impl LabWorker for Worker {
                     altitude_m: *altitude_m,
                     // One thread: the station's own work keeps the other cores.
                     threads: 1,
+                    // The runs are flown around the vehicle being edited, as every other job.
+                    vehicle: vehicle.clone(),
+                    vehicle_name: Some("the Lab's vehicle".into()),
                     ..MonteCarloConfig::default()
                 };
                 monte_carlo(&config, control)
