@@ -79,6 +79,7 @@ function restNames(method, path, status) {
   if (method === "GET" && path === "/api/recordings") return [null, "RecordingsBody"];
   if (method === "POST" && /^\/api\/recordings\/[^/]+\/replay$/.test(path)) return [null, "ReplayOpened"];
   if (method === "POST" && path === "/api/sondehub/chase") return ["ChaseCarBody", "SondehubView"];
+  if (path === "/api/surface_wind" && ["GET", "POST", "DELETE"].includes(method)) return [method === "POST" ? "SurfaceWindBody" : null, "SurfaceWindView"];
   for (const [m, p, req, res] of extraRest) if (m === method && p.test(path)) return [req, res];
   return [null, null];
 }

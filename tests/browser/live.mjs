@@ -13,10 +13,11 @@
 //     with a gap, the landing badge marked), and cutdown — refused by a click and an aborted hold,
 //     done by a completed hold — where the drone would accept it.
 //  2. `rehearsal` (`stx serve --sim`, under the parafoil): telemetry, what guidance learned of the
-//     canopy, viewer refusal, parameter read-back, modes, gamepad with dead-man and
-//     `manual_release`, layout at 1440×900 and on a phone, map framing, a target set in the page flown to, the landed state, and the recovery
-//     page with and without the phone's position (its grid, its dots named, the location-denied
-//     box gone once a position is typed).
+//     canopy, the surface wind typed in the page and held by the drone (./surfaceWind.mjs),
+//     viewer refusal, parameter read-back, modes, gamepad with dead-man and `manual_release`,
+//     layout at 1440×900 and on a phone, map framing, a target set in the page flown to, the
+//     landed state, and the recovery page with and without the phone's position (its grid, its
+//     dots named, the location-denied box gone once a position is typed).
 // Then the rehearsal's recording replayed (`stx replay`: pause, seek, speed from the page), and a
 // new live station listing the recordings (size, run, landing and miss, download, open in replay).
 //
@@ -30,6 +31,7 @@ import {
   OPERATOR, VIEWER, FIELD_HOST, root, out, speed, sleep, check, newContext, distanceM, bearingDeg, fromNorthEast, angleDiff, shownMetres, rad,
   run, recordDir, startStation, freeUdpPort, apiOf, until, text, attr, watchErrors, hold, lastRequest, stopChildren, runFlights, cutShort, legendAgainstMap, checkLegend,
 } from "./harness.mjs";
+import { surfaceWindForViewer, surfaceWindFromPage } from "./surfaceWind.mjs";
 
 /** What the recovery map draws (ui/recoveryMap.ts), as the page's elements show it. */
 const RECOVERY_SYMBOLS = {
@@ -58,7 +60,7 @@ const altitudePlot = (page) => page.evaluate(() => {
 // Each kind the pages must have met, so that the contract check cannot pass on silence.
 const expected = ["RecordingsBody", "ReplayOpened", "ServerMessage:hello", "ServerMessage:state", "ServerMessage:history", "ServerMessage:event", "ServerMessage:command_result", "ServerMessage:params",
   "ClientMessage:manual", "ClientMessage:manual_release", "Session", "StateMsg", "ParamsMsg", "EventsBody", "TrackBody", "ClientsBody", "CommandResultMsg", "CommandAccepted",
-  "CutdownArm", "ErrorBody", "ModeBody", "TargetBody", "ParamBody", "ConfirmBody"];
+  "CutdownArm", "ErrorBody", "ModeBody", "TargetBody", "ParamBody", "ConfirmBody", "SurfaceWindView", "SurfaceWindBody"];
 await runFlights(async () => {
   await missionShort();
   const rehearsed = await rehearsal();
@@ -233,6 +235,7 @@ async function rehearsal() {
   check("1440×900: the wind chart and the Link panel are in view in the left column", layout.windBottom <= layout.leftBottom && layout.linkBottom <= layout.leftBottom, `wind ${layout.windBottom.toFixed(0)}, link ${layout.linkBottom.toFixed(0)}, column ends ${layout.leftBottom.toFixed(0)}`);
   check("1440×900: Heading/Course/Localizer fully above Command Outcomes", layout.guidanceBottom <= layout.tabBottom && layout.guidanceBottom <= layout.outcomesTop, `panel ends ${layout.guidanceBottom.toFixed(0)}, tab ends ${layout.tabBottom.toFixed(0)}, outcomes start ${layout.outcomesTop.toFixed(0)}`);
   await page.screenshot({ path: join(out, "live-operator.png") });
+  await surfaceWindFromPage(page, api);
 
   // ---------------------------------------------------------------- a viewer watches but cannot command
   const vctx = await newContext("viewer", { viewport: { width: 1440, height: 900 } });
@@ -251,6 +254,7 @@ async function rehearsal() {
   check("viewer sees live data", !(await text(vpage, "ro-alt-msl")).startsWith("—"));
   check("viewer: command controls disabled, nothing posted", disabled.every(Boolean) && viewerPosts.length === 0, `${disabled} / ${viewerPosts.length} posts`);
   check("viewer: the API refuses with 403 and says why", viewerApi.status === 403 && /operator/.test(viewerApi.body?.reason ?? ""), JSON.stringify(viewerApi.body));
+  await surfaceWindForViewer(vpage, api);
   await vpage.screenshot({ path: join(out, "live-viewer.png") });
   await vctx.close();
 

@@ -19,6 +19,8 @@ const FORMATS = {
   uint16: int(0, 65535),
   uint32: int(0, 4294967295),
   uint64: int(0, Number.MAX_SAFE_INTEGER),
+  // Rust's usize (a count).
+  uint: int(0, Number.MAX_SAFE_INTEGER),
   int32: int(-2147483648, 2147483647),
   int64: int(Number.MIN_SAFE_INTEGER, Number.MAX_SAFE_INTEGER),
 };

@@ -454,8 +454,9 @@ pub struct EventMsg {
     pub level: Level,
     /// Where it comes from: guidance, link, command, station, vehicle, keep_out (the keep-out
     /// zones: loaded, edited, a landing predicted in one), readiness (the go/no-go board: its
-    /// checklist read, an item ticked, a launch with checks open).
-    #[schemars(extend("enum" = ["guidance", "link", "command", "station", "vehicle", "keep_out", "readiness"]))]
+    /// checklist read, an item ticked, a launch with checks open), anemometer (the surface
+    /// wind: the ground anemometer heard or silent, a line refused, the drone's copy).
+    #[schemars(extend("enum" = ["guidance", "link", "command", "station", "vehicle", "keep_out", "readiness", "anemometer"]))]
     pub source: &'static str,
     /// Text.
     pub text: String,

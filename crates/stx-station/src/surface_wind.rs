@@ -148,7 +148,9 @@ pub struct SurfaceWindReadingView {
     pub from_deg: f64,
     /// Its source.
     pub source: SurfaceWindSource,
-    /// Seconds since it was measured (an anemometer's newest sentence in the mean) or typed.
+    /// Seconds since it was measured: an anemometer's newest sentence in the mean; for the
+    /// operator's value as the wind in force (`wind`, `held`) 0 when sent, as the operator
+    /// vouches for it as the wind now, and in `operator` the seconds since it was typed.
     pub age_s: f64,
 }
 

@@ -41,6 +41,7 @@ export type StxStationAPI =
   | CourseBody
   | LocalizerBody
   | TargetBody
+  | SurfaceWindBody
   | PlanBody
   | ParamBody
   | ConfirmBody
@@ -121,6 +122,14 @@ export type BodySource = "measured" | "rigging";
  * A line of the rigging.
  */
 export type StackLine = "main_right" | "main_left" | "capsule" | "transponder";
+/**
+ * The drone's copy of the surface wind.
+ */
+export type DroneCopy = "none" | "sending" | "held" | "failed";
+/**
+ * Where the wind in force comes from.
+ */
+export type SurfaceWindSource = "anemometer" | "operator";
 /**
  * GNSS fix type (GPS_FIX_TYPE).
  */
@@ -777,6 +786,11 @@ export interface StateMsg {
    * attitude is heard.
    */
   stack: StackView | null;
+  /**
+   * The wind at the target (a ground anemometer's mean or the operator's value) and the
+   * drone's copy of it.
+   */
+  surface_wind: SurfaceWindView;
   /**
    * The station's clock: s since it started (its timers and ages run on it).
    */
@@ -1678,6 +1692,93 @@ export interface StackLineView {
   top_enu_m: [number, number, number];
 }
 /**
+ * The `surface_wind` part of the `state` message.
+ */
+export interface SurfaceWindView {
+  /**
+   * The anemometer; `null` when none is configured.
+   */
+  anemometer: AnemometerView | null;
+  /**
+   * The drone's copy.
+   */
+  drone: DroneCopy;
+  /**
+   * Seconds since the drone last accepted one; `null` before.
+   */
+  drone_accepted_age_s: number | null;
+  /**
+   * What the drone accepted last (its age since measured, as for `wind`); `null` before.
+   */
+  held: SurfaceWindReadingView | null;
+  /**
+   * Why the last send failed.
+   */
+  last_error: string | null;
+  /**
+   * The operator's value, while it is valid (shown also when the anemometer's wins).
+   */
+  operator: SurfaceWindReadingView | null;
+  /**
+   * The wind in force, sent to the drone; `null` when there is none (no anemometer heard
+   * within `stale_after_s` and no operator value within `operator_valid_s`).
+   */
+  wind: SurfaceWindReadingView | null;
+}
+/**
+ * The ground anemometer's intake.
+ */
+export interface AnemometerView {
+  /**
+   * The address read, as configured.
+   */
+  address: string;
+  /**
+   * Seconds since the last wind sentence; `null` before the first.
+   */
+  heard_age_s: number | null;
+  /**
+   * Sentences in the mean now.
+   */
+  in_mean: number;
+  /**
+   * Why the last line was refused, or the reader failed.
+   */
+  last_error: string | null;
+  /**
+   * Lines refused (bad checksum, bad field, status "invalid"); other NMEA sentences are
+   * passed over without counting.
+   */
+  rejected: number;
+  /**
+   * Wind sentences taken.
+   */
+  sentences: number;
+}
+/**
+ * A surface wind as the pages show it.
+ */
+export interface SurfaceWindReadingView {
+  /**
+   * Seconds since it was measured: an anemometer's newest sentence in the mean; for the
+   * operator's value as the wind in force (`wind`, `held`) 0 when sent, as the operator
+   * vouches for it as the wind now, and in `operator` the seconds since it was typed.
+   */
+  age_s: number;
+  /**
+   * Where it blows from, degrees true, 0…360.
+   */
+  from_deg: number;
+  /**
+   * Its source.
+   */
+  source: SurfaceWindSource;
+  /**
+   * Speed, m/s.
+   */
+  speed_mps: number;
+}
+/**
  * What the drone reports about itself.
  */
 export interface VehicleView {
@@ -1887,9 +1988,10 @@ export interface EventMsg {
   /**
    * Where it comes from: guidance, link, command, station, vehicle, keep_out (the keep-out
    * zones: loaded, edited, a landing predicted in one), readiness (the go/no-go board: its
-   * checklist read, an item ticked, a launch with checks open).
+   * checklist read, an item ticked, a launch with checks open), anemometer (the surface
+   * wind: the ground anemometer heard or silent, a line refused, the drone's copy).
    */
-  source: "guidance" | "link" | "command" | "station" | "vehicle" | "keep_out" | "readiness";
+  source: "guidance" | "link" | "command" | "station" | "vehicle" | "keep_out" | "readiness" | "anemometer";
   /**
    * Text.
    */
@@ -3762,6 +3864,19 @@ export interface TargetBody {
    * Longitude, degrees.
    */
   lon_deg: number;
+}
+/**
+ * `POST /api/surface_wind`: the operator's reading of the wind at the target.
+ */
+export interface SurfaceWindBody {
+  /**
+   * Where the wind blows from, degrees true.
+   */
+  from_deg: number;
+  /**
+   * Speed, m/s (0–60).
+   */
+  speed_mps: number;
 }
 /**
  * `POST /api/commands/plan`.

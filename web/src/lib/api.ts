@@ -47,6 +47,10 @@ export class Api {
     return this.request<T>("PUT", path, body);
   }
 
+  delete<T = unknown>(path: string): Promise<T> {
+    return this.request<T>("DELETE", path);
+  }
+
   /** POST of a file's bytes as the raw body (a forecast file for the Plan page). */
   upload<T = unknown>(path: string, bytes: Blob): Promise<T> {
     return this.request<T>("POST", path, bytes, true);

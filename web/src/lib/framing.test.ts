@@ -31,6 +31,7 @@ function state(stage: FlightStage, extra: Partial<State> = {}): State {
     recording: null,
     readiness: NO_READINESS,
     replay: null,
+    surface_wind: null,
     ...extra,
   };
 }

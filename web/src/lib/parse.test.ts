@@ -60,6 +60,12 @@ const STATE = {
     open: 0, launched_with_open: [], checklist_error: null,
   },
   replay: null,
+  surface_wind: {
+    wind: { speed_mps: 3.2, from_deg: 275.0, source: "anemometer", age_s: 2.5 },
+    operator: { speed_mps: 4.0, from_deg: 260.0, source: "operator", age_s: 310.0 },
+    drone: "held", held: { speed_mps: 3.1, from_deg: 276.0, source: "anemometer", age_s: 4.0 }, drone_accepted_age_s: 1.5, last_error: null,
+    anemometer: { address: "udpin:0.0.0.0:10110", sentences: 412, rejected: 3, last_error: null, heard_age_s: 0.9, in_mean: 10 },
+  },
 };
 const SESSION = {
   role: "operator", name: "ops-1",
@@ -173,6 +179,35 @@ describe("decodeMessage: malformed input never throws", () => {
     const { learned: _drop, ...noLearned } = STATE.guidance;
     const n = decodeMessage(j({ ...STATE, guidance: noLearned }));
     expect(n.ok && n.msg.type === "state" && n.msg.guidance?.learned).toBeNull();
+  });
+
+  it("surface wind: a full block as sent; none from an older station or recording; garbled leaves null", () => {
+    const parsed = (surface_wind: unknown) => {
+      const d = decodeMessage(j({ ...STATE, surface_wind }));
+      if (!d.ok || d.msg.type !== "state") throw new Error("should parse");
+      return d.msg.surface_wind;
+    };
+    expect(parsed(STATE.surface_wind)).toEqual(STATE.surface_wind);
+    const { surface_wind: _drop, ...old } = STATE;
+    const d = decodeMessage(j(old));
+    expect(d.ok && d.msg.type === "state" && d.msg.surface_wind).toBeNull();
+    for (const garbled of [null, "3 m/s", 7, [1, 2]]) expect(parsed(garbled)).toBeNull();
+    const sw = STATE.surface_wind;
+    const bad = parsed({
+      ...sw,
+      // A reading without its speed, a negative speed or an unknown source says nothing: dropped.
+      wind: { ...sw.wind, source: "windsock" },
+      operator: { ...sw.operator, speed_mps: -1 },
+      held: { ...sw.held, from_deg: "west" },
+      drone: "maybe", drone_accepted_age_s: "1.5", last_error: 12,
+      anemometer: { address: null, sentences: "many", rejected: 3, last_error: "bad checksum", heard_age_s: null, in_mean: Infinity },
+    });
+    expect(bad).toEqual({
+      wind: null, operator: null, held: null, drone: null, drone_accepted_age_s: null, last_error: null,
+      anemometer: { address: "?", sentences: null, rejected: 3, last_error: "bad checksum", heard_age_s: null, in_mean: null },
+    });
+    expect(parsed({ ...sw, wind: { speed_mps: 2, from_deg: 90, source: "operator" } })?.wind).toEqual({ speed_mps: 2, from_deg: 90, source: "operator", age_s: null });
+    expect(parsed({ ...sw, wind: null, anemometer: "udp" })).toMatchObject({ wind: null, anemometer: null, drone: "held" });
   });
 
   it("pattern corners out of range are dropped", () => {

@@ -5,6 +5,7 @@ import { parseReadiness } from "./readiness";
 import { parseFlightPath } from "./flightPath";
 import { zonesOf } from "./zones";
 import { parseStack } from "./stack";
+import { parseSurfaceWind } from "./surfaceWind";
 import type {
   Estimate,
   FlightMode,
@@ -362,6 +363,7 @@ export function parseState(v: Obj): Parsed<State> {
     recording: sub(v, "recording", parseRecording),
     readiness: parseReadiness(v.readiness),
     replay: sub(v, "replay", parseReplay),
+    surface_wind: parseSurfaceWind(v.surface_wind),
   });
 }
 

@@ -124,11 +124,25 @@ export type Replay = Lenient<Wire.ReplayView, "file" | "mode">;
 export type Check = Pick<Wire.CheckView, "id" | "label" | "manual" | "status" | "detail"> & { ticked_by: string | null; ticked_wall_ms: number | null };
 export type Readiness = Omit<Wire.ReadinessView, "checks" | "checklist_error"> & { checks: Check[]; checklist_error: string | null };
 
+/** A surface wind: one without its speed, direction or source says nothing and is dropped. */
+export type SurfaceWindReading = Lenient<Wire.SurfaceWindReadingView, "speed_mps" | "from_deg" | "source">;
+/** The ground anemometer's intake, as configured (its address) and heard. */
+export type Anemometer = Lenient<Wire.AnemometerView, "address">;
+/** The wind at the ground by the target (`state.surface_wind`, lib/surfaceWind.ts reads it). */
+export type SurfaceWind = Omit<Lenient<Wire.SurfaceWindView>, "wind" | "operator" | "held" | "anemometer"> & {
+  wind: SurfaceWindReading | null;
+  operator: SurfaceWindReading | null;
+  held: SurfaceWindReading | null;
+  anemometer: Anemometer | null;
+};
+
 export type State = Omit<
   Lenient<Wire.StateMsg, "type" | "time_s" | "link" | "forecast_wind" | "mission">,
-  "link" | "vehicle" | "guidance" | "prediction" | "forecast_wind" | "recording" | "replay" | "footprint" | "keep_out_alarms" | "flight_path" | "mission" | "readiness" | "stack"
+  "link" | "vehicle" | "guidance" | "prediction" | "forecast_wind" | "recording" | "replay" | "footprint" | "keep_out_alarms" | "flight_path" | "mission" | "readiness" | "stack" | "surface_wind"
 > & {
   stack: Stack | null;
+  /** Null from a station (or a recording) older than the surface wind, or a block that does not parse. */
+  surface_wind: SurfaceWind | null;
   mission: Mission;
   readiness: Readiness;
   recording: Recording | null;

@@ -39,6 +39,7 @@ import { WindPanel } from "../ui/windPanel";
 import { ReadinessPanel } from "../ui/readinessPanel";
 import { SharingPanel } from "../ui/sharingPanel";
 import { parseSharing } from "../lib/sharing";
+import { parseSurfaceWind } from "../lib/surfaceWind";
 
 const app = document.getElementById("app")!;
 const token = resolveToken(location.search, sessionStorage);
@@ -94,7 +95,10 @@ function build(session: Session): void {
   const compass = new Compass();
   const flight = new FlightData();
   const actuators = new Actuators();
-  const wind = new WindPanel(station.origin.alt_msl_m);
+  const wind = new WindPanel(station.origin.alt_msl_m, {
+    set: async (body) => parseSurfaceWind(await api.post("/api/surface_wind", body)),
+    clear: async () => parseSurfaceWind(await api.delete("/api/surface_wind")),
+  });
   const readiness = new ReadinessPanel(async (id, ticked) => {
     await api.post(`/api/readiness/${encodeURIComponent(id)}`, { ticked });
   });
