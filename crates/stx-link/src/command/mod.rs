@@ -17,7 +17,7 @@
 //! | `Cutdown` | COMMAND_LONG `MAV_CMD_DO_FLIGHTTERMINATION` | p1 = 1 |
 //! | `RequestMessage` | COMMAND_LONG `MAV_CMD_REQUEST_MESSAGE` | p1 = message id |
 //! | `SetMessageInterval` | COMMAND_LONG `MAV_CMD_SET_MESSAGE_INTERVAL` | p1 = message id, p2 = interval µs (−1 stop, 0 default) |
-//! | `SetSurfaceWind` | COMMAND_LONG `MAV_CMD_USER_1` | p1 = speed m/s (0…60), p2 = direction the wind blows from, degrees true, p3 = age of the measurement when sent, s (0…3600): the common dialect has no message for a wind measured on the ground, and USER_1 is the range it leaves to vehicle-specific commands |
+//! | `SetSurfaceWind` | COMMAND_LONG `MAV_CMD_USER_1` | p1 = speed m/s (0…60), p2 = direction the wind blows from, degrees true, p3 = age of the measurement when sent, s (0…3600; guidance ignores a surface wind older than 120 s, so the station withdraws one by sending it 3600 s old): the common dialect has no message for a wind measured on the ground, and USER_1 is the range it leaves to vehicle-specific commands |
 //!
 //! COMMAND_LONG retries carry an incremented `confirmation`; COMMAND_INT has no such field, so
 //! its retries are identical copies, which the vehicle recognises by content within

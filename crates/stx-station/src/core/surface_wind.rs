@@ -13,6 +13,12 @@
 //! (the mission clock's run between then and now), so in a rehearsal at 20× an anemometer
 //! mean 5 s old is 100 s old to the drone, as it truly is in its world.
 //!
+//! **Withdrawn.** The operator's value is sent as the wind now, again every period, so once it
+//! is withdrawn or lapses the drone would fly on with it for guidance's two minutes: it is
+//! sent once more as [`SURFACE_WIND_MAX_AGE_S`] old, which guidance ignores, and the station
+//! and the replica hold no surface wind from then. An anemometer's mean carries its true time
+//! of measurement, so when the anemometer falls silent the drone's copy lapses by itself.
+//!
 //! **Its own request ids.** The uplinks are the station's own initiative, not operators'
 //! requests: they go out under ids from [`FIRST_ID`] upwards (operators' requests count from
 //! 1), so their answers are told apart, and they make no `command_result` (one every few
@@ -52,6 +58,8 @@ struct Sent {
     source: SurfaceWindSource,
     /// When it was measured, on the drone's clock, s; `None` before the drone's clock is known.
     measured_drone_s: Option<f64>,
+    /// It withdraws the operator's value from the drone.
+    withdraw: bool,
 }
 
 /// The surface wind's sources and the drone's copy.
@@ -182,6 +190,7 @@ impl StationCore {
     /// Withdraws the operator's surface wind.
     pub fn clear_operator_surface_wind(&mut self, now_s: f64, who: &str) {
         if self.surface_wind.operator.take().is_some() {
+            self.surface_wind.next_send_s = now_s;
             self.log(
                 now_s,
                 Level::Info,
@@ -244,20 +253,27 @@ impl StationCore {
                 (Some(SurfaceWindSource::Anemometer), None) => {
                     "ground anemometer silent: no surface wind (the drone's lapses in 2 min)"
                 }
-                (_, None) => "the operator's surface wind lapsed",
+                (_, None) => "no surface wind: the operator's is withdrawn or lapsed",
             };
             self.log(now_s, Level::Info, "anemometer", text.into());
         }
         let w = &self.surface_wind;
-        let Some((ne, source, measured_s)) = now else {
-            return;
-        };
         if !w.connected || w.sending.is_some() || now_s < w.next_send_s {
             return;
         }
+        let (ne, source, measured_s, withdraw) = match (now, w.held) {
+            (Some((ne, source, measured_s)), _) => (ne, source, measured_s, false),
+            (None, Some((ne, SurfaceWindSource::Operator, _))) => {
+                (ne, SurfaceWindSource::Operator, now_s, true)
+            }
+            (None, _) => return,
+        };
         // The age on the drone's clock, which runs at the mission clock's rate.
-        let age_s =
-            ((now_s - measured_s) * self.mission_clock.rate()).clamp(0.0, SURFACE_WIND_MAX_AGE_S);
+        let age_s = if withdraw {
+            SURFACE_WIND_MAX_AGE_S
+        } else {
+            ((now_s - measured_s) * self.mission_clock.rate()).clamp(0.0, SURFACE_WIND_MAX_AGE_S)
+        };
         let (speed_mps, from_deg) = speed_from(ne);
         let w = &mut self.surface_wind;
         w.next_id += 1;
@@ -269,6 +285,7 @@ impl StationCore {
             ne_mps: ne,
             source,
             measured_drone_s: self.mission_clock.at(now_s).map(|t| t - age_s),
+            withdraw,
         });
         self.outbox.issue(
             now_s,
@@ -304,10 +321,11 @@ impl StationCore {
         match e.outcome {
             CommandOutcome::InProgress { .. } => return,
             CommandOutcome::Accepted => {
-                let first = self.surface_wind.accepted_s.is_none();
+                let first = self.surface_wind.held.is_none();
                 let recovered = std::mem::take(&mut self.surface_wind.failed);
                 self.surface_wind.accepted_s = Some(now_s);
-                self.surface_wind.held = Some((sent.ne_mps, sent.source, sent.measured_s));
+                self.surface_wind.held =
+                    (!sent.withdraw).then_some((sent.ne_mps, sent.source, sent.measured_s));
                 self.surface_wind.send_error = None;
                 // The replica takes what the drone took, with the same time of measurement.
                 if let Some(measured) = sent.measured_drone_s {
@@ -316,7 +334,10 @@ impl StationCore {
                         time_s: measured,
                     }));
                 }
-                if first || recovered {
+                if sent.withdraw {
+                    let text = "the drone no longer uses the operator's surface wind";
+                    self.log(now_s, Level::Info, "anemometer", text.into());
+                } else if first || recovered {
                     let (speed, from) = speed_from(sent.ne_mps);
                     let source = match sent.source {
                         SurfaceWindSource::Anemometer => "anemometer",
@@ -381,7 +402,7 @@ impl StationCore {
             DroneCopy::Sending
         } else if w.failed {
             DroneCopy::Failed
-        } else if w.accepted_s.is_some() {
+        } else if w.held.is_some() {
             DroneCopy::Held
         } else {
             DroneCopy::None

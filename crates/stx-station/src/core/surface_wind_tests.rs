@@ -210,15 +210,33 @@ fn the_operators_value_stands_in_for_a_silent_anemometer_and_lapses() {
         log.iter().any(|(_, t)| t.contains("anemometer silent")),
         "{log:?}"
     );
-    // The operator's value lapses after `operator_valid_s` (900 s), said once.
-    assert!(uplinks(&mut c, 901.0).is_empty());
-    assert!(c.state_msg_now(901.0).surface_wind.wind.is_none());
+    // The operator's value lapses after `operator_valid_s` (900 s), said once, and is
+    // withdrawn from the drone: sent once more as too old for guidance.
+    hear_clock(&mut c, 900.0, 2000.0);
+    let sent = uplinks(&mut c, 901.0);
+    assert_eq!(sent.len(), 1, "{sent:?}");
+    let (id, _, _, age) = sent[0];
+    assert_eq!(age, stx_link::command::SURFACE_WIND_MAX_AGE_S);
+    answer(&mut c, 901.1, id, CommandOutcome::Accepted);
+    let v = c.state_msg_now(901.2).surface_wind;
+    assert!(v.wind.is_none() && v.held.is_none(), "{v:?}");
+    assert_eq!(v.drone, DroneCopy::None);
+    let replica = c
+        .guidance
+        .surface_wind()
+        .expect("the drone's stale copy, mirrored");
+    assert!(replica.time_s < 2000.0 - 3000.0, "{}", replica.time_s);
     let log = said(&mut c);
     assert!(
-        log.iter()
-            .any(|(_, t)| t.contains("lapsed") || t.contains("no surface wind")),
+        log.iter().any(|(_, t)| t.contains("withdrawn or lapsed")),
         "{log:?}"
     );
+    assert!(
+        log.iter().any(|(_, t)| t.contains("no longer uses")),
+        "{log:?}"
+    );
+    // Nothing more to send.
+    assert!(uplinks(&mut c, 910.0).is_empty());
 }
 
 #[test]

@@ -198,4 +198,36 @@ async fn an_operator_types_the_surface_wind_and_the_drone_takes_it() {
         reply["wind"].is_null() && reply["operator"].is_null(),
         "{reply}"
     );
+    // Withdrawn from the drone too: its guidance holds it as too old to use.
+    let mut withdrawn = None;
+    for _ in 0..100 {
+        let (held, now) = drone
+            .query(|d| {
+                let d = d.drone();
+                (d.onboard().guidance().surface_wind(), d.time_s())
+            })
+            .await;
+        if held.is_some_and(|w| now - w.time_s > 120.0) {
+            withdrawn = Some(now);
+            break;
+        }
+        tokio::time::sleep(Duration::from_millis(100)).await;
+    }
+    assert!(
+        withdrawn.is_some(),
+        "the drone never let the withdrawn wind go"
+    );
+    // The station says so once the drone's answer is in.
+    let mut after = Value::Null;
+    for _ in 0..50 {
+        after = surface_wind(addr).await;
+        if after["held"].is_null() && after["drone"] == "none" {
+            break;
+        }
+        tokio::time::sleep(Duration::from_millis(100)).await;
+    }
+    assert!(
+        after["held"].is_null() && after["drone"] == "none",
+        "{after}"
+    );
 }
