@@ -145,13 +145,7 @@ impl Anemometer {
 /// opposite; a calm has no direction and is said to come from the north.
 pub fn from_deg_and_speed(report: &SurfaceWind) -> (f64, f64) {
     let [north, east] = report.ne_mps;
-    let speed_mps = north.hypot(east);
-    if speed_mps == 0.0 {
-        return (0.0, 0.0);
-    }
-    // rem_euclid of a tiny negative angle rounds up to 360.0 itself, outside 0..360.
-    let from_deg = (-east).atan2(-north).to_degrees().rem_euclid(360.0);
-    (if from_deg >= 360.0 { 0.0 } else { from_deg }, speed_mps)
+    stx_types::wind::from_deg_and_speed(north, east)
 }
 
 /// The NMEA 0183 MWV sentence of `report` (true reference, m/s), CR LF included, as the

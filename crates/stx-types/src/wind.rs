@@ -145,9 +145,22 @@ pub enum WindError {
 }
 
 /// North and east components of the air's velocity for a meteorological wind, m/s.
-fn blowing_north_east_mps(speed_mps: f64, from_deg: f64) -> (f64, f64) {
+pub fn blowing_north_east_mps(speed_mps: f64, from_deg: f64) -> (f64, f64) {
     let (sin, cos) = from_deg.to_radians().sin_cos();
     (-speed_mps * cos, -speed_mps * sin)
+}
+
+/// The meteorological wind of the air's velocity (`north`, `east`, m/s): where it blows from,
+/// degrees clockwise from true north in 0..360, and its speed, m/s (the inverse of
+/// [`blowing_north_east_mps`]). A calm has no direction and is said to come from the north.
+pub fn from_deg_and_speed(north: f64, east: f64) -> (f64, f64) {
+    let speed_mps = north.hypot(east);
+    if speed_mps == 0.0 {
+        return (0.0, 0.0);
+    }
+    // rem_euclid of a tiny negative angle rounds up to 360.0 itself, outside 0..360.
+    let from_deg = (-east).atan2(-north).to_degrees().rem_euclid(360.0);
+    (if from_deg >= 360.0 { 0.0 } else { from_deg }, speed_mps)
 }
 
 /// No wind anywhere.

@@ -94,16 +94,14 @@ impl SurfaceWindState {
 
 /// The air's velocity (north, east) of a wind of `speed_mps` blowing from `from_deg`.
 fn velocity(speed_mps: f64, from_deg: f64) -> [f64; 2] {
-    let from = from_deg.to_radians();
-    [-speed_mps * from.cos(), -speed_mps * from.sin()]
+    let (north, east) = stx_types::wind::blowing_north_east_mps(speed_mps, from_deg);
+    [north, east]
 }
 
 /// Speed, m/s, and where it blows from, degrees 0…360, of the air's velocity (north, east).
 fn speed_from(ne: [f64; 2]) -> (f64, f64) {
-    (
-        ne[0].hypot(ne[1]),
-        (-ne[1]).atan2(-ne[0]).to_degrees().rem_euclid(360.0),
-    )
+    let (from_deg, speed_mps) = stx_types::wind::from_deg_and_speed(ne[0], ne[1]);
+    (speed_mps, from_deg)
 }
 
 impl StationCore {

@@ -122,10 +122,9 @@ impl Onboard {
                 from_deg,
                 age_s,
             } => {
-                // Where the air goes is the opposite of where it comes from.
-                let to = from_deg.to_radians();
+                let (north, east) = stx_types::wind::blowing_north_east_mps(speed_mps, from_deg);
                 let wind = SurfaceWind {
-                    ne_mps: [-speed_mps * to.cos(), -speed_mps * to.sin()],
+                    ne_mps: [north, east],
                     time_s: time_s - age_s,
                 };
                 // Said once: the station sends a fresh mean every few seconds.
