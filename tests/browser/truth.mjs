@@ -219,6 +219,13 @@ async function wholeMission() {
   const landedReadouts = { glideAir: await text(page, "ro-glide-air"), glideGround: await text(page, "ro-glide-ground"), height: await text(page, "ro-height") };
   check("landed: no glide ratio, and the height reads \"landed\"",
     landedReadouts.glideAir === "—" && landedReadouts.glideGround === "—" && landedReadouts.height === "landed", JSON.stringify(landedReadouts));
+  // What the flight learned of the canopy stays on the page after the landing, as the station keeps it.
+  const learnedAfter = (await api("/api/state")).body?.guidance?.learned ?? null;
+  const learnedRows = await page.evaluate(() => [...document.querySelectorAll('[data-testid="learned-polar"] tr')].map((tr) => [...tr.querySelectorAll("th, td")].map((c) => c.textContent)));
+  check("landed: the learned polar stays, headed \"at landing\", the page's airspeed row the station's",
+    learnedAfter?.flying === false && learnedRows[0]?.[0] === "at landing"
+      && learnedAfter.learned_s > 0 && learnedAfter.airspeed_scale.every((v, i) => learnedRows[1]?.[i + 1] === `${Math.round(v * 100)} %${Math.abs(Math.round(v * 100) - 100) > 15 ? "!" : ""}`),
+    `page ${JSON.stringify(learnedRows)}; station ${JSON.stringify(learnedAfter)}`);
   // The wind chart's height axis stops at the ground: the landing's own altitude, give or take its GPS.
   const axisMin = Number(await page.locator('[data-testid="wind-axis-min"]').textContent());
   check("landed: the wind chart's height axis does not run below the ground", ground !== null && axisMin >= ground - 10, `axis from ${axisMin} m MSL, the landing at ${ground?.toFixed(0)} m MSL`);

@@ -201,6 +201,9 @@ pub struct LearnedView {
     pub turn_scale: f64,
     /// Seconds of turning the turn rate was learned from, s.
     pub turn_learned_s: f64,
+    /// The replica still flies under the parafoil; `false` once the drone has landed (or left
+    /// the parafoil stage): these are then the values it last learned, kept for the debrief.
+    pub flying: bool,
 }
 
 /// The localizer line the replica follows.
@@ -234,7 +237,8 @@ pub struct GuidanceView {
     pub localizer: Option<LocalizerView>,
     /// Spiral plan, in spiral landing.
     pub pattern: Option<PatternView>,
-    /// What the spiral has learned of the glide and the turn, once it has flown.
+    /// What the spiral has learned of the glide and the turn, once it has flown (kept after
+    /// the landing until the next parafoil flight starts the replica afresh).
     pub learned: Option<LearnedView>,
     /// What the replica would command.
     pub commands: CommandsView,

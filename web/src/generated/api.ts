@@ -1090,7 +1090,8 @@ export interface GuidanceView {
    */
   disagreement: DisagreementView | null;
   /**
-   * What the spiral has learned of the glide and the turn, once it has flown.
+   * What the spiral has learned of the glide and the turn, once it has flown (kept after
+   * the landing until the next parafoil flight starts the replica afresh).
    */
   learned: LearnedView | null;
   /**
@@ -1190,6 +1191,11 @@ export interface LearnedView {
    * @maxItems 3
    */
   brake: [number, number, number];
+  /**
+   * The replica still flies under the parafoil; `false` once the drone has landed (or left
+   * the parafoil stage): these are then the values it last learned, kept for the debrief.
+   */
+  flying: boolean;
   /**
    * Seconds of straight, settled flight the glide was learned from, s.
    */

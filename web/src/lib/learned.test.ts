@@ -3,7 +3,7 @@ import { learnedTable, type LearnedTable } from "./learned";
 import type { Learned } from "./types";
 
 // API.md's example: the canopy flies a little slow and sinks a little fast, turns a little slowly.
-const LEARNED: Learned = { brake: [0, 0.5, 1], airspeed_scale: [0.97, 0.97, 0.97], sink_scale: [1.08, 1.1, 1.12], learned_s: 84, turn_scale: 0.91, turn_learned_s: 36.5 };
+const LEARNED: Learned = { brake: [0, 0.5, 1], airspeed_scale: [0.97, 0.97, 0.97], sink_scale: [1.08, 1.1, 1.12], learned_s: 84, turn_scale: 0.91, turn_learned_s: 36.5, flying: true };
 
 const texts = (t: LearnedTable): string[][] => [t.head, ...t.rows].map((r) => r.map((c) => c.text));
 /** Columns each row fills, spans counted, the cells that a row span above reaches included. */
@@ -52,13 +52,23 @@ describe("the learned polar's table", () => {
     expect(t.rows.flat().some((c) => /%/.test(c.text))).toBe(false);
   });
 
+  it("after the landing: the flight's last values stay, headed as such, the seconds behind them in the title", () => {
+    const t = learnedTable({ ...LEARNED, flying: false });
+    expect(texts(t)).toEqual([
+      ["at landing", "brakes 0", "½", "1", "turn 37 s"],
+      ["airspeed", "97 %", "97 %", "97 %", "91 %"],
+      ["sink", "108 %", "110 %", "112 %"],
+    ]);
+    expect(t.head[0]?.title).toMatch(/^as last learned before the landing, from 84 s of straight, settled flight: /);
+  });
+
   it("a scale the parser could not read shows a dash, not a number", () => {
     const t = learnedTable({ ...LEARNED, sink_scale: null, turn_scale: null });
     expect(texts(t).slice(1)).toEqual([["airspeed", "97 %", "97 %", "97 %", "—"], ["sink", "—", "—", "—"]]);
   });
 
   it("keeps one shape in every case: the left column's layout never jumps", () => {
-    const cases = [LEARNED, { ...LEARNED, learned_s: 0 }, { ...LEARNED, turn_learned_s: 0 }, { ...LEARNED, learned_s: 0, turn_learned_s: 0 }, null];
+    const cases = [LEARNED, { ...LEARNED, flying: false }, { ...LEARNED, learned_s: 0 }, { ...LEARNED, turn_learned_s: 0 }, { ...LEARNED, learned_s: 0, turn_learned_s: 0 }, null];
     for (const l of cases) expect(widths(learnedTable(l))).toEqual([5, 5, 5]);
   });
 });

@@ -57,8 +57,9 @@ export function learnedTable(l: Learned | null): LearnedTable {
   const turnS = learnedFor(l?.turn_learned_s ?? null);
   const head: LearnedCell[] = [
     {
-      text: glideS === null ? "learned" : `learned ${seconds(glideS)}`,
-      title: "what the guidance replica's spiral has learned of the canopy in flight, in percent of the polar guidance was given: airspeed and sink rate at each brake setting, from this many seconds of straight, settled flight",
+      // After the landing the values stay for the debrief, marked as the flight's last ones.
+      text: l !== null && l.flying === false ? "at landing" : glideS === null ? "learned" : `learned ${seconds(glideS)}`,
+      title: `${l !== null && l.flying === false ? `as last learned before the landing${glideS === null ? "" : `, from ${seconds(glideS)} of straight, settled flight`}: ` : ""}what the guidance replica's spiral has learned of the canopy in flight, in percent of the polar guidance was given: airspeed and sink rate at each brake setting, from this many seconds of straight, settled flight`,
     },
     ...brakes.map((b, i) => ({ text: i === 0 ? `brakes ${brakeName(b)}` : brakeName(b) })),
     { text: turnS === null ? "turn" : `turn ${seconds(turnS)}`, title: "turn rate flown over the polar's for the same main-line commands, from this many seconds of turning" },

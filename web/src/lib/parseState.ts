@@ -180,6 +180,7 @@ const parseLearned = (o: Obj): Learned => ({
   learned_s: num(o, "learned_s"),
   turn_scale: num(o, "turn_scale"),
   turn_learned_s: num(o, "turn_learned_s"),
+  flying: bool(o, "flying"),
 });
 
 function parseLocalizer(o: Obj): Localizer | null {

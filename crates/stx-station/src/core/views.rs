@@ -238,7 +238,9 @@ impl StationCore {
                     -1.0
                 },
             }),
-            learned: (flying && self.guidance.spiral_has_run()).then(|| {
+            // Kept after the landing: what this flight learned is what the debrief (and the
+            // next flight's vehicle file) wants.
+            learned: self.guidance.spiral_has_run().then(|| {
                 let l = self.guidance.learned_polar();
                 LearnedView {
                     brake: l.brake,
@@ -247,6 +249,7 @@ impl StationCore {
                     learned_s: l.learned_s,
                     turn_scale: l.turn_scale,
                     turn_learned_s: l.turn_learned_s,
+                    flying,
                 }
             }),
             commands: CommandsView {
