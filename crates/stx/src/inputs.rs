@@ -7,6 +7,7 @@ use std::path::Path;
 use anyhow::Context;
 use stx_dynamics::vehicle::Vehicle;
 use stx_gnc::control::ControlGains;
+use stx_gnc::performance::GlidePerformance;
 use stx_sim::drone::MissionConfig;
 use stx_sim::scenario::Scenario;
 
@@ -54,6 +55,20 @@ pub fn load_vehicle(path: Option<&Path>) -> anyhow::Result<Vehicle> {
                 .map_err(|e| BadInput(e).into())
         }
     }
+}
+
+/// The steady-glide table guidance plans with for the vehicle file `path`, trimmed at each of
+/// the table's brake settings ([`stx_analysis::performance::glide_performance_of`]); `what`
+/// names the file in errors (a flag, or "vehicle file"). A file that does not load, or a vehicle
+/// with no steady glide at one of the settings, is [`BadInput`].
+pub fn load_polar(what: &str, path: &Path) -> anyhow::Result<GlidePerformance> {
+    let vehicle = load_vehicle(Some(path)).map_err(|e| match e.downcast::<BadInput>() {
+        Ok(BadInput(e)) => BadInput(e.context(what.to_string())).into(),
+        Err(e) => e.context(what.to_string()),
+    })?;
+    // The error's message holds its cause already: as text, so the chain is not printed twice.
+    stx_analysis::performance::glide_performance_of(&vehicle)
+        .map_err(|e| BadInput(anyhow::anyhow!("{what} {}: {e}", path.display())).into())
 }
 
 /// A gains file (`stx tune` writes them), validated.

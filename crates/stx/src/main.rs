@@ -16,6 +16,7 @@ mod logging;
 mod montecarlo;
 mod plan;
 mod plan_window;
+mod polar;
 mod record;
 mod relay;
 mod replay;
@@ -78,6 +79,9 @@ enum Command {
     /// Fit chosen vehicle coefficients to flights (recordings or flight-log CSVs): estimates,
     /// 95 % intervals, correlations and the fitted vehicle file.
     Identify(identify::IdentifyArgs),
+    /// A vehicle file's planning polar as the drone's `PL_*` parameters (a parameter file, or
+    /// `--json` for the station's API), so guidance plans the next flight with it.
+    Polar(polar::PolarArgs),
     /// Station tokens: `stx token new` prints a strong random one as a `[[tokens]]` entry.
     Token(token::TokenArgs),
 }
@@ -124,6 +128,7 @@ fn main() -> ExitCode {
         Command::Plan(args) => plan::run(args),
         Command::Compare(args) => compare::run(args),
         Command::Identify(args) => identify::run(args),
+        Command::Polar(args) => polar::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -156,6 +161,7 @@ impl Command {
                 | Command::Plan(_)
                 | Command::Compare(_)
                 | Command::Identify(_)
+                | Command::Polar(_)
         )
     }
 }

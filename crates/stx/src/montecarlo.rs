@@ -226,7 +226,7 @@ fn campaign(args: CampaignArgs) -> anyhow::Result<()> {
         config.vehicle_name = Some(path.display().to_string());
     }
     if let Some(path) = &args.guidance_vehicle {
-        config.guidance.performance = guidance_performance(path)?;
+        config.guidance.performance = crate::inputs::load_polar("--guidance-vehicle", path)?;
         config.guidance_vehicle_name = Some(path.display().to_string());
     }
     if let Some(path) = &args.keep_out {
@@ -276,18 +276,6 @@ fn campaign(args: CampaignArgs) -> anyhow::Result<()> {
         return Ok(());
     }
     print_report(&report, args.json, args.details)
-}
-
-/// The steady-glide table of the vehicle file `path` for guidance; a file that does not load,
-/// or a vehicle with no steady glide at one of the table's brake settings, is [`BadInput`].
-fn guidance_performance(
-    path: &std::path::Path,
-) -> anyhow::Result<stx_gnc::performance::GlidePerformance> {
-    const FLAG: &str = "--guidance-vehicle";
-    let vehicle = load_vehicle_flag(FLAG, path)?;
-    // The error's message holds its cause already: as text, so the chain is not printed twice.
-    stx_analysis::performance::glide_performance_of(&vehicle)
-        .map_err(|e| BadInput(anyhow::anyhow!("{FLAG} {}: {e}", path.display())).into())
 }
 
 /// The zones of `path` around the campaign's target, which must lie outside every one.

@@ -145,7 +145,7 @@ export type Outcome = "in_progress" | "accepted" | "denied" | "failed" | "unsupp
 /**
  * Which part of the onboard software a parameter belongs to.
  */
-export type ParamGroup = "gains" | "spiral" | "failsafe" | "mission";
+export type ParamGroup = "gains" | "spiral" | "failsafe" | "mission" | "polar";
 /**
  * Where a band's wind comes from.
  */

@@ -77,7 +77,7 @@ export const PHASES = {
   idle: true, approximation: true, branch1: true, branch2: true, branch3: true, branch4: true, final_approach: true, flare: true, best_reachable: true, landed: true,
 } as const satisfies Record<GuidancePhase, true>;
 export const FIXES = { no_gps: true, no_fix: true, fix2d: true, fix3d: true, dgps: true, rtk_float: true, rtk_fixed: true, static: true, ppp: true } as const satisfies Record<GpsFix, true>;
-export const GROUPS = { gains: true, spiral: true, failsafe: true, mission: true } as const satisfies Record<ParamGroup, true>;
+export const GROUPS = { gains: true, spiral: true, failsafe: true, mission: true, polar: true } as const satisfies Record<ParamGroup, true>;
 export const SOURCES = { guidance: true, link: true, command: true, station: true, vehicle: true, keep_out: true, readiness: true, anemometer: true } as const satisfies Record<WireServerMessageOf<"event">["source"], true>;
 export const METHODS = { gps_velocity: true, position_differences: true } as const satisfies Record<BandMethod, true>;
 export const TARGET_SOURCES = { drone_plan: true, drone_telemetry: true, operator: true } as const satisfies Record<NonNullable<Guidance["target_source"]>, true>;

@@ -149,6 +149,12 @@ impl Guidance {
         self.config.spiral = spiral;
     }
 
+    /// Replaces the polar guidance plans with (a vehicle's table sent as parameters). What
+    /// was learned in flight stays: its scales are on whichever polar is in force.
+    pub fn set_performance(&mut self, performance: crate::performance::GlidePerformance) {
+        self.config.performance = performance;
+    }
+
     /// The mode in force.
     pub fn mode(&self) -> FlightMode {
         self.mode

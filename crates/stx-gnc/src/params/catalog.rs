@@ -19,6 +19,29 @@ macro_rules! real {
     };
 }
 
+/// One point of the planning polar's steady-glide table: the airspeed or the sink rate at the
+/// table's `$k`-th brake setting (`GlidePerformance::brake_points`, 0, 0.2 … 1 as shipped).
+macro_rules! polar_point {
+    ($name:literal, $what:literal, $min:expr, $max:expr, $k:literal, |$s:ident| $table:expr) => {
+        ParamDef {
+            name: $name,
+            units: "m/s",
+            min: $min,
+            max: $max,
+            kind: ParamKind::Real,
+            group: ParamGroup::Polar,
+            description: concat!(
+                $what,
+                " at the table's brake setting ",
+                stringify!($k),
+                " (0, 0.2, 0.4, 0.6, 0.8, 1), at the polar's reference density"
+            ),
+            get: |$s: &OnboardSettings| $table[$k],
+            set: |$s: &mut OnboardSettings, v: f64| $table[$k] = v,
+        }
+    };
+}
+
 /// Every onboard parameter, in the order of the drone's table.
 pub const CATALOG: &[ParamDef] = &[
     real!(
@@ -298,5 +321,102 @@ pub const CATALOG: &[ParamDef] = &[
         Mission,
         "expected mean ascent rate from launch to burst, loaded before launch for the station's flight-path prediction; 0 = not loaded",
         |s| s.mission.expected_ascent_rate_mps
+    ),
+    // The planning polar last: appended, so the drone's table keeps every older index.
+    polar_point!("PL_AS_0", "steady true airspeed", 2.0, 25.0, 0, |s| s
+        .guidance
+        .performance
+        .airspeed_mps),
+    polar_point!("PL_AS_1", "steady true airspeed", 2.0, 25.0, 1, |s| s
+        .guidance
+        .performance
+        .airspeed_mps),
+    polar_point!("PL_AS_2", "steady true airspeed", 2.0, 25.0, 2, |s| s
+        .guidance
+        .performance
+        .airspeed_mps),
+    polar_point!("PL_AS_3", "steady true airspeed", 2.0, 25.0, 3, |s| s
+        .guidance
+        .performance
+        .airspeed_mps),
+    polar_point!("PL_AS_4", "steady true airspeed", 2.0, 25.0, 4, |s| s
+        .guidance
+        .performance
+        .airspeed_mps),
+    polar_point!("PL_AS_5", "steady true airspeed", 2.0, 25.0, 5, |s| s
+        .guidance
+        .performance
+        .airspeed_mps),
+    polar_point!("PL_SINK_0", "steady sink rate", 0.3, 15.0, 0, |s| s
+        .guidance
+        .performance
+        .sink_rate_mps),
+    polar_point!("PL_SINK_1", "steady sink rate", 0.3, 15.0, 1, |s| s
+        .guidance
+        .performance
+        .sink_rate_mps),
+    polar_point!("PL_SINK_2", "steady sink rate", 0.3, 15.0, 2, |s| s
+        .guidance
+        .performance
+        .sink_rate_mps),
+    polar_point!("PL_SINK_3", "steady sink rate", 0.3, 15.0, 3, |s| s
+        .guidance
+        .performance
+        .sink_rate_mps),
+    polar_point!("PL_SINK_4", "steady sink rate", 0.3, 15.0, 4, |s| s
+        .guidance
+        .performance
+        .sink_rate_mps),
+    polar_point!("PL_SINK_5", "steady sink rate", 0.3, 15.0, 5, |s| s
+        .guidance
+        .performance
+        .sink_rate_mps),
+    // The rest of the polar: a vehicle file trims only the straight glide, and `stx polar`
+    // sends these as the shipped table has them; they are parameters so that what a flight
+    // learned of the turn can be sent too.
+    real!(
+        "PL_RHO",
+        "kg/m³",
+        0.3,
+        1.5,
+        Polar,
+        "air density the polar's airspeeds and sink rates are given at",
+        |s| s.guidance.performance.reference_density_kg_per_m3
+    ),
+    real!(
+        "PL_TURN_MAX",
+        "rad/s",
+        0.1,
+        3.0,
+        Polar,
+        "steady turn rate with the main line fully over",
+        |s| s.guidance.performance.max_turn_rate_rad_s
+    ),
+    real!(
+        "PL_TURN_LINE",
+        "m",
+        0.001,
+        0.1,
+        Polar,
+        "main-line command that gives tanh(1) ≈ 76 % of the maximum turn rate",
+        |s| s.guidance.performance.turn_main_line_scale_m
+    ),
+    real!(
+        "PL_TURN_TAU",
+        "s",
+        0.1,
+        10.0,
+        Polar,
+        "time constant of the turn rate's response to the main line",
+        |s| s.guidance.performance.turn_time_constant_s
+    ),
+    real!(
+        "PL_TURN_SINK",
+        "m/s per (rad/s)²",
+        0.0,
+        50.0,
+        Polar,
+        "extra sink in a steady turn per (rad/s)² of turn rate",
+        |s| s.guidance.performance.turn_sink_mps_per_rad2_s2
     ),
 ];

@@ -138,6 +138,9 @@ pub enum ParamGroup {
     Failsafe,
     /// Mission decisions ([`MissionSettings`]).
     Mission,
+    /// The glide and turn guidance plans with ([`crate::performance::GlidePerformance`]): a
+    /// vehicle file's trimmed table (`stx polar`), so what one flight identified serves the next.
+    Polar,
 }
 
 /// What values a parameter takes.
@@ -252,6 +255,33 @@ impl ParamDef {
     }
 }
 
+/// The polar's airspeed parameters, by the table's brake setting.
+pub const AIRSPEED_NAMES: [&str; crate::performance::BRAKE_POINTS] = [
+    "PL_AS_0", "PL_AS_1", "PL_AS_2", "PL_AS_3", "PL_AS_4", "PL_AS_5",
+];
+/// The polar's sink-rate parameters, by the table's brake setting.
+pub const SINK_NAMES: [&str; crate::performance::BRAKE_POINTS] = [
+    "PL_SINK_0",
+    "PL_SINK_1",
+    "PL_SINK_2",
+    "PL_SINK_3",
+    "PL_SINK_4",
+    "PL_SINK_5",
+];
+
+/// A planning polar as the parameters that carry it, in the drone's table order: what
+/// `stx polar` writes and the station sends. The brake settings are not parameters: every
+/// table guidance is given is over the shipped ones.
+pub fn polar_params(perf: &crate::performance::GlidePerformance) -> Vec<(&'static str, f64)> {
+    let mut settings = OnboardSettings::default();
+    settings.guidance.performance = *perf;
+    CATALOG
+        .iter()
+        .filter(|p| p.group == ParamGroup::Polar)
+        .map(|p| (p.name, p.get(&settings)))
+        .collect()
+}
+
 /// The parameter named `name`.
 pub fn find(name: &str) -> Option<&'static ParamDef> {
     CATALOG.iter().find(|p| p.name == name)
@@ -272,6 +302,18 @@ impl OnboardSettings {
                 b_value: sp.max_final_m,
                 rule: "the shortest final approach cannot be longer than the longest",
             });
+        }
+        let perf = &self.guidance.performance;
+        for k in 0..perf.brake_points.len() {
+            if perf.sink_rate_mps[k] >= perf.airspeed_mps[k] {
+                return Err(ParamError::Inconsistent {
+                    a: SINK_NAMES[k],
+                    a_value: perf.sink_rate_mps[k],
+                    b: AIRSPEED_NAMES[k],
+                    b_value: perf.airspeed_mps[k],
+                    rule: "a glide sinks slower than it flies through the air",
+                });
+            }
         }
         Ok(())
     }
@@ -376,7 +418,36 @@ mod tests {
             s.apply("NO_SUCH", 1.0),
             Err(ParamError::Unknown { .. })
         ));
+        // In range on its own, but a sink rate above the airspeed is no glide.
+        assert!(matches!(
+            s.apply("PL_SINK_3", 6.0),
+            Err(ParamError::Inconsistent {
+                a: "PL_SINK_3",
+                b: "PL_AS_3",
+                ..
+            })
+        ));
         assert_eq!(s, before);
+    }
+
+    #[test]
+    fn a_polar_sent_as_parameters_is_the_polar_guidance_plans_with() {
+        let mut polar = crate::performance::GlidePerformance::default();
+        for k in 0..polar.brake_points.len() {
+            polar.airspeed_mps[k] *= 0.9;
+            polar.sink_rate_mps[k] *= 1.1;
+        }
+        polar.turn_time_constant_s = 2.1;
+        let params = polar_params(&polar);
+        assert_eq!(params.len(), 2 * polar.brake_points.len() + 5);
+        let mut s = OnboardSettings::default();
+        for (name, value) in &params {
+            s.apply(name, *value).expect(name);
+        }
+        assert_eq!(s.guidance.performance, polar);
+        // Their names are the table's: the first is the airspeed released, in catalog order.
+        assert_eq!(params[0].0, AIRSPEED_NAMES[0]);
+        assert_eq!(params[6].0, SINK_NAMES[0]);
     }
 
     #[test]

@@ -579,6 +579,31 @@ fn a_parameter_set_changes_the_guidance_gain_at_once() {
     );
 }
 
+/// What one flight identified serves the next: a vehicle's polar sent as the `PL_*`
+/// parameters (`stx polar`) is the polar the drone's guidance plans with from the next period.
+#[test]
+fn a_polar_sent_as_parameters_is_what_the_drones_guidance_plans_with() {
+    let config = mission("rehearsal");
+    let mut d = drone(&config);
+    let mut slow = stx_gnc::performance::GlidePerformance::default();
+    for k in 0..slow.brake_points.len() {
+        slow.airspeed_mps[k] *= 0.9;
+        slow.sink_rate_mps[k] *= 1.12;
+    }
+    for (name, value) in stx_gnc::params::polar_params(&slow) {
+        d.set_param(name, value as f32).expect(name);
+        assert_eq!(d.param(name), Some(value as f32), "{name} reads back");
+    }
+    let held = d.onboard().guidance().config().performance;
+    for k in 0..slow.brake_points.len() {
+        assert!((held.airspeed_mps[k] - slow.airspeed_mps[k]).abs() < 1e-5);
+        assert!((held.sink_rate_mps[k] - slow.sink_rate_mps[k]).abs() < 1e-5);
+    }
+    // Not a glide (sink above airspeed): refused, the polar in force kept.
+    assert!(d.set_param("PL_SINK_0", 9.0).is_err());
+    assert_eq!(d.onboard().guidance().config().performance, held);
+}
+
 #[test]
 fn the_same_seed_flies_the_same_mission() {
     let config = mission("rehearsal");

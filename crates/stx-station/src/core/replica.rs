@@ -218,9 +218,13 @@ impl StationCore {
             return;
         }
         let config = self.guidance.config();
-        if config.gains != settings.guidance.gains || config.spiral != settings.guidance.spiral {
+        if config.gains != settings.guidance.gains
+            || config.spiral != settings.guidance.spiral
+            || config.performance != settings.guidance.performance
+        {
             self.guidance.set_gains(settings.guidance.gains);
             self.guidance.set_spiral_config(settings.guidance.spiral);
+            self.guidance.set_performance(settings.guidance.performance);
         }
     }
 }
@@ -266,5 +270,37 @@ mod tests {
         // (`observe_drone_clock`).
         c.replica_catch_up(0.0, 500, Stamp::AfterControl);
         assert_eq!(c.guided_at_s, Some(61.0));
+    }
+
+    fn drone_says(c: &mut crate::core::StationCore, name: &str, value: f32) {
+        c.on_link_event(
+            0.0,
+            stx_link::endpoint::GroundEvent::Param(stx_link::param::ParamEvent::Value {
+                param: stx_link::param::ParamValue {
+                    name: name.into(),
+                    value,
+                    index: 0,
+                    count: 1,
+                },
+            }),
+        );
+    }
+
+    #[test]
+    fn the_replica_plans_with_the_polar_the_drones_parameters_hold() {
+        let mut c = core();
+        let shipped = c.guidance.config().performance;
+        // A slower canopy sent as parameters (`stx polar`): the replica plans with it, as the
+        // drone's guidance does.
+        drone_says(&mut c, "PL_AS_0", 6.1);
+        drone_says(&mut c, "PL_SINK_0", 3.2);
+        let perf = c.guidance.config().performance;
+        assert_eq!(perf.airspeed_mps[0], f64::from(6.1_f32));
+        assert_eq!(perf.sink_rate_mps[0], f64::from(3.2_f32));
+        assert_eq!(perf.airspeed_mps[1..], shipped.airspeed_mps[1..]);
+        // A table that is no glide (sink above airspeed) is the drone's mistake: logged, the
+        // polar in force kept.
+        drone_says(&mut c, "PL_SINK_2", 7.0);
+        assert_eq!(c.guidance.config().performance, perf);
     }
 }

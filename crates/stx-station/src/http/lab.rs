@@ -321,6 +321,13 @@ fn is_gain(name: &str) -> bool {
     name.starts_with("GN_")
 }
 
+/// What the Lab sends to the drone: gains, and the planning polar (`PL_…`, `stx polar --json`),
+/// so that what a flight identified is what guidance plans the next with. Only gains are saved
+/// as a gains file.
+fn is_sendable(name: &str) -> bool {
+    is_gain(name) || name.starts_with("PL_")
+}
+
 pub(crate) async fn gains(_caller: Caller) -> Response {
     let defaults = OnboardSettings::default();
     let gains = CATALOG
@@ -338,16 +345,21 @@ pub(crate) async fn gains(_caller: Caller) -> Response {
     Json(LabGainsListBody { gains }).into_response()
 }
 
-/// The built-in settings with `gains` applied, each checked as the drone checks it.
-fn settings_with(gains: &BTreeMap<String, f64>) -> Result<OnboardSettings, FieldError> {
+/// The built-in settings with `gains` applied, each checked as the drone checks it; a name
+/// `allowed` refuses is refused as `not_allowed` says.
+fn settings_with(
+    gains: &BTreeMap<String, f64>,
+    allowed: fn(&str) -> bool,
+    not_allowed: &str,
+) -> Result<OnboardSettings, FieldError> {
     let mut settings = OnboardSettings::default();
     for (name, value) in gains {
         let refused = |reason: String| FieldError {
             field: name.clone(),
             reason,
         };
-        if !is_gain(name) {
-            return Err(refused("not a control gain (GN_…)".into()));
+        if !allowed(name) {
+            return Err(refused(not_allowed.into()));
         }
         settings
             .apply(name, *value)
@@ -364,7 +376,7 @@ pub(crate) async fn gains_save(
     caller.operator()?;
     let lab = lab_of(&state)?;
     let b = json_body(body)?;
-    let settings = match settings_with(&b.gains) {
+    let settings = match settings_with(&b.gains, is_gain, "not a control gain (GN_…)") {
         Ok(s) => s,
         Err(e) => return Ok(field_error(StatusCode::BAD_REQUEST, "invalid_gains", e)),
     };
@@ -386,7 +398,11 @@ pub(crate) async fn gains_send(
 ) -> Result<Response, HttpError> {
     caller.operator()?;
     let b = json_body(body)?;
-    if let Err(e) = settings_with(&b.gains) {
+    if let Err(e) = settings_with(
+        &b.gains,
+        is_sendable,
+        "neither a control gain (GN_…) nor the planning polar (PL_…)",
+    ) {
         return Ok(field_error(StatusCode::BAD_REQUEST, "invalid_gains", e));
     }
     if !b.confirm {

@@ -46,7 +46,8 @@ pub struct LabVehicleBody {
     pub overwrite: bool,
 }
 
-/// `POST /api/lab/gains/save` and `/send`: control gains by parameter name (`GN_…`).
+/// `POST /api/lab/gains/save` and `/send`: control gains by parameter name (`GN_…`); `send`
+/// takes the planning polar's parameters too (`PL_…`, as `stx polar --json` writes them).
 #[derive(Debug, Clone, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct LabGainsBody {

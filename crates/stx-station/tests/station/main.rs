@@ -12,6 +12,7 @@ mod field_network;
 mod flight_path;
 mod lab;
 mod plan;
+mod polar;
 mod radios;
 mod recordings;
 mod relay;

@@ -18,6 +18,7 @@ mod cli_pipe;
 mod cli_plan;
 mod cli_plan_gfs;
 mod cli_plan_window;
+mod cli_polar;
 mod cli_record;
 mod cli_relay;
 mod cli_serve;

@@ -306,6 +306,8 @@ impl Onboard {
         self.guidance.set_gains(self.settings.guidance.gains);
         self.guidance
             .set_spiral_config(self.settings.guidance.spiral);
+        self.guidance
+            .set_performance(self.settings.guidance.performance);
         Ok(())
     }
 
