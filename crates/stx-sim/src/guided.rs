@@ -15,7 +15,7 @@ use stx_dynamics::vehicle::Vehicle;
 use stx_dynamics::wind::{Calm, WindField};
 use stx_gnc::guidance::Guidance;
 
-use crate::closed_loop::{GuidedFlight, SensedNavigation};
+use crate::closed_loop::{GuidedFlight, SensedNavigation, Touchdown};
 use crate::geometry::max_line_length_error_m;
 use crate::run::{Run, RunError};
 use crate::scenario::{Scenario, ScenarioError};
@@ -101,7 +101,7 @@ pub fn run(scenario: &Scenario, vehicle: &Vehicle) -> Result<Run, RunError> {
         .map(|(_, state, controls)| max_line_length_error_m(vehicle, state, controls.main_line_m))
         .collect();
     let localizer = (g.mode == stx_gnc::mission::FlightMode::Localizer).then(|| g.plan().localizer);
-    let landing = touchdown.map(|t| Landing {
+    let landing_of = |t: &Touchdown| Landing {
         x_m: t.position_ne_m[0],
         y_m: t.position_ne_m[1],
         time_s: t.time_s,
@@ -120,7 +120,18 @@ pub fn run(scenario: &Scenario, vehicle: &Vehicle) -> Result<Run, RunError> {
             .upwind_rad
             .is_finite()
             .then(|| wrap_pi(t.heading_rad - t.upwind_rad).to_degrees()),
-    });
+    };
+    let landing = touchdown.as_ref().map(landing_of);
+    // The payload is what the target is for: fly on to the capsule's touchdown, as the Monte
+    // Carlo does (the recorded samples end at the first contact, as before).
+    let payload_landing = match touchdown {
+        Some(first) => Some(landing_of(
+            &flight
+                .land_payload(first)
+                .map_err(|reason| RunError::Payload { reason })?,
+        )),
+        None => None,
+    };
     let mut summary = summarise(
         scenario,
         &steps,
@@ -131,6 +142,7 @@ pub fn run(scenario: &Scenario, vehicle: &Vehicle) -> Result<Run, RunError> {
         flight.model.evaluations(),
         started.elapsed().as_secs_f64(),
     );
+    summary.payload_landing = payload_landing;
     summary.phases = flight
         .phases
         .iter()

@@ -21,6 +21,13 @@ pub enum RunError {
     /// Navigation could not be set up.
     #[error(transparent)]
     Navigation(#[from] crate::closed_loop::NavigationError),
+    /// After the transponder's contact the payload did not come down (the model failed, or
+    /// it flew on too long).
+    #[error("the payload's landing: {reason}")]
+    Payload {
+        /// What went wrong.
+        reason: String,
+    },
 }
 
 /// A finished run.

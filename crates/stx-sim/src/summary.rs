@@ -134,6 +134,12 @@ pub struct Summary {
     pub yaw_rate_settle_s: Option<f64>,
     /// Ground contact, if the run reached the ground.
     pub landing: Option<Landing>,
+    /// The payload's (the capsule's) touchdown in a guided run: the stack flies on after the
+    /// transponder's contact until the capsule touches (`GuidedFlight::land_payload`), as the
+    /// Monte Carlo's `payload_miss_m`; the same as `landing` when another body touched first.
+    /// Absent in open loop, or when the run did not reach the ground.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub payload_landing: Option<Landing>,
     /// Seconds the run was extended past the scenario's duration to find a steady stretch.
     pub extended_s: f64,
     /// Guidance phases in order with their start times (closed-loop scenarios).
@@ -236,6 +242,7 @@ pub fn summarise(
             .fold(f64::INFINITY, f64::min),
         yaw_rate_settle_s,
         landing,
+        payload_landing: None,
         extended_s,
         phases: Vec::new(),
     }

@@ -148,7 +148,8 @@ fn merge(paths: &[PathBuf], json: bool, details: bool) -> anyhow::Result<()> {
 }
 
 fn print_report(report: &MonteCarloReport, json: bool, details: bool) -> anyhow::Result<()> {
-    let nominal = stx_sim::montecarlo::nominal_single_landing().context("nominal landing")?;
+    let (nominal, nominal_payload) =
+        stx_sim::montecarlo::nominal_single_landing().context("nominal landing")?;
     if json {
         let mut value = serde_json::to_value(report)?;
         if let Some(object) = value.as_object_mut() {
@@ -158,6 +159,10 @@ fn print_report(report: &MonteCarloReport, json: bool, details: bool) -> anyhow:
             object.insert(
                 "nominal_single_landing".into(),
                 serde_json::to_value(nominal)?,
+            );
+            object.insert(
+                "nominal_single_payload_landing".into(),
+                serde_json::to_value(nominal_payload)?,
             );
         }
         println!("{}", serde_json::to_string(&value)?);
@@ -169,6 +174,13 @@ fn print_report(report: &MonteCarloReport, json: bool, details: bool) -> anyhow:
                  from the target",
                 landing.body,
                 landing.miss_m.unwrap_or(f64::NAN)
+            );
+        }
+        if let Some(payload) = nominal_payload.filter(|p| Some(p) != nominal.as_ref()) {
+            println!(
+                "  then the payload: the {} touched {:.1} m from the target",
+                payload.body,
+                payload.miss_m.unwrap_or(f64::NAN)
             );
         }
     }

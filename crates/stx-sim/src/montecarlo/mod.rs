@@ -60,11 +60,18 @@ pub enum NominalLandingError {
 
 /// The nominal single landing, which a campaign's report names beside its own figures: the
 /// built-in `spiral-landing` scenario (the shipped vehicle and no dispersions, the onboard
-/// software in closed loop; what `stx sim --scenario spiral-landing` flies), its first contact.
-pub fn nominal_single_landing() -> Result<Option<crate::summary::Landing>, NominalLandingError> {
+/// software in closed loop; what `stx sim --scenario spiral-landing` flies): its first contact
+/// and the payload's (the capsule's) touchdown, `None` each if the run did not land.
+pub fn nominal_single_landing() -> Result<
+    (
+        Option<crate::summary::Landing>,
+        Option<crate::summary::Landing>,
+    ),
+    NominalLandingError,
+> {
     let scenario = crate::scenario::Scenario::builtin("spiral-landing")?;
     let run = crate::open_loop::run(&scenario, &Vehicle::straplex())?;
-    Ok(run.summary.landing)
+    Ok((run.summary.landing, run.summary.payload_landing))
 }
 
 /// Flies every run on `config.threads` threads, calling `progress(done)` as runs finish.

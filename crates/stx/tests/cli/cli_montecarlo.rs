@@ -288,6 +288,17 @@ fn a_campaign_with_the_ground_anemometer_says_so_and_every_run_shows_what_was_le
     let sim: serde_json::Value = serde_json::from_slice(&sim.stdout).expect("summary");
     assert_eq!(with["nominal_single_landing"], sim["landing"]);
     assert!(with["nominal_single_landing"]["miss_m"].as_f64().is_some());
+    // And the payload's touchdown after it, the capsule's when the transponder touched first.
+    assert_eq!(
+        with["nominal_single_payload_landing"],
+        sim["payload_landing"]
+    );
+    assert_eq!(sim["landing"]["body"], "transponder");
+    assert_eq!(sim["payload_landing"]["body"], "capsule");
+    assert!(
+        sim["payload_landing"]["time_s"].as_f64() > sim["landing"]["time_s"].as_f64(),
+        "{sim}"
+    );
 }
 
 /// `--vehicle` and `--guidance-vehicle` fly around, and plan with, vehicle files, and the
