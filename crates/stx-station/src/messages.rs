@@ -195,10 +195,17 @@ pub struct LearnedView {
     pub airspeed_scale: [f64; 3],
     /// Sink rate flown over the polar's, at each brake setting.
     pub sink_scale: [f64; 3],
+    /// 1-σ of the airspeed scales (at the mean brake flown): their samples' scatter over the
+    /// independent samples behind them; `null` before any.
+    pub airspeed_sigma: Option<f64>,
+    /// 1-σ of the sink-rate scales, as `airspeed_sigma`.
+    pub sink_sigma: Option<f64>,
     /// Seconds of straight, settled flight the glide was learned from, s.
     pub learned_s: f64,
     /// Turn rate flown over the polar's for the same main-line commands.
     pub turn_scale: f64,
+    /// 1-σ of the turn factor; `null` before any turn was learned from.
+    pub turn_sigma: Option<f64>,
     /// Seconds of turning the turn rate was learned from, s.
     pub turn_learned_s: f64,
     /// The replica still flies under the parafoil; `false` once the drone has landed (or left

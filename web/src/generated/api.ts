@@ -1185,6 +1185,11 @@ export interface LearnedView {
    */
   airspeed_scale: [number, number, number];
   /**
+   * 1-σ of the airspeed scales (at the mean brake flown): their samples' scatter over the
+   * independent samples behind them; `null` before any.
+   */
+  airspeed_sigma: number | null;
+  /**
    * The brake settings the scales are shown at, 0…1 (released, half, full).
    *
    * @minItems 3
@@ -1208,6 +1213,10 @@ export interface LearnedView {
    */
   sink_scale: [number, number, number];
   /**
+   * 1-σ of the sink-rate scales, as `airspeed_sigma`.
+   */
+  sink_sigma: number | null;
+  /**
    * Seconds of turning the turn rate was learned from, s.
    */
   turn_learned_s: number;
@@ -1215,6 +1224,10 @@ export interface LearnedView {
    * Turn rate flown over the polar's for the same main-line commands.
    */
   turn_scale: number;
+  /**
+   * 1-σ of the turn factor; `null` before any turn was learned from.
+   */
+  turn_sigma: number | null;
 }
 /**
  * The localizer line the replica follows.
@@ -4052,7 +4065,8 @@ export interface LabVehicleBody {
   };
 }
 /**
- * `POST /api/lab/gains/save` and `/send`: control gains by parameter name (`GN_…`).
+ * `POST /api/lab/gains/save` and `/send`: control gains by parameter name (`GN_…`); `send`
+ * takes the planning polar's parameters too (`PL_…`, as `stx polar --json` writes them).
  */
 export interface LabGainsBody {
   /**

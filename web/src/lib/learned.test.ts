@@ -3,7 +3,7 @@ import { learnedTable, type LearnedTable } from "./learned";
 import type { Learned } from "./types";
 
 // API.md's example: the canopy flies a little slow and sinks a little fast, turns a little slowly.
-const LEARNED: Learned = { brake: [0, 0.5, 1], airspeed_scale: [0.97, 0.97, 0.97], sink_scale: [1.08, 1.1, 1.12], learned_s: 84, turn_scale: 0.91, turn_learned_s: 36.5, flying: true };
+const LEARNED: Learned = { brake: [0, 0.5, 1], airspeed_scale: [0.97, 0.97, 0.97], sink_scale: [1.08, 1.1, 1.12], learned_s: 84, turn_scale: 0.91, turn_learned_s: 36.5, flying: true, airspeed_sigma: 0.012, sink_sigma: 0.018, turn_sigma: 0.04 };
 
 const texts = (t: LearnedTable): string[][] => [t.head, ...t.rows].map((r) => r.map((c) => c.text));
 /** Columns each row fills, spans counted, the cells that a row span above reaches included. */
@@ -22,15 +22,18 @@ describe("the learned polar's table", () => {
       ["sink", "108 %", "110 %", "112 %"],
     ]);
     expect([...t.head, ...t.rows.flat()].some((c) => c.off)).toBe(false);
-    expect(t.rows[0][1]?.title).toBe("airspeed at brakes 0: 97.0 % of nominal");
-    expect(t.rows[1][2]?.title).toBe("sink rate at brakes ½: 110.0 % of nominal");
+    expect(t.rows[0][1]?.title).toBe("airspeed at brakes 0: 97.0 % of nominal ± 1.2 % (1σ)");
+    expect(t.rows[1][2]?.title).toBe("sink rate at brakes ½: 110.0 % of nominal ± 1.8 % (1σ)");
+    expect(t.rows[0][4]?.title).toBe("turn rate: 91.0 % of nominal ± 4.0 % (1σ)");
+    // No σ received: the figure alone.
+    expect(learnedTable({ ...LEARNED, sink_sigma: null }).rows[1][1]?.title).toBe("sink rate at brakes 0: 108.0 % of nominal");
   });
 
   it("more than 15 % from nominal, either way, stands out, and not by colour alone", () => {
     const t = learnedTable({ ...LEARNED, airspeed_scale: [0.84, 0.85, 1.0], sink_scale: [1.16, 1.15, 1.3], turn_scale: 0.6 });
     expect(texts(t).slice(1)).toEqual([["airspeed", "84 %!", "85 %", "100 %", "60 %!"], ["sink", "116 %!", "115 %", "130 %!"]]);
     expect(t.rows.map((r) => r.slice(1).map((c) => c.off === true))).toEqual([[true, false, false, true], [true, false, true]]);
-    expect(t.rows[1][3]?.title).toBe("sink rate at brakes 1: 130.0 % of nominal, more than 15 % off");
+    expect(t.rows[1][3]?.title).toBe("sink rate at brakes 1: 130.0 % of nominal ± 1.8 % (1σ), more than 15 % off");
   });
 
   it("nothing learned yet: says so, no percentages (the scales are still the polar's)", () => {

@@ -40,14 +40,18 @@ const seconds = (s: number): string => `${s < 10 ? s.toFixed(1) : s.toFixed(0)} 
 /** The seconds behind a scale, or null while there are none: until then the scale is the polar's own. */
 const learnedFor = (s: N): number | null => (s !== null && s > 0 ? s : null);
 
-/** A scale as a percent of nominal, marked when it is more than `OFF_NOMINAL_PERCENT` away. */
-function scaleCell(v: N, what: string): LearnedCell {
+/**
+ * A scale as a percent of nominal, marked when it is more than `OFF_NOMINAL_PERCENT` away; its
+ * 1-σ, when known, in the title (the cell itself has no room for it in the left column).
+ */
+function scaleCell(v: N, what: string, sigma: N = null): LearnedCell {
   if (v === null) return { text: "—", title: `${what}: not received` };
   // Judged on the percent shown, so that the mark and the figure agree ("85 %" is not "more than 15 % off").
   const percent = Math.round(v * 100);
   const off = Math.abs(percent - 100) > OFF_NOMINAL_PERCENT;
+  const doubt = sigma === null ? "" : ` ± ${(sigma * 100).toFixed(1)} % (1σ)`;
   // Colour is never the only carrier of meaning: an off-nominal value also carries a "!".
-  return { text: `${percent} %${off ? "!" : ""}`, off, title: `${what}: ${(v * 100).toFixed(1)} % of nominal${off ? `, more than ${OFF_NOMINAL_PERCENT} % off` : ""}` };
+  return { text: `${percent} %${off ? "!" : ""}`, off, title: `${what}: ${(v * 100).toFixed(1)} % of nominal${doubt}${off ? `, more than ${OFF_NOMINAL_PERCENT} % off` : ""}` };
 }
 
 /** The table for `learned`; `null` (the replica is not flying its spiral) gives the same shape, saying so. */
@@ -67,11 +71,11 @@ export function learnedTable(l: Learned | null): LearnedTable {
   const airspeed: LearnedCell = { text: "airspeed" };
   const sink: LearnedCell = { text: "sink" };
   if (l === null) return { head, rows: [[airspeed, { text: "— guidance replica not flying", cols: brakes.length + 1, rows: 2 }], [sink]] };
-  const turn: LearnedCell = turnS === null ? { text: "not yet", rows: 2, title: "turn rate: not learned yet, the polar's" } : { ...scaleCell(l.turn_scale, "turn rate"), rows: 2 };
+  const turn: LearnedCell = turnS === null ? { text: "not yet", rows: 2, title: "turn rate: not learned yet, the polar's" } : { ...scaleCell(l.turn_scale, "turn rate", l.turn_sigma ?? null), rows: 2 };
   if (glideS === null) {
     const notYet = { text: "not learned yet", cols: brakes.length, rows: 2, title: "airspeed and sink rate: the polar's, until the spiral has flown straight and settled" };
     return { head, rows: [[airspeed, notYet, turn], [sink]] };
   }
-  const at = (scales: N[] | null, what: string): LearnedCell[] => brakes.map((b, i) => scaleCell(scales?.[i] ?? null, `${what} at brakes ${brakeName(b)}`));
-  return { head, rows: [[airspeed, ...at(l.airspeed_scale, "airspeed"), turn], [sink, ...at(l.sink_scale, "sink rate")]] };
+  const at = (scales: N[] | null, what: string, sigma: N): LearnedCell[] => brakes.map((b, i) => scaleCell(scales?.[i] ?? null, `${what} at brakes ${brakeName(b)}`, sigma));
+  return { head, rows: [[airspeed, ...at(l.airspeed_scale, "airspeed", l.airspeed_sigma ?? null), turn], [sink, ...at(l.sink_scale, "sink rate", l.sink_sigma ?? null)]] };
 }

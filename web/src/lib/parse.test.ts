@@ -41,7 +41,7 @@ const STATE = {
     localizer: { point: [38.5333, -7.8889], course_deg: 80.0, glide_slope: 0.3 },
     pattern: { corners: [[38.531, -7.889], [38.532, -7.887], [38.534, -7.888], [38.533, -7.890]], final_entry: [38.531, -7.889], final_course_deg: 161.6,
       final_approach_height_m: 172.0, target_reachable: true, reach_ratio: 0.41 },
-    learned: { brake: [0.0, 0.5, 1.0], airspeed_scale: [0.97, 0.97, 0.97], sink_scale: [1.08, 1.1, 1.12], learned_s: 84.0, turn_scale: 0.91, turn_learned_s: 36.5, flying: true },
+    learned: { brake: [0.0, 0.5, 1.0], airspeed_scale: [0.97, 0.97, 0.97], sink_scale: [1.08, 1.1, 1.12], learned_s: 84.0, turn_scale: 0.91, turn_learned_s: 36.5, flying: true, airspeed_sigma: 0.012, sink_sigma: 0.018, turn_sigma: 0.04 },
     commands: { main_line: 0.35, brake: 0.0 }, age_s: 0.05, stale: false,
     disagreement: { what: "phase", replica: "branch3", drone: "branch2", since_s: 1102.25, for_s: 2.25, resolved: false, adopted: false } },
   prediction: { planned: { lat_deg: 38.5334, lon_deg: -7.8888, time_to_land_s: 187.0, semi_major_m: 12.1, semi_minor_m: 6.0, major_axis_deg: 40.0 },

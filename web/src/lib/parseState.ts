@@ -181,6 +181,9 @@ const parseLearned = (o: Obj): Learned => ({
   turn_scale: num(o, "turn_scale"),
   turn_learned_s: num(o, "turn_learned_s"),
   flying: bool(o, "flying"),
+  airspeed_sigma: num(o, "airspeed_sigma"),
+  sink_sigma: num(o, "sink_sigma"),
+  turn_sigma: num(o, "turn_sigma"),
 });
 
 function parseLocalizer(o: Obj): Localizer | null {

@@ -246,8 +246,11 @@ impl StationCore {
                     brake: l.brake,
                     airspeed_scale: l.airspeed_scale,
                     sink_scale: l.sink_scale,
+                    airspeed_sigma: l.airspeed_sigma,
+                    sink_sigma: l.sink_sigma,
                     learned_s: l.learned_s,
                     turn_scale: l.turn_scale,
+                    turn_sigma: l.turn_sigma,
                     turn_learned_s: l.turn_learned_s,
                     flying,
                 }

@@ -34,6 +34,10 @@ const SCALE_LIMITS: [f64; 2] = [0.6, 1.6];
 /// Weight of the prior "as the polar says" (scale 1), in seconds of samples: small, so that
 /// the first samples count, but enough to hold the scales before any.
 const PRIOR_S: f64 = 0.5;
+/// Seconds over which the samples' errors are correlated (the gusts and the wind estimate's
+/// wander): a moving sum of `n` seconds holds about `n / CORRELATION_S` independent samples,
+/// which the learned scales' 1-σ counts.
+pub(crate) const CORRELATION_S: f64 = 4.0;
 /// Weight of the prior "the brakes do what the polar says" (no slope of the scale over the
 /// brake), in seconds of samples per unit brake squared: a slope is learned only from
 /// samples at brake settings well apart, not from the scatter at one setting.
@@ -51,6 +55,8 @@ struct BrakeScale {
     moments: [f64; 3],
     /// Forgotten sums of weight × ratio and weight × brake × ratio.
     rhs: [f64; 2],
+    /// Forgotten sum of weight × ratio², for the scatter about the level.
+    square: f64,
 }
 
 impl BrakeScale {
@@ -66,6 +72,19 @@ impl BrakeScale {
             keep * self.rhs[0] + dt * ratio,
             keep * self.rhs[1] + dt * brake * ratio,
         ];
+        self.square = keep * self.square + dt * ratio * ratio;
+    }
+
+    /// 1-σ of the level learned (at the mean brake flown): the samples' scatter about it over
+    /// the square root of the independent samples behind it. `None` before any sample.
+    fn sigma(&self) -> Option<f64> {
+        let m0 = self.moments[0];
+        if m0 <= 0.0 {
+            return None;
+        }
+        let mean = self.rhs[0] / m0;
+        let variance = (self.square / m0 - mean * mean).max(0.0);
+        Some((variance / (m0 / CORRELATION_S).max(1.0)).sqrt())
     }
 
     /// The scale at `brake`.
@@ -93,10 +112,17 @@ pub struct LearnedPolar {
     pub airspeed_scale: [f64; 3],
     /// Sink rate flown over the polar's at each.
     pub sink_scale: [f64; 3],
+    /// 1-σ of the airspeed and sink scales at the mean brake flown (their scatter over the
+    /// independent samples behind them); `None` before anything was learned.
+    pub airspeed_sigma: Option<f64>,
+    /// See `airspeed_sigma`.
+    pub sink_sigma: Option<f64>,
     /// Seconds of straight, settled flight the glide was learned from, s.
     pub learned_s: f64,
     /// Turn rate flown over the rate the polar's turn model gives for the same commands.
     pub turn_scale: f64,
+    /// 1-σ of the turn factor; `None` before any turn was learned from.
+    pub turn_sigma: Option<f64>,
     /// Seconds of turning the turn rate was learned from, s.
     pub turn_learned_s: f64,
 }
@@ -180,8 +206,11 @@ impl LearnedGlide {
             brake: SHOWN_AT,
             airspeed_scale: SHOWN_AT.map(|b| self.airspeed.at(b)),
             sink_scale: SHOWN_AT.map(|b| self.sink.at(b)),
+            airspeed_sigma: self.airspeed.sigma(),
+            sink_sigma: self.sink.sigma(),
             learned_s: self.learned_s,
             turn_scale: 1.0,
+            turn_sigma: None,
             turn_learned_s: 0.0,
         }
     }
@@ -311,5 +340,26 @@ mod tests {
         assert_eq!(brief.learned_s, 0.0, "{brief:?}");
         let perf = GlidePerformance::default();
         assert_eq!(brief.performance(&perf), perf);
+    }
+
+    #[test]
+    fn the_learned_scales_carry_their_uncertainty_from_the_samples_scatter() {
+        // Before anything is learned there is no figure to doubt.
+        assert_eq!(learn(1.2, 0.0, true, 30).polar().sink_sigma, None);
+        // A steady canopy: samples that agree, a scale known to a fraction of a per cent.
+        let steady = learn(1.1, 0.0, false, 64).polar();
+        let steady_sigma = steady.sink_sigma.expect("learned");
+        assert!(steady_sigma < 0.005, "{steady:?}");
+        // Sinking 15 % more and less in turn (a gusty day, one brake setting): the same level
+        // learned, but known only to the scatter over the ~16 independent samples behind it,
+        // about 0.15 / 4.
+        let legs: Vec<_> = (0..8)
+            .map(|k| (if k % 2 == 0 { 1.15 } else { 0.85 }, 0.0, 8))
+            .collect();
+        let gusty = learn_legs(&legs, false).polar();
+        let sigma = gusty.sink_sigma.expect("learned");
+        assert!((gusty.sink_scale[0] - 1.0).abs() < 0.05, "{gusty:?}");
+        assert!((0.02..0.08).contains(&sigma), "{gusty:?}");
+        assert!(gusty.airspeed_sigma.is_some());
     }
 }

@@ -31,6 +31,8 @@ const PRIOR_RATE_RAD_S: f64 = 0.2;
 pub struct LearnedTurn {
     /// Forgotten sums of weight × predicted², weight × predicted × measured.
     sums: [f64; 2],
+    /// Forgotten sums of weight and weight × measured², for the scatter about the fit.
+    scatter: [f64; 2],
     /// The main line the servo is at in the prediction, m.
     servo_m: f64,
     /// The turn rate the polar predicts now, rad/s.
@@ -75,6 +77,10 @@ impl LearnedTurn {
             keep * self.sums[0] + dt * predicted * predicted,
             keep * self.sums[1] + dt * predicted * measured,
         ];
+        self.scatter = [
+            keep * self.scatter[0] + dt,
+            keep * self.scatter[1] + dt * measured * measured,
+        ];
         self.learned_s += dt;
     }
 
@@ -82,6 +88,21 @@ impl LearnedTurn {
     pub fn scale(&self) -> f64 {
         let prior = PRIOR_S * PRIOR_RATE_RAD_S * PRIOR_RATE_RAD_S;
         ((self.sums[1] + prior) / (self.sums[0] + prior)).clamp(SCALE_LIMITS[0], SCALE_LIMITS[1])
+    }
+
+    /// 1-σ of [`scale`](Self::scale): the residual of the fit over the independent samples
+    /// behind it (errors correlated over `CORRELATION_S`, as the glide's). `None` before any.
+    pub fn sigma(&self) -> Option<f64> {
+        let [weight, measured2] = self.scatter;
+        let [predicted2, cross] = self.sums;
+        if weight <= 0.0 || predicted2 <= 0.0 {
+            return None;
+        }
+        let k = cross / predicted2;
+        // Σw·(m − k·p)², per unit weight: the residual turn rate's variance, (rad/s)².
+        let residual = ((measured2 - 2.0 * k * cross + k * k * predicted2) / weight).max(0.0);
+        let independent = (weight / super::learned::CORRELATION_S).max(1.0);
+        Some((residual / (predicted2 / weight * independent)).sqrt())
     }
 
     /// The polar `perf` with the learned turn rate.
@@ -181,6 +202,10 @@ mod tests {
             let perf = GlidePerformance::default();
             let planned = learned.performance(&perf).turn_rate(0.005) / perf.turn_rate(0.005);
             assert!((planned - learned.scale()).abs() < 1e-9);
+            // The model turns as the polar says bar the factor: the fit's residual, and so
+            // its 1-σ, is small.
+            let sigma = learned.sigma().expect("learned");
+            assert!(sigma < 0.02 * factor, "{factor}: σ {sigma:.4}");
         }
     }
 
@@ -204,5 +229,6 @@ mod tests {
         let learned = learn(1.3, 60, false);
         assert_eq!(learned.learned_s, 0.0, "{learned:?}");
         assert_eq!(learned.scale(), 1.0);
+        assert_eq!(learned.sigma(), None);
     }
 }

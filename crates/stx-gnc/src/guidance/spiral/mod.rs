@@ -242,6 +242,7 @@ impl Spiral {
     pub fn learned_polar(&self) -> LearnedPolar {
         LearnedPolar {
             turn_scale: self.turn.scale(),
+            turn_sigma: self.turn.sigma(),
             turn_learned_s: self.turn.learned_s,
             ..self.glide.polar()
         }
