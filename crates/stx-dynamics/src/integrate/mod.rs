@@ -220,6 +220,21 @@ pub enum IntegrateError {
         /// Index of the first offending component (the state size for an error estimate).
         component: usize,
     },
+    /// A fixed step's 4th- and 3rd-order solutions differ by more than its method accepts
+    /// ([`Rk4::with_max_error`]): the step did not follow the solution.
+    #[error(
+        "step of {step_s} s from {time_s} s did not follow the solution: its two orders differ by {error} in component {component}"
+    )]
+    InaccurateStep {
+        /// Time at the start of the step, s.
+        time_s: f64,
+        /// Size of the step, s.
+        step_s: f64,
+        /// Index of the first component over the bound.
+        component: usize,
+        /// That component's difference, in its units.
+        error: f64,
+    },
     /// Adaptive error control needs a step smaller than the configured minimum.
     #[error("step size {step_s} s at {time_s} s is below the minimum {min_step_s} s")]
     StepSizeTooSmall {
