@@ -360,15 +360,42 @@ impl<N: Navigator> GuidedFlight<N> {
     }
 }
 
+/// Largest difference between an RK4 step's 4th- and 3rd-order solutions in any state (m,
+/// rad, m/s, rad/s) before the step counts as failed and its period is flown again with
+/// shorter steps ([`Rk4::with_max_error`]).
+///
+/// A 0.05 s step loses two kinds of flight, both seen only in dispersed stacks:
+/// - a dive: the canopy's pitch against its lines is a fast, heavily damped mode (≈ −32 1/s at
+///   the trim) whose rate grows with airspeed; at 10–11 m/s with a low-drag, nose-down rigged
+///   canopy it passes −56 1/s, beyond RK4's stability at 0.05 s, and the mode doubles each
+///   step (seed 3 runs 372 and 514, realistic: −67 1/s two seconds after release);
+/// - a pendant near its chart's pole: a hanging body's relative pitch turns at `q / cos φ`,
+///   so a line swinging past near-sideways (roll 80°, with the drone spinning about its lines)
+///   turns the pitch 140° in 40 ms (seed 7 run 2712 at 45.7 s; through the pole itself, at
+///   roll 90°, no step helps: `crates/stx-gnc/GNC_NOTES.md`, "Failed runs").
+///
+/// Either used to be accepted while finite and to overflow seconds later, so the shorter steps
+/// started from a lost state and the run failed. The bound sees such a step when it happens:
+/// the unstable pitch mode differs by 2–4 rad/s a step within a second of its start. It is 1
+/// (m, rad, m/s or rad/s) in one step: in 400 realistic runs (seed 7) every step after the
+/// first 0.3 s stayed below 0.26 but in one run, 0.79. The transient at release, where a
+/// dispersed stack starts out of its trim, reaches 1–3.6 in 7 of those runs, whose first
+/// period is then flown with the shorter steps.
+pub const MAX_STEP_ERROR: f64 = 1.0;
+
+/// How many times shorter than the nominal step the last retry of a failed period steps.
+const FINEST_REFINEMENT: f64 = 16.0;
+
 /// Integrates `model` from `state` at `time_s` over `period_s` with the servo commands held,
 /// in fixed RK4 steps of `step_s`, stopping exactly at ground contact. Returns the time
 /// reached, the state there and the contact time if the stack touched down.
 ///
-/// If the steps fail (hard main-line reversals can spin the drone about its lines faster than
-/// a 0.05 s step follows; a speed or rate above 1,000 m/s or rad/s counts as failed), the same
-/// period is flown again from the same state with steps four
-/// and then sixteen times shorter, so a run is deterministic and only its rare violent seconds
-/// cost more.
+/// If a step fails, the same period is flown again from the same state with steps four and
+/// then sixteen times shorter, so a run is deterministic and only its rare violent seconds cost
+/// more. A step fails when it goes non-finite, when a speed or rate reaches 1,000 m/s or rad/s
+/// (hard main-line reversals can spin the drone about its lines faster than a 0.05 s step
+/// follows), or, but for the shortest steps, when its two orders differ by more than
+/// [`MAX_STEP_ERROR`]: see there for what else a 0.05 s step cannot follow.
 pub fn fly_period(
     model: &mut ParafoilModel,
     time_s: f64,
@@ -395,9 +422,16 @@ pub fn fly_period_over(
         start_time_s: time_s,
         end_time_s: end_s,
     });
-    for refinement in [1.0, 4.0, 16.0] {
+    for refinement in [1.0, 4.0, FINEST_REFINEMENT] {
+        // The shortest steps take every finite step: a flight still that violent is flown as
+        // well as the model can, not failed.
+        let method = Rk4::new(step_s / refinement);
         outcome = integrate(
-            &mut Rk4::new(step_s / refinement),
+            &mut if refinement < FINEST_REFINEMENT {
+                method.with_max_error(MAX_STEP_ERROR)
+            } else {
+                method
+            },
             model,
             time_s,
             state,
@@ -420,7 +454,10 @@ pub fn fly_period_over(
                 component,
             });
         }
-        if !matches!(outcome, Err(IntegrateError::NonFiniteStep { .. })) {
+        if !matches!(
+            outcome,
+            Err(IntegrateError::NonFiniteStep { .. } | IntegrateError::InaccurateStep { .. })
+        ) {
             break;
         }
     }

@@ -6,6 +6,7 @@ mod body_imus;
 mod campaign_regression;
 mod drone_core;
 mod drone_vehicle;
+mod failed_runs;
 mod flight_path_matches_mission;
 mod footprint_against_full_model;
 mod guided_scenarios;
