@@ -27,17 +27,7 @@ fn model() -> ParafoilModel {
 
 /// The seed's uncontrolled-flight initial conditions (§4.6), 1,000 m up.
 fn seed_state() -> StateVector {
-    Pose {
-        position_ned_m: [0.0, 0.0, -1000.0],
-        canopy_euler_deg: [0.0, 6.5, 0.0],
-        canopy_velocity_mps: [3.3, 0.0, 1.0],
-        line_pitch_deg: -9.0,
-        drone_euler_deg: [0.0, 20.0, 0.0],
-        capsule_angles_deg: [0.0, -7.0],
-        transponder_angles_deg: [0.0, 5.0],
-        ..Default::default()
-    }
-    .to_state()
+    Pose::seed_release(1000.0).to_state()
 }
 
 fn fly_one_second(model: &mut ParafoilModel, mut method: Rk4, x0: &StateVector) -> StateVector {

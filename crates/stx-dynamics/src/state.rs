@@ -137,6 +137,22 @@ pub struct Pose {
 }
 
 impl Pose {
+    /// The seed's initial conditions for uncontrolled flight (§4.6), `altitude_m` up: the canopy
+    /// pitched 6.5° and flying 3.3 m/s with 1 m/s down its axis, the lines 9° behind it and the
+    /// hanging bodies at their §4.6 angles, servos neutral.
+    pub fn seed_release(altitude_m: f64) -> Self {
+        Self {
+            position_ned_m: [0.0, 0.0, -altitude_m],
+            canopy_euler_deg: [0.0, 6.5, 0.0],
+            canopy_velocity_mps: [3.3, 0.0, 1.0],
+            line_pitch_deg: -9.0,
+            drone_euler_deg: [0.0, 20.0, 0.0],
+            capsule_angles_deg: [0.0, -7.0],
+            transponder_angles_deg: [0.0, 5.0],
+            ..Default::default()
+        }
+    }
+
     /// The state vector for this pose, every relative rate zero except the canopy's.
     pub fn to_state(&self) -> StateVector {
         let mut x = StateVector::zeros();

@@ -14,20 +14,6 @@ use stx_dynamics::state::{Controls, Pose, StateVector, idx, vec3_at};
 use stx_dynamics::vehicle::Vehicle;
 use stx_dynamics::wind::{Calm, ConstantWind, WindField};
 
-/// The seed's uncontrolled-flight initial conditions (§4.6), at `altitude_m`.
-fn seed_pose(altitude_m: f64) -> Pose {
-    Pose {
-        position_ned_m: [0.0, 0.0, -altitude_m],
-        canopy_euler_deg: [0.0, 6.5, 0.0],
-        canopy_velocity_mps: [3.3, 0.0, 1.0],
-        line_pitch_deg: -9.0,
-        drone_euler_deg: [0.0, 20.0, 0.0],
-        capsule_angles_deg: [0.0, -7.0],
-        transponder_angles_deg: [0.0, 5.0],
-        ..Default::default()
-    }
-}
-
 fn model(wind: Arc<dyn WindField>) -> ParafoilModel {
     model_of(Vehicle::straplex(), wind)
 }
@@ -163,7 +149,7 @@ fn newton_euler_holds(vehicle: Vehicle, h: f64) {
     );
     let flight = fly(
         &mut m,
-        seed_pose(200.0).to_state(),
+        Pose::seed_release(200.0).to_state(),
         8.0,
         h,
         exciting_schedule,
@@ -371,7 +357,7 @@ fn canopy_momentum_balance(vehicle: Vehicle) -> MomentumBalance {
     let h = 1e-3;
     let flight = fly(
         &mut m,
-        seed_pose(200.0).to_state(),
+        Pose::seed_release(200.0).to_state(),
         8.0,
         h,
         exciting_schedule,
@@ -468,7 +454,7 @@ fn the_chains_velocities_are_the_derivatives_of_its_positions() {
     let h = 1e-3;
     let flight = fly(
         &mut m,
-        seed_pose(200.0).to_state(),
+        Pose::seed_release(200.0).to_state(),
         7.0,
         h,
         exciting_schedule,
@@ -605,7 +591,13 @@ fn body_positions_and_line_lengths_match_the_tabled_geometry_over_a_300_s_flight
         brake_right: 0.3 + 0.3 * (t / 13.0).sin(),
         brake_left: 0.3,
     };
-    let flight = fly(&mut m, seed_pose(1500.0).to_state(), 300.0, 0.01, schedule);
+    let flight = fly(
+        &mut m,
+        Pose::seed_release(1500.0).to_state(),
+        300.0,
+        0.01,
+        schedule,
+    );
     let mut worst_position = [0.0_f64; 4];
     let mut worst_length = [0.0_f64; 3];
     let mut main_range = (f64::INFINITY, f64::NEG_INFINITY);
@@ -690,7 +682,7 @@ fn without_air_every_body_falls_at_g_and_the_lines_go_slack() {
         },
     );
     // Any attitude, any common velocity, no rotation: nothing but gravity acts.
-    let mut pose = seed_pose(1000.0);
+    let mut pose = Pose::seed_release(1000.0);
     pose.canopy_euler_deg = [10.0, -20.0, 30.0];
     pose.canopy_velocity_mps = [5.0, -1.0, 2.0];
     let flight = fly(&mut m, pose.to_state(), 10.0, 0.01, |_| Controls::default());
@@ -752,9 +744,13 @@ fn lateral_excursion(
 #[test]
 fn without_wind_or_control_no_lateral_motion_appears() {
     let mut m = model(Arc::new(Calm));
-    let flight = fly(&mut m, seed_pose(1500.0).to_state(), 300.0, 0.01, |_| {
-        Controls::default()
-    });
+    let flight = fly(
+        &mut m,
+        Pose::seed_release(1500.0).to_state(),
+        300.0,
+        0.01,
+        |_| Controls::default(),
+    );
     // Exactly zero, not merely small: the equations are solved so that mirrored terms cancel
     // in floating point (model::unknown), so there is no rounding for anything to amplify.
     let worst = flight
@@ -776,7 +772,12 @@ fn released_at_35_km_without_wind_the_stack_stays_symmetric_at_a_loose_tolerance
     // centre line (1e-8 m with RK4); lateral states left zero about 20 s after release.
     let mut m = model(Arc::new(Calm));
     let mut loose = DormandPrince54::new(3e-4, 3e-4).with_max_step_s(0.5);
-    let (worst, _) = lateral_excursion(&mut m, &mut loose, &seed_pose(35_000.0).to_state(), 200.0);
+    let (worst, _) = lateral_excursion(
+        &mut m,
+        &mut loose,
+        &Pose::seed_release(35_000.0).to_state(),
+        200.0,
+    );
     assert_eq!(worst, 0.0, "lateral state reached {worst}");
 }
 
@@ -788,7 +789,7 @@ fn a_lateral_seed_outgrows_the_true_motion_when_dormand_prince_steps_past_the_ro
     // too small for the error estimate to see then grows from step to step until it is not.
     // A 1e-12 rad/s roll-rate seed shows it: RK4 at 10 ms and Dormand–Prince held below the
     // limit agree on the true motion, the unconstrained one departs from it by decades.
-    let mut x0 = seed_pose(35_000.0).to_state();
+    let mut x0 = Pose::seed_release(35_000.0).to_state();
     x0[idx::DRONE_RATES] = 1e-12;
     let mut m = model(Arc::new(Calm));
     let (truth, _) = lateral_excursion(&mut m, &mut Rk4::new(0.01), &x0, 100.0);
@@ -813,9 +814,13 @@ fn a_lateral_seed_outgrows_the_true_motion_when_dormand_prince_steps_past_the_ro
 #[test]
 fn every_line_is_taut_in_steady_glide() {
     let mut m = model(Arc::new(Calm));
-    let flight = fly(&mut m, seed_pose(500.0).to_state(), 40.0, 0.01, |_| {
-        Controls::default()
-    });
+    let flight = fly(
+        &mut m,
+        Pose::seed_release(500.0).to_state(),
+        40.0,
+        0.01,
+        |_| Controls::default(),
+    );
     for (t, x) in flight.iter().filter(|(t, _)| *t > 15.0).step_by(50) {
         let tensions = m.evaluate(*t, x).tensions;
         assert!(tensions.min() > 5.0, "slack line at t = {t}: {tensions:?}");
@@ -837,9 +842,13 @@ fn at_the_glide_the_munk_moment_would_pitch_nose_up_twice_as_hard_as_the_pressur
             ground_altitude_msl_m: 0.0,
         },
     );
-    let flight = fly(&mut m, seed_pose(100.0).to_state(), 60.0, 0.01, |_| {
-        Controls::default()
-    });
+    let flight = fly(
+        &mut m,
+        Pose::seed_release(100.0).to_state(),
+        60.0,
+        0.01,
+        |_| Controls::default(),
+    );
     let (t, x) = flight.last().copied().expect("flown");
     let steady = m.evaluate(t, &x);
     assert!(

@@ -38,17 +38,7 @@ fn model(vehicle: Vehicle) -> ParafoilModel {
 
 /// States of a 6 s flight from the seed's initial conditions, one every half second.
 fn flight(m: &ParafoilModel) -> Vec<(f64, StateVector)> {
-    let x0 = Pose {
-        position_ned_m: [0.0, 0.0, -300.0],
-        canopy_euler_deg: [0.0, 6.5, 0.0],
-        canopy_velocity_mps: [3.3, 0.0, 1.0],
-        line_pitch_deg: -9.0,
-        drone_euler_deg: [0.0, 20.0, 0.0],
-        capsule_angles_deg: [0.0, -7.0],
-        transponder_angles_deg: [0.0, 5.0],
-        ..Default::default()
-    }
-    .to_state();
+    let x0 = Pose::seed_release(300.0).to_state();
     let mut states = Vec::new();
     let mut x = x0;
     for k in 0..12 {

@@ -153,16 +153,7 @@ pub fn steady_glide_state(vehicle: &Vehicle) -> Result<StateVector, IntegrateErr
             ground_altitude_msl_m: 0.0,
         },
     );
-    let pose = Pose {
-        position_ned_m: [0.0, 0.0, -1000.0],
-        canopy_euler_deg: [0.0, 6.5, 0.0],
-        canopy_velocity_mps: [3.3, 0.0, 1.0],
-        line_pitch_deg: -9.0,
-        drone_euler_deg: [0.0, 20.0, 0.0],
-        capsule_angles_deg: [0.0, -7.0],
-        transponder_angles_deg: [0.0, 5.0],
-        ..Default::default()
-    };
+    let pose = Pose::seed_release(1000.0);
     let outcome = integrate(
         &mut Rk4::new(0.02),
         &mut model,

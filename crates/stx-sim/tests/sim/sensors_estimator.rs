@@ -192,16 +192,7 @@ fn fly(case: &Case) -> Run {
         },
     );
     // The seed's release conditions (§4.6), high enough for the whole run.
-    let pose = Pose {
-        position_ned_m: [0.0, 0.0, -1500.0],
-        canopy_euler_deg: [0.0, 6.5, 0.0],
-        canopy_velocity_mps: [3.3, 0.0, 1.0],
-        line_pitch_deg: -9.0,
-        drone_euler_deg: [0.0, 20.0, 0.0],
-        capsule_angles_deg: [0.0, -7.0],
-        transponder_angles_deg: [0.0, 5.0],
-        ..Default::default()
-    };
+    let pose = Pose::seed_release(1500.0);
     let mut x: StateVector = pose.to_state();
     let mut sensors = SensorSuite::new(&case.sensors, case.seed).expect("valid sensors");
     let mut estimator = Estimator::new(EstimatorConfig::default()).expect("valid estimator");
