@@ -96,21 +96,49 @@ impl GlidePerformance {
     /// Glide over the ground (distance per height) flying straight into a headwind
     /// `headwind_mps` at symmetric brake `brake`; negative when blown backwards.
     pub fn ground_glide(&self, brake: f64, headwind_mps: f64, density_kg_per_m3: f64) -> f64 {
-        (self.horizontal_airspeed(brake, density_kg_per_m3) - headwind_mps)
-            / self.sink_rate(brake, 0.0, density_kg_per_m3)
+        self.course_glide(brake, headwind_mps, 0.0, density_kg_per_m3)
+    }
+
+    /// Glide over the ground along a course with `headwind_mps` along it and `crosswind_mps`
+    /// across it: the canopy crabs into the crosswind, so only the rest of its airspeed
+    /// carries it along the course (none when the crosswind is as strong as the airspeed).
+    pub fn course_glide(
+        &self,
+        brake: f64,
+        headwind_mps: f64,
+        crosswind_mps: f64,
+        density_kg_per_m3: f64,
+    ) -> f64 {
+        let airspeed = self.horizontal_airspeed(brake, density_kg_per_m3);
+        let along = (airspeed * airspeed - crosswind_mps * crosswind_mps)
+            .max(0.0)
+            .sqrt();
+        (along - headwind_mps) / self.sink_rate(brake, 0.0, density_kg_per_m3)
     }
 
     /// The symmetric brake that makes the ground glide into `headwind_mps` equal
     /// `wanted_glide`, clamped to 0…1 (0 when even released brakes glide too short, 1 when even
-    /// full brakes glide too far). The glide falls monotonically with brake, so a bisection is
-    /// exact to its tolerance.
+    /// full brakes glide too far).
     pub fn brake_for_ground_glide(
         &self,
         wanted_glide: f64,
         headwind_mps: f64,
         density_kg_per_m3: f64,
     ) -> f64 {
-        let glide = |b: f64| self.ground_glide(b, headwind_mps, density_kg_per_m3);
+        self.brake_for_course_glide(wanted_glide, headwind_mps, 0.0, density_kg_per_m3)
+    }
+
+    /// [`Self::brake_for_ground_glide`] along a course with a crosswind as well. The glide
+    /// falls monotonically with brake (less airspeed, more sink, and a larger share of the
+    /// airspeed spent crabbing), so a bisection is exact to its tolerance.
+    pub fn brake_for_course_glide(
+        &self,
+        wanted_glide: f64,
+        headwind_mps: f64,
+        crosswind_mps: f64,
+        density_kg_per_m3: f64,
+    ) -> f64 {
+        let glide = |b: f64| self.course_glide(b, headwind_mps, crosswind_mps, density_kg_per_m3);
         if wanted_glide >= glide(0.0) {
             return 0.0;
         }
@@ -143,6 +171,33 @@ impl GlidePerformance {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_crosswind_takes_the_airspeed_the_crab_needs_from_the_glide_along_the_course() {
+        let perf = GlidePerformance::default();
+        let rho = perf.reference_density_kg_per_m3;
+        let va = perf.horizontal_airspeed(0.0, rho);
+        let sink = perf.sink_rate(0.0, 0.0, rho);
+        // 3-4-5: a crosswind of 0.6 of the airspeed leaves 0.8 of it along the course.
+        let glide = perf.course_glide(0.0, 1.0, 0.6 * va, rho);
+        assert!((glide - (0.8 * va - 1.0) / sink).abs() < 1e-12, "{glide}");
+        assert_eq!(
+            perf.course_glide(0.3, 2.0, 0.0, rho),
+            perf.ground_glide(0.3, 2.0, rho)
+        );
+        // A crosswind as strong as the airspeed: nothing along the course.
+        assert!((perf.course_glide(0.0, 0.0, 2.0 * va, rho)).abs() < 1e-12);
+        // The same glide wanted across a crosswind needs less brake.
+        let wanted = 0.6 * perf.ground_glide(0.0, 2.0, rho);
+        let straight = perf.brake_for_ground_glide(wanted, 2.0, rho);
+        let crossed = perf.brake_for_course_glide(wanted, 2.0, 3.0, rho);
+        assert!(crossed < straight - 0.05, "{crossed} against {straight}");
+        let achieved = perf.course_glide(crossed, 2.0, 3.0, rho);
+        assert!(
+            (achieved - wanted).abs() < 1e-6,
+            "{achieved} against {wanted}"
+        );
+    }
 
     #[test]
     fn brakes_slow_and_steepen_and_thin_air_speeds_up() {

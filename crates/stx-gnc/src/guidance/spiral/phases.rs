@@ -214,10 +214,12 @@ impl PhaseMachine {
                         "target out of reach at {height:.0} m: wind {wind_speed:.1} m/s from \
                          {:.0}°, the glide reaches {reach:.0} m around a drift point \
                          {drift_distance:.0} m from the target (ratio {reach_ratio:.2}); flying to \
-                         the best reachable point ({:.0} N, {:.0} E), {miss:.0} m from the target",
+                         the best reachable point ({:.0} N, {:.0} E){}, {miss:.0} m from the \
+                         target",
                         wind_from_deg(wind),
                         best[0],
-                        best[1]
+                        best[1],
+                        s.reach.clear_note()
                     ),
                     now_s,
                 );
@@ -273,11 +275,12 @@ impl PhaseMachine {
                     GuidancePhase::BestReachable,
                     GuidancePhase::BestReachable,
                     format!(
-                        "best reachable point moved: now ({:.0} N, {:.0} E), {miss:.0} m from the \
-                         target, at {height:.0} m in a wind of {wind_speed:.1} m/s from {:.0}° \
+                        "best reachable point moved: now ({:.0} N, {:.0} E){}, {miss:.0} m from \
+                         the target, at {height:.0} m in a wind of {wind_speed:.1} m/s from {:.0}° \
                          (reach ratio {reach_ratio:.2})",
                         best[0],
                         best[1],
+                        s.reach.clear_note(),
                         wind_from_deg(wind)
                     ),
                 ));

@@ -116,6 +116,16 @@ impl Reach {
         ]
     }
 
+    /// Said after the best reachable point when it was moved off the nearest point, so the
+    /// operator knows why the recovery team is sent further than the glide could reach.
+    pub(super) fn clear_note(&self) -> &'static str {
+        if self.best_moved {
+            " (moved clear of the keep-out zones)"
+        } else {
+            ""
+        }
+    }
+
     /// Distance from the best reachable point to the target, m.
     pub(super) fn miss_m(&self) -> f64 {
         self.best_rel[0].hypot(self.best_rel[1])

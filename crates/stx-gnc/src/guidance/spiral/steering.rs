@@ -130,13 +130,16 @@ fn to_clear_point(
     };
     let wind = s.wind.measured_ne_mps;
     let headwind = -(wind[0] * course.cos() + wind[1] * course.sin());
+    // On a course 60° off the wind (seed 12 run 726 of the keep-out campaign), brakes set for
+    // the headwind alone left too little airspeed for the crab and the stack fell off its way.
+    let crosswind = -wind[0] * course.sin() + wind[1] * course.cos();
     let height = s.final_approach.height_to_flare;
     let brake = if height <= 0.0 {
         0.0
     } else if to_go <= 0.0 {
         1.0
     } else {
-        perf.brake_for_ground_glide(to_go / height, headwind, density)
+        perf.brake_for_course_glide(to_go / height, headwind, crosswind, density)
     };
     Controls {
         main_line_m: control::course(
