@@ -69,6 +69,21 @@ pub struct Estimate {
     pub wind_ned_mps: Vector3<f64>,
     /// 1-σ of the wind's north and east components (and 0 for down), m/s.
     pub wind_sigma_mps: Vector3<f64>,
+    /// The AHRS's heading bias as the estimator has learnt it (the AHRS's yaw minus the
+    /// drone's true yaw), rad; 0 before the navigation filter starts. Learnt in turns: in
+    /// straight flight it cannot be told from the drone's own sideslip.
+    #[serde(default)]
+    pub heading_bias_rad: f64,
+    /// 1-σ of the heading bias, rad (∞ before the navigation filter starts).
+    #[serde(default = "not_measured")]
+    pub heading_bias_sigma_rad: f64,
+    /// The pitot's scale as the estimator has learnt it: the pitot reads this many times the
+    /// air's true speed along the drone's x axis; 1 before the navigation filter starts.
+    #[serde(default = "unit_scale")]
+    pub pitot_scale: f64,
+    /// 1-σ of the pitot scale (∞ before the navigation filter starts).
+    #[serde(default = "not_measured")]
+    pub pitot_scale_sigma: f64,
     /// A GPS fix was used within the estimator's GPS timeout.
     pub gps_ok: bool,
     /// Seconds since the last GPS fix used (∞ before the first).
@@ -81,6 +96,10 @@ pub struct Estimate {
 
 fn not_measured() -> f64 {
     f64::INFINITY
+}
+
+fn unit_scale() -> f64 {
+    1.0
 }
 
 impl Estimate {

@@ -157,6 +157,11 @@ impl PointMass {
             air_density_sigma_kg_per_m3: f64::INFINITY,
             wind_ned_mps: Vector3::new(wind_ned_mps.x, wind_ned_mps.y, 0.0),
             wind_sigma_mps: Vector3::zeros(),
+            // No AHRS, no pitot: nothing to be biased.
+            heading_bias_rad: 0.0,
+            heading_bias_sigma_rad: 0.0,
+            pitot_scale: 1.0,
+            pitot_scale_sigma: 0.0,
             gps_ok: true,
             gps_age_s: 0.0,
             attitude_ok: true,

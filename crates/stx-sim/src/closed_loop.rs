@@ -168,6 +168,11 @@ pub fn truth_estimate(model: &ParafoilModel, time_s: f64, x: &StateVector) -> Es
         air_density_sigma_kg_per_m3: 0.0,
         wind_ned_mps: nalgebra::Vector3::new(wind.x, wind.y, 0.0),
         wind_sigma_mps: Default::default(),
+        // No AHRS, no pitot: nothing to be biased.
+        heading_bias_rad: 0.0,
+        heading_bias_sigma_rad: 0.0,
+        pitot_scale: 1.0,
+        pitot_scale_sigma: 0.0,
         gps_ok: true,
         gps_age_s: 0.0,
         attitude_ok: true,

@@ -1,4 +1,4 @@
-//! The navigation EKF proper: the layout of its thirteen states, the process model that
+//! The navigation EKF proper: the layout of its fourteen states, the process model that
 //! carries them through a turn (with `F·P·Fᵀ` by row operations), and the Kalman update with its
 //! innovation gate. The measurements that feed it have a file each (`gps.rs`, `pitot.rs`,
 //! `baro.rs`, `sideslip.rs`); the parent module's documentation has the equations.
@@ -8,7 +8,7 @@ use nalgebra::{Matrix2, SMatrix, SVector, Vector2, Vector3};
 use super::config::Tuning;
 
 /// Number of navigation states.
-pub(crate) const N: usize = 13;
+pub(crate) const N: usize = 14;
 pub(crate) type StateVec = SVector<f64, N>;
 pub(crate) type Covariance = SMatrix<f64, N, N>;
 
@@ -28,9 +28,10 @@ pub(crate) mod ix {
     pub const SCALE: usize = 10;
     /// Barometric bias, natural log of pressure.
     pub const BARO: usize = 11;
-    /// Sideslip of the air velocity from the drone's measured heading in straight flight, rad
-    /// (the AHRS's heading bias included).
+    /// Sideslip of the air velocity from the drone's true heading in straight flight, rad.
     pub const SIDESLIP: usize = 12;
+    /// The AHRS's heading bias: its yaw minus the drone's true yaw, rad.
+    pub const HEADING_BIAS: usize = 13;
 }
 
 /// What became of one measurement.
@@ -164,7 +165,7 @@ impl Nav {
         self.x[ix::AIR + 1] = new_air_h.y;
 
         // F = I except for the blocks below; F·P·Fᵀ by row operations costs a tenth of two
-        // dense 12×12 products, and this runs at every measurement and estimate.
+        // dense 14×14 products, and this runs at every measurement and estimate.
         // ∂(R(ωΔt)·v)/∂ω = Δt·R(ωΔt + π/2)·v.
         let d_turn = rotation(omega * dt_s + std::f64::consts::FRAC_PI_2) * air_h * dt_s;
         let transition = Transition {
@@ -178,7 +179,7 @@ impl Nav {
         let fp = transition.apply_rows(&self.p);
         self.p = transition.apply_rows(&fp.transpose());
 
-        // Random walks on the air velocity, turn rate, wind, scale and bias, with the air
+        // Random walks on the air velocity, turn rate, wind, scale and biases, with the air
         // velocity's and the wind's carried into position (Δt²/2 and Δt³/3 terms).
         let mut q = Covariance::zeros();
         let dt2 = dt_s * dt_s;
@@ -205,6 +206,7 @@ impl Nav {
         q[(ix::SCALE, ix::SCALE)] = t.q_scale * dt_s;
         q[(ix::BARO, ix::BARO)] = t.q_baro * dt_s;
         q[(ix::SIDESLIP, ix::SIDESLIP)] = t.q_sideslip * dt_s;
+        q[(ix::HEADING_BIAS, ix::HEADING_BIAS)] = t.q_heading_bias * dt_s;
 
         self.p += q;
     }
@@ -274,6 +276,7 @@ mod tests {
         t.q_scale = 0.0;
         t.q_baro = 0.0;
         t.q_sideslip = 0.0;
+        t.q_heading_bias = 0.0;
         t.vertical_wind_variance = 0.0;
         t
     }
@@ -282,7 +285,7 @@ mod tests {
     fn covariance_propagation_is_the_jacobian_of_the_state_propagation() {
         let t = noiseless();
         let x = StateVec::from_column_slice(&[
-            10.0, -20.0, -500.0, 6.0, -3.0, 4.5, 0.7, -2.0, 3.0, 0.4, 0.97, 0.01, 0.05,
+            10.0, -20.0, -500.0, 6.0, -3.0, 4.5, 0.7, -2.0, 3.0, 0.4, 0.97, 0.01, 0.05, -0.08,
         ]);
         // A full, symmetric positive-definite covariance.
         let a = Covariance::from_fn(|i, j| ((i * 7 + j * 3) % 11) as f64 * 0.1 - 0.5);

@@ -20,6 +20,15 @@ pub(super) struct GpsGate {
     velocity_in_row: u32,
 }
 
+/// The sensor calibration a (re)started state takes over: the pitot scale and the AHRS
+/// heading bias, each as (value, variance). A restart after rejected fixes is about the air
+/// velocity and the wind; what was learnt of the sensors still holds.
+#[derive(Debug, Clone, Copy)]
+struct Calibration {
+    scale: (f64, f64),
+    heading_bias: (f64, f64),
+}
+
 /// What a fix did: the navigation state after it, and whether it (re)started that state.
 pub(super) struct GpsStep {
     pub(super) nav: Nav,
@@ -64,7 +73,7 @@ impl GpsGate {
         g: &GpsFix,
         wind: Vector2<f64>,
         wind_variance: f64,
-        scale: (f64, f64),
+        calibration: Calibration,
         t: &Tuning,
     ) -> Nav {
         let (h_var, v_var, s_var) = gps_variances(g, t);
@@ -88,8 +97,8 @@ impl GpsGate {
             x[ix::WIND + k] = wind[k];
             p[(ix::WIND + k, ix::WIND + k)] = wind_variance;
         }
-        x[ix::SCALE] = scale.0;
-        p[(ix::SCALE, ix::SCALE)] = scale.1;
+        (x[ix::SCALE], p[(ix::SCALE, ix::SCALE)]) = calibration.scale;
+        (x[ix::HEADING_BIAS], p[(ix::HEADING_BIAS, ix::HEADING_BIAS)]) = calibration.heading_bias;
         p[(ix::BARO, ix::BARO)] = t.initial_baro_variance;
         p[(ix::SIDESLIP, ix::SIDESLIP)] = t.initial_sideslip_variance;
         let mut nav = Nav { x, p };
@@ -106,7 +115,10 @@ impl GpsGate {
                 g,
                 Vector2::zeros(),
                 t.initial_wind_variance,
-                (1.0, t.initial_scale_variance),
+                Calibration {
+                    scale: (1.0, t.initial_scale_variance),
+                    heading_bias: (0.0, t.initial_heading_bias_variance),
+                },
                 t,
             );
             return GpsStep {
@@ -151,8 +163,12 @@ impl GpsGate {
             if self.velocity_in_row >= t.reset_after_rejections {
                 // Keep the wind as a prior but let the fix set the velocities.
                 let wind = Vector2::new(nav.x[ix::WIND], nav.x[ix::WIND + 1]);
-                let scale = (nav.x[ix::SCALE], nav.p[(ix::SCALE, ix::SCALE)]);
-                let nav = self.start(g, wind, t.initial_wind_variance, scale, t);
+                let kept = |i: usize| (nav.x[i], nav.p[(i, i)]);
+                let calibration = Calibration {
+                    scale: kept(ix::SCALE),
+                    heading_bias: kept(ix::HEADING_BIAS),
+                };
+                let nav = self.start(g, wind, t.initial_wind_variance, calibration, t);
                 return GpsStep {
                     nav,
                     outcome: Outcome::Reset,

@@ -95,9 +95,13 @@ impl Pitot {
     }
 
     /// Pitot: indicated airspeed `z = k·(e_x·v_air)`, the air along the drone's x axis from
-    /// the AHRS's pitch and heading; their uncertainty is added to the noise.
-    /// `attitude` is the pitch, its variance, the heading and its variance at the sample's
-    /// instant ([`attitude_at`]).
+    /// the AHRS's pitch and its heading less the heading-bias state `δψ`; their uncertainty is
+    /// added to the noise. `attitude` is the pitch, its variance, the AHRS heading and its
+    /// variance at the sample's instant ([`attitude_at`]).
+    ///
+    /// `∂z/∂δψ = −k·cos θ·(e_y·a_h)`: the bias shows where the air comes from beside the x
+    /// axis, in the drone's swing and in turns; in a straight, steady glide the pitot hardly
+    /// sees it (the parent module's documentation says where it is observable).
     pub(super) fn update(
         &mut self,
         nav: &mut Nav,
@@ -106,7 +110,8 @@ impl Pitot {
         t: &Tuning,
     ) -> Outcome {
         let measured = a.indicated_airspeed_mps();
-        let (pitch, pitch_variance, yaw, yaw_variance) = attitude;
+        let (pitch, pitch_variance, measured_yaw, yaw_variance) = attitude;
+        let yaw = measured_yaw - nav.x[ix::HEADING_BIAS];
         let air = nav.air_ned();
         let e_x = x_axis_ned(pitch, yaw);
         let along_x = e_x.dot(&air);
@@ -170,6 +175,7 @@ impl Pitot {
             h[(0, ix::AIR + k)] = scale * e_x[k];
         }
         h[(0, ix::SCALE)] = along_x;
+        h[(0, ix::HEADING_BIAS)] = -scale * d_yaw;
         let y = SMatrix::<f64, 1, 1>::new(measured - scale * along_x);
         if nav.update(
             &y,

@@ -1,5 +1,6 @@
 //! The estimate read out of the navigation state: velocity, course, airspeed, sink rate and
-//! glide ratios, the stack's heading and turn rate, and the wind, each with its 1-σ.
+//! glide ratios, the stack's heading and turn rate, the wind, and what has been learnt of the
+//! pitot's scale and the AHRS's heading bias, each with its 1-σ.
 
 use nalgebra::{Matrix3, SMatrix, Vector2, Vector3};
 use stx_types::rotation::wrap_pi;
@@ -83,6 +84,10 @@ pub(super) fn read_nav(e: &mut Estimate, nav: &Nav) {
         sigma(nav.p[(ix::WIND + 1, ix::WIND + 1)]),
         0.0,
     );
+    e.heading_bias_rad = nav.x[ix::HEADING_BIAS];
+    e.heading_bias_sigma_rad = sigma(nav.p[(ix::HEADING_BIAS, ix::HEADING_BIAS)]);
+    e.pitot_scale = nav.x[ix::SCALE];
+    e.pitot_scale_sigma = sigma(nav.p[(ix::SCALE, ix::SCALE)]);
 }
 
 /// 1-σ of the glide ratio `g = |v_h|/v_D` of velocity `v` with covariance `cov`, to first

@@ -3,7 +3,9 @@
 
 mod ascent_wind;
 mod estimator;
+mod estimator_calibration;
 mod flight_path;
 mod flight_plan;
 mod guidance;
 mod guidance_keep_out;
+mod synthetic_flight;
