@@ -63,6 +63,11 @@ impl SensedNavigation {
         &self.estimator
     }
 
+    /// The sensors, for the errors they drew.
+    pub fn sensors(&self) -> &SensorSuite {
+        &self.sensors
+    }
+
     /// Samples the sensors on `truth` and hands the estimator every measurement that has
     /// reached it by `truth.time_s`; returns those measurements, in arrival order (the drone
     /// also sends them to the station). Any truth will do: the simulated drone's stages
@@ -91,12 +96,34 @@ impl Navigator for SensedNavigation {
         self.sense(&Truth::from_model(model, time_s, x));
         self.estimator.estimate(time_s)
     }
+
+    fn sensor_errors(&self) -> Option<SensorErrors> {
+        Some(SensorErrors {
+            heading_bias_rad: self.sensors.ahrs_bias_rad().z,
+            pitot_scale: self.sensors.pitot_airspeed_scale(),
+        })
+    }
+}
+
+/// The errors of the drone's sensors that the estimator learns, as drawn for a flight: what
+/// its estimates of them are held against.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SensorErrors {
+    /// The AHRS's heading bias now (its yaw minus the true yaw), rad.
+    pub heading_bias_rad: f64,
+    /// The pitot's airspeed scale (its airspeed over the true one along the x axis).
+    pub pitot_scale: f64,
 }
 
 /// Produces the estimate guidance flies on.
 pub trait Navigator {
     /// The estimate at `time_s`, given the true state (from which sensors measure).
     fn navigate(&mut self, model: &ParafoilModel, time_s: f64, x: &StateVector) -> Estimate;
+
+    /// The sensor errors the estimate should find, where there are sensors.
+    fn sensor_errors(&self) -> Option<SensorErrors> {
+        None
+    }
 }
 
 /// The estimate read straight from the simulator's truth. Never used by scenarios or the Monte

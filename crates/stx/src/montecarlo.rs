@@ -395,6 +395,14 @@ fn print_table(r: &MonteCarloReport) {
         r.wind_estimate_rmse_per_run_mps.max
     );
     println!(
+        "learnt at touchdown, error: AHRS heading bias median {:.1}°, 95th percentile {:.1}°; \
+         pitot scale median {:.3}, 95th percentile {:.3}",
+        r.heading_bias_error_deg.median,
+        r.heading_bias_error_deg.p95,
+        r.pitot_scale_error.median,
+        r.pitot_scale_error.p95
+    );
+    println!(
         "payload miss where guidance found the target within reach ({} runs): median {:.1} m, \
          95th percentile {:.1} m, worst {:.1} m",
         r.runs - r.unreachable_runs,

@@ -41,8 +41,8 @@ pub use report::{
     into_wind_fraction,
 };
 pub use run::{
-    CALM_WIND_MPS, RunConditions, RunResult, TrackPoint, conditions, run_one, steady_glide_state,
-    wind_field, wind_shape,
+    CALM_WIND_MPS, RunConditions, RunResult, SensorsLearned, TrackPoint, conditions, run_one,
+    steady_glide_state, wind_field, wind_shape,
 };
 pub use shard::{CampaignPart, MergeError, merge};
 pub use zones::{WIND_BIN_MPS, ZoneCount, ZoneLanding, ZoneLandings};

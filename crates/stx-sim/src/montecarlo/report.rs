@@ -6,7 +6,7 @@ use stx_gnc::stats::percentile;
 
 use super::config::MonteCarloConfig;
 use super::growth::MissGrowth;
-use super::run::{RunConditions, RunResult};
+use super::run::{RunConditions, RunResult, SensorsLearned};
 use super::zones::ZoneLandings;
 use crate::dispersions::Dispersions;
 
@@ -182,6 +182,11 @@ pub struct MonteCarloReport {
     pub wind_estimate_rmse_mps: f64,
     /// Per-run wind-estimate RMS errors, m/s.
     pub wind_estimate_rmse_per_run_mps: Stats,
+    /// The estimator's AHRS heading bias at touchdown less the truth, size of, over the runs
+    /// flown with sensors, degrees.
+    pub heading_bias_error_deg: Stats,
+    /// The estimator's pitot scale at touchdown less the truth, size of, over the same runs.
+    pub pitot_scale_error: Stats,
     /// The payload's miss over the runs guidance found the target within reach (failed runs
     /// count among them, as [`Self::miss_m`] says), m.
     pub reachable_payload_miss_m: Stats,
@@ -233,6 +238,13 @@ impl MonteCarloReport {
             0.0
         } else {
             (wind_errors.iter().map(|e| e * e).sum::<f64>() / wind_errors.len() as f64).sqrt()
+        };
+        let learned = |f: fn(&SensorsLearned) -> f64| {
+            let values: Vec<f64> = results
+                .iter()
+                .filter_map(|r| r.sensors_learned.as_ref().map(|s| f(s).abs()))
+                .collect();
+            Stats::of(&values)
         };
         let mut by_miss: Vec<&RunResult> = results.iter().collect();
         by_miss.sort_by(|a, b| b.miss_m.total_cmp(&a.miss_m).then(a.index.cmp(&b.index)));
@@ -286,6 +298,8 @@ impl MonteCarloReport {
             touchdown_vertical_speed_mps: of_landings(|r| r.touchdown_vertical_speed_mps),
             wind_estimate_rmse_mps: pooled,
             wind_estimate_rmse_per_run_mps: Stats::of(&wind_errors),
+            heading_bias_error_deg: learned(|s| s.heading_bias_error_deg()),
+            pitot_scale_error: learned(|s| s.pitot_scale_error()),
             reachable_payload_miss_m: Stats::of(
                 &results
                     .iter()
@@ -357,6 +371,7 @@ mod tests {
             payload_zone: None,
             payload_after_first_contact_s: 2.0,
             wind_estimate_rmse_mps: 0.2,
+            sensors_learned: None,
             unreachable: false,
             best_reachable_ne_m: None,
             from_best_reachable_m: None,

@@ -17,13 +17,14 @@ use stx_dynamics::vehicle::Vehicle;
 use stx_dynamics::wind::{
     ProfileRow, Turbulence, TurbulenceParams, WindComposite, WindField, WindProfile,
 };
+use stx_gnc::estimate::Estimate;
 use stx_gnc::guidance::{Guidance, LearnedPolar, PhaseEvent, Plan};
 use stx_gnc::mission::{FlightMode, GuidancePhase};
 
 use super::config::MonteCarloConfig;
 use super::growth::{MissGrowth, PhaseSnapshots};
 use crate::anemometer::{Anemometer, AnemometerConfig};
-use crate::closed_loop::{GuidedFlight, Navigator};
+use crate::closed_loop::{GuidedFlight, Navigator, SensorErrors};
 use crate::dispersions::{DispersedFlight, DrawSummary, WindShape};
 use crate::guided::{CONTROL_PERIOD_S, STEP_S};
 use crate::sensors::SensorConfig;
@@ -86,6 +87,10 @@ pub struct RunResult {
     pub payload_after_first_contact_s: f64,
     /// RMS of the horizontal wind-estimate error from 30 s after release on, m/s.
     pub wind_estimate_rmse_mps: f64,
+    /// What the estimator had learnt of the sensors by the touchdown, beside the truth (runs
+    /// flown with sensors).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sensors_learned: Option<SensorsLearned>,
     /// Guidance found the target out of reach at some point.
     pub unreachable: bool,
     /// The best reachable point (north, east, m) guidance announced when it first called the
@@ -115,6 +120,42 @@ pub struct RunResult {
     /// The flight every second (kept only when one run is replayed).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub track: Vec<TrackPoint>,
+}
+
+/// The sensor errors the estimator learns, as it had them at the touchdown beside the truth.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct SensorsLearned {
+    /// The AHRS's heading bias: the truth, the estimate and the estimate's 1-σ, degrees.
+    pub heading_bias_deg: [f64; 3],
+    /// The pitot's airspeed scale: the truth, the estimate and the estimate's 1-σ.
+    pub pitot_scale: [f64; 3],
+}
+
+impl SensorsLearned {
+    fn of(truth: SensorErrors, estimate: &Estimate) -> Self {
+        Self {
+            heading_bias_deg: [
+                truth.heading_bias_rad.to_degrees(),
+                estimate.heading_bias_rad.to_degrees(),
+                estimate.heading_bias_sigma_rad.to_degrees(),
+            ],
+            pitot_scale: [
+                truth.pitot_scale,
+                estimate.pitot_scale,
+                estimate.pitot_scale_sigma,
+            ],
+        }
+    }
+
+    /// The heading bias's estimate less the truth, degrees.
+    pub fn heading_bias_error_deg(&self) -> f64 {
+        self.heading_bias_deg[1] - self.heading_bias_deg[0]
+    }
+
+    /// The pitot scale's estimate less the truth.
+    pub fn pitot_scale_error(&self) -> f64 {
+        self.pitot_scale[1] - self.pitot_scale[0]
+    }
 }
 
 /// One second of a replayed run: truth and what guidance saw.
@@ -365,6 +406,12 @@ pub fn run_one<N: Navigator>(
             ));
         }
     };
+    // Before the payload's landing: the estimate of the first contact, as guidance last had it.
+    let sensors_learned = flight
+        .navigator
+        .sensor_errors()
+        .zip(flight.estimate.as_ref())
+        .map(|(truth, estimate)| SensorsLearned::of(truth, estimate));
     let payload = flight.land_payload(touchdown).map_err(with_draw)?;
     let payload_miss_m = payload.position_ne_m[0].hypot(payload.position_ne_m[1]);
     let miss_grew = snapshots.where_miss_grew(
@@ -408,6 +455,7 @@ pub fn run_one<N: Navigator>(
         } else {
             0.0
         },
+        sensors_learned,
         unreachable: !flight.best_reachable_announced.is_empty(),
         best_reachable_ne_m: first_announced,
         from_best_reachable_m: first_announced.map(from_touchdown),

@@ -369,6 +369,13 @@ impl SensorSuite {
         Vector3::from(self.ahrs.bias_rad)
     }
 
+    /// This run's pitot airspeed scale: the differential pressure reads `(1 + k)·q`, so the
+    /// airspeed derived from it reads `√(1 + k)` times the true one (what the estimator's
+    /// pitot scale should find).
+    pub fn pitot_airspeed_scale(&self) -> f64 {
+        self.pitot.differential_scale.sqrt()
+    }
+
     /// This run's differential-pressure offset, Pa.
     pub fn differential_offset_pa(&self) -> f64 {
         self.pitot.differential_offset_pa
