@@ -360,9 +360,11 @@ pub(crate) struct Tuning {
     pub gps_min_horizontal_m: f64,
     pub gps_min_vertical_m: f64,
     pub gps_min_speed_mps: f64,
-    /// Initial variances.
+    /// Initial values and variances.
     pub initial_wind_variance: f64,
+    pub initial_scale: f64,
     pub initial_scale_variance: f64,
+    pub initial_heading_bias_rad: f64,
     pub initial_baro_variance: f64,
     /// Largest normalised innovation squared accepted for 1, 2 and 3 dimensions.
     pub gate_nis: [f64; 3],
@@ -410,7 +412,9 @@ impl Tuning {
             gps_min_vertical_m: c.gps_min_vertical_accuracy_m,
             gps_min_speed_mps: c.gps_min_speed_accuracy_mps,
             initial_wind_variance: c.initial_wind_sigma_mps.powi(2),
+            initial_scale: 1.0,
             initial_scale_variance: c.initial_pitot_scale_sigma.powi(2),
+            initial_heading_bias_rad: 0.0,
             initial_baro_variance: c.initial_baro_bias_sigma.powi(2),
             gate_nis: [1, 2, 3].map(|dof| chi_square_quantile(dof, z)),
             reset_after_rejections: c.reset_after_rejections,

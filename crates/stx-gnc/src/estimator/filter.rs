@@ -14,7 +14,7 @@ use nalgebra::Vector3;
 use super::angle::AngleFilter;
 use super::baro::{Barometer, air_density};
 use super::config::Tuning;
-use super::ekf::{Nav, Outcome};
+use super::ekf::{Nav, Outcome, ix};
 use super::gps::GpsGate;
 use super::pitot::{Pitot, attitude_at};
 use super::readout::read_nav;
@@ -70,6 +70,15 @@ impl NavFilter {
             straight: StraightFlight::new(),
             density: None,
         }
+    }
+
+    /// What the navigation state has learnt of the sensors, each as (value, variance): the
+    /// pitot's scale and the AHRS's heading bias; `None` before it started.
+    pub fn calibration(&self) -> Option<((f64, f64), (f64, f64))> {
+        self.nav.as_ref().map(|n| {
+            let kept = |i: usize| (n.x[i], n.p[(i, i)]);
+            (kept(ix::SCALE), kept(ix::HEADING_BIAS))
+        })
     }
 
     /// Instant of the latest AHRS sample applied, s (−∞ before the first).

@@ -116,8 +116,8 @@ impl GpsGate {
                 Vector2::zeros(),
                 t.initial_wind_variance,
                 Calibration {
-                    scale: (1.0, t.initial_scale_variance),
-                    heading_bias: (0.0, t.initial_heading_bias_variance),
+                    scale: (t.initial_scale, t.initial_scale_variance),
+                    heading_bias: (t.initial_heading_bias_rad, t.initial_heading_bias_variance),
                 },
                 t,
             );

@@ -2,7 +2,6 @@
 //! balloon's end, the deployment, the landing) and what it tells the operator.
 
 use nalgebra::Vector3;
-use stx_gnc::estimator::Estimator;
 use stx_gnc::guidance::PhaseEvent;
 use stx_link::telemetry::Severity;
 
@@ -74,11 +73,10 @@ impl Drone {
                 heading_rad,
             } => {
                 self.deployment = Some((now, height_m));
-                // Guidance starts from a filter that has only seen the parafoil fly.
-                if let Ok(e) = Estimator::new(self.config.estimator.clone()) {
-                    self.estimator = e;
-                    self.estimate = None;
-                }
+                // Guidance starts from a filter that has only seen the parafoil fly, with what
+                // was learnt of the sensors kept.
+                self.estimator = self.estimator.restarted();
+                self.estimate = None;
                 (
                     Severity::Notice,
                     format!(

@@ -36,7 +36,7 @@ use stx_gnc::params::{OnboardSettings, find};
 use stx_link::telemetry::VehicleStatus;
 
 use super::StationCore;
-use super::navigation::{Stamp, new_estimator};
+use super::navigation::Stamp;
 use crate::messages::Level;
 
 /// The drone's control period in its clock's unit (ms).
@@ -147,7 +147,7 @@ impl StationCore {
         }
         if stage == FlightStage::ParafoilDeploy && previous.is_some() {
             // As the drone does when its round chute is released.
-            self.estimator = new_estimator(self.frame.alt_msl_m);
+            self.estimator = self.estimator.restarted();
             self.estimate = None;
             self.guided_at_s = None;
         }
