@@ -48,7 +48,13 @@ fn a_pattern_laid_on_an_unsettled_wind_is_turned_fully_once_the_wind_is_known() 
 /// Regression (seed 12 run 726, wind 3.7 m/s from 263°, released 300 m downwind): out of
 /// reach, guidance flew to the best reachable point moved clear of the road (35–47 m E of the
 /// target) to 68 m E, arrived over it 70 m up, glided on into the wind and put the capsule on
-/// the road 40 m E. The way to a moved point now brakes to the glide that ends on it.
+/// the road 40 m E; the way to a moved point now brakes to the glide that ends on it. Since
+/// 2026-11-30, with the heading bias learned, the clear stretch east of the road had two
+/// candidates, 3 m apart in miss and 31 m apart on the ground; the wind estimate's jitter
+/// swapped them every update, the stack flew between them and its capsule came down 30.5 m
+/// from the point announced. The point chosen is now held while it stays reachable and clear,
+/// and a point that moved 20 m is announced again: one move, announced at 98 m, and the
+/// capsule 14.8 m from it.
 #[test]
 fn the_way_to_a_best_point_moved_clear_of_a_zone_ends_on_it() {
     let run = fly(12, 726);
@@ -57,6 +63,12 @@ fn the_way_to_a_best_point_moved_clear_of_a_zone_ends_on_it() {
         .last_best_reachable_ne_m
         .expect("a best reachable point");
     assert_eq!(run.payload_zone, None, "was on the road");
+    let moves = run
+        .events
+        .iter()
+        .filter(|e| e.reason.starts_with("best reachable point moved"))
+        .count();
+    assert!(moves <= 1, "the point swapped sides {moves} times");
     let [n, e] = run.payload_touchdown_ne_m;
     let from_best = (n - best[0]).hypot(e - best[1]);
     assert!(

@@ -171,6 +171,8 @@ pub struct Spiral {
     keep_out: KeepOutZones,
     /// The final-approach course chosen to keep clear of them.
     clear_approach: keep_clear::ClearApproach,
+    /// The best reachable point moved clear of them.
+    clear_point: keep_clear::ClearPoint,
     /// Notes for the operator on keep-out choices since the last [`Spiral::take_notes`].
     notes: Vec<String>,
 }
@@ -194,6 +196,7 @@ impl Spiral {
             status: SpiralStatus::default(),
             keep_out: KeepOutZones::default(),
             clear_approach: keep_clear::ClearApproach::default(),
+            clear_point: keep_clear::ClearPoint::default(),
             notes: Vec::new(),
         }
     }
@@ -414,7 +417,7 @@ impl Spiral {
         );
         let mut reach = reach;
         if !self.keep_out.zones.is_empty()
-            && let Some(best) = keep_clear::best_clear_rel(&self.keep_out, target_ne, &reach)
+            && let Some(best) = self.clear_point.best(&self.keep_out, target_ne, &reach)
         {
             reach.move_best(best);
         }
