@@ -129,3 +129,44 @@ fn in_straight_flight_the_heading_bias_stays_unknown_and_the_estimate_says_so() 
         );
     }
 }
+
+/// A restart for a new flight phase (the parafoil after the round chute) starts air and wind
+/// afresh but keeps the heading bias and pitot scale learnt, with their uncertainty: learnt in
+/// the turns before, they would otherwise be lost to the straight flight after, where they do
+/// not show (and the station's replica, restarting later than the drone, would learn them
+/// differently).
+#[test]
+fn a_restart_keeps_what_was_learnt_of_the_sensors() {
+    let drone = swinging_drone(6.0, 0.95);
+    let pieces = pattern(&drone, &square_pattern(10));
+    let mut learnt = estimator();
+    feed(&mut learnt, &pattern_deliveries(&pieces, USUAL));
+    let before = learnt.estimate(f64::INFINITY);
+    let mut restarted = learnt.restarted();
+    let mut fresh = estimator();
+    let straight = deliveries(&drone, 0.0, 30.0, USUAL, |_| true);
+    let (_, kept) = feed(&mut restarted, &straight).pop().expect("estimates");
+    let (_, lost) = feed(&mut fresh, &straight).pop().expect("estimates");
+    let deg = f64::to_degrees;
+    assert!(
+        (deg(kept.heading_bias_rad) - 6.0).abs() < 1.5
+            && kept.heading_bias_sigma_rad < 1.2 * before.heading_bias_sigma_rad,
+        "bias {:.2}° ± {:.2}° (before the restart {:.2}° ± {:.2}°)",
+        deg(kept.heading_bias_rad),
+        deg(kept.heading_bias_sigma_rad),
+        deg(before.heading_bias_rad),
+        deg(before.heading_bias_sigma_rad)
+    );
+    assert!(
+        (kept.pitot_scale - 0.95).abs() < 0.01,
+        "{}",
+        kept.pitot_scale
+    );
+    assert!(
+        lost.heading_bias_sigma_rad > 2.0 * kept.heading_bias_sigma_rad,
+        "a fresh start knows {:.2}°",
+        deg(lost.heading_bias_sigma_rad)
+    );
+    // Air and wind are the new phase's own: the restarted filter counts as new.
+    assert_eq!(restarted.counters(), fresh.counters());
+}
