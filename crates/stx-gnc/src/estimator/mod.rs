@@ -355,7 +355,12 @@ impl Estimator {
             attitude_s: config.attitude_timeout_s,
             air_data_s: config.air_data_timeout_s,
         };
-        Ok(Self {
+        Ok(Self::unstarted(config, tuning, timeouts))
+    }
+
+    /// An estimator with this configuration and tuning that has seen nothing.
+    fn unstarted(config: EstimatorConfig, tuning: Tuning, timeouts: Timeouts) -> Self {
+        Self {
             config,
             tuning,
             timeouts,
@@ -364,7 +369,7 @@ impl Estimator {
             latest_arrival_s: f64::NEG_INFINITY,
             committed_time_s: f64::NEG_INFINITY,
             counters: EstimatorCounters::default(),
-        })
+        }
     }
 
     /// A fresh estimator that starts from what this one has learnt of the sensors (the pitot's
@@ -375,24 +380,15 @@ impl Estimator {
     /// first swinging seconds that place the heading bias, and its wind parted from the
     /// drone's by 0.7° of direction for the whole flight (agreement campaign, seed 1).
     pub fn restarted(&self) -> Self {
-        let nav = self.head();
-        let mut fresh = self.clone();
-        fresh.committed = NavFilter::new();
-        fresh.pending.clear();
-        fresh.latest_arrival_s = f64::NEG_INFINITY;
-        fresh.committed_time_s = f64::NEG_INFINITY;
-        fresh.counters = EstimatorCounters::default();
-        if let Some((scale, bias)) = nav.calibration() {
+        let mut tuning = self.tuning;
+        if let Some((scale, bias)) = self.head().calibration() {
+            (tuning.initial_scale, tuning.initial_scale_variance) = scale;
             (
-                fresh.tuning.initial_scale,
-                fresh.tuning.initial_scale_variance,
-            ) = scale;
-            (
-                fresh.tuning.initial_heading_bias_rad,
-                fresh.tuning.initial_heading_bias_variance,
+                tuning.initial_heading_bias_rad,
+                tuning.initial_heading_bias_variance,
             ) = bias;
         }
-        fresh
+        Self::unstarted(self.config.clone(), tuning, self.timeouts)
     }
 
     /// The configuration in use.
