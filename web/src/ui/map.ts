@@ -32,6 +32,8 @@ const twoPoints = (latlngs: unknown[]): boolean => {
   return false;
 };
 const MAX_TRACK = 20_000;
+/** Half the largest marker drawn on key geometry (the vehicle's 40 px icon), px. */
+const MARKER_HALF_PX = 20;
 /** Failed tiles (and none loaded) after which the tile layer is dropped for the grid alone. */
 const GIVE_UP_AFTER_FAILED_TILES = 6;
 
@@ -103,7 +105,7 @@ export class MapView {
     this.target = L.marker(ll(this.origin), { icon: icon("mk-target", targetIcon(), 34, "map-target"), keyboard: false, interactive: false });
     this.planned = L.marker(ll(this.origin), { icon: icon("mk-planned", dotIcon(ELLIPSE_PLANNED.color!), 18, "map-pred-planned"), interactive: false });
     this.uncontrolled = L.marker(ll(this.origin), { icon: icon("mk-uncontrolled", dotIcon(ELLIPSE_UNCONTROLLED.color!), 18, "map-pred-uncontrolled"), interactive: false });
-    this.vehicle = L.marker(ll(this.origin), { icon: icon("mk-vehicle", vehicleIcon(), 40, "map-vehicle"), zIndexOffset: 1000, interactive: false });
+    this.vehicle = L.marker(ll(this.origin), { icon: icon("mk-vehicle", vehicleIcon(), 2 * MARKER_HALF_PX, "map-vehicle"), zIndexOffset: 1000, interactive: false });
     this.draftTarget = L.marker(ll(this.origin), { icon: icon("mk-draft", targetIcon(), 34, "map-draft-target"), interactive: false, opacity: 0.6 });
     this.zones = new ZoneEditor(this.map, { save: saveZones, onEditing: (on) => on && this.setFollow(false) });
     this.flightPath = new FlightPathLayer(this.map);
@@ -131,6 +133,8 @@ export class MapView {
     // The legend under the map grows and shrinks as symbols come and go, and the map with it:
     // Leaflet must measure its box again, or it frames and clips to the old one.
     new ResizeObserver(() => this.invalidate()).observe(el);
+    // A badge that appears or wraps to a new row deepens the strip between two states.
+    new ResizeObserver(() => this.keepInView()).observe(overlay);
 
     this.map.on("moveend zoomend", () => this.noteView());
     this.map.on("click", (e: L.LeafletMouseEvent) => {
@@ -150,25 +154,48 @@ export class MapView {
     if (on && this.lastWant) this.frame(this.lastWant);
   }
 
+  /**
+   * Where the badge strip ends, px from the map's top. The strip sits 8 px below the edge
+   * (live.css), so its height alone would leave the geometry just under its last row.
+   */
+  private badgesBottom(): number {
+    return this.overlay.offsetTop + this.overlay.offsetHeight;
+  }
+
   private frame(want: Box): void {
     const size = this.map.getSize();
     if (size.x === 0 || size.y === 0) return; // not laid out yet: Leaflet would zoom to the limit
     this.framing = true;
     try {
-      // The badges run along the top edge: keep the key geometry below them.
-      const top = this.overlay.offsetHeight + 24;
-      this.map.fitBounds([[want.south, want.west], [want.north, want.east]], { paddingTopLeft: [36, top], paddingBottomRight: [36, 36], maxZoom: 18, animate: false });
+      // The badges run along the top edge: keep the key geometry, markers and all, below them.
+      const top = this.badgesBottom() + MARKER_HALF_PX + 8;
+      const side = MARKER_HALF_PX + 16;
+      this.map.fitBounds([[want.south, want.west], [want.north, want.east]], { paddingTopLeft: [side, top], paddingBottomRight: [side, side], maxZoom: 18, animate: false });
     } finally {
       this.framing = false;
     }
   }
 
-  /** The part of the view below the badge strip, where key geometry must stay. */
+  /**
+   * The part of the view where a key point's marker is whole and clear of the badge strip: the
+   * strip and half the largest marker are cut off each edge. Framing again is decided on this box
+   * (lib/framing.ts), so a vehicle flying towards the badges is re-framed before they cover it.
+   */
   private viewBox(): Box {
     const size = this.map.getSize();
-    const nw = this.map.containerPointToLatLng([0, Math.min(size.y - 1, this.overlay.offsetHeight + 8)]);
-    const se = this.map.containerPointToLatLng([size.x, size.y]);
+    const top = Math.min(size.y - 1, this.badgesBottom() + MARKER_HALF_PX);
+    const bottom = Math.max(top + 1, size.y - MARKER_HALF_PX);
+    const left = Math.min(MARKER_HALF_PX, size.x / 2 - 1);
+    const right = Math.max(left + 1, size.x - MARKER_HALF_PX);
+    const nw = this.map.containerPointToLatLng([left, top]);
+    const se = this.map.containerPointToLatLng([right, bottom]);
     return { south: se.lat, west: nw.lng, north: nw.lat, east: se.lng };
+  }
+
+  /** Frames the key points again if following and they are at an edge, under the badges or out of view. */
+  private keepInView(): void {
+    if (this.follow && this.lastWant && this.map.getSize().x > 0 && needsFraming(this.viewBox(), this.lastWant)) this.frame(this.lastWant);
+    this.noteView();
   }
 
   /** Leaflet measures its container: call once the element is in the document and when it resizes. */
@@ -180,7 +207,7 @@ export class MapView {
       this.framing = false;
     }
     this.grid.draw();
-    this.noteView();
+    this.keepInView();
   }
 
   setPicker(p: Picker): void {
@@ -295,8 +322,7 @@ export class MapView {
       setText(this.windText, `wind ${fmt(e.wind_speed_mps, "m/s")} from ${fmtDir(e.wind_from_deg)}`);
     } else setText(this.windText, "wind —");
     this.lastWant = boxAround(keyPoints(s));
-    if (this.follow && this.lastWant && needsFraming(this.viewBox(), this.lastWant)) this.frame(this.lastWant);
-    this.noteView();
+    this.keepInView();
     this.showLegend();
   }
 

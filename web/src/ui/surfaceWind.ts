@@ -52,6 +52,8 @@ export class SurfaceWindBlock {
   private readonly err = h("div", { class: "form-error", role: "alert", "data-testid": "surface-wind-error" });
   private latest: SurfaceWind | null = null;
   private busy = false;
+  /** States shown from the stream, counted: an answer to a request must not hide a newer one. */
+  private updates = 0;
 
   constructor(private readonly actions: SurfaceWindActions | null) {
     const input = (testid: string, aria: string, placeholder: string): HTMLInputElement =>
@@ -73,11 +75,16 @@ export class SurfaceWindBlock {
     this.toggle.setAttribute("aria-expanded", "false");
     this.toggle.addEventListener("click", () => this.open(this.form.hidden));
     this.root = h("div", { class: "sw", "data-testid": "surface-wind" }, this.wind.root, this.drone.root, this.mast.root, this.form);
-    this.update(null);
+    this.show(null);
     if (actions === null) this.toggle.hidden = true;
   }
 
   update(sw: SurfaceWind | null): void {
+    this.updates += 1;
+    this.show(sw);
+  }
+
+  private show(sw: SurfaceWind | null): void {
     this.latest = sw;
     const shown = surfaceWindShown(sw);
     show(this.wind, shown.wind);
@@ -119,10 +126,13 @@ export class SurfaceWindBlock {
     }
     // One request at a time: a double click must not send the wind twice.
     this.busy = true;
+    const updatesBefore = this.updates;
     try {
       const view = await request();
       setText(this.err, "");
-      if (view !== null) this.update(view);
+      // The answer is the station's view when it took the request. A state streamed since is
+      // newer (in a rehearsal the drone can accept before the answer arrives): keep that.
+      if (view !== null && this.updates === updatesBefore) this.show(view);
       if (what === "clear") this.speed.value = this.from.value = "";
       this.open(false);
     } catch (e) {
