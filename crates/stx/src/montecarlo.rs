@@ -378,11 +378,13 @@ fn print_table(r: &MonteCarloReport) {
     );
     println!(
         "into the wind (within 30°): {:.1} % of touchdowns ({} in calm air, below 0.5 m/s, count \
-         as into the wind; judged like the others: {:.1} %; of the others alone: {:.1} %)",
+         as into the wind; judged like the others: {:.1} %; of the others alone: {:.1} %, or \
+         {:.1} % against their mean surface wind, gusts left out)",
         100.0 * r.into_wind_fraction,
         r.calm_runs,
         100.0 * r.into_wind_fraction_strict,
-        100.0 * r.into_wind_fraction_non_calm
+        100.0 * r.into_wind_fraction_non_calm,
+        100.0 * r.into_surface_wind_fraction_non_calm
     );
     println!(
         "touchdown vertical speed: median {:.2} m/s, 95th percentile {:.2} m/s",

@@ -172,8 +172,12 @@ pub struct MonteCarloReport {
     /// The same share with calm runs judged like the others, against the instantaneous wind
     /// (gusts included) where they touched down.
     pub into_wind_fraction_strict: f64,
-    /// The share among the runs not in calm air alone (the goal's figure).
+    /// The share among the runs not in calm air alone (the goal's figure), against the
+    /// instantaneous wind (gusts included) where they touched down.
     pub into_wind_fraction_non_calm: f64,
+    /// The share among the runs not in calm air within 30° of the surface wind: the mean wind
+    /// at the touchdown (gusts left out), as a windsock or weather report gives it.
+    pub into_surface_wind_fraction_non_calm: f64,
     /// Runs that touched down in calm air (mean wind below [`CALM_WIND_MPS`]).
     pub calm_runs: usize,
     /// Vertical speed at touchdown, m/s.
@@ -294,6 +298,9 @@ impl MonteCarloReport {
                     .collect::<Vec<_>>(),
                 false,
             ),
+            into_surface_wind_fraction_non_calm: share(results.iter().filter(|r| !r.calm), |r| {
+                r.heading_vs_surface_wind_deg.abs() <= INTO_WIND_DEG
+            }),
             calm_runs: results.iter().filter(|r| r.calm).count(),
             touchdown_vertical_speed_mps: of_landings(|r| r.touchdown_vertical_speed_mps),
             wind_estimate_rmse_mps: pooled,
@@ -342,6 +349,16 @@ pub fn into_wind_fraction(results: &[RunResult], calm_counts: bool) -> f64 {
     into_wind as f64 / results.len() as f64
 }
 
+/// Share of `runs` for which `holds`; 0 of none.
+fn share<'a>(runs: impl Iterator<Item = &'a RunResult>, holds: impl Fn(&RunResult) -> bool) -> f64 {
+    let (mut n, mut yes) = (0usize, 0usize);
+    for r in runs {
+        n += 1;
+        yes += usize::from(holds(r));
+    }
+    if n == 0 { 0.0 } else { yes as f64 / n as f64 }
+}
+
 /// How many of the worst runs a report names.
 pub const WORST_RUNS: usize = 5;
 
@@ -361,6 +378,7 @@ mod tests {
             ),
             miss_m: 1.0,
             heading_vs_upwind_deg,
+            heading_vs_surface_wind_deg: heading_vs_upwind_deg,
             calm,
             touchdown_vertical_speed_mps: 2.5,
             payload_miss_m: 1.0,
@@ -476,6 +494,36 @@ mod tests {
         ];
         assert_eq!(into_wind_fraction(&runs, true), 0.5);
         assert_eq!(into_wind_fraction(&runs, false), 0.5);
+    }
+
+    #[test]
+    fn the_surface_wind_share_judges_the_non_calm_runs_against_the_mean_wind_not_the_gust() {
+        // Into a gust but 40° off the mean wind, and the other way round; calm runs left out.
+        let run = |gust: f64, mean: f64, calm: bool| RunResult {
+            heading_vs_surface_wind_deg: mean,
+            ..landed(gust, calm)
+        };
+        let runs = vec![
+            run(10.0, 40.0, false),
+            run(40.0, 10.0, false),
+            run(5.0, 5.0, false),
+            run(170.0, 170.0, true),
+        ];
+        let report = MonteCarloReport::assemble(
+            CampaignHeader::of(&MonteCarloConfig::default()),
+            runs,
+            Vec::new(),
+            0.0,
+        );
+        assert_eq!(report.into_surface_wind_fraction_non_calm, 2.0 / 3.0);
+        assert_eq!(report.into_wind_fraction_non_calm, 2.0 / 3.0);
+        let gusty_only = [run(10.0, 40.0, false), run(5.0, 5.0, false)];
+        assert_eq!(
+            share(gusty_only.iter(), |r| r.heading_vs_surface_wind_deg.abs()
+                <= INTO_WIND_DEG),
+            0.5
+        );
+        assert_eq!(share([].iter(), |_| true), 0.0);
     }
 
     #[test]

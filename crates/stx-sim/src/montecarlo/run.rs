@@ -59,6 +59,10 @@ pub struct RunResult {
     pub miss_m: f64,
     /// Canopy heading at touchdown minus the upwind direction, degrees.
     pub heading_vs_upwind_deg: f64,
+    /// Canopy heading at touchdown minus where the surface wind comes from, degrees: the mean
+    /// wind at the touchdown (shear, veer and the low-level turn, gusts left out), as a
+    /// windsock or a weather report gives it; 0 in calm air.
+    pub heading_vs_surface_wind_deg: f64,
     /// The mean wind where the stack touched down (gusts left out) was below
     /// [`CALM_WIND_MPS`]: there is no upwind to land into.
     pub calm: bool,
@@ -428,6 +432,13 @@ pub fn run_one<N: Navigator>(
         touchdown.time_s,
         &Vector3::new(touchdown.position_ne_m[0], touchdown.position_ne_m[1], 0.0),
     );
+    let heading_vs_surface_wind = if mean_wind_at_touchdown.x.hypot(mean_wind_at_touchdown.y) > 1e-6
+    {
+        let upwind = (-mean_wind_at_touchdown.y).atan2(-mean_wind_at_touchdown.x);
+        wrap_pi(touchdown.heading_rad - upwind).to_degrees()
+    } else {
+        0.0
+    };
     let first_announced = flight.best_reachable_announced.first().map(|(_, ne)| *ne);
     let last_announced = flight.best_reachable_announced.last().map(|(_, ne)| *ne);
     let from_touchdown =
@@ -438,6 +449,7 @@ pub fn run_one<N: Navigator>(
         wind_shape: shape,
         miss_m: touchdown.position_ne_m[0].hypot(touchdown.position_ne_m[1]),
         heading_vs_upwind_deg: heading_vs_upwind,
+        heading_vs_surface_wind_deg: heading_vs_surface_wind,
         calm: mean_wind_at_touchdown.x.hypot(mean_wind_at_touchdown.y) < CALM_WIND_MPS,
         touchdown_vertical_speed_mps: touchdown.vertical_speed_mps,
         payload_miss_m,
