@@ -374,6 +374,7 @@ impl Spiral {
             pattern::Courses {
                 operator_rad: plan.approach_course_rad,
                 keep_clear_rad,
+                zones_in_force: !self.keep_out.zones.is_empty(),
             },
             &wind,
             sc,

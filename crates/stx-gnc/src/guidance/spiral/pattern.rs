@@ -21,6 +21,16 @@ pub(super) const BRANCHES: [GuidancePhase; 4] = [
 const LOOP_REORIENT_MAX_RAD: f64 = std::f64::consts::FRAC_PI_4;
 /// Largest turn of the final-approach course when turning final, rad (20°).
 const FINAL_REORIENT_MAX_RAD: f64 = 0.3491;
+/// On the final, the line may turn with the wind about the target by as much as moves the
+/// vehicle this far off it, m: the wind turns under a final laid 150–300 m up (the low-level
+/// turn), and a touchdown into the wind needs the line turned with it near the ground.
+const FINAL_FOLLOW_OFFSET_M: f64 = 10.0;
+/// Within this of the target the line's turn with the wind is held where the distance left
+/// it, m: close in, a small turn of the wind would swing the line across the vehicle.
+const FINAL_FOLLOW_HOLD_WITHIN_M: f64 = 30.0;
+/// Largest turn of the final's line with the wind, from its course at the turn onto it, rad
+/// (35°).
+const FINAL_FOLLOW_MAX_RAD: f64 = 0.6109;
 
 pub(super) fn branch_index(phase: GuidancePhase) -> Option<usize> {
     BRANCHES.iter().position(|b| *b == phase)
@@ -45,6 +55,9 @@ pub(super) struct Courses {
     /// The one keep-out zones ask for (see `keep_clear`): the axis turns towards it as it
     /// would towards the wind, within the same limits. The operator's wins over it.
     pub(super) keep_clear_rad: Option<f64>,
+    /// Keep-out zones are in force: the final's course was checked clear of them where it
+    /// was chosen, so it does not turn with the wind on the final.
+    pub(super) zones_in_force: bool,
 }
 
 /// The pattern's axis and half-length, held between the moments they may follow the wind.
@@ -56,6 +69,9 @@ pub(super) struct Axis {
     half_length_m: Option<f64>,
     /// Whether the axis was last placed on a wind the estimator had not yet settled on.
     placed_unsettled: bool,
+    /// The downwind direction chosen at the turn onto the final, rad: what the final's line
+    /// turns from as the wind turns under it.
+    final_entry_rad: Option<f64>,
 }
 
 impl Axis {
@@ -82,6 +98,7 @@ impl Axis {
         let Courses {
             operator_rad: approach_course_rad,
             keep_clear_rad,
+            zones_in_force,
         } = courses;
         let wind_speed = wind.speed_mps;
         let wind_known = wind.known;
@@ -114,8 +131,16 @@ impl Axis {
         let toward = keep_clear_rad
             .map(|course| wrap_pi(course + std::f64::consts::PI))
             .or_else(|| (wind_speed >= sc.calm_wind_mps).then(|| wind[1].atan2(wind[0])));
+        let on_final = phase == GuidancePhase::FinalApproach;
+        let asked_for = approach_course_rad.is_some() || keep_clear_rad.is_some() || zones_in_force;
+        let follow = if on_final && !reorient && !asked_for {
+            self.follow_on_final(toward, rel)
+        } else {
+            None
+        };
         let downwind = match (approach_course_rad, self.downwind_rad, toward) {
             (Some(course), _, _) => wrap_pi(course + std::f64::consts::PI),
+            _ if let Some(followed) = follow => followed,
             (None, Some(previous), None) => previous,
             (None, Some(previous), Some(_)) if frozen => previous,
             (None, Some(previous), Some(toward)) => {
@@ -126,10 +151,40 @@ impl Axis {
             (None, None, None) => rel[1].atan2(rel[0]),
         };
         self.downwind_rad = Some(downwind);
+        self.final_entry_rad = match (on_final, reorient) {
+            (false, _) => None,
+            (true, true) => Some(downwind),
+            (true, false) => self.final_entry_rad,
+        };
         if !frozen {
             self.placed_unsettled = !wind_known;
         }
         (downwind, frozen)
+    }
+
+    /// The final's line turned with the wind (`toward`, downwind, rad) about the target, the
+    /// vehicle at `rel` (north, east of it, m): by as much as moves the vehicle
+    /// [`FINAL_FOLLOW_OFFSET_M`] off the line, more as the target nears, up to
+    /// [`FINAL_FOLLOW_MAX_RAD`] from the course at the turn onto the final. `None` (the line
+    /// held) before that turn, in calm air and within [`FINAL_FOLLOW_HOLD_WITHIN_M`].
+    ///
+    /// Why: the final is laid into the wind 150–300 m up and the wind turns under it (by up to
+    /// 30° below 100 m in the realistic dispersions); held, the canopy met the ground up to 48°
+    /// off the wind (results/2026-12-01.md). Turning the line about the target keeps the
+    /// landing point and leaves the localizer a small offset to take out.
+    fn follow_on_final(&self, toward: Option<f64>, rel: [f64; 2]) -> Option<f64> {
+        let (entry, toward) = (self.final_entry_rad?, toward?);
+        let distance = rel[0].hypot(rel[1]);
+        if distance <= FINAL_FOLLOW_HOLD_WITHIN_M {
+            return None;
+        }
+        let largest = (FINAL_FOLLOW_OFFSET_M / distance)
+            .min(1.0)
+            .asin()
+            .min(FINAL_FOLLOW_MAX_RAD);
+        Some(wrap_pi(
+            entry + wrap_pi(toward - entry).clamp(-largest, largest),
+        ))
     }
 
     /// The pattern's half-length along the wind, m (see [the spiral](super): "branches scaled
@@ -320,6 +375,7 @@ mod tests {
         let no_courses = Courses {
             operator_rad: None,
             keep_clear_rad: None,
+            zones_in_force: false,
         };
         let wind = |from_deg: f64, known: bool| {
             let to = (from_deg + 180.0).to_radians();
@@ -369,6 +425,87 @@ mod tests {
                 deg(turned)
             );
         }
+    }
+
+    /// On the final the line turns with the wind about the target, more as the target nears
+    /// (the vehicle at most 10 m off the turned line), and is held within 30 m of it and for a
+    /// course the operator set.
+    #[test]
+    fn the_final_line_turns_with_the_wind_as_the_target_nears_and_is_held_close_in() {
+        let sc = SpiralConfig::default();
+        let courses = |operator_rad: Option<f64>, zones_in_force: bool| Courses {
+            operator_rad,
+            keep_clear_rad: None,
+            zones_in_force,
+        };
+        let wind = |from_deg: f64| {
+            let to = (from_deg + 180.0).to_radians();
+            let ne_mps = [3.0 * to.cos(), 3.0 * to.sin()];
+            WindNow {
+                measured_ne_mps: ne_mps,
+                ne_mps,
+                speed_mps: 3.0,
+                known: true,
+            }
+        };
+        let deg = |rad: f64| wrap_pi(rad).to_degrees();
+        let final_at = |operator_rad: Option<f64>| {
+            let mut axis = Axis::default();
+            // Turned onto the final into a wind from the south: downwind is north (0°), the
+            // vehicle north of the target.
+            let (entry, _) = axis.orient(
+                GuidancePhase::FinalApproach,
+                true,
+                courses(operator_rad, false),
+                &wind(180.0),
+                &sc,
+                [200.0, 0.0],
+            );
+            (axis, entry)
+        };
+        let (mut axis, entry) = final_at(None);
+        assert!(deg(entry).abs() < 1e-9);
+        // The wind turns 30° (from 210°: downwind 30°) as the vehicle comes in.
+        let mut at = |north_m: f64| {
+            let (downwind, _) = axis.orient(
+                GuidancePhase::FinalApproach,
+                false,
+                courses(None, false),
+                &wind(210.0),
+                &sc,
+                [north_m, 0.0],
+            );
+            deg(downwind)
+        };
+        let expect = |d: f64| (10.0 / d).asin().to_degrees();
+        assert!((at(200.0) - expect(200.0)).abs() < 1e-9);
+        assert!((at(40.0) - expect(40.0)).abs() < 1e-9);
+        // Within 30 m the line stays where it was.
+        assert!((at(25.0) - expect(40.0)).abs() < 1e-9);
+        // Far out it never turns further than the offset allows, whatever the wind did.
+        assert!(at(1000.0) < 0.6);
+        // A course the operator set is kept.
+        let (mut axis, _) = final_at(Some(std::f64::consts::PI));
+        let (held, _) = axis.orient(
+            GuidancePhase::FinalApproach,
+            false,
+            courses(Some(std::f64::consts::PI), false),
+            &wind(210.0),
+            &sc,
+            [40.0, 0.0],
+        );
+        assert!(deg(held).abs() < 1e-9);
+        // So is one checked clear of keep-out zones.
+        let (mut axis, _) = final_at(None);
+        let (held, _) = axis.orient(
+            GuidancePhase::FinalApproach,
+            false,
+            courses(None, true),
+            &wind(210.0),
+            &sc,
+            [40.0, 0.0],
+        );
+        assert!(deg(held).abs() < 1e-9);
     }
 
     fn spiral_turn_distance(config: &GuidanceConfig) -> f64 {
