@@ -135,12 +135,15 @@ async function wholeMission() {
   // The stage's start must fall between the clock of the last sample still showing the stage
   // before and that of the first showing it (the page's clock then, give or take 1 s, and the
   // few mission seconds telemetry takes to reach the page): whatever the sampling interval.
+  // The telemetry's way to the page is a wall-clock delay: at SPEED× it is SPEED times as many
+  // mission seconds (half a second of it on a loaded machine, at least 5 mission seconds).
+  const lagS = Math.max(5, 0.5 * SPEED);
   const clockChecks = ["round_chute", "parafoil"].map((stage) => {
     const i = samples.findIndex((s) => s.stage === stage.replace(/_/g, " "));
     const before = i > 0 ? clockSeconds(samples[i - 1].clock) : null;
     const at = i >= 0 ? clockSeconds(samples[i].clock) : null;
     const t = start(stage);
-    return { stage, truth: t, before, page: at, ok: at !== null && before !== null && t !== null && at >= t - 1 && before <= t + 5 };
+    return { stage, truth: t, before, page: at, ok: at !== null && before !== null && t !== null && at >= t - 1 && before <= t + lagS };
   });
   const ticking = samples.filter((s) => clockSeconds(s.clock) !== null && s.apiStage !== "landed");
   const a = ticking[0];
