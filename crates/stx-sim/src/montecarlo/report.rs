@@ -290,14 +290,9 @@ impl MonteCarloReport {
             }),
             into_wind_fraction: into_wind_fraction(&results, true),
             into_wind_fraction_strict: into_wind_fraction(&results, false),
-            into_wind_fraction_non_calm: into_wind_fraction(
-                &results
-                    .iter()
-                    .filter(|r| !r.calm)
-                    .cloned()
-                    .collect::<Vec<_>>(),
-                false,
-            ),
+            into_wind_fraction_non_calm: share(results.iter().filter(|r| !r.calm), |r| {
+                r.heading_vs_upwind_deg.abs() <= INTO_WIND_DEG
+            }),
             into_surface_wind_fraction_non_calm: share(results.iter().filter(|r| !r.calm), |r| {
                 r.heading_vs_surface_wind_deg.abs() <= INTO_WIND_DEG
             }),
@@ -339,14 +334,9 @@ pub const INTO_WIND_DEG: f64 = 30.0;
 /// Share of `results` that touched down into the wind (within [`INTO_WIND_DEG`] of upwind);
 /// with `calm_counts`, runs in calm air count as into the wind whatever their heading.
 pub fn into_wind_fraction(results: &[RunResult], calm_counts: bool) -> f64 {
-    if results.is_empty() {
-        return 0.0;
-    }
-    let into_wind = results
-        .iter()
-        .filter(|r| (calm_counts && r.calm) || r.heading_vs_upwind_deg.abs() <= INTO_WIND_DEG)
-        .count();
-    into_wind as f64 / results.len() as f64
+    share(results.iter(), |r| {
+        (calm_counts && r.calm) || r.heading_vs_upwind_deg.abs() <= INTO_WIND_DEG
+    })
 }
 
 /// Share of `runs` for which `holds`; 0 of none.

@@ -320,6 +320,18 @@ mod tests {
     use crate::pointmass::PointMass;
     use nalgebra::Vector3;
 
+    /// A planning wind of `speed_mps` from `from_deg`, as measured.
+    fn wind_from(speed_mps: f64, from_deg: f64, known: bool) -> WindNow {
+        let to = (from_deg + 180.0).to_radians();
+        let ne_mps = [speed_mps * to.cos(), speed_mps * to.sin()];
+        WindNow {
+            measured_ne_mps: ne_mps,
+            ne_mps,
+            speed_mps,
+            known,
+        }
+    }
+
     /// The branches along the wind shrink as the wind grows (seed §5.3, "scaling the branches
     /// length"): the upwind leg takes as long as in still air, down to a turn's length.
     #[test]
@@ -377,16 +389,7 @@ mod tests {
             keep_clear_rad: None,
             zones_in_force: false,
         };
-        let wind = |from_deg: f64, known: bool| {
-            let to = (from_deg + 180.0).to_radians();
-            let ne_mps = [3.9 * to.cos(), 3.9 * to.sin()];
-            WindNow {
-                measured_ne_mps: ne_mps,
-                ne_mps,
-                speed_mps: 3.9,
-                known,
-            }
-        };
+        let wind = |from_deg: f64, known: bool| wind_from(3.9, from_deg, known);
         let deg = |rad: f64| rad.to_degrees().rem_euclid(360.0);
         // Downwind of a wind from 188° is 8°; the first axis was laid for one from 57°.
         for (placed_known, expected_deg) in [(false, 8.0), (true, 237.0 + 45.0)] {
@@ -438,16 +441,7 @@ mod tests {
             keep_clear_rad: None,
             zones_in_force,
         };
-        let wind = |from_deg: f64| {
-            let to = (from_deg + 180.0).to_radians();
-            let ne_mps = [3.0 * to.cos(), 3.0 * to.sin()];
-            WindNow {
-                measured_ne_mps: ne_mps,
-                ne_mps,
-                speed_mps: 3.0,
-                known: true,
-            }
-        };
+        let wind = |from_deg: f64| wind_from(3.0, from_deg, true);
         let deg = |rad: f64| wrap_pi(rad).to_degrees();
         let final_at = |operator_rad: Option<f64>| {
             let mut axis = Axis::default();
