@@ -200,8 +200,11 @@ async function flight() {
       const zones = (await api("/api/keep-out")).body.zones;
       const ring = [[-250, -250], [-250, 250], [250, 250], [250, -250], [-250, -250]].map(([n, e]) => fromNorthEast(u, n, e)).map((q) => [q.lon_deg, q.lat_deg]);
       // Ours alone: a landing inside a shipped zone too is reported under that zone's name only.
+      // Timed when sent: the station raises the alarm as it takes the zone, and the page can
+      // say it before the PUT's answer is back here.
+      const sentAt = Date.now();
       const put = await api("/api/keep-out", OPERATOR, { method: "PUT", body: JSON.stringify({ ...zones, features: [{ type: "Feature", properties: { name: ZONE }, geometry: { type: "Polygon", coordinates: [ring] } }] }) });
-      zonePut = { at: Date.now(), status: put.status };
+      zonePut = { at: sentAt, status: put.status };
     }
     // The link back after its cut: the operator asks for manual without sticks, which the drone denies.
     if (!commanded && polls.some((q) => q.stale === true && q.stage === "ascent") && p.stale === false && p.stage !== "pre_launch") {
