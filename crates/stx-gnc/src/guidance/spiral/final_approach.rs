@@ -14,8 +14,17 @@ use crate::estimate::Estimate;
 use crate::guidance::config::GuidanceConfig;
 use crate::performance::GlidePerformance;
 
-/// Height above the steepest glide on final at which S-turns start, m.
-const S_TURN_EXCESS_M: f64 = 10.0;
+/// Height above the steepest glide on final at which S-turns start in light air, m. A few
+/// metres: there full brakes steepen the glide by only a seventh (1.75 against 2.04 in still
+/// air), so each metre of height they cannot take off lands nearly two metres long (10 m here
+/// left the long finals of the realistic Monte Carlo; the comparison is in GNC_NOTES.md).
+const S_TURN_EXCESS_M: f64 = 5.0;
+/// Headwind up to which S-turns start at [`S_TURN_EXCESS_M`], m/s.
+const S_TURN_LIGHT_WIND_MPS: f64 = 1.5;
+/// Height the S-turns' start rises by per m/s of headwind beyond that, m per m/s.
+const S_TURN_EXCESS_PER_WIND_M_PER_MPS: f64 = 3.5;
+/// Highest height above the full-brake glide at which S-turns start, m.
+const S_TURN_EXCESS_MAX_M: f64 = 10.0;
 /// S-turns swing this far either side of the final line, m.
 const S_TURN_HALF_WIDTH_M: f64 = 40.0;
 /// Course offset of an S-turn leg from the final course, rad (100°: slightly back downwind).
@@ -222,7 +231,7 @@ impl FinalApproach {
         // Horizontal: the final line; while far too high for even full brakes to
         // bring it down in time, S-turns across the line burn the height.
         self.last_brake = brake;
-        let weave = final_excess_m > S_TURN_EXCESS_M;
+        let weave = final_excess_m > s_turn_excess_m(w_along_measured);
         let main_line_m = if weave {
             let ct = final_line.cross_track_m(position);
             if ct > S_TURN_HALF_WIDTH_M {
@@ -287,7 +296,7 @@ impl FinalApproach {
             None => return,
         };
         let straight = est.heading_rate_rad_s.abs() < GLIDE_LEARN_MAX_TURN_RAD_S
-            && excess_m <= S_TURN_EXCESS_M
+            && excess_m <= s_turn_excess_m(headwind_mps)
             && est.sink_rate_mps > GLIDE_LEARN_MIN_SINK_MPS;
         if !straight || dt <= 0.0 {
             return;
@@ -301,6 +310,17 @@ impl FinalApproach {
             + gain * (flown - polar - self.glide_correction))
             .clamp(-GLIDE_CORRECTION_LIMIT, GLIDE_CORRECTION_LIMIT);
     }
+}
+
+/// Height above the steepest glide on final at which S-turns start in a headwind of
+/// `headwind_mps`, m. Into a strong wind full brakes have more say over the glide (a third of
+/// it at 4 m/s), and an S-turn's leg off the wind is blown back fast: from 5 m there, finals
+/// into 3–4 m/s were blown out of reach (seed 1, run 87: 4.5 → 139 m), and one S-turn at full
+/// brakes ended in a spiral dive (run 277).
+fn s_turn_excess_m(headwind_mps: f64) -> f64 {
+    (S_TURN_EXCESS_M
+        + S_TURN_EXCESS_PER_WIND_M_PER_MPS * (headwind_mps - S_TURN_LIGHT_WIND_MPS).max(0.0))
+    .min(S_TURN_EXCESS_MAX_M)
 }
 
 /// How far beyond the target the first contact is aimed along the final, m: the setting's
@@ -342,6 +362,8 @@ mod tests {
     use nalgebra::Vector3;
 
     use super::*;
+    use crate::guidance::spiral::energy::Energy;
+    use crate::guidance::spiral::pattern::WindFrame;
     use crate::pointmass::{Conditions, PointMass};
 
     /// A point mass flown straight up the final (north, into a 3.5 m/s north wind) at a fixed
@@ -369,6 +391,67 @@ mod tests {
             fa.learn_glide(&perf, &est, 0.0, 3.5, air.density_kg_per_m3, 0.0);
         }
         fa.glide_correction
+    }
+
+    /// A point mass put on the final 150 m short of the target into a wind of `wind_mps`,
+    /// `excess_m` higher than the polar says full brakes need to reach the flare's start, and
+    /// flown by the final approach until its lowest body is at the flare height: how far it
+    /// then is past the flare's start along the line (positive long), and how far it strayed
+    /// from the line on the way, m.
+    fn flown_to_the_flare(excess_m: f64, wind_mps: f64) -> (f64, f64) {
+        let config = GuidanceConfig::default();
+        let sc = &config.spiral;
+        let perf = config.performance;
+        let density = perf.reference_density_kg_per_m3;
+        // Wind from the north: the final is flown north, the frame's downwind is south.
+        let wind = Vector3::new(-wind_mps, 0.0, 0.0);
+        let air = Conditions::nominal(wind, density);
+        let frame = WindFrame::new([0.0, 0.0], std::f64::consts::PI);
+        let energy = Energy::plan(sc, &perf, config.gains.brake_trim, density, wind_mps, 0.3);
+        let geometry = |position: [f64; 2], height: f64| {
+            FinalGeometry::assess(sc, &perf, density, &frame, &energy, position, height)
+        };
+        let start = [-150.0, 0.0];
+        let height = excess_m - geometry(start, 0.0).excess_m;
+        let mut stack = PointMass::new(0.0, Vector3::new(start[0], start[1], -height), 0.0);
+        let mut fa = FinalApproach::default();
+        let mut strayed: f64 = 0.0;
+        for _ in 0..6000 {
+            let est = stack.estimate(&wind);
+            let position = [est.position_ned_m.x, est.position_ned_m.y];
+            strayed = strayed.max(position[1].abs());
+            let g = geometry(position, est.height_m());
+            if g.height_to_flare <= 0.0 {
+                return (-g.to_go_before_flare, strayed);
+            }
+            let controls = fa.fly(&config, &g, &est, position, 0.0, density);
+            stack.step(&perf, &controls, &air, 0.1);
+        }
+        panic!("the stack never came down to the flare height");
+    }
+
+    #[test]
+    fn a_final_a_few_metres_too_high_for_full_brakes_s_turns_the_height_away_in_light_air() {
+        // Just high enough for full brakes: the flare starts on the aim, on the line.
+        let (long, strayed) = flown_to_the_flare(0.0, 1.0);
+        assert!(
+            long.abs() < 2.0 && strayed < 1.0,
+            "{long:.1} m long, {strayed:.1} m off"
+        );
+        // 8 m too high into 1 m/s: full brakes alone would fly it 8 × 1.37 = 11 m past the aim
+        // (their glide over the ground there); S-turns burn the height first.
+        let (long, strayed) = flown_to_the_flare(8.0, 1.0);
+        assert!(
+            long.abs() < 5.0 && strayed > 10.0,
+            "{long:.1} m long, {strayed:.1} m off"
+        );
+        // Into 4 m/s the same 8 m is left to the brakes, whose glide over the ground is 0.5
+        // there (4 m long at most): an S-turn's leg off the wind would be blown back.
+        let (long, strayed) = flown_to_the_flare(8.0, 4.0);
+        assert!(
+            long.abs() < 5.0 && strayed < 1.0,
+            "{long:.1} m long, {strayed:.1} m off"
+        );
     }
 
     #[test]
