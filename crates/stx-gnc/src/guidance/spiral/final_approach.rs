@@ -162,14 +162,9 @@ impl FinalApproach {
             excess_m: final_excess_m,
         } = *geometry;
         let target_ne = final_line.point_ne_m;
-        self.learn_glide(
-            perf,
-            est,
-            final_course,
-            w_along_measured,
-            density,
-            final_excess_m,
-        );
+        // Far enough above the full-brake glide to burn the height in S-turns, off the line.
+        let weave = final_excess_m > s_turn_excess_m(w_along_measured);
+        self.learn_glide(perf, est, final_course, w_along_measured, density, weave);
         let brake = if height_to_flare <= 0.0 || to_go_before_flare <= 0.0 {
             if sc.flare { 1.0 } else { self.last_brake }
         } else {
@@ -231,7 +226,6 @@ impl FinalApproach {
         // Horizontal: the final line; while far too high for even full brakes to
         // bring it down in time, S-turns across the line burn the height.
         self.last_brake = brake;
-        let weave = final_excess_m > s_turn_excess_m(w_along_measured);
         let main_line_m = if weave {
             let ct = final_line.cross_track_m(position);
             if ct > S_TURN_HALF_WIDTH_M {
@@ -289,14 +283,14 @@ impl FinalApproach {
         final_course: f64,
         headwind_mps: f64,
         density: f64,
-        excess_m: f64,
+        s_turning: bool,
     ) {
         let dt = match self.last_time_s.replace(est.time_s) {
             Some(t) => (est.time_s - t).max(0.0),
             None => return,
         };
         let straight = est.heading_rate_rad_s.abs() < GLIDE_LEARN_MAX_TURN_RAD_S
-            && excess_m <= s_turn_excess_m(headwind_mps)
+            && !s_turning
             && est.sink_rate_mps > GLIDE_LEARN_MIN_SINK_MPS;
         if !straight || dt <= 0.0 {
             return;
@@ -388,7 +382,7 @@ mod tests {
         for _ in 0..600 {
             stack.step(&perf, &controls, &air, 0.1);
             let est = stack.estimate(&wind);
-            fa.learn_glide(&perf, &est, 0.0, 3.5, air.density_kg_per_m3, 0.0);
+            fa.learn_glide(&perf, &est, 0.0, 3.5, air.density_kg_per_m3, false);
         }
         fa.glide_correction
     }
