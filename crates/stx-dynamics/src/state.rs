@@ -35,11 +35,14 @@ pub mod idx {
     pub const DRONE_EULER: usize = 14;
     /// Drone angular velocity relative to the line frame, drone frame, rad/s.
     pub const DRONE_RATES: usize = 17;
-    /// Capsule roll and pitch relative to the drone, rad.
+    /// Capsule roll and pitch relative to the drone, rad. A roll within π of 2π means the
+    /// pair is read from the drone's axes turned 90° about z, away from the seed chart's pole
+    /// (`model::pendant`).
     pub const CAPSULE_ANGLES: usize = 20;
     /// Capsule relative rates `p, q` (x and y of its relative angular velocity, capsule frame).
     pub const CAPSULE_RATES: usize = 22;
-    /// Transponder roll and pitch relative to the capsule, rad.
+    /// Transponder roll and pitch relative to the capsule, rad, in either chart as for the
+    /// capsule.
     pub const TRANSPONDER_ANGLES: usize = 24;
     /// Transponder relative rates `p, q`, transponder frame, rad/s.
     pub const TRANSPONDER_RATES: usize = 26;

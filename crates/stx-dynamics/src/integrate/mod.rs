@@ -17,6 +17,8 @@
 //!
 //! Cost in derivative evaluations (the system counts them; the driver does not):
 //! - one at the start of every [`integrate`] call, for the derivative at `t0`;
+//! - one after every step whose end the system asks to move to other coordinates
+//!   ([`OdeSystem::rechart`]);
 //! - [`Rk4`]: four per step (three stages plus the derivative at the new point, which is the
 //!   next step's first stage);
 //! - [`DormandPrince54`]: six per attempt, accepted or rejected (the seventh stage is the
@@ -42,11 +44,22 @@ use thiserror::Error;
 pub trait OdeSystem<const N: usize> {
     /// The derivative of `state` at `time_s` (s). Units are those of the state per second.
     fn derivative(&mut self, time_s: f64, state: &SVector<f64, N>) -> SVector<f64, N>;
+
+    /// The same point in other coordinates, for a system whose coordinates have a singularity
+    /// it must move away from (the flight model's hanging bodies), or `None` to keep them.
+    /// [`integrate`] asks after every accepted step; the default keeps every state.
+    fn rechart(&self, _state: &SVector<f64, N>) -> Option<SVector<f64, N>> {
+        None
+    }
 }
 
 impl<const N: usize, S: OdeSystem<N> + ?Sized> OdeSystem<N> for &mut S {
     fn derivative(&mut self, time_s: f64, state: &SVector<f64, N>) -> SVector<f64, N> {
         (**self).derivative(time_s, state)
+    }
+
+    fn rechart(&self, state: &SVector<f64, N>) -> Option<SVector<f64, N>> {
+        (**self).rechart(state)
     }
 }
 
@@ -349,6 +362,11 @@ pub fn integrate<const N: usize, M: Stepper, S: OdeSystem<N>>(
         }
 
         point = step.end;
+        if let Some(state) = system.rechart(&point.state) {
+            // The next step starts from the new coordinates' own derivative.
+            point.derivative = system.derivative(point.time_s, &state);
+            point.state = state;
+        }
         if let Some(observe) = hooks.observer.as_mut() {
             observe(point.time_s, &point.state);
         }

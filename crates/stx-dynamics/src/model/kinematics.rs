@@ -9,7 +9,8 @@
 
 use nalgebra::{Matrix3, SMatrix, Vector3};
 
-use crate::rotation::{t_from_euler, t_from_roll_pitch, t_pitch};
+use super::pendant::{pendant_rel_rate, t_parent_to_pendant};
+use crate::rotation::{t_from_euler, t_pitch};
 use crate::state::{StateVector, idx, vec3_at};
 use crate::vehicle::Vehicle;
 
@@ -88,9 +89,9 @@ impl Kinematics {
         let t_c_l = t_pitch(x[idx::LINE_PITCH]);
         let t_l_d = t_from_euler(&vec3_at(x, idx::DRONE_EULER));
         let (phi_cap, theta_cap) = (x[idx::CAPSULE_ANGLES], x[idx::CAPSULE_ANGLES + 1]);
-        let t_d_cap = t_from_roll_pitch(phi_cap, theta_cap);
+        let t_d_cap = t_parent_to_pendant(phi_cap, theta_cap);
         let (phi_t, theta_t) = (x[idx::TRANSPONDER_ANGLES], x[idx::TRANSPONDER_ANGLES + 1]);
-        let t_cap_t = t_from_roll_pitch(phi_t, theta_t);
+        let t_cap_t = t_parent_to_pendant(phi_t, theta_t);
         let t_i_l = t_c_l * t_i_c;
         let t_i_d = t_l_d * t_i_l;
         let t_i_cap = t_d_cap * t_i_d;
@@ -196,13 +197,6 @@ impl Kinematics {
     }
 }
 
-/// Angular velocity of a hanging body relative to its parent, in its own frame, from its
-/// two states: with the roll-then-pitch sequence and no relative yaw, `[φ̇, cos φ·θ̇, −sin φ·θ̇]`
-/// (seed eq. 4.33), and the states are its x and y components `p = φ̇`, `q = cos φ·θ̇`.
-fn pendant_rel_rate(phi_rad: f64, p: f64, q: f64) -> Vector3<f64> {
-    Vector3::new(p, q, -phi_rad.tan() * q)
-}
-
 /// A vector that is affine in the 14 generalized-speed derivatives `ν̇`: `bias + jac · ν̇`.
 #[derive(Debug, Clone, Copy)]
 pub struct Affine {
@@ -298,7 +292,7 @@ pub struct Accelerations {
 
 /// Derivative (in its own frame) of a hanging body's relative angular velocity
 /// `[p, q, −tan φ · q]`, affine in its `ṗ, q̇` at column `first`.
-fn pendant_rel_rate_dot(phi_rad: f64, p: f64, q: f64, first: usize) -> Affine {
+pub fn pendant_rel_rate_dot(phi_rad: f64, p: f64, q: f64, first: usize) -> Affine {
     let tan_phi = phi_rad.tan();
     let sec2 = 1.0 + tan_phi * tan_phi;
     let mut jac = SMatrix::<f64, 3, 14>::zeros();

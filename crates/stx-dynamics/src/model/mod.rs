@@ -13,11 +13,14 @@
 //! - apparent mass acts at the canopy CM for a wind that is steady over a step (eq. 4.65);
 //! - no Munk moment unless the vehicle file switches it on (`canopy.munk_moment`; the seed's
 //!   N4 has none, and its coefficients were tuned without it: MODEL_NOTES.md);
-//! - the whole 12-m stack sees the density and wind at the canopy.
+//! - the whole 12-m stack sees the density and wind at the canopy;
+//! - the hanging bodies' two angles are read in whichever of two charts keeps them clear of a
+//!   pole, and the integrator moves them between charts ([`pendant`]).
 
 pub mod aero;
 pub mod kinematics;
 mod linear;
+pub mod pendant;
 
 use std::sync::Arc;
 
@@ -41,6 +44,18 @@ pub struct Environment {
     pub wind: Arc<dyn WindField>,
     /// Altitude of the NED origin above mean sea level, m: the ground is at z = 0.
     pub ground_altitude_msl_m: f64,
+}
+
+impl Environment {
+    /// Still air of the US Standard Atmosphere over a ground at sea level: what tests and
+    /// benchmarks of the model alone fly in.
+    pub fn calm() -> Self {
+        Self {
+            atmosphere: Arc::new(crate::atmosphere::StandardAtmosphere),
+            wind: Arc::new(crate::wind::Calm),
+            ground_altitude_msl_m: 0.0,
+        }
+    }
 }
 
 impl std::fmt::Debug for Environment {
@@ -442,5 +457,9 @@ impl ParafoilModel {
 impl crate::integrate::OdeSystem<{ crate::state::N_STATES }> for ParafoilModel {
     fn derivative(&mut self, time_s: f64, state: &StateVector) -> StateVector {
         ParafoilModel::derivative(self, time_s, state)
+    }
+
+    fn rechart(&self, state: &StateVector) -> Option<StateVector> {
+        pendant::rechart(state)
     }
 }

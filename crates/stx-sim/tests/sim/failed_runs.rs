@@ -32,3 +32,16 @@ fn diving_stacks_whose_pitch_mode_outran_the_step_land() {
         assert_eq!(report.results.len(), 1);
     }
 }
+
+/// Seed 7 runs 2251 and 6245: the transponder's line, nearly slack, swung through the pole of
+/// its two angles (roll 90° from the capsule, where `θ̇ = q / cos φ` has no value) and no step
+/// could fly on. The hanging bodies' angles are now read in two charts, each clear of the
+/// other's pole (`crates/stx-dynamics/MODEL_NOTES.md`, "The hanging bodies' two charts").
+#[test]
+fn transponders_that_swung_through_the_pole_of_their_angles_land() {
+    for index in [2251, 6245] {
+        let report = fly(7, index);
+        assert_eq!(report.failed_runs, Vec::new(), "seed 7 run {index}");
+        assert_eq!(report.results.len(), 1);
+    }
+}
