@@ -435,10 +435,10 @@ fn print_table(r: &MonteCarloReport) {
     }
     for w in &r.worst {
         println!(
-            "worst: run {} missed by {:.1} m, {}{}{} ({:+.1} m long, {:+.1} m right), heading \
-             {:+.0}° from upwind, wind {:.1} m/s (--replay {})",
+            "worst: run {}, payload missed by {:.1} m, {}{}{} ({:+.1} m long, {:+.1} m right; \
+             first contact {:.1} m), heading {:+.0}° from upwind, wind {:.1} m/s (--replay {})",
             w.index,
-            w.miss_m,
+            w.payload_miss_m,
             w.cause,
             if w.unreachable { ", out of reach" } else { "" },
             w.miss_grew.map_or(String::new(), |g| if g.grew_m < 1.0 {
@@ -453,6 +453,7 @@ fn print_table(r: &MonteCarloReport) {
             }),
             w.long_short_m,
             w.left_right_m,
+            w.miss_m,
             w.heading_vs_upwind_deg,
             w.conditions.wind_speed_mps,
             w.index

@@ -141,6 +141,10 @@ function build(session: Session): void {
   const guidanceInputs = new GuidanceInputs(send, picks, map);
   const plan = new PlanEditor(send, picks, map);
   const params = new ParamEditor((name, value) => runCommand("set_param", `param ${name} → ${value}`, `/api/params/${encodeURIComponent(name)}`, { value }));
+  // Ascent bands pushed over the WebSocket (`loadAscentWind`): a push that arrives
+  // while the request is out is newer than its answer, which must then not replace it (a slow
+  // answer did, and the first band vanished from the panel until the next one came).
+  let ascentPushes = 0;
   const socket = new LiveSocket({
     url: () => withToken(`${location.protocol === "https:" ? "wss:" : "ws:"}//${location.host}/api/ws`, token),
     onMessage: (m) => {
@@ -168,6 +172,7 @@ function build(session: Session): void {
           params.setParams(m.params, m.complete);
           break;
         case "ascent_wind":
+          ascentPushes += 1;
           wind.setAscent(m);
           break;
         case "keep_out":
@@ -410,10 +415,11 @@ function build(session: Session): void {
   }
 
   function loadAscentWind(): void {
+    const pushesBefore = ascentPushes;
     api.get("/api/ascent_wind").then(
       (r) => {
         const a = isObj(r) ? parseAscentWind(r) : null;
-        if (a?.ok) wind.setAscent(a.value);
+        if (a?.ok && ascentPushes === pushesBefore) wind.setAscent(a.value);
       },
       (e: unknown) => localEvent("warning", `ascent winds not loaded: ${e instanceof Error ? e.message : String(e)}`),
     );

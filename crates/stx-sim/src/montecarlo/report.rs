@@ -10,20 +10,24 @@ use super::run::{RunConditions, RunResult, SensorsLearned};
 use super::zones::ZoneLandings;
 use crate::dispersions::Dispersions;
 
-/// A run among the worst of a campaign, enough to replay it (`only_run`).
+/// A run among the worst of a campaign by its payload's miss (what the campaign's goals are
+/// about), enough to replay it (`only_run`).
 #[derive(Debug, Clone, Serialize)]
 pub struct WorstRun {
     /// Index in the campaign.
     pub index: usize,
-    /// Miss distance, m.
+    /// The payload's (capsule's) miss distance, m.
+    pub payload_miss_m: f64,
+    /// The first contact's miss distance (the lowest body, the transponder), m.
     pub miss_m: f64,
-    /// Long (+) or short (−) along the upwind direction, m.
+    /// The payload's touchdown long (+) or short (−) along the upwind direction, m.
     pub long_short_m: f64,
     /// Right (+) or left (−) of it, m.
     pub left_right_m: f64,
     /// Heading at touchdown minus upwind, degrees.
     pub heading_vs_upwind_deg: f64,
-    /// The miss in a word: `long`, `short`, `left` or `right`, whichever component is larger.
+    /// The payload's miss in a word: `long`, `short`, `left` or `right`, whichever component
+    /// is larger.
     pub cause: &'static str,
     /// Whether guidance found the target out of reach (its miss is then the wind's and the
     /// stack's, not guidance's).
@@ -251,17 +255,22 @@ impl MonteCarloReport {
             Stats::of(&values)
         };
         let mut by_miss: Vec<&RunResult> = results.iter().collect();
-        by_miss.sort_by(|a, b| b.miss_m.total_cmp(&a.miss_m).then(a.index.cmp(&b.index)));
+        by_miss.sort_by(|a, b| {
+            b.payload_miss_m
+                .total_cmp(&a.payload_miss_m)
+                .then(a.index.cmp(&b.index))
+        });
         let worst = by_miss
             .iter()
             .take(WORST_RUNS)
             .map(|r| WorstRun {
                 index: r.index,
+                payload_miss_m: r.payload_miss_m,
                 miss_m: r.miss_m,
-                long_short_m: r.long_short_m,
-                left_right_m: r.left_right_m,
+                long_short_m: r.payload_long_short_m,
+                left_right_m: r.payload_left_right_m,
                 heading_vs_upwind_deg: r.heading_vs_upwind_deg,
-                cause: miss_in_a_word(r.long_short_m, r.left_right_m),
+                cause: miss_in_a_word(r.payload_long_short_m, r.payload_left_right_m),
                 unreachable: r.unreachable,
                 miss_grew: r.miss_grew,
                 conditions: r.conditions.clone(),
@@ -388,6 +397,8 @@ mod tests {
             flight_time_s: 200.0,
             long_short_m: 0.0,
             left_right_m: 0.0,
+            payload_long_short_m: 0.0,
+            payload_left_right_m: 0.0,
             events: Vec::new(),
             track: Vec::new(),
         }
@@ -435,13 +446,17 @@ mod tests {
 
     #[test]
     fn reachable_and_unreachable_runs_are_reported_apart_and_each_worst_run_named() {
-        let run = |index, miss, unreachable, long_short_m, left_right_m| RunResult {
+        // The first contact (the transponder) lands elsewhere, in the reverse order of misses
+        // and on the other side: the worst runs are the payload's, named by its touchdown.
+        let run = |index, miss: f64, unreachable, long_short_m: f64, left_right_m: f64| RunResult {
             index,
-            miss_m: miss,
+            miss_m: 50.0 - miss,
             payload_miss_m: miss,
             unreachable,
-            long_short_m,
-            left_right_m,
+            long_short_m: -long_short_m,
+            left_right_m: -left_right_m,
+            payload_long_short_m: long_short_m,
+            payload_left_right_m: left_right_m,
             ..landed(0.0, false)
         };
         let report = MonteCarloReport::assemble(

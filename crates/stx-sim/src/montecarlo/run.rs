@@ -118,6 +118,11 @@ pub struct RunResult {
     pub long_short_m: f64,
     /// See `long_short_m`.
     pub left_right_m: f64,
+    /// The payload's touchdown the same way, m: it lands a couple of seconds after the first
+    /// contact, further along.
+    pub payload_long_short_m: f64,
+    /// See `payload_long_short_m`.
+    pub payload_left_right_m: f64,
     /// Guidance phase changes with their reasons (kept only when one run is replayed).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub events: Vec<PhaseEvent>,
@@ -474,18 +479,10 @@ pub fn run_one<N: Navigator>(
         last_best_reachable_ne_m: last_announced,
         from_last_best_reachable_m: last_announced.map(from_touchdown),
         flight_time_s: touchdown.time_s,
-        long_short_m: if touchdown.upwind_rad.is_finite() {
-            touchdown.position_ne_m[0] * touchdown.upwind_rad.cos()
-                + touchdown.position_ne_m[1] * touchdown.upwind_rad.sin()
-        } else {
-            0.0
-        },
-        left_right_m: if touchdown.upwind_rad.is_finite() {
-            -touchdown.position_ne_m[0] * touchdown.upwind_rad.sin()
-                + touchdown.position_ne_m[1] * touchdown.upwind_rad.cos()
-        } else {
-            0.0
-        },
+        long_short_m: along_and_across(touchdown.position_ne_m, touchdown.upwind_rad)[0],
+        left_right_m: along_and_across(touchdown.position_ne_m, touchdown.upwind_rad)[1],
+        payload_long_short_m: along_and_across(payload.position_ne_m, touchdown.upwind_rad)[0],
+        payload_left_right_m: along_and_across(payload.position_ne_m, touchdown.upwind_rad)[1],
         conditions: c,
         events: if replay {
             std::mem::take(&mut flight.events)
@@ -494,4 +491,18 @@ pub fn run_one<N: Navigator>(
         },
         track,
     })
+}
+
+/// A touchdown `[north, east]` from the target (m) along the upwind direction `upwind_rad`
+/// (positive: beyond the target, long) and across it (positive: right); zeros when the
+/// direction is unknown.
+fn along_and_across(ne_m: [f64; 2], upwind_rad: f64) -> [f64; 2] {
+    if !upwind_rad.is_finite() {
+        return [0.0, 0.0];
+    }
+    let (sin, cos) = upwind_rad.sin_cos();
+    [
+        ne_m[0] * cos + ne_m[1] * sin,
+        -ne_m[0] * sin + ne_m[1] * cos,
+    ]
 }
