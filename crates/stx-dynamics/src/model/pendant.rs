@@ -89,7 +89,13 @@ impl Chart {
 /// Parent-to-body matrix of a pendant from its stored angles, in whichever chart the roll
 /// says.
 pub fn t_parent_to_pendant(phi_rad: f64, theta_rad: f64) -> Matrix3<f64> {
-    t_from_roll_pitch(phi_rad, theta_rad) * Chart::of_roll(phi_rad).base()
+    let t = t_from_roll_pitch(phi_rad, theta_rad);
+    // Every evaluation walks the chain through here: the seed's chart, nearly always the one,
+    // costs no product with its identity base.
+    match Chart::of_roll(phi_rad) {
+        Chart::Seed => t,
+        turned => t * turned.base(),
+    }
 }
 
 /// Angular velocity of a hanging body relative to its parent, in its own frame, from its
@@ -109,20 +115,23 @@ fn near_pole(phi_rad: f64) -> bool {
 /// and so the equations' solution, are unchanged (see the module doc).
 pub fn rechart(x: &StateVector) -> Option<StateVector> {
     let (phi_c, phi_t) = (x[idx::CAPSULE_ANGLES], x[idx::TRANSPONDER_ANGLES]);
-    if !near_pole(phi_c) && !near_pole(phi_t) {
+    let capsule_moves = near_pole(phi_c);
+    if !capsule_moves && !near_pole(phi_t) {
         return None;
     }
-    let capsule = match near_pole(phi_c) {
-        true => Chart::of_roll(phi_c).other(),
-        false => Chart::of_roll(phi_c),
+    let capsule = if capsule_moves {
+        Chart::of_roll(phi_c).other()
+    } else {
+        Chart::of_roll(phi_c)
     };
     // The transponder is read again in the capsule's new axes, where it may be clear of its
     // pole already.
     let transponder = Chart::of_roll(phi_t);
     let y = in_charts(x, capsule, transponder);
-    Some(match near_pole(y[idx::TRANSPONDER_ANGLES]) {
-        true => in_charts(x, capsule, transponder.other()),
-        false => y,
+    Some(if near_pole(y[idx::TRANSPONDER_ANGLES]) {
+        in_charts(x, capsule, transponder.other())
+    } else {
+        y
     })
 }
 

@@ -17,6 +17,7 @@ use stx_dynamics::vehicle::Vehicle;
 use stx_dynamics::wind::{
     ProfileRow, Turbulence, TurbulenceParams, WindComposite, WindField, WindProfile,
 };
+use stx_gnc::control::Localizer;
 use stx_gnc::estimate::Estimate;
 use stx_gnc::guidance::{Guidance, LearnedPolar, PhaseEvent, Plan};
 use stx_gnc::mission::{FlightMode, GuidancePhase};
@@ -448,6 +449,19 @@ pub fn run_one<N: Navigator>(
     let last_announced = flight.best_reachable_announced.last().map(|(_, ne)| *ne);
     let from_touchdown =
         |b: [f64; 2]| (touchdown.position_ne_m[0] - b[0]).hypot(touchdown.position_ne_m[1] - b[1]);
+    // Touchdowns along the upwind line through the target (long +) and across it (right +);
+    // zeros when the direction is unknown.
+    let upwind = touchdown.upwind_rad.is_finite().then_some(Localizer {
+        point_ne_m: [0.0, 0.0],
+        course_rad: touchdown.upwind_rad,
+    });
+    let along_and_across = |ne_m: [f64; 2]| {
+        upwind.map_or([0.0, 0.0], |line| {
+            [line.along_track_m(ne_m), line.cross_track_m(ne_m)]
+        })
+    };
+    let [long_short_m, left_right_m] = along_and_across(touchdown.position_ne_m);
+    let [payload_long_short_m, payload_left_right_m] = along_and_across(payload.position_ne_m);
     Ok(RunResult {
         index,
         vehicle_draw: drawn.summary,
@@ -479,10 +493,10 @@ pub fn run_one<N: Navigator>(
         last_best_reachable_ne_m: last_announced,
         from_last_best_reachable_m: last_announced.map(from_touchdown),
         flight_time_s: touchdown.time_s,
-        long_short_m: along_and_across(touchdown.position_ne_m, touchdown.upwind_rad)[0],
-        left_right_m: along_and_across(touchdown.position_ne_m, touchdown.upwind_rad)[1],
-        payload_long_short_m: along_and_across(payload.position_ne_m, touchdown.upwind_rad)[0],
-        payload_left_right_m: along_and_across(payload.position_ne_m, touchdown.upwind_rad)[1],
+        long_short_m,
+        left_right_m,
+        payload_long_short_m,
+        payload_left_right_m,
         conditions: c,
         events: if replay {
             std::mem::take(&mut flight.events)
@@ -491,18 +505,4 @@ pub fn run_one<N: Navigator>(
         },
         track,
     })
-}
-
-/// A touchdown `[north, east]` from the target (m) along the upwind direction `upwind_rad`
-/// (positive: beyond the target, long) and across it (positive: right); zeros when the
-/// direction is unknown.
-fn along_and_across(ne_m: [f64; 2], upwind_rad: f64) -> [f64; 2] {
-    if !upwind_rad.is_finite() {
-        return [0.0, 0.0];
-    }
-    let (sin, cos) = upwind_rad.sin_cos();
-    [
-        ne_m[0] * cos + ne_m[1] * sin,
-        -ne_m[0] * sin + ne_m[1] * cos,
-    ]
 }

@@ -19,6 +19,15 @@ fn fly(seed: u64, index: usize) -> MonteCarloReport {
     run_sensed(&config, &EstimatorConfig::default()).expect("the campaign runs")
 }
 
+/// Runs `indices` of the realistic campaign of `seed` each fly to a landing.
+fn assert_they_land(seed: u64, indices: &[usize]) {
+    for &index in indices {
+        let report = fly(seed, index);
+        assert_eq!(report.failed_runs, Vec::new(), "seed {seed} run {index}");
+        assert_eq!(report.results.len(), 1);
+    }
+}
+
 /// Seed 3 runs 372 and 514: low-drag canopies rigged nose-down (+2.9°, +3.8°) dive at
 /// 10–11 m/s after release, where the canopy's pitch against its lines is a damped mode of
 /// −67 1/s, beyond what a 0.05 s RK4 step holds (−56 1/s): the mode doubled each step, the
@@ -26,11 +35,7 @@ fn fly(seed: u64, index: usize) -> MonteCarloReport {
 /// loses the mode is now refused and its period flown with shorter steps.
 #[test]
 fn diving_stacks_whose_pitch_mode_outran_the_step_land() {
-    for index in [372, 514] {
-        let report = fly(3, index);
-        assert_eq!(report.failed_runs, Vec::new(), "seed 3 run {index}");
-        assert_eq!(report.results.len(), 1);
-    }
+    assert_they_land(3, &[372, 514]);
 }
 
 /// Seed 7 runs 2251 and 6245: the transponder's line, nearly slack, swung through the pole of
@@ -39,9 +44,5 @@ fn diving_stacks_whose_pitch_mode_outran_the_step_land() {
 /// other's pole (`crates/stx-dynamics/MODEL_NOTES.md`, "The hanging bodies' two charts").
 #[test]
 fn transponders_that_swung_through_the_pole_of_their_angles_land() {
-    for index in [2251, 6245] {
-        let report = fly(7, index);
-        assert_eq!(report.failed_runs, Vec::new(), "seed 7 run {index}");
-        assert_eq!(report.results.len(), 1);
-    }
+    assert_they_land(7, &[2251, 6245]);
 }
