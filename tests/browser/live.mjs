@@ -668,20 +668,22 @@ async function replay(rehearsalStation) {
   const toggle = await text(page, "replay-toggle");
   check("replay: pause from the page stops the position", p1 !== undefined && p1 === r2?.position_ms && r2?.paused === true && toggle === "Play",
     `${p1} → ${r2?.position_ms} ms while paused (of ${r2?.duration_ms} ms; station paused ${r2?.paused}, finished ${r2?.finished}); button "${toggle}"`);
-  // Seek back from the page's timeline to 5 s while paused: the page shows the flight as it was
+  // Seek back from the page's timeline to 10 s while paused: the page shows the flight as it was
   // then — the track and the plots end there, the state is that moment's (mode, stage), fresh.
+  // (10 s, not 5: the track starts with the first estimate, which a loaded machine's recording
+  // holds later; at 5 s CI's had 2 points.)
   const epochBefore = (await api("/api/replay")).body?.epoch;
   await page.locator('[data-testid="replay-seek"]').evaluate((el) => {
-    el.value = "5000";
+    el.value = "10000";
     el.dispatchEvent(new Event("input"));
     el.dispatchEvent(new Event("change"));
   });
   await page.waitForFunction((e) => {
     const bar = document.querySelector('[data-testid="replay-bar"]');
-    return Number(bar?.dataset.positionMs) === 5000 && Number(bar?.dataset.epoch) > e && bar?.dataset.seeking === "false";
+    return Number(bar?.dataset.positionMs) === 10000 && Number(bar?.dataset.epoch) > e && bar?.dataset.seeking === "false";
   }, epochBefore, { timeout: 30000 }).catch(() => {});
   const sought = (await api("/api/replay")).body;
-  check("replay: a seek back on the page's timeline moves the replay there (paused)", sought?.position_ms === 5000 && sought?.paused === true && sought?.epoch > epochBefore && sought?.seeking === false, JSON.stringify(sought));
+  check("replay: a seek back on the page's timeline moves the replay there (paused)", sought?.position_ms === 10000 && sought?.paused === true && sought?.epoch > epochBefore && sought?.seeking === false, JSON.stringify(sought));
   await sleep(3000); // paused: nothing may age into stale; the plots redraw once a second
   const then = (await api("/api/state")).body;
   const shownThen = await page.evaluate(() => {
@@ -698,11 +700,11 @@ async function replay(rehearsalStation) {
   const stageText = await text(page, "hdr-stage");
   const wantMode = (then?.vehicle?.mode ?? "").replace(/_/g, " ");
   const wantStage = (then?.mission?.stage ?? "").replace(/_/g, " ");
-  check("replay: after the seek back the track and the plots end at 5 s (no line back from later), not empty",
-    shownThen.trackLastS <= 5 && shownThen.trackLastS > 3 && shownThen.trackPoints > 2 && shownThen.plotLastS !== null && shownThen.plotLastS <= then?.mission_time_s + 0.01 && shownThen.plotPoints > 2,
+  check("replay: after the seek back the track and the plots end at 10 s (no line back from later), not empty",
+    shownThen.trackLastS <= 10 && shownThen.trackLastS > 8 && shownThen.trackPoints > 2 && shownThen.plotLastS !== null && shownThen.plotLastS <= then?.mission_time_s + 0.01 && shownThen.plotPoints > 2,
     `${JSON.stringify(shownThen)} (the plots on the mission clock: ${then?.mission_time_s} s then)`);
-  check("replay: paused after the seek, the page shows that moment's state, fresh (mode, stage as the station had them at 5 s, no STALE)",
-    then?.time_s === 5 && then?.link?.stale === false && wantMode !== "" && wantMode !== "uncontrolled" && modeText === wantMode && stageText === wantStage && shownThen.freshness === "fresh" && shownThen.banner === true,
+  check("replay: paused after the seek, the page shows that moment's state, fresh (mode, stage as the station had them at 10 s, no STALE)",
+    then?.time_s === 10 && then?.link?.stale === false && wantMode !== "" && wantMode !== "uncontrolled" && modeText === wantMode && stageText === wantStage && shownThen.freshness === "fresh" && shownThen.banner === true,
     `station at ${then?.time_s} s: mode ${then?.vehicle?.mode}, stage ${then?.mission?.stage}, stale ${then?.link?.stale}; page: mode "${modeText}", stage "${stageText}", ${shownThen.freshness}, banner hidden ${shownThen.banner}`);
   // Any speed the station accepts, typed in the box: 3×.
   await page.fill('[data-testid="replay-speed"]', "3");

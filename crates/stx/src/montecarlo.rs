@@ -426,6 +426,15 @@ fn print_table(r: &MonteCarloReport) {
             r.unreachable_from_last_best_m.p95,
             r.unreachable_from_last_best_m.max
         );
+        println!(
+            "  {} of them found the target within reach again and flew for it; the payload from \
+             the point chosen last (that target, else the best reachable point announced last): \
+             median {:.0} m, 95th percentile {:.0} m, worst {:.0} m",
+            r.unreachable_back_in_reach_runs,
+            r.unreachable_payload_from_last_aim_m.median,
+            r.unreachable_payload_from_last_aim_m.p95,
+            r.unreachable_payload_from_last_aim_m.max
+        );
     }
     if let Some(z) = &r.keep_out {
         print_zone_landings(z);

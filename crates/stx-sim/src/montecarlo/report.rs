@@ -207,6 +207,11 @@ pub struct MonteCarloReport {
     pub unreachable_from_best_m: Stats,
     /// The same from the best reachable point announced last, m.
     pub unreachable_from_last_best_m: Stats,
+    /// Of those runs, the ones that found the target within reach again and flew for it.
+    pub unreachable_back_in_reach_runs: usize,
+    /// Over those runs, the payload's touchdown from the point guidance chose last: the best
+    /// reachable point announced last, or the target for a run back within reach, m.
+    pub unreachable_payload_from_last_aim_m: Stats,
     /// Capsules landed in keep-out zones, overall and by wind (campaigns with zones only).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub keep_out: Option<ZoneLandings>,
@@ -329,6 +334,8 @@ impl MonteCarloReport {
             unreachable_runs: results.iter().filter(|r| r.unreachable).count(),
             unreachable_from_best_m: announced(|r| r.from_best_reachable_m),
             unreachable_from_last_best_m: announced(|r| r.from_last_best_reachable_m),
+            unreachable_back_in_reach_runs: results.iter().filter(|r| r.back_in_reach).count(),
+            unreachable_payload_from_last_aim_m: announced(|r| r.payload_from_last_aim_m),
             failed_runs,
             wall_time_s,
             worst,
@@ -394,6 +401,8 @@ mod tests {
             from_best_reachable_m: None,
             last_best_reachable_ne_m: None,
             from_last_best_reachable_m: None,
+            back_in_reach: false,
+            payload_from_last_aim_m: None,
             flight_time_s: 200.0,
             long_short_m: 0.0,
             left_right_m: 0.0,
@@ -561,32 +570,5 @@ mod failed_run_tests {
         assert_eq!(report.runs, 1);
         assert!(report.miss_m.median.is_infinite());
         assert!(report.reachable_payload_miss_m.median.is_infinite());
-    }
-}
-
-#[cfg(test)]
-mod vehicle_file_tests {
-    use super::*;
-
-    /// The header names the vehicle files only when a campaign was given them, so that a part
-    /// written before the fields existed still reads as the shipped stack planned with the
-    /// shipped table, and parts planned with different files are different campaigns.
-    #[test]
-    fn the_header_names_vehicle_files_only_when_given_and_parts_without_them_still_read() {
-        let plain = CampaignHeader::of(&MonteCarloConfig::default());
-        let written = serde_json::to_value(&plain).expect("serialises");
-        assert!(written.get("vehicle").is_none() && written.get("guidance_vehicle").is_none());
-        let read: CampaignHeader = serde_json::from_value(written).expect("reads");
-        assert_eq!(read, plain);
-        let named = CampaignHeader::of(&MonteCarloConfig {
-            vehicle_name: Some("identified.toml".into()),
-            guidance_vehicle_name: Some("identified.toml".into()),
-            ..MonteCarloConfig::default()
-        });
-        let written = serde_json::to_value(&named).expect("serialises");
-        assert_eq!(written["guidance_vehicle"], "identified.toml");
-        let read: CampaignHeader = serde_json::from_value(written).expect("reads");
-        assert_eq!(read, named);
-        assert_ne!(named, plain);
     }
 }

@@ -25,7 +25,7 @@ use stx_gnc::mission::{FlightMode, GuidancePhase};
 use super::config::MonteCarloConfig;
 use super::growth::{MissGrowth, PhaseSnapshots};
 use crate::anemometer::{Anemometer, AnemometerConfig};
-use crate::closed_loop::{GuidedFlight, Navigator, SensorErrors};
+use crate::closed_loop::{GuidedFlight, Navigator, SensorErrors, phase_name};
 use crate::dispersions::{DispersedFlight, DrawSummary, WindShape};
 use crate::guided::{CONTROL_PERIOD_S, STEP_S};
 use crate::sensors::SensorConfig;
@@ -112,6 +112,15 @@ pub struct RunResult {
     /// Distance from that point to the touchdown, m.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub from_last_best_reachable_m: Option<f64>,
+    /// Called out of reach, then found the target within reach again and flew for it: the
+    /// point guidance chose last is the target, not a best reachable point.
+    #[serde(default)]
+    pub back_in_reach: bool,
+    /// For a run called out of reach, the payload's touchdown from the point guidance chose
+    /// last (the best reachable point announced last, or the target if it came back within
+    /// reach after that), m.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub payload_from_last_aim_m: Option<f64>,
     /// Flight time, s.
     pub flight_time_s: f64,
     /// Touchdown point relative to the target along the upwind direction (positive: beyond
@@ -447,6 +456,8 @@ pub fn run_one<N: Navigator>(
     };
     let first_announced = flight.best_reachable_announced.first().map(|(_, ne)| *ne);
     let last_announced = flight.best_reachable_announced.last().map(|(_, ne)| *ne);
+    let back_in_reach = chose_the_target_again(&flight.phases);
+    let last_aim = last_announced.map(|best| if back_in_reach { [0.0, 0.0] } else { best });
     let from_touchdown =
         |b: [f64; 2]| (touchdown.position_ne_m[0] - b[0]).hypot(touchdown.position_ne_m[1] - b[1]);
     // Touchdowns along the upwind line through the target (long +) and across it (right +);
@@ -492,6 +503,10 @@ pub fn run_one<N: Navigator>(
         from_best_reachable_m: first_announced.map(from_touchdown),
         last_best_reachable_ne_m: last_announced,
         from_last_best_reachable_m: last_announced.map(from_touchdown),
+        back_in_reach,
+        payload_from_last_aim_m: last_aim.map(|aim| {
+            (payload.position_ne_m[0] - aim[0]).hypot(payload.position_ne_m[1] - aim[1])
+        }),
         flight_time_s: touchdown.time_s,
         long_short_m,
         left_right_m,
@@ -505,4 +520,60 @@ pub fn run_one<N: Navigator>(
         },
         track,
     })
+}
+
+/// Whether guidance, having called the target out of reach, found it within reach again and
+/// flew for it: it leaves the best reachable point only for the target ("within reach again"
+/// enters the approximation), so an approximation entered after the last best reachable point
+/// is the target chosen again. `phases` as [`GuidedFlight::phases`] keeps them.
+fn chose_the_target_again(phases: &[(String, f64)]) -> bool {
+    let (best, approach) = (
+        phase_name(GuidancePhase::BestReachable),
+        phase_name(GuidancePhase::Approximation),
+    );
+    phases
+        .iter()
+        .rposition(|(name, _)| *name == best)
+        .is_some_and(|i| phases[i..].iter().any(|(name, _)| *name == approach))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn phases(names: &[&str]) -> Vec<(String, f64)> {
+        names
+            .iter()
+            .enumerate()
+            .map(|(i, n)| (n.to_string(), i as f64 * 10.0))
+            .collect()
+    }
+
+    /// Only a return to the approximation after the last call out of reach is the target chosen
+    /// again: one before it, or a flare on the way to the best point, is not.
+    #[test]
+    fn the_target_is_chosen_again_only_by_an_approximation_after_the_last_best_point() {
+        let back = phases(&[
+            "approximation",
+            "branch1",
+            "best_reachable",
+            "approximation",
+            "final_approach",
+        ]);
+        assert!(chose_the_target_again(&back));
+        let stayed = phases(&[
+            "approximation",
+            "best_reachable",
+            "approximation",
+            "best_reachable",
+            "flare",
+        ]);
+        assert!(!chose_the_target_again(&stayed));
+        assert!(!chose_the_target_again(&phases(&[
+            "approximation",
+            "branch1",
+            "final_approach"
+        ])));
+        assert!(!chose_the_target_again(&[]));
+    }
 }

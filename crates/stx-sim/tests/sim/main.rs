@@ -3,6 +3,7 @@
 //! `cargo test -p stx-sim --test sim seed_behaviour::` runs one file's tests.
 
 mod body_imus;
+mod campaign_header;
 mod campaign_regression;
 mod drone_core;
 mod drone_vehicle;
