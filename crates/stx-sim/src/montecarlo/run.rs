@@ -458,8 +458,8 @@ pub fn run_one<N: Navigator>(
     let last_announced = flight.best_reachable_announced.last().map(|(_, ne)| *ne);
     let back_in_reach = chose_the_target_again(&flight.phases);
     let last_aim = last_announced.map(|best| if back_in_reach { [0.0, 0.0] } else { best });
-    let from_touchdown =
-        |b: [f64; 2]| (touchdown.position_ne_m[0] - b[0]).hypot(touchdown.position_ne_m[1] - b[1]);
+    let apart = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).hypot(a[1] - b[1]);
+    let from_touchdown = |b: [f64; 2]| apart(touchdown.position_ne_m, b);
     // Touchdowns along the upwind line through the target (long +) and across it (right +);
     // zeros when the direction is unknown.
     let upwind = touchdown.upwind_rad.is_finite().then_some(Localizer {
@@ -504,9 +504,7 @@ pub fn run_one<N: Navigator>(
         last_best_reachable_ne_m: last_announced,
         from_last_best_reachable_m: last_announced.map(from_touchdown),
         back_in_reach,
-        payload_from_last_aim_m: last_aim.map(|aim| {
-            (payload.position_ne_m[0] - aim[0]).hypot(payload.position_ne_m[1] - aim[1])
-        }),
+        payload_from_last_aim_m: last_aim.map(|aim| apart(payload.position_ne_m, aim)),
         flight_time_s: touchdown.time_s,
         long_short_m,
         left_right_m,
