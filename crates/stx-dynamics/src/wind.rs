@@ -13,10 +13,16 @@
 //! - [`WindComposite`] adds a mean wind and optional turbulence; [`WindConfig`] is its TOML
 //!   form, validated by [`WindConfig::build`].
 //!
+//! The gusts are the dearest part of a model evaluation (192 cosines), and a fixed-step RK4
+//! asks for them twice at every time it visits (its two half-step stages, then its end point and
+//! the derivative there), so [`Turbulence`] keeps its last answer: half the cosines, the same
+//! bits.
+//!
 //! Conventions are those of `stx_types::wind`: NED velocities where the air goes, directions
 //! the wind blows from, altitude above ground `−z`.
 
 use std::f64::consts::PI;
+use std::sync::Mutex;
 
 use nalgebra::Vector3;
 use rand::{RngExt, SeedableRng};
@@ -91,6 +97,42 @@ struct Sinusoid {
 pub struct Turbulence {
     params: TurbulenceParams,
     axes: [Vec<Sinusoid>; 3],
+    last: LastGust,
+}
+
+/// The gust last computed and its time. A lock, not a cell, because a field is shared between
+/// threads (`WindField: Sync`); a caller that finds it taken computes the gust itself.
+#[derive(Debug, Default)]
+struct LastGust(Mutex<Option<(f64, Vector3<f64>)>>);
+
+impl LastGust {
+    fn get_or(&self, time_s: f64, compute: impl FnOnce() -> Vector3<f64>) -> Vector3<f64> {
+        let Ok(mut last) = self.0.try_lock() else {
+            return compute();
+        };
+        match *last {
+            Some((t, gust)) if t.to_bits() == time_s.to_bits() => gust,
+            _ => {
+                let gust = compute();
+                *last = Some((time_s, gust));
+                gust
+            }
+        }
+    }
+}
+
+/// A copy starts with nothing remembered.
+impl Clone for LastGust {
+    fn clone(&self) -> Self {
+        Self::default()
+    }
+}
+
+/// What is remembered is not part of the field's value.
+impl PartialEq for LastGust {
+    fn eq(&self, _: &Self) -> bool {
+        true
+    }
 }
 
 /// Which Dryden form an axis uses.
@@ -188,7 +230,11 @@ impl Turbulence {
                 params.components,
             )
         });
-        Ok(Self { params, axes })
+        Ok(Self {
+            params,
+            axes,
+            last: LastGust::default(),
+        })
     }
 
     /// The parameters the gusts were drawn from.
@@ -198,13 +244,16 @@ impl Turbulence {
 
     /// The gust velocity in NED at `time_s`, m/s.
     pub fn gust_ned_mps(&self, time_s: f64) -> Vector3<f64> {
-        Vector3::from_fn(|axis, _| {
-            self.axes[axis]
-                .iter()
-                .map(|s| {
-                    s.amplitude_mps * (s.angular_frequency_rad_per_s * time_s + s.phase_rad).cos()
-                })
-                .sum()
+        self.last.get_or(time_s, || {
+            Vector3::from_fn(|axis, _| {
+                self.axes[axis]
+                    .iter()
+                    .map(|s| {
+                        s.amplitude_mps
+                            * (s.angular_frequency_rad_per_s * time_s + s.phase_rad).cos()
+                    })
+                    .sum()
+            })
         })
     }
 }

@@ -38,6 +38,32 @@ fn turbulence_reproduces_bit_for_bit_for_a_seed_and_differs_between_seeds() {
     }
 }
 
+#[test]
+fn the_remembered_gust_is_the_one_asked_for() {
+    let remembering = gusts(42, 64);
+    // Times a step apart, repeated as RK4 repeats them, and returning to earlier ones.
+    let times = [0.0, 0.025, 0.025, 0.05, 0.05, 0.025, 0.0, 1e-300, 0.0];
+    for t in times {
+        let fresh = gusts(42, 64).gust_ned_mps(t);
+        let answer = remembering.gust_ned_mps(t);
+        for i in 0..3 {
+            assert_eq!(answer[i].to_bits(), fresh[i].to_bits(), "t = {t}");
+        }
+    }
+    // From several threads at once, whoever holds the memory.
+    std::thread::scope(|scope| {
+        for k in 0..4 {
+            let remembering = &remembering;
+            scope.spawn(move || {
+                for j in 0..200 {
+                    let t = ((j + k) % 7) as f64 * 0.3;
+                    assert_eq!(remembering.gust_ned_mps(t), gusts(42, 64).gust_ned_mps(t));
+                }
+            });
+        }
+    });
+}
+
 /// Samples one axis of the gusts every `dt` seconds.
 fn series(turbulence: &Turbulence, axis: usize, dt: f64, samples: usize) -> Vec<f64> {
     let terms = &turbulence.axes[axis];
