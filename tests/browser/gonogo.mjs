@@ -32,9 +32,13 @@ const ON_PAD_S = 140;
 /** The drone's own GN_HK1, saved as the flight's set. */
 const HK1 = 0.00661;
 
-/** A loopback UDP socket of the test's own, keeping what it hears. */
+/**
+ * A loopback UDP socket of the test's own, keeping what it hears. Its receive buffer holds
+ * seconds of the forward's ~190 frames/s: with the default (208 KiB, ~200 datagrams) a CI run
+ * on a loaded machine, whose event loop was busy with the browser, lost 64 of 2,803 frames.
+ */
 async function listener() {
-  const sock = createSocket("udp4");
+  const sock = createSocket({ type: "udp4", recvBufferSize: 4 * 1024 * 1024 });
   const heard = [];
   sock.on("message", (m) => heard.push(m));
   await new Promise((r) => sock.bind(0, "127.0.0.1", r));
