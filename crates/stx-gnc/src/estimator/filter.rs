@@ -22,6 +22,10 @@ use super::sideslip::StraightFlight;
 use crate::estimate::Estimate;
 use crate::measurement::{AirDataSample, AttitudeSample, GpsFix, Measurement};
 
+/// A GPS fix at most this old has set the ground velocity a pitot restart keeps, s: four
+/// fix periods at 4 Hz. Older, the ground velocity is dead-reckoned (`pitot.rs`).
+const GROUND_KNOWN_S: f64 = 1.0;
+
 /// The filter at one instant: three angle filters and, once started by a GPS fix, the
 /// navigation EKF.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -208,7 +212,8 @@ impl NavFilter {
             next_attitude,
             t,
         );
-        let pitot = self.pitot.update(&mut nav, a, attitude, t);
+        let ground_known = a.time_s - self.last_gps_s <= GROUND_KNOWN_S;
+        let pitot = self.pitot.update(&mut nav, a, attitude, ground_known, t);
         self.nav = Some(nav);
         match (baro, pitot) {
             (Outcome::Gated, _) | (_, Outcome::Gated) => Outcome::Gated,
