@@ -66,6 +66,41 @@ async function drag(page, from, to) {
   await sleep(300);
 }
 
+const whole = (p) => ({ x: Math.round(p.x), y: Math.round(p.y) });
+const sameView = (a, b) => JSON.stringify(a) === JSON.stringify(b);
+/** The map's view once it has stopped moving (the same for 300 ms; at most 5 s). */
+async function settledView(page) {
+  let last = await viewOf(page);
+  for (let still = 0, t = 0; still < 3 && t < 50; t++) {
+    await sleep(100);
+    const now = await viewOf(page);
+    still = sameView(now, last) ? still + 1 : 0;
+    last = now;
+  }
+  return last;
+}
+/** Where to click for a position on the map as it is now: the whole pixel, the position under it, the view. */
+async function aim(page, q) {
+  const view = await viewOf(page);
+  const exact = pixelOf(view, q);
+  const px = whole(exact);
+  return { px, exact, at: positionAt(view, px), view };
+}
+/**
+ * Drags the map so that what is at `from` comes to `to` (page pixels); false if it is there
+ * already. The mouse rests before it is released, so Leaflet adds no inertia.
+ */
+async function panTo(page, from, to) {
+  if (Math.hypot(to.x - from.x, to.y - from.y) < 20) return false;
+  await page.mouse.move(from.x, from.y);
+  await page.mouse.down();
+  for (let i = 1; i <= 10; i++) await page.mouse.move(from.x + ((to.x - from.x) * i) / 10, from.y + ((to.y - from.y) * i) / 10);
+  await sleep(200);
+  await page.mouse.up();
+  await sleep(300);
+  return true;
+}
+
 async function flight() {
   const copy = await configWithZoneCopy();
   const { base } = await startStation(["--config", copy.file, "--sim", "--sim-scenario", "rehearsal", "--sim-speed", String(speed), "--link", "udpin:127.0.0.1:0"]);
@@ -95,39 +130,51 @@ async function flight() {
   // ---- draw a zone around the predicted landing with the mouse
   await tb("zones-edit").click();
   await until(() => bar.getAttribute("data-editing"), (e) => e === "true", 3000);
-  await sleep(300); // the last framing move (if any) has ended
-  const v = await viewOf(page);
+  let v = await settledView(page); // the last framing move (if any) has ended
   const u = (await api("/api/state")).body.prediction.uncontrolled;
-  const pu = pixelOf(v, u);
   // A square of ±90 px around the landing, kept clear of the badges along the top (with room for
   // a row more: the alarm comes) and of the bar (bottom left).
   const badges = await page.locator('[data-testid="map-overlay"]').boundingBox();
   const top = badges.y + badges.height + 60;
   const barTop = (await bar.boundingBox()).y - 20;
   const side = 90;
-  const cx = Math.min(Math.max(pu.x, v.box.x + side + 60), v.box.x + v.box.width - side - 20);
-  const cy = Math.min(Math.max(pu.y, top + side), barTop - side);
-  // Whole pixels: the browser's mouse events carry whole CSS pixels.
-  const clicked = [[-1, -1], [1, -1], [1, 1], [-1, 1]].map(([dx, dy]) => ({ x: Math.round(cx + dx * side), y: Math.round(cy + dy * side) }));
+  const cx = Math.min(Math.max(pixelOf(v, u).x, v.box.x + side + 60), v.box.x + v.box.width - side - 20);
+  const cy = Math.min(Math.max(pixelOf(v, u).y, top + side), barTop - side);
+  // Framed at an edge, the landing would fall outside the square: the operator drags it to the
+  // square's centre first (the map has stopped following for the edit).
+  const panned = await panTo(page, pixelOf(v, u), { x: cx, y: cy });
+  if (panned) v = await settledView(page);
+  const pu = pixelOf(v, u);
+  const square = [[-1, -1], [1, -1], [1, 1], [-1, 1]].map(([dx, dy]) => positionAt(v, { x: cx + dx * side, y: cy + dy * side }));
   await tb("zones-draw").click();
-  for (const p of clicked) {
+  // Each click where the corner is on the screen at that moment, as an operator aims: a
+  // layout shift (a banner, the header wrapping) between clicks moves the map under the mouse.
+  const shifts = [];
+  const clicked = [];
+  const wanted = [];
+  for (const q of [...square, square[0]]) { // the first corner again closes the zone
+    const { px: p, at, view } = await aim(page, q);
+    if (!sameView(view, v)) shifts.push(view);
     await page.mouse.click(p.x, p.y);
+    if (clicked.length < 4) {
+      clicked.push(p);
+      wanted.push(at);
+    }
     await sleep(80);
   }
-  await page.mouse.click(clicked[0].x, clicked[0].y); // the first corner again closes the zone
   const named = await until(() => tb("zones-name").inputValue(), (n) => n !== "", 3000);
   await tb("zones-name").fill("Test field");
   await tb("zones-kind").selectOption("people");
   await tb("zones-save").click();
   await until(() => bar.getAttribute("data-editing"), (e) => e === "false", 5000);
   const tol = metresPerPixel(v) + 0.1;
-  const wanted = clicked.map((p) => positionAt(v, p));
   const saved = (await api("/api/keep-out")).body;
   const got = feature(saved, "Test field");
   const err1 = worstM(corners(got), wanted);
+  const viewNote = `${panned ? "map dragged to put the landing in the square; " : ""}${shifts.length ? `the map moved under the mouse during the drawing (${JSON.stringify(shifts[0])} from ${JSON.stringify(v)}); ` : ""}`;
   check("zones: an operator draws a zone with four clicks; the station has it where it was clicked, named, with its kind",
     named === "Zone 1" && got?.properties?.kind === "people" && err1 <= tol && saved.areas === zonesAtStart.areas + 1,
-    `new zone first named "${named}"; corners within ${err1.toFixed(2)} m of the clicks (tolerance 1 px = ${tol.toFixed(2)} m at zoom ${v.zoom}); ${saved.areas} areas; the predicted landing ${(pu.x - cx).toFixed(0)}, ${(pu.y - cy).toFixed(0)} px off the square's centre`);
+    `new zone first named "${named}"; corners within ${err1.toFixed(2)} m of the clicks (tolerance 1 px = ${tol.toFixed(2)} m at zoom ${v.zoom}); ${saved.areas} areas; ${viewNote}the predicted landing ${(pu.x - cx).toFixed(0)}, ${(pu.y - cy).toFixed(0)} px off the square's centre`);
   const onDisk = JSON.parse(await readFile(copy.zones, "utf8"));
   check("zones: the drawn zone is written to the configured file", worstM(corners(feature(onDisk, "Test field")), wanted) <= tol, `${onDisk.features?.length} features in ${copy.zones}`);
   const alarm = await until(() => page.locator('[data-testid="map-keep-out-alarm"]').isVisible().then(async (s) => (s ? text(page, "map-keep-out-alarm") : "")), (t) => /Test field/.test(t), 15000);
@@ -139,27 +186,30 @@ async function flight() {
   // ---- drag one corner, add one at a midpoint and drag it out, delete one by a right-click
   await tb("zones-edit").click();
   await until(() => bar.getAttribute("data-editing"), (e) => e === "true", 3000);
-  const v2 = await viewOf(page);
-  const px = corners(got).map((p) => pixelOf(v2, p));
-  const whole = (p) => ({ x: Math.round(p.x), y: Math.round(p.y) });
+  const drawn = corners(got);
   // Leaflet drags a corner by the mouse's travel from where it was pressed: the corner should
   // end 40 px right and 30 px down of where it was (to its marker's whole pixel).
-  const from = whole(px[2]);
-  await drag(page, from, { x: from.x + 40, y: from.y + 30 });
+  const dragged = await aim(page, drawn[2]);
+  await drag(page, dragged.px, { x: dragged.px.x + 40, y: dragged.px.y + 30 });
+  const draggedTo = positionAt(dragged.view, { x: dragged.exact.x + 40, y: dragged.exact.y + 30 });
   // The handle halfway along the first edge becomes a corner when clicked; then it is dragged out.
-  const mid = { x: (px[0].x + px[1].x) / 2, y: (px[0].y + px[1].y) / 2 };
+  const v2 = await viewOf(page);
+  const mid = { x: (pixelOf(v2, drawn[0]).x + pixelOf(v2, drawn[1]).x) / 2, y: (pixelOf(v2, drawn[0]).y + pixelOf(v2, drawn[1]).y) / 2 };
   await page.mouse.click(whole(mid).x, whole(mid).y);
   await sleep(200);
   await drag(page, whole(mid), { x: whole(mid).x, y: whole(mid).y - 30 });
-  await page.mouse.click(whole(px[3]).x, whole(px[3]).y, { button: "right" });
+  const midTo = positionAt(v2, { x: mid.x, y: mid.y - 30 });
+  const deleted = await aim(page, drawn[3]);
+  await page.mouse.click(deleted.px.x, deleted.px.y, { button: "right" });
   await sleep(100);
   await tb("zones-save").click();
   await until(() => bar.getAttribute("data-editing"), (e) => e === "false", 5000);
   const moved = corners(feature((await api("/api/keep-out")).body, "Test field"));
-  const movedWanted = [wanted[0], positionAt(v2, { x: mid.x, y: mid.y - 30 }), wanted[1], positionAt(v2, { x: px[2].x + 40, y: px[2].y + 30 })];
+  const movedWanted = [wanted[0], midTo, wanted[1], draggedTo];
+  const px = drawn.map((p) => pixelOf(v2, p));
   const err2 = worstM(moved, movedWanted);
   check("zones: a corner dragged, one added at a midpoint and dragged out, one deleted by a right-click: saved so, the others unchanged", err2 <= tol,
-    `${moved.length} corners (4 wanted) at ${JSON.stringify(moved.map((p) => whole(pixelOf(v2, p))))} px (clicked ${JSON.stringify(px.map(whole))}), within ${err2.toFixed(2)} m of where they should be; the dragged one moved ${distanceM(corners(got)[2] ?? u, moved[3] ?? u).toFixed(0)} m`);
+    `${moved.length} corners (4 wanted) at ${JSON.stringify(moved.map((p) => whole(pixelOf(v2, p))))} px (drawn at ${JSON.stringify(px.map(whole))}), within ${err2.toFixed(2)} m of where they should be; the dragged one moved ${distanceM(corners(got)[2] ?? u, moved[3] ?? u).toFixed(0)} m`);
 
   // ---- a refused edit is shown and kept
   await tb("zones-edit").click();
