@@ -1814,6 +1814,12 @@ export interface VehicleView {
    */
   attitude: AttitudeView | null;
   /**
+   * Times the onboard phase has become `final_approach` since the station started, counted
+   * on every status the drone sent. A page is sent the newest state when it is ready, so a
+   * final approach short enough to fall between two of its states shows only here.
+   */
+  final_approaches: number;
+  /**
    * GPS.
    */
   gps: GpsView | null;

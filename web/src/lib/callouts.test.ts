@@ -10,6 +10,8 @@ import type { CommandResult, FlightStage, GuidancePhase, State } from "./types";
 interface Over {
   stage?: FlightStage;
   phase?: GuidancePhase;
+  /** The station's count of the drone's final approaches; absent as from a station without it. */
+  finals?: number;
   stale?: boolean;
   miss_m?: number | null;
   alarms?: { prediction: "planned" | "uncontrolled"; zone: string }[];
@@ -23,7 +25,7 @@ function state(o: Over = {}): State {
   const msg = decodeMessage(JSON.stringify({
     type: "state", time_s: 1,
     link: { connected: true, stale: o.stale ?? false, age_s: o.stale ? 5 : 0.1, ages_s: {} },
-    vehicle: { stage: o.stage ?? "parafoil", phase: o.phase ?? "branch2" },
+    vehicle: { stage: o.stage ?? "parafoil", phase: o.phase ?? "branch2", final_approaches: o.finals },
     guidance: { mode: "spiral_landing", phase: o.phase ?? "branch2", disagreement: d },
     keep_out_alarms: (o.alarms ?? []).map((a) => ({ ...a, since_s: 500 })),
     mission: { stage: o.stage ?? "parafoil", landing },
@@ -80,6 +82,15 @@ describe("final approach", () => {
   it("a new pattern (back to approximation) makes the next final approach news again", () => {
     const phases: GuidancePhase[] = ["branch4", "final_approach", "approximation", "branch1", "final_approach"];
     expect(texts(run(phases.map((phase) => state({ phase }))).said)).toEqual(["Final approach", "Final approach"]);
+  });
+  it("one that fell between two states the page was sent is said from the station's count", () => {
+    const states = [state({ phase: "branch4", finals: 0 }), state({ phase: "branch4", finals: 0 }), state({ phase: "flare", finals: 1 })];
+    expect(texts(run(states).said)).toEqual(["Final approach"]);
+  });
+  it("by the count too, once while it flaps with the leg before, and again after a new pattern", () => {
+    const seen: [GuidancePhase, number][] = [["branch4", 0], ["final_approach", 1], ["branch4", 1], ["final_approach", 2], ["approximation", 2], ["branch4", 3]];
+    const said = run(seen.map(([phase, finals]) => state({ phase, finals }))).said;
+    expect(texts(said)).toEqual(["Final approach", "Final approach"]);
   });
   it("a page opened during the final approach does not say it", () => {
     expect(run([state({ phase: "final_approach" }), state({ phase: "final_approach" }), state({ phase: "flare" })]).said).toEqual([]);

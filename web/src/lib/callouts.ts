@@ -88,6 +88,11 @@ export interface CalloutMemory {
   phase: string | null;
   /** "Final approach" is due when the phase next becomes it (re-armed by a new pattern). */
   approachArmed: boolean;
+  /**
+   * The station's count of the drone's final approaches (`vehicle.final_approaches`) in the last
+   * state; `null` while it is not known (no drone heard: the replica's phase is all there is).
+   */
+  finalApproaches: number | null;
   /** The measured landing was said (or was already there at the baseline). */
   landingSaid: boolean;
   /** The landing was said before its touchdown was measured. */
@@ -123,6 +128,7 @@ export function baseline(s: State, nowMs: number): CalloutMemory {
     stage,
     phase,
     approachArmed: phase !== "final_approach" && phase !== "flare" && stage !== "landed",
+    finalApproaches: s.vehicle?.final_approaches ?? null,
     landingSaid: s.mission.landing !== null,
     landedSaid: stage === "landed",
     landedAtMs: stage === "landed" ? nowMs : null,
@@ -169,13 +175,17 @@ export function stateCallouts(memory: CalloutMemory | null, s: State, nowMs: num
     m.stage = stage;
   }
 
-  // ---- final approach
+  // ---- final approach: from the station's count where it has one (a busy page is sent only the
+  // newest state, and a short final approach can fall between two), else from the phase seen
   const phase = phaseLabel(s);
+  const count = s.vehicle?.final_approaches ?? null;
+  const begun = count !== null && m.finalApproaches !== null ? count > m.finalApproaches : phase === "final_approach" && phase !== m.phase;
+  if (begun && m.approachArmed) {
+    say("approach", "Final approach");
+    m.approachArmed = false;
+  }
+  m.finalApproaches = count;
   if (phase !== null && phase !== m.phase) {
-    if (phase === "final_approach" && m.approachArmed) {
-      say("approach", "Final approach");
-      m.approachArmed = false;
-    }
     if (REARMING_PHASES.includes(phase)) m.approachArmed = true;
     m.phase = phase;
   }

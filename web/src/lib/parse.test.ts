@@ -10,7 +10,7 @@ const STATE = {
     ages_s: { HEARTBEAT: 0.4, GPS_RAW_INT: 0.2, ATTITUDE: 0.2, SCALED_PRESSURE: 0.2, SERVO_OUTPUT_RAW: 0.2, WIND_COV: 0.2 },
     radios: [{ address: "udpin:127.0.0.1:14550", transmitting: true, stale: false, age_s: 0.2, rate_hz: 31.5, loss_percent: 0.4, duplicates: 0 }] },
   vehicle: {
-    mode: "spiral_landing", stage: "parafoil", phase: "branch2",
+    mode: "spiral_landing", stage: "parafoil", phase: "branch2", final_approaches: 0,
     gps: { fix: "fix3d", satellites: 11, lat_deg: 38.53, lon_deg: -7.88, alt_msl_m: 812.4, velocity_ned_mps: [5.1, -1.2, 2.9], h_acc_m: 1.5 },
     attitude: { time_boot_ms: 123456, roll_deg: -12.0, pitch_deg: -3.1, yaw_deg: 141.2 },
     air: { static_pressure_pa: 92000, differential_pressure_pa: 25.2, temperature_c: 11.2, airspeed_mps: 6.6 },

@@ -121,6 +121,7 @@ const parseVehicle = (o: Obj): Vehicle => ({
   mode: oneOf(o, "mode", MODES),
   stage: oneOf(o, "stage", STAGES),
   phase: oneOf(o, "phase", PHASES),
+  final_approaches: num(o, "final_approaches"),
   gps: sub(o, "gps", parseGps),
   attitude: sub(o, "attitude", (a) => ({ time_boot_ms: num(a, "time_boot_ms"), roll_deg: num(a, "roll_deg"), pitch_deg: num(a, "pitch_deg"), yaw_deg: num(a, "yaw_deg") })),
   air: sub(o, "air", (a) => ({

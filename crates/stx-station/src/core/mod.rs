@@ -93,6 +93,9 @@ pub(crate) struct Latest {
     pub battery: Option<(stx_link::telemetry::BatteryStatus, f64)>,
     pub wind: Option<(stx_link::telemetry::Wind, f64)>,
     pub guidance: Option<(stx_link::telemetry::GuidanceStatus, f64)>,
+    /// Times the drone's phase became the final approach, counted on every status heard: a
+    /// page that sees only some states (the newest when it is ready) still learns of each.
+    pub final_approaches: u32,
     /// The drone's own prediction of its touchdown.
     pub predicted_landing: Option<(stx_link::telemetry::PredictedLanding, f64)>,
     /// The drone's clock of the newest GPS_INPUT the estimator took, s.

@@ -11,7 +11,7 @@ use stx_gnc::estimate::Estimate;
 use stx_gnc::estimator::{Estimator, EstimatorConfig};
 use stx_gnc::guidance::{Guidance, Plan};
 use stx_gnc::measurement::{AirDataSample, AttitudeSample, GpsFix, Measurement};
-use stx_gnc::mission::{FlightMode, FlightStage};
+use stx_gnc::mission::{FlightMode, FlightStage, GuidancePhase};
 use stx_gnc::predict::{LandingPrediction, PredictorConfig, predict_in_wind};
 use stx_link::telemetry::Telemetry;
 
@@ -196,6 +196,11 @@ impl StationCore {
             Telemetry::Status(s) => {
                 let previous = self.latest.status.map(|(p, _)| p);
                 self.latest.status = Some((s, now_s));
+                if s.phase == GuidancePhase::FinalApproach
+                    && previous.map(|p| p.phase) != Some(GuidancePhase::FinalApproach)
+                {
+                    self.latest.final_approaches += 1;
+                }
                 self.replica_on_stage(now_s, previous.map(|p| p.stage), s);
                 let drone_s = self.drone_time_s.unwrap_or(0.0);
                 self.landing_on_stage(previous.map(|p| p.stage), s.stage, drone_s);

@@ -58,14 +58,8 @@ pub(super) fn gps_raw(ms: u32, [lat, lon, alt]: [f64; 3], [north, east]: [f64; 2
     }
 }
 
-/// The drone reports `stage` (heading mode, guidance idle) at `now_s`.
-pub(super) fn hear_stage(core: &mut StationCore, now_s: f64, stage: stx_gnc::mission::FlightStage) {
-    let status = VehicleStatus {
-        mode: FlightMode::Heading,
-        stage,
-        phase: stx_gnc::mission::GuidancePhase::Idle,
-        state: SystemState::Active,
-    };
+/// The drone's heartbeat `status` heard at `now_s`.
+fn hear_status(core: &mut StationCore, now_s: f64, status: VehicleStatus) {
     let telemetry = Telemetry::Status(status);
     core.on_link_event(
         now_s,
@@ -76,6 +70,17 @@ pub(super) fn hear_stage(core: &mut StationCore, now_s: f64, stage: stx_gnc::mis
     );
 }
 
+/// The drone reports `stage` (heading mode, guidance idle) at `now_s`.
+pub(super) fn hear_stage(core: &mut StationCore, now_s: f64, stage: stx_gnc::mission::FlightStage) {
+    let status = VehicleStatus {
+        mode: FlightMode::Heading,
+        stage,
+        phase: stx_gnc::mission::GuidancePhase::Idle,
+        state: SystemState::Active,
+    };
+    hear_status(core, now_s, status);
+}
+
 /// The drone reports it has landed (its guidance landed, standing by) at `now_s`.
 fn hear_landed(core: &mut StationCore, now_s: f64) {
     let status = VehicleStatus {
@@ -84,14 +89,7 @@ fn hear_landed(core: &mut StationCore, now_s: f64) {
         phase: stx_gnc::mission::GuidancePhase::Landed,
         state: SystemState::Standby,
     };
-    let telemetry = Telemetry::Status(status);
-    core.on_link_event(
-        now_s,
-        GroundEvent::Telemetry {
-            from: (1, 1),
-            telemetry,
-        },
-    );
+    hear_status(core, now_s, status);
 }
 
 /// Telemetry of a parafoil gliding north in still air at 6 m/s, sinking 3 m/s, from 800 m
@@ -256,6 +254,47 @@ fn silence_turns_the_vehicle_stale_and_the_stage_change_is_logged() {
     assert!(core.state_msg_now(5.0 + stale_after + 0.5).link.stale);
     hear_landed(&mut core, 6.0);
     assert!(core.events.iter().any(|e| e.text.contains("Landed")));
+}
+
+#[test]
+fn every_final_approach_the_drone_reports_is_counted_for_pages_that_skip_states() {
+    use stx_gnc::mission::GuidancePhase as P;
+    let mut core = core();
+    let heard = |core: &mut StationCore, now_s: f64, phase: P| {
+        let stage = stx_gnc::mission::FlightStage::Parafoil;
+        let (mode, state) = (FlightMode::SpiralLanding, SystemState::Active);
+        hear_status(
+            core,
+            now_s,
+            VehicleStatus {
+                mode,
+                stage,
+                phase,
+                state,
+            },
+        );
+    };
+    let count = |core: &StationCore, now_s: f64| {
+        core.state_msg_now(now_s)
+            .vehicle
+            .map(|v| v.final_approaches)
+    };
+    // A page sent the state at 1 s and at 5 s sees branch 4, then the flare: the final approach
+    // between shows in the count. A repeated status is the same approach; a second is counted.
+    heard(&mut core, 1.0, P::Branch4);
+    assert_eq!(count(&core, 1.0), Some(0));
+    for (t, phase) in [
+        (2.0, P::FinalApproach),
+        (3.0, P::FinalApproach),
+        (4.0, P::Flare),
+    ] {
+        heard(&mut core, t, phase);
+    }
+    assert_eq!(count(&core, 5.0), Some(1));
+    for (t, phase) in [(6.0, P::Approximation), (7.0, P::FinalApproach)] {
+        heard(&mut core, t, phase);
+    }
+    assert_eq!(count(&core, 8.0), Some(2));
 }
 
 #[test]

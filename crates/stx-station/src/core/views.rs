@@ -74,6 +74,7 @@ impl StationCore {
             mode: l.status.map(|(s, _)| snake(s.mode)),
             stage: l.status.map(|(s, _)| snake(s.stage)),
             phase: l.status.map(|(s, _)| snake(s.phase)),
+            final_approaches: l.final_approaches,
             gps: l.gps.map(|(g, _)| {
                 let speed = g.ground_speed_mps.unwrap_or(0.0);
                 let course = g.course_deg.unwrap_or(0.0).to_radians();

@@ -87,6 +87,10 @@ pub struct VehicleView {
     /// Guidance phase (onboard).
     #[schemars(with = "Option<GuidancePhase>")]
     pub phase: Option<String>,
+    /// Times the onboard phase has become `final_approach` since the station started, counted
+    /// on every status the drone sent. A page is sent the newest state when it is ready, so a
+    /// final approach short enough to fall between two of its states shows only here.
+    pub final_approaches: u32,
     /// GPS.
     pub gps: Option<GpsView>,
     /// Attitude.
