@@ -24,7 +24,7 @@ import { mkdtemp, readFile, writeFile } from "node:fs/promises";
 import { tmpdir } from "node:os";
 import { join } from "node:path";
 import {
-  OPERATOR, VIEWER, root, out, sleep, check, newContext, startStation, freeUdpPort, apiOf, run, text, attr, watchErrors, runFlights, registerRest, configWithZoneCopy, fromNorthEast,
+  OPERATOR, VIEWER, root, out, sleep, check, newContext, startStation, freeUdpPort, apiOf, run, text, attr, watchErrors, runFlights, registerRest, configWithZoneCopy, fromNorthEast, distanceM,
 } from "./harness.mjs";
 
 registerRest("PUT", /^\/api\/keep-out$/, "KeepOutBody", "KeepOutMsg");
@@ -192,11 +192,16 @@ async function flight() {
   const deadline = t0 + (420 / SPEED) * 1000 + 40_000;
   for (;;) {
     const s = (await api("/api/state")).body;
-    const p = { at: Date.now(), stage: s?.mission?.stage ?? null, stale: s?.link?.stale ?? null, landing: s?.mission?.landing ?? null, alarms: (s?.keep_out_alarms ?? []).map((a) => `${a.prediction}|${a.zone}`) };
+    const p = { at: Date.now(), stage: s?.mission?.stage ?? null, stale: s?.link?.stale ?? null, landing: s?.mission?.landing ?? null, alarms: (s?.keep_out_alarms ?? []).map((a) => `${a.prediction}|${a.zone}`), uncontrolled: s?.prediction?.uncontrolled ?? null };
     polls.push(p);
-    // Under the parafoil: a zone around where the stack would land uncontrolled.
+    // Under the parafoil: a zone around where the stack would land uncontrolled, once that
+    // prediction has settled. As the parafoil starts, the station's estimate starts over and the
+    // prediction jumps (by 1.3 km on one run): a zone put under the first one was never entered.
     const u = s?.prediction?.uncontrolled;
-    if (zonePut === null && p.stage === "parafoil" && u) {
+    const underCanopy = polls.filter((q) => q.stage === "parafoil" && q.uncontrolled);
+    const recent = underCanopy.slice(-6);
+    const settled = u && recent.length === 6 && p.at - underCanopy[0].at >= 2000 && recent.every((q) => distanceM(q.uncontrolled, u) < 60);
+    if (zonePut === null && p.stage === "parafoil" && settled) {
       const zones = (await api("/api/keep-out")).body.zones;
       const ring = [[-250, -250], [-250, 250], [250, 250], [250, -250], [-250, -250]].map(([n, e]) => fromNorthEast(u, n, e)).map((q) => [q.lon_deg, q.lat_deg]);
       // Ours alone: a landing inside a shipped zone too is reported under that zone's name only.
