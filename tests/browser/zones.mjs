@@ -88,13 +88,16 @@ async function aim(page, q) {
 }
 /**
  * Drags the map so that what is at `from` comes to `to` (page pixels); false if it is there
- * already. The mouse rests before it is released, so Leaflet adds no inertia.
+ * already. The drag starts at `to`, a point of the map clear of its controls (`from` may be at
+ * an edge, under the edit bar), and moves by as much. The mouse rests before it is released,
+ * so Leaflet adds no inertia.
  */
 async function panTo(page, from, to) {
-  if (Math.hypot(to.x - from.x, to.y - from.y) < 20) return false;
-  await page.mouse.move(from.x, from.y);
+  const [dx, dy] = [to.x - from.x, to.y - from.y];
+  if (Math.hypot(dx, dy) < 20) return false;
+  await page.mouse.move(to.x, to.y);
   await page.mouse.down();
-  for (let i = 1; i <= 10; i++) await page.mouse.move(from.x + ((to.x - from.x) * i) / 10, from.y + ((to.y - from.y) * i) / 10);
+  for (let i = 1; i <= 10; i++) await page.mouse.move(to.x + (dx * i) / 10, to.y + (dy * i) / 10);
   await sleep(200);
   await page.mouse.up();
   await sleep(300);
