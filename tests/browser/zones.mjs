@@ -104,6 +104,25 @@ async function panTo(page, from, to) {
   return true;
 }
 
+/**
+ * The first point of a 40 px grid over `area` (page px) where the points of `shape` (offsets,
+ * px) around it are all on bare map: no zone, marker, line or control under any of them.
+ */
+async function clearSpot(page, shape, area) {
+  return page.evaluate(({ shape, area }) => {
+    const bare = (x, y) => {
+      const el = document.elementFromPoint(x, y);
+      return el !== null && el.closest('[data-testid="map"]') !== null && el.closest(".leaflet-interactive, .leaflet-marker-icon, .leaflet-control, .marker-icon, [data-testid='map-overlay'], [data-testid='zone-editor']") === null;
+    };
+    for (let y = area.top; y <= area.bottom; y += 40) {
+      for (let x = area.left; x <= area.right; x += 40) {
+        if (shape.every(([dx, dy]) => bare(x + dx, y + dy))) return { x, y };
+      }
+    }
+    return null;
+  }, { shape, area });
+}
+
 async function flight() {
   const copy = await configWithZoneCopy();
   const { base } = await startStation(["--config", copy.file, "--sim", "--sim-scenario", "rehearsal", "--sim-speed", String(speed), "--link", "udpin:127.0.0.1:0"]);
@@ -263,7 +282,11 @@ async function flight() {
   await tb("zones-edit").click();
   await until(() => bar.getAttribute("data-editing"), (e) => e === "true", 3000);
   await tb("zones-draw").click();
-  const tri = [[0, -60], [60, 40], [-60, 40], [0, -60]].map(([dx, dy]) => ({ x: Math.round(cx + dx), y: Math.round(cy + dy) }));
+  // On bare map: a click on another zone's corner handle, a marker or a control adds no corner.
+  const shape = [[0, -60], [60, 40], [-60, 40], [0, -60]];
+  const box = (await viewOf(page)).box;
+  const tc = (await clearSpot(page, shape, { left: box.x + 80, right: box.x + box.width - 80, top: top + 70, bottom: barTop - 50 })) ?? { x: cx, y: cy };
+  const tri = shape.map(([dx, dy]) => ({ x: Math.round(tc.x + dx), y: Math.round(tc.y + dy) }));
   for (const p of tri) {
     await page.mouse.click(p.x, p.y);
     await sleep(80);
