@@ -203,6 +203,19 @@ export function fromNorthEast(site, north_m, east_m) {
   const prime = 6378137 / w;
   return { lat_deg: site.lat_deg + north_m / meridian / rad, lon_deg: site.lon_deg + east_m / (prime * Math.cos(site.lat_deg * rad)) / rad };
 }
+/**
+ * Whether a predicted landing has settled: of `heard` ({ at: ms, point: lat/lon or null }, oldest
+ * first) the newest is known, the last `n` known lie within `withinM` of it, and the first known
+ * was heard at least `afterMs` before it. As the parafoil opens the station's estimate
+ * starts over and its predictions jump (by 1.3 km on one run); a zone put under the first one may
+ * never be entered.
+ */
+export function settled(heard, { n = 6, withinM = 60, afterMs = 2000 } = {}) {
+  const known = heard.filter((h) => h.point);
+  const recent = known.slice(-n);
+  const last = recent[recent.length - 1];
+  return recent.length === n && heard[heard.length - 1] === last && last.at - known[0].at >= afterMs && recent.every((h) => distanceM(h.point, last.point) < withinM);
+}
 export const angleDiff = (a, b) => Math.abs(((a - b + 540) % 360) - 180);
 /** "812 m" / "1.23 km" → metres. */
 export const shownMetres = (t) => (/km/.test(t) ? parseFloat(t) * 1000 : parseFloat(t));

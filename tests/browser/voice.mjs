@@ -24,7 +24,7 @@ import { mkdtemp, readFile, writeFile } from "node:fs/promises";
 import { tmpdir } from "node:os";
 import { join } from "node:path";
 import {
-  OPERATOR, VIEWER, root, out, sleep, check, newContext, startStation, freeUdpPort, apiOf, run, text, attr, watchErrors, runFlights, registerRest, configWithZoneCopy, fromNorthEast, distanceM,
+  OPERATOR, VIEWER, root, out, sleep, check, newContext, startStation, freeUdpPort, apiOf, run, text, attr, watchErrors, runFlights, registerRest, configWithZoneCopy, fromNorthEast, settled,
 } from "./harness.mjs";
 
 registerRest("PUT", /^\/api\/keep-out$/, "KeepOutBody", "KeepOutMsg");
@@ -195,13 +195,10 @@ async function flight() {
     const p = { at: Date.now(), stage: s?.mission?.stage ?? null, stale: s?.link?.stale ?? null, landing: s?.mission?.landing ?? null, alarms: (s?.keep_out_alarms ?? []).map((a) => `${a.prediction}|${a.zone}`), uncontrolled: s?.prediction?.uncontrolled ?? null };
     polls.push(p);
     // Under the parafoil: a zone around where the stack would land uncontrolled, once that
-    // prediction has settled. As the parafoil starts, the station's estimate starts over and the
-    // prediction jumps (by 1.3 km on one run): a zone put under the first one was never entered.
+    // prediction has settled.
     const u = s?.prediction?.uncontrolled;
-    const underCanopy = polls.filter((q) => q.stage === "parafoil" && q.uncontrolled);
-    const recent = underCanopy.slice(-6);
-    const settled = u && recent.length === 6 && p.at - underCanopy[0].at >= 2000 && recent.every((q) => distanceM(q.uncontrolled, u) < 60);
-    if (zonePut === null && p.stage === "parafoil" && settled) {
+    const underCanopy = polls.filter((q) => q.stage === "parafoil").map((q) => ({ at: q.at, point: q.uncontrolled }));
+    if (zonePut === null && p.stage === "parafoil" && settled(underCanopy)) {
       const zones = (await api("/api/keep-out")).body.zones;
       const ring = [[-250, -250], [-250, 250], [250, 250], [250, -250], [-250, -250]].map(([n, e]) => fromNorthEast(u, n, e)).map((q) => [q.lon_deg, q.lat_deg]);
       // Ours alone: a landing inside a shipped zone too is reported under that zone's name only.

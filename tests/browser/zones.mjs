@@ -1,8 +1,9 @@
 #!/usr/bin/env node
 // Keep-out zones edited on the live map by an operator, with the mouse (issue 15 item 2), while
 // `stx serve --sim` flies the `rehearsal` on a copy of the shipped config (an edit is written to
-// the configured file). A zone drawn by clicking its corners around the predicted uncontrolled
-// landing is saved where it was clicked (in the API and in the file) and raises the landing
+// the configured file). With the drone let go (mode uncontrolled, so that where it would land
+// stays put: under guidance that prediction swings by a kilometre as the stack turns), a zone
+// drawn by clicking its corners around the predicted uncontrolled landing is saved where it was clicked (in the API and in the file) and raises the landing
 // alarm on the map and in the log; a corner dragged moves; a name the station refuses (and one
 // this page refuses) is shown and the edit is kept; a change by another operator is announced
 // during an edit and drawn after it; a deleted zone is gone; Cancel forgets an edit; a viewer has
@@ -15,7 +16,7 @@
 
 import { readFile } from "node:fs/promises";
 import { join } from "node:path";
-import { OPERATOR, VIEWER, out, speed, check, newContext, startStation, apiOf, until, text, watchErrors, runFlights, registerRest, distanceM, sleep, configWithZoneCopy } from "./harness.mjs";
+import { OPERATOR, VIEWER, out, speed, check, newContext, startStation, apiOf, until, text, watchErrors, runFlights, registerRest, distanceM, sleep, configWithZoneCopy, settled } from "./harness.mjs";
 
 registerRest("PUT", /^\/api\/keep-out$/, "KeepOutBody", "KeepOutMsg");
 
@@ -55,6 +56,15 @@ const feature = (k, name) => (k?.zones ?? k)?.features?.find((f) => f.properties
 /** A GeoJSON ring's corners (closing point dropped) as positions. */
 const corners = (f) => (f?.geometry?.coordinates?.[0] ?? []).slice(0, -1).map(([lon, lat]) => ({ lat_deg: lat, lon_deg: lon }));
 /** The largest distance between matching corners, m (Infinity when their counts differ). */
+/** Whether a point lies inside a GeoJSON ring ([lon, lat] pairs): crossings of a ray to the east. */
+function inPolygon(p, ring) {
+  let inside = false;
+  for (let i = 0, j = ring.length - 1; i < ring.length; j = i++) {
+    const [[xi, yi], [xj, yj]] = [ring[i], ring[j]];
+    if (yi > p.lat_deg !== yj > p.lat_deg && p.lon_deg < xi + ((p.lat_deg - yi) * (xj - xi)) / (yj - yi)) inside = !inside;
+  }
+  return inside;
+}
 const worstM = (a, b) => (a.length === b.length && a.length > 0 ? Math.max(...a.map((p, i) => distanceM(p, b[i]))) : Infinity);
 
 async function drag(page, from, to) {
@@ -125,7 +135,10 @@ async function clearSpot(page, shape, area) {
 
 async function flight() {
   const copy = await configWithZoneCopy();
-  const { base } = await startStation(["--config", copy.file, "--sim", "--sim-scenario", "rehearsal", "--sim-speed", String(speed), "--link", "udpin:127.0.0.1:0"]);
+  // At most 2× real time the stack is still flying when the alarm is awaited on a slow machine
+  // (at 5× it lands about 60 s after the start).
+  const simSpeed = Math.min(speed, 2);
+  const { base } = await startStation(["--config", copy.file, "--sim", "--sim-scenario", "rehearsal", "--sim-speed", String(simSpeed), "--link", "udpin:127.0.0.1:0"]);
   const api = apiOf(base);
   const ctx = await newContext("zones", { viewport: { width: 1440, height: 900 } });
 
@@ -143,9 +156,16 @@ async function flight() {
   await page.goto(`${base}/?token=${OPERATOR}`);
   const zonesAtStart = (await api("/api/keep-out")).body;
   await until(() => page.locator("path.map-keep-out").count(), (n) => n === zonesAtStart.areas, 10000);
-  // A flight with a predicted uncontrolled landing, framed by the map (it follows until an edit begins).
+  // A flight with a predicted uncontrolled landing, framed by the map (it follows until an edit
+  // begins). The operator lets the drone go, and waits for the prediction to settle.
   await until(() => api("/api/state"), (r) => r.body?.prediction?.uncontrolled, 60000);
-  await sleep(1000);
+  await page.click('[data-testid="mode-uncontrolled"]');
+  await until(() => api("/api/state"), (r) => r.body?.vehicle?.mode === "uncontrolled", 20000);
+  const heard = [];
+  await until(async () => {
+    heard.push({ at: Date.now(), point: (await api("/api/state")).body?.prediction?.uncontrolled ?? null });
+    return settled(heard);
+  }, (ok) => ok, 30000);
   const bar = page.locator('[data-testid="zone-editor"]');
   const tb = (id) => page.locator(`[data-testid="${id}"]`);
 
@@ -199,10 +219,18 @@ async function flight() {
     `new zone first named "${named}"; corners within ${err1.toFixed(2)} m of the clicks (tolerance 1 px = ${tol.toFixed(2)} m at zoom ${v.zoom}); ${saved.areas} areas; ${viewNote}the predicted landing ${(pu.x - cx).toFixed(0)}, ${(pu.y - cy).toFixed(0)} px off the square's centre`);
   const onDisk = JSON.parse(await readFile(copy.zones, "utf8"));
   check("zones: the drawn zone is written to the configured file", worstM(corners(feature(onDisk, "Test field")), wanted) <= tol, `${onDisk.features?.length} features in ${copy.zones}`);
-  const alarm = await until(() => page.locator('[data-testid="map-keep-out-alarm"]').isVisible().then(async (s) => (s ? text(page, "map-keep-out-alarm") : "")), (t) => /Test field/.test(t), 15000);
+  // Where the drone would land meanwhile: in the zone or not, and still flying.
+  const since = Date.now();
+  const meanwhile = [];
+  const alarm = await until(async () => {
+    const s = (await api("/api/state")).body;
+    meanwhile.push({ stage: s?.mission?.stage, inside: s?.prediction?.uncontrolled ? inPolygon(s.prediction.uncontrolled, got?.geometry?.coordinates?.[0] ?? []) : null });
+    return (await page.locator('[data-testid="map-keep-out-alarm"]').isVisible()) ? text(page, "map-keep-out-alarm") : "";
+  }, (t) => /Test field/.test(t), 15000);
+  const whereNote = `; the predicted uncontrolled landing in the zone at ${meanwhile.filter((a) => a.inside).length} of ${meanwhile.length} polls over ${((Date.now() - since) / 1000).toFixed(1)} s, outside at ${meanwhile.filter((a) => a.inside === false).length}, stage at the end ${meanwhile.at(-1)?.stage}`;
   const logged = ((await api("/api/events")).body?.events ?? []).some((e) => e.level === "warning" && /inside keep-out zone 'Test field'/.test(e.text));
   const onPage = (await page.locator('[data-testid="event-item"]').allTextContents()).some((t) => /inside keep-out zone 'Test field'/.test(t));
-  check("zones: the landing predicted in the drawn zone raises the alarm on the map and in the log (station and page)", /Test field/.test(alarm) && logged && onPage, `map "${alarm}"; station log ${logged}; page log ${onPage}`);
+  check("zones: the landing predicted in the drawn zone raises the alarm on the map and in the log (station and page)", /Test field/.test(alarm) && logged && onPage, `map "${alarm}"; station log ${logged}; page log ${onPage}${whereNote}`);
   await page.screenshot({ path: join(out, "zones-drawn.png") });
 
   // ---- drag one corner, add one at a midpoint and drag it out, delete one by a right-click

@@ -149,6 +149,11 @@ pub enum ClientMessage {
     ManualRelease,
     /// Answered with `pong`.
     Ping,
+    /// The page has handled a `state` (or a frame it could not read, which may have been one).
+    /// From a page's first, the station sends it a new state only while fewer than two are
+    /// unacknowledged (and once every 2 s regardless), so that a busy page is sent the newest
+    /// state, not a backlog of old ones queued in the network's buffers. Any role.
+    StateAck,
     /// From a public relay (`stx relay`) on this socket: the pages it serves, its own and those
     /// of the relays below it, for the station's sharing panel. Sent when the figure changes
     /// (at most once a second) and every 10 s. Any role; a page never sends it.

@@ -449,6 +449,9 @@ export type ClientMessage =
       type: "ping";
     }
   | {
+      type: "state_ack";
+    }
+  | {
       type: "relay_viewers";
       /**
        * Pages served through the relay.

@@ -78,6 +78,28 @@ describe("LiveSocket", () => {
     expect([sock.stats.received, sock.stats.bad]).toEqual([4, 3]);
   });
 
+  it("acknowledges each state once handed to the page, and each unreadable frame, nothing else", () => {
+    const order: string[] = [];
+    sock = new LiveSocket({
+      url: () => "ws://x/api/ws?token=op",
+      create: (u) => {
+        const w = new FakeWs(u);
+        w.send = (d) => order.push(`sent ${d}`);
+        made.push(w);
+        return w;
+      },
+      onMessage: (m) => order.push(`page ${m.type}`),
+      onStatus: () => {},
+    });
+    sock.start();
+    made[0]!.open();
+    const state = JSON.stringify({ type: "state", time_s: 1, link: { connected: false, stale: true, age_s: null, ages_s: {} }, mission: { stage: null, landing: null } });
+    for (const data of [state, '{"type":"pong"}', "garbage", state]) made[0]!.onmessage?.({ data });
+    const ack = 'sent {"type":"state_ack"}';
+    expect(order).toEqual(["page state", ack, "page pong", ack, "page state", ack]);
+    expect(made[0]!.url).toBe("ws://x/api/ws?token=op&state_acks=true");
+  });
+
   it("sends only while open; nothing is queued", () => {
     sock.start();
     expect(sock.send({ type: "ping" })).toBe(false);

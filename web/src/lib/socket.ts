@@ -1,6 +1,6 @@
 // The live WebSocket, reconnecting with backoff. It decodes every frame (parse.ts), counts bad
-// ones, and hands good messages to the page. The socket factory and timers are injectable so the
-// reconnect logic can be tested without a network.
+// ones, hands good messages to the page, and acknowledges each state once handled. The socket
+// factory and timers are injectable so the reconnect logic can be tested without a network.
 
 import { backoffMs } from "./backoff";
 import { decodeMessage, MessageStats } from "./parse";
@@ -78,7 +78,9 @@ export class LiveSocket {
     const create = this.deps.create ?? ((u: string) => new WebSocket(u) as unknown as WsLike);
     let ws: WsLike;
     try {
-      ws = create(this.deps.url());
+      // It says so as it connects: the station then holds states for it from the first.
+      const url = this.deps.url();
+      ws = create(`${url}${url.includes("?") ? "&" : "?"}state_acks=true`);
     } catch (e) {
       this.scheduleRetry(e instanceof Error ? e.message : "cannot open");
       return;
@@ -92,6 +94,10 @@ export class LiveSocket {
       const d = decodeMessage(ev.data);
       this.stats.record(d);
       if (d.ok) this.deps.onMessage(d.msg);
+      // Handled: the station sends the next state only then (API.md, `state_ack`), so a busy
+      // page is sent the newest state instead of a backlog. A frame that could not be read
+      // may have been a state: acknowledged too, or the station would wait for it.
+      if (!d.ok || d.msg.type === "state") this.send({ type: "state_ack" });
     };
     ws.onerror = () => {
       // onclose follows with the code; nothing to do here but not let the error escape.

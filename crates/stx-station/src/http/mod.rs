@@ -33,6 +33,7 @@ mod replay;
 mod rest;
 mod shared;
 mod sondehub;
+mod state_flow;
 mod surface_wind;
 mod tawhiri;
 mod tiles;

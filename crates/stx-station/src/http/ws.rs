@@ -1,6 +1,7 @@
 //! The WebSocket of `API.md`. Each page is fed from two sources: `state` messages through a
 //! `watch` channel (latest wins: a page that falls behind skips to the newest state, counted
-//! as coalesced), and events, command results and parameter tables through a broadcast
+//! as coalesced; a page that acknowledges states is sent one only when it is ready, see
+//! [`super::state_flow`]), and events, command results and parameter tables through a broadcast
 //! backlog of [`crate::daemon::RELIABLE_BACKLOG`] messages, never skipped silently: a page
 //! that falls further behind gets a `lagged` message with the number it missed, and re-reads
 //! the event log. Operators' sticks come in on it.
@@ -8,24 +9,35 @@
 use std::sync::Arc;
 use std::sync::atomic::Ordering;
 
-use axum::extract::State;
 use axum::extract::ws::{Message, WebSocket, WebSocketUpgrade};
+use axum::extract::{Query, State};
 use axum::response::{IntoResponse, Response};
+use serde::Deserialize;
 use stx_link::manual::Sticks;
 use tokio::sync::broadcast;
 
 use super::auth::Caller;
 use super::rest::session_of;
 use super::shared::{AppState, ClientCounters, HttpError, Shared};
+use super::state_flow::StateFlow;
 use crate::config::Role;
 use crate::limits::RetryAfter;
 use crate::messages::{EventMsg, Level};
 use crate::replies::{HelloMsg, HistoryMsg, LaggedMsg, PongMsg};
 use crate::requests::ClientMessage;
 
+/// The WebSocket's query besides the token.
+#[derive(Debug, Default, Deserialize)]
+pub(crate) struct WsQuery {
+    /// The page acknowledges every state it handles (`state_ack`), from the first.
+    #[serde(default)]
+    state_acks: bool,
+}
+
 pub(crate) async fn websocket(
     State(state): State<AppState>,
     caller: Caller,
+    Query(query): Query<WsQuery>,
     upgrade: WebSocketUpgrade,
 ) -> Response {
     let pages = state
@@ -45,10 +57,15 @@ pub(crate) async fn websocket(
         )
         .into_response();
     }
-    upgrade.on_upgrade(move |socket| serve_socket(state, caller, socket))
+    let flow = if query.state_acks {
+        StateFlow::acknowledged()
+    } else {
+        StateFlow::default()
+    };
+    upgrade.on_upgrade(move |socket| serve_socket(state, caller, flow, socket))
 }
 
-async fn serve_socket(state: AppState, caller: Caller, mut socket: WebSocket) {
+async fn serve_socket(state: AppState, caller: Caller, mut flow: StateFlow, mut socket: WebSocket) {
     let mut updates = state.broadcast.subscribe();
     let base = state.broadcast_total.load(Ordering::Relaxed);
     let mut states = state.states.subscribe();
@@ -108,7 +125,12 @@ async fn serve_socket(state: AppState, caller: Caller, mut socket: WebSocket) {
             break;
         }
     }
+    // The greeting's state.
+    flow.sent(std::time::Instant::now());
     while open {
+        let now = std::time::Instant::now();
+        let may_send = flow.may_send(now);
+        let held_until = flow.held_until(now).unwrap_or(now);
         tokio::select! {
             // Events and command results before states: they are what must not be lost.
             biased;
@@ -134,7 +156,7 @@ async fn serve_socket(state: AppState, caller: Caller, mut socket: WebSocket) {
                 }
                 Err(broadcast::error::RecvError::Closed) => break,
             },
-            changed = states.changed() => {
+            changed = states.changed(), if may_send => {
                 if changed.is_err() {
                     break;
                 }
@@ -145,11 +167,14 @@ async fn serve_socket(state: AppState, caller: Caller, mut socket: WebSocket) {
                 }
                 last_seq = frame.seq;
                 counters.states_sent.fetch_add(1, Ordering::Relaxed);
+                flow.sent(std::time::Instant::now());
                 open = socket.send(Message::Text(frame.text)).await.is_ok();
             }
+            // A page that stopped acknowledging gets the newest state anyway, now and then.
+            () = tokio::time::sleep_until(held_until.into()), if !may_send => {}
             incoming = socket.recv() => match incoming {
                 Some(Ok(Message::Text(text))) => {
-                    handle_client(&state, &caller, &counters, &mut socket, text.as_str()).await;
+                    handle_client(&state, &caller, &counters, &mut socket, &mut flow, text.as_str()).await;
                 }
                 Some(Ok(Message::Close(_))) | None | Some(Err(_)) => break,
                 Some(Ok(_)) => {}
@@ -187,6 +212,7 @@ async fn handle_client(
     caller: &Caller,
     counters: &ClientCounters,
     socket: &mut WebSocket,
+    flow: &mut StateFlow,
     text: &str,
 ) {
     let message = serde_json::from_str::<ClientMessage>(text);
@@ -222,6 +248,7 @@ async fn handle_client(
             }
             *held = Some(viewers);
         }
+        Ok(ClientMessage::StateAck) => flow.acked(),
         Ok(ClientMessage::Ping) => {
             let pong = serde_json::to_string(&PongMsg { kind: "pong" }).unwrap_or_default();
             let _ = socket.send(Message::Text(pong.into())).await;

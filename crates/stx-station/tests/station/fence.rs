@@ -8,14 +8,10 @@ use std::time::Duration;
 
 use common::*;
 use serde_json::{Value, json};
-use stx_sim::drone::config::{BUILTIN, MissionConfig};
+use stx_sim::drone::config::MissionConfig;
 
 fn rehearsal() -> MissionConfig {
-    let (_, text) = BUILTIN
-        .iter()
-        .find(|(name, _)| *name == "rehearsal")
-        .expect("built-in rehearsal");
-    MissionConfig::from_toml_str("rehearsal", text).expect("mission")
+    MissionConfig::builtin("rehearsal").expect("built-in rehearsal")
 }
 
 /// The zones the drone's guidance flies: each as its boundary's (latitude, longitude)

@@ -18,6 +18,7 @@ mod recordings;
 mod relay;
 mod replay;
 mod replica;
+mod slow_page;
 mod surface_wind;
 mod tiles;
 mod tls;
