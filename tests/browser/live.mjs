@@ -60,7 +60,7 @@ const altitudePlot = (page) => page.evaluate(() => {
 
 // Each kind the pages must have met, so that the contract check cannot pass on silence.
 const expected = ["RecordingsBody", "ReplayOpened", "ServerMessage:hello", "ServerMessage:state", "ServerMessage:history", "ServerMessage:event", "ServerMessage:command_result", "ServerMessage:params",
-  "ClientMessage:manual", "ClientMessage:manual_release", "Session", "StateMsg", "ParamsMsg", "EventsBody", "TrackBody", "ClientsBody", "CommandResultMsg", "CommandAccepted",
+  "ClientMessage:manual", "ClientMessage:manual_release", "ClientMessage:state_ack", "Session", "StateMsg", "ParamsMsg", "EventsBody", "TrackBody", "ClientsBody", "CommandResultMsg", "CommandAccepted",
   "CutdownArm", "ErrorBody", "ModeBody", "TargetBody", "ParamBody", "ConfirmBody", "SurfaceWindView", "SurfaceWindBody"];
 await runFlights(async () => {
   await missionShort();
@@ -205,8 +205,8 @@ async function rehearsal() {
   });
   const page = await ctx.newPage();
   watchErrors(page, "operator");
-  // Frames the page sent since an instant of its clock, pings left out.
-  const sentSince = (t) => page.evaluate((t) => window.__sent.filter((f) => f.t >= t && f.type !== "ping").map((f) => f.type), t);
+  // Frames the page sent since an instant of its clock, pings and states' acknowledgements left out.
+  const sentSince = (t) => page.evaluate((t) => window.__sent.filter((f) => f.t >= t && f.type !== "ping" && f.type !== "state_ack").map((f) => f.type), t);
   await page.goto(`${base}/?token=${OPERATOR}`);
   await page.waitForFunction(() => document.querySelector('[data-testid="conn-status"]')?.textContent === "CONNECTED", null, { timeout: 15000 });
 
