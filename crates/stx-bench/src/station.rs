@@ -28,7 +28,7 @@ use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, bail};
-use futures_util::StreamExt;
+use futures_util::{SinkExt, StreamExt};
 use serde::Serialize;
 use stx_gnc::stats::percentile;
 use stx_link_tokio::DriverEvent;
@@ -259,26 +259,36 @@ impl FlightObserver for Clocks {
     }
 }
 
-/// A page: records when each attitude stamp first arrives in a `state`.
+/// A page: records when each attitude stamp first arrives in a `state`, and acknowledges each
+/// state as the dashboard does (`state_acks`), so the figure includes the station's holding a
+/// state back until the page is ready for it.
 pub(crate) async fn page(
     http: SocketAddr,
     token: String,
     seen: Arc<Mutex<HashMap<u32, Instant>>>,
     ready: oneshot::Sender<()>,
 ) -> anyhow::Result<()> {
-    let (mut ws, _) = tokio_tungstenite::connect_async(format!("ws://{http}/api/ws?token={token}"))
-        .await
-        .context("WebSocket")?;
+    let (mut ws, _) = tokio_tungstenite::connect_async(format!(
+        "ws://{http}/api/ws?token={token}&state_acks=true"
+    ))
+    .await
+    .context("WebSocket")?;
     let _ = ready.send(());
     while let Some(message) = ws.next().await {
         let Message::Text(text) = message? else {
             continue;
         };
         let arrived = Instant::now();
+        if !text.as_str().starts_with(r#"{"type":"state""#) {
+            continue;
+        }
         if let Some(stamp) = attitude_stamp(text.as_str()) {
             let mut seen = seen.lock().unwrap_or_else(|e| e.into_inner());
             seen.entry(stamp).or_insert(arrived);
         }
+        ws.send(Message::Text(r#"{"type":"state_ack"}"#.into()))
+            .await
+            .context("acknowledging a state")?;
     }
     Ok(())
 }
