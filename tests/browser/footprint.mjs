@@ -11,20 +11,10 @@
 
 import { readFile } from "node:fs/promises";
 import { join } from "node:path";
-import { OPERATOR, VIEWER, root, out, speed, check, newContext, startStation, apiOf, until, attr, text, watchErrors, runFlights, registerRest, fromNorthEast, configWithZoneCopy, legendAgainstMap, checkLegend, LIVE_SYMBOLS, zoomOut } from "./harness.mjs";
+import { OPERATOR, VIEWER, root, out, speed, check, newContext, startStation, apiOf, until, attr, text, watchErrors, runFlights, registerRest, fromNorthEast, configWithZoneCopy, legendAgainstMap, checkLegend, LIVE_SYMBOLS, zoomOut, inRing } from "./harness.mjs";
 
 registerRest("PUT", /^\/api\/keep-out$/, "KeepOutBody", "KeepOutMsg");
 
-/** Ray casting in [lat, lon]: inside the outer ring and outside its holes. */
-function inRing(ring, p) {
-  let inside = false;
-  for (let i = 0, j = ring.length - 1; i < ring.length; j = i++) {
-    const [ai, bi] = ring[i];
-    const [aj, bj] = ring[j];
-    if (bi > p[1] !== bj > p[1] && p[0] < ((aj - ai) * (p[1] - bi)) / (bj - bi) + ai) inside = !inside;
-  }
-  return inside;
-}
 const inPolygons = (polys, p) => polys.some(([outer, ...holes]) => inRing(outer, p) && !holes.some((h) => inRing(h, p)));
 
 async function flight() {

@@ -216,6 +216,16 @@ export function settled(heard, { n = 6, withinM = 60, afterMs = 2000 } = {}) {
   const last = recent[recent.length - 1];
   return recent.length === n && heard[heard.length - 1] === last && last.at - known[0].at >= afterMs && recent.every((h) => distanceM(h.point, last.point) < withinM);
 }
+/** Ray casting: whether point `p` lies inside `ring`, both as pairs in the same order ([lat, lon] or GeoJSON's [lon, lat]). */
+export function inRing(ring, p) {
+  let inside = false;
+  for (let i = 0, j = ring.length - 1; i < ring.length; j = i++) {
+    const [ai, bi] = ring[i];
+    const [aj, bj] = ring[j];
+    if (bi > p[1] !== bj > p[1] && p[0] < ((aj - ai) * (p[1] - bi)) / (bj - bi) + ai) inside = !inside;
+  }
+  return inside;
+}
 export const angleDiff = (a, b) => Math.abs(((a - b + 540) % 360) - 180);
 /** "812 m" / "1.23 km" → metres. */
 export const shownMetres = (t) => (/km/.test(t) ? parseFloat(t) * 1000 : parseFloat(t));

@@ -16,7 +16,7 @@
 
 import { readFile } from "node:fs/promises";
 import { join } from "node:path";
-import { OPERATOR, VIEWER, out, speed, check, newContext, startStation, apiOf, until, text, watchErrors, runFlights, registerRest, distanceM, sleep, configWithZoneCopy, settled } from "./harness.mjs";
+import { OPERATOR, VIEWER, out, speed, check, newContext, startStation, apiOf, until, text, watchErrors, runFlights, registerRest, distanceM, sleep, configWithZoneCopy, settled, inRing } from "./harness.mjs";
 
 registerRest("PUT", /^\/api\/keep-out$/, "KeepOutBody", "KeepOutMsg");
 
@@ -56,15 +56,6 @@ const feature = (k, name) => (k?.zones ?? k)?.features?.find((f) => f.properties
 /** A GeoJSON ring's corners (closing point dropped) as positions. */
 const corners = (f) => (f?.geometry?.coordinates?.[0] ?? []).slice(0, -1).map(([lon, lat]) => ({ lat_deg: lat, lon_deg: lon }));
 /** The largest distance between matching corners, m (Infinity when their counts differ). */
-/** Whether a point lies inside a GeoJSON ring ([lon, lat] pairs): crossings of a ray to the east. */
-function inPolygon(p, ring) {
-  let inside = false;
-  for (let i = 0, j = ring.length - 1; i < ring.length; j = i++) {
-    const [[xi, yi], [xj, yj]] = [ring[i], ring[j]];
-    if (yi > p.lat_deg !== yj > p.lat_deg && p.lon_deg < xi + ((p.lat_deg - yi) * (xj - xi)) / (yj - yi)) inside = !inside;
-  }
-  return inside;
-}
 const worstM = (a, b) => (a.length === b.length && a.length > 0 ? Math.max(...a.map((p, i) => distanceM(p, b[i]))) : Infinity);
 
 async function drag(page, from, to) {
@@ -224,7 +215,7 @@ async function flight() {
   const meanwhile = [];
   const alarm = await until(async () => {
     const s = (await api("/api/state")).body;
-    meanwhile.push({ stage: s?.mission?.stage, inside: s?.prediction?.uncontrolled ? inPolygon(s.prediction.uncontrolled, got?.geometry?.coordinates?.[0] ?? []) : null });
+    meanwhile.push({ stage: s?.mission?.stage, inside: s?.prediction?.uncontrolled ? inRing(got?.geometry?.coordinates?.[0] ?? [], [s.prediction.uncontrolled.lon_deg, s.prediction.uncontrolled.lat_deg]) : null });
     return (await page.locator('[data-testid="map-keep-out-alarm"]').isVisible()) ? text(page, "map-keep-out-alarm") : "";
   }, (t) => /Test field/.test(t), 15000);
   const whereNote = `; the predicted uncontrolled landing in the zone at ${meanwhile.filter((a) => a.inside).length} of ${meanwhile.length} polls over ${((Date.now() - since) / 1000).toFixed(1)} s, outside at ${meanwhile.filter((a) => a.inside === false).length}, stage at the end ${meanwhile.at(-1)?.stage}`;

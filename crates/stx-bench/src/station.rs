@@ -279,7 +279,7 @@ pub(crate) async fn page(
             continue;
         };
         let arrived = Instant::now();
-        if !text.as_str().starts_with(r#"{"type":"state""#) {
+        if !text.as_str().starts_with(STATE_PREFIX) {
             continue;
         }
         if let Some(stamp) = attitude_stamp(text.as_str()) {
@@ -323,11 +323,14 @@ pub(crate) fn page_latencies(
     (samples, missed, timed.len())
 }
 
+/// How a `state` message starts (the station writes `type` first).
+const STATE_PREFIX: &str = r#"{"type":"state""#;
+
 /// The attitude stamp of a `state` message. A page of the benchmark reads only this, so that
 /// fifty pages in one process do not spend more time parsing than the station spends sending.
 fn attitude_stamp(text: &str) -> Option<u32> {
     const KEY: &str = r#""attitude":{"time_boot_ms":"#;
-    if !text.starts_with(r#"{"type":"state""#) {
+    if !text.starts_with(STATE_PREFIX) {
         return None;
     }
     let at = text.find(KEY)? + KEY.len();

@@ -128,9 +128,7 @@ async fn serve_socket(state: AppState, caller: Caller, mut flow: StateFlow, mut 
     // The greeting's state.
     flow.sent(std::time::Instant::now());
     while open {
-        let now = std::time::Instant::now();
-        let may_send = flow.may_send(now);
-        let held_until = flow.held_until(now).unwrap_or(now);
+        let held_until = flow.held_until(std::time::Instant::now());
         tokio::select! {
             // Events and command results before states: they are what must not be lost.
             biased;
@@ -156,7 +154,7 @@ async fn serve_socket(state: AppState, caller: Caller, mut flow: StateFlow, mut 
                 }
                 Err(broadcast::error::RecvError::Closed) => break,
             },
-            changed = states.changed(), if may_send => {
+            changed = states.changed(), if held_until.is_none() => {
                 if changed.is_err() {
                     break;
                 }
@@ -171,7 +169,7 @@ async fn serve_socket(state: AppState, caller: Caller, mut flow: StateFlow, mut 
                 open = socket.send(Message::Text(frame.text)).await.is_ok();
             }
             // A page that stopped acknowledging gets the newest state anyway, now and then.
-            () = tokio::time::sleep_until(held_until.into()), if !may_send => {}
+            () = tokio::time::sleep_until(held_until.unwrap_or_else(std::time::Instant::now).into()), if held_until.is_some() => {}
             incoming = socket.recv() => match incoming {
                 Some(Ok(Message::Text(text))) => {
                     handle_client(&state, &caller, &counters, &mut socket, &mut flow, text.as_str()).await;
