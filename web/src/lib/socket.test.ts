@@ -100,6 +100,28 @@ describe("LiveSocket", () => {
     expect(made[0]!.url).toBe("ws://x/api/ws?token=op&state_acks=true");
   });
 
+  it("acknowledges a state whose handling threw", () => {
+    const sent: string[] = [];
+    sock = new LiveSocket({
+      url: () => "ws://x/api/ws?token=op",
+      create: (u) => {
+        const w = new FakeWs(u);
+        w.send = (d) => sent.push(d);
+        made.push(w);
+        return w;
+      },
+      onMessage: () => {
+        throw new Error("a panel failed");
+      },
+      onStatus: () => {},
+    });
+    sock.start();
+    made[0]!.open();
+    const state = JSON.stringify({ type: "state", time_s: 1, link: { connected: false, stale: true, age_s: null, ages_s: {} }, mission: { stage: null, landing: null } });
+    expect(() => made[0]!.onmessage?.({ data: state })).toThrow("a panel failed");
+    expect(sent).toEqual(['{"type":"state_ack"}']);
+  });
+
   it("sends only while open; nothing is queued", () => {
     sock.start();
     expect(sock.send({ type: "ping" })).toBe(false);

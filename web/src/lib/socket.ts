@@ -93,11 +93,16 @@ export class LiveSocket {
     ws.onmessage = (ev) => {
       const d = decodeMessage(ev.data);
       this.stats.record(d);
-      if (d.ok) this.deps.onMessage(d.msg);
-      // Handled: the station sends the next state only then (API.md, `state_ack`), so a busy
-      // page is sent the newest state instead of a backlog. A frame that could not be read
-      // may have been a state: acknowledged too, or the station would wait for it.
-      if (!d.ok || d.msg.type === "state") this.send({ type: "state_ack" });
+      try {
+        if (d.ok) this.deps.onMessage(d.msg);
+      } finally {
+        // Handled: the station sends the next state only then (API.md, `state_ack`), so a busy
+        // page is sent the newest state instead of a backlog. A frame that could not be read
+        // may have been a state: acknowledged too, or the station would wait for it. In
+        // `finally`: a state whose handling threw is done with too, and an acknowledgement
+        // lost for good would narrow the page's flow for the rest of the connection.
+        if (!d.ok || d.msg.type === "state") this.send({ type: "state_ack" });
+      }
     };
     ws.onerror = () => {
       // onclose follows with the code; nothing to do here but not let the error escape.

@@ -16,8 +16,12 @@ use std::time::{Duration, Instant};
 /// way, so it never waits a round trip for the next, and never has more queued.
 pub const IN_FLIGHT: u32 = 2;
 /// A page that stops acknowledging is still sent a state this long after the last one: a lost
-/// or forgotten acknowledgement must not freeze it.
-pub const HOLD_MAX: Duration = Duration::from_secs(2);
+/// or forgotten acknowledgement must not freeze it. Well below the 2 s without a state after
+/// which the page shows everything STALE (`STATE_GAP_STALE_S` in `web/src/lib/staleness.ts`):
+/// held for as long as that, the held state went out at the next 4 Hz tick after 2 s, and a
+/// busy page paused on a replay flickered STALE while the station was fine (a local CI run,
+/// 2026-12-02).
+pub const HOLD_MAX: Duration = Duration::from_secs(1);
 
 /// One page's flow of states.
 #[derive(Debug, Default)]
@@ -146,5 +150,27 @@ mod tests {
         f.sent(t + HOLD_MAX);
         assert!(!f.may_send(t + HOLD_MAX + Duration::from_millis(1)));
         assert_eq!(f.held_until(t + HOLD_MAX), Some(t + HOLD_MAX * 2));
+    }
+
+    #[test]
+    fn a_held_page_hears_from_the_station_before_it_would_call_the_station_silent() {
+        // The page's threshold, read from its source so the two cannot drift apart.
+        let path = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../web/src/lib/staleness.ts"
+        );
+        let source = std::fs::read_to_string(path).expect("the page's staleness rules");
+        let gap_s: f64 = source
+            .lines()
+            .find_map(|l| l.strip_prefix("export const STATE_GAP_STALE_S = "))
+            .and_then(|v| v.trim_end_matches(';').trim().parse().ok())
+            .expect("STATE_GAP_STALE_S = <seconds>;");
+        // A held state goes at the first 4 Hz tick after HOLD_MAX; half a second more for a
+        // loaded machine's delivery and the page's own handling.
+        let worst_gap_s = HOLD_MAX.as_secs_f64() + 0.25 + 0.5;
+        assert!(
+            worst_gap_s < gap_s,
+            "held {worst_gap_s} s, the page calls {gap_s} s silent"
+        );
     }
 }
