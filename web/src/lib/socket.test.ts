@@ -78,48 +78,41 @@ describe("LiveSocket", () => {
     expect([sock.stats.received, sock.stats.bad]).toEqual([4, 3]);
   });
 
-  it("acknowledges each state once handed to the page, and each unreadable frame, nothing else", () => {
-    const order: string[] = [];
+  /** A started socket whose open connection's sends go to `log` as `sent <frame>`. */
+  function openRecording(log: string[], onMessage: (m: { type: string }) => void): FakeWs {
     sock = new LiveSocket({
       url: () => "ws://x/api/ws?token=op",
       create: (u) => {
         const w = new FakeWs(u);
-        w.send = (d) => order.push(`sent ${d}`);
+        w.send = (d) => log.push(`sent ${d}`);
         made.push(w);
         return w;
       },
-      onMessage: (m) => order.push(`page ${m.type}`),
+      onMessage,
       onStatus: () => {},
     });
     sock.start();
     made[0]!.open();
-    const state = JSON.stringify({ type: "state", time_s: 1, link: { connected: false, stale: true, age_s: null, ages_s: {} }, mission: { stage: null, landing: null } });
-    for (const data of [state, '{"type":"pong"}', "garbage", state]) made[0]!.onmessage?.({ data });
-    const ack = 'sent {"type":"state_ack"}';
-    expect(order).toEqual(["page state", ack, "page pong", ack, "page state", ack]);
-    expect(made[0]!.url).toBe("ws://x/api/ws?token=op&state_acks=true");
+    return made[0]!;
+  }
+  const STATE = JSON.stringify({ type: "state", time_s: 1, link: { connected: false, stale: true, age_s: null, ages_s: {} }, mission: { stage: null, landing: null } });
+  const ACK = 'sent {"type":"state_ack"}';
+
+  it("acknowledges each state once handed to the page, and each unreadable frame, nothing else", () => {
+    const order: string[] = [];
+    const ws = openRecording(order, (m) => order.push(`page ${m.type}`));
+    for (const data of [STATE, '{"type":"pong"}', "garbage", STATE]) ws.onmessage?.({ data });
+    expect(order).toEqual(["page state", ACK, "page pong", ACK, "page state", ACK]);
+    expect(ws.url).toBe("ws://x/api/ws?token=op&state_acks=true");
   });
 
   it("acknowledges a state whose handling threw", () => {
     const sent: string[] = [];
-    sock = new LiveSocket({
-      url: () => "ws://x/api/ws?token=op",
-      create: (u) => {
-        const w = new FakeWs(u);
-        w.send = (d) => sent.push(d);
-        made.push(w);
-        return w;
-      },
-      onMessage: () => {
-        throw new Error("a panel failed");
-      },
-      onStatus: () => {},
+    const ws = openRecording(sent, () => {
+      throw new Error("a panel failed");
     });
-    sock.start();
-    made[0]!.open();
-    const state = JSON.stringify({ type: "state", time_s: 1, link: { connected: false, stale: true, age_s: null, ages_s: {} }, mission: { stage: null, landing: null } });
-    expect(() => made[0]!.onmessage?.({ data: state })).toThrow("a panel failed");
-    expect(sent).toEqual(['{"type":"state_ack"}']);
+    expect(() => ws.onmessage?.({ data: STATE })).toThrow("a panel failed");
+    expect(sent).toEqual([ACK]);
   });
 
   it("sends only while open; nothing is queued", () => {
