@@ -16,6 +16,9 @@ use tokio_tungstenite::tungstenite::Message;
 /// Time a slow page takes to handle each message (a busy dashboard on a loaded laptop).
 const HANDLING: Duration = Duration::from_millis(150);
 
+/// How long the slow page watches, s.
+const WINDOW_S: f64 = 10.0;
+
 fn rehearsal() -> MissionConfig {
     MissionConfig::builtin("rehearsal").expect("built-in rehearsal")
 }
@@ -79,7 +82,7 @@ async fn a_slow_page_that_acknowledges_states_is_shown_the_newest_not_a_backlog(
     let mut fast = ws_connect(addr, VIEWER).await;
     let counting = tokio::spawn(async move {
         let mut states = 0usize;
-        let until = Instant::now() + Duration::from_secs(8);
+        let until = Instant::now() + Duration::from_secs_f64(WINDOW_S);
         while let Ok(Some(Ok(m))) = tokio::time::timeout_at(until, fast.next()).await {
             if matches!(&m, Message::Text(t) if t.as_str().starts_with(r#"{"type":"state""#)) {
                 states += 1;
@@ -87,12 +90,16 @@ async fn a_slow_page_that_acknowledges_states_is_shown_the_newest_not_a_backlog(
         }
         states
     });
-    let (ages, handled) = slow_page_ages(addr, 2.0, 8.0).await;
+    // The first seconds are the page working through what a connection starts with: the
+    // greeting (hello, state, history), the keep-out zones and the link's first events, about
+    // 13 messages or 2 s of handling, more on a loaded machine (CI saw a state 1.76 s old at
+    // 2 s). That wait is bounded; a backlog is not, so ages are taken once it is over.
+    let (ages, handled) = slow_page_ages(addr, WINDOW_S - 6.0, WINDOW_S).await;
     let sent = counting.await.expect("counted");
     // More states than the slow page can handle, or the test shows nothing.
     assert!(
         sent as f64 > 2.0 * handled as f64,
-        "the station sent {sent} states in 8 s, the slow page handled {handled}"
+        "the station sent {sent} states in {WINDOW_S} s, the slow page handled {handled}"
     );
     let worst = ages.iter().copied().fold(0.0, f64::max);
     // Two states in flight, each handled in 0.15 s (0.3 s), the events between them and a
