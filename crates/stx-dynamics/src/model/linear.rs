@@ -11,12 +11,16 @@
 /// one `N`; `&[N]` is ordinary partial pivoting). Each diagonal block must be regular: pivots
 /// are sought only inside the current block, so the zeros below the block diagonal that a
 /// body-by-body ordering creates are never filled in by a row swap from another block.
-/// Returns `None` when a pivot is zero or not finite (singular or poisoned system).
-pub fn solve_blocked<const N: usize>(
-    mut a: [[f64; N]; N],
-    mut b: [f64; N],
+///
+/// Works in place, `b` becoming `x` and `a` its elimination: the system is 2.6 kB, and taken by
+/// value it was copied at every model evaluation (about 1 % of a campaign's time).
+/// Returns false, leaving both half-eliminated, when a pivot is zero or not finite (singular or
+/// poisoned system).
+pub fn solve_blocked_in_place<const N: usize>(
+    a: &mut [[f64; N]; N],
+    b: &mut [f64; N],
     block_ends: &[usize],
-) -> Option<[f64; N]> {
+) -> bool {
     let mut block = 0;
     for k in 0..N {
         while block + 1 < block_ends.len() && k >= block_ends[block] {
@@ -33,7 +37,7 @@ pub fn solve_blocked<const N: usize>(
             }
         }
         if !(pivot_abs > 0.0 && pivot_abs.is_finite()) {
-            return None;
+            return false;
         }
         if pivot_row != k {
             a.swap(k, pivot_row);
@@ -53,21 +57,32 @@ pub fn solve_blocked<const N: usize>(
             }
         }
     }
-    let mut x = [0.0; N];
     for k in (0..N).rev() {
+        let (head, known) = b.split_at_mut(k + 1);
         let sum: f64 = a[k][k + 1..]
             .iter()
-            .zip(&x[k + 1..])
-            .fold(b[k], |sum, (coefficient, known)| sum - coefficient * known);
-        x[k] = sum / a[k][k];
+            .zip(known.iter())
+            .fold(head[k], |sum, (coefficient, known)| {
+                sum - coefficient * known
+            });
+        head[k] = sum / a[k][k];
     }
-    Some(x)
+    true
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use nalgebra::{SMatrix, SVector};
+
+    /// `x`, or `None` for a singular or poisoned system.
+    fn solve_blocked<const N: usize>(
+        mut a: [[f64; N]; N],
+        mut b: [f64; N],
+        block_ends: &[usize],
+    ) -> Option<[f64; N]> {
+        solve_blocked_in_place(&mut a, &mut b, block_ends).then_some(b)
+    }
 
     #[test]
     fn agrees_with_lu_on_pseudo_random_systems_that_need_pivoting() {

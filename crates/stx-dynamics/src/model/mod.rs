@@ -222,10 +222,11 @@ impl Equations {
     }
 
     /// The unknowns in their natural order, NaN if the system is singular.
-    fn solve(self) -> [f64; 18] {
-        match linear::solve_blocked(self.a, self.b, &BLOCK_ENDS) {
-            Some(permuted) => std::array::from_fn(|j| permuted[UNKNOWN_POSITION[j]]),
-            None => [f64::NAN; 18],
+    fn solve(&mut self) -> [f64; 18] {
+        if linear::solve_blocked_in_place(&mut self.a, &mut self.b, &BLOCK_ENDS) {
+            std::array::from_fn(|j| self.b[UNKNOWN_POSITION[j]])
+        } else {
+            [f64::NAN; 18]
         }
     }
 }
