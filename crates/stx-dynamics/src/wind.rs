@@ -159,15 +159,11 @@ impl GustMemory {
             return sum(axes, |s, _| s.angle_rad(time_s).cos());
         };
         let Remembered { last, other } = &mut *memory;
-        let at = |p: &Option<Phasors>| {
-            p.as_ref()
-                .is_some_and(|p| p.time_s.to_bits() == time_s.to_bits())
-        };
-        if at(other) {
+        if other.as_ref().is_some_and(|p| p.is_at(time_s)) {
             std::mem::swap(last, other);
         }
         if let Some(p) = last.as_mut() {
-            if p.time_s.to_bits() == time_s.to_bits() {
+            if p.is_at(time_s) {
                 return p.gust;
             }
             let step_s = time_s - p.time_s;
@@ -242,6 +238,10 @@ impl Phasors {
             rotation,
             rotated: 0,
         }
+    }
+
+    fn is_at(&self, time_s: f64) -> bool {
+        self.time_s.to_bits() == time_s.to_bits()
     }
 
     fn has_rotation_for(&self, step_s: f64) -> bool {
